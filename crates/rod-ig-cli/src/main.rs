@@ -1,0 +1,4 @@
+fn main() {
+    eprintln!("rod-ig: being written");
+    std::process::exit(2);
+}

@@ -1,0 +1,34 @@
+//! # rod-ig-core
+//!
+//! Equilibrium shapes of a Kirchhoff elastic rod held by two grippers, and their inverse
+//! geometry, after Roussel, Renaud & Taïx (2015), "Closed-forms of planar Kirchhoff elastic
+//! rods: application to inverse geometry" (corrections in `shared/paper/FINDINGS.md`).
+//!
+//! The rod has unit length and unit stiffness, its base is held at the identity. An
+//! equilibrium is parametrised by the base wrench a = μ(0): a ∈ R³ for the planar rod
+//! (a3 = moment, a4, a5 = force), a ∈ R⁶ for the 3-D rod. Scaling to physical length and
+//! stiffness is the caller's business (see the node and the CLI); this crate does no I/O.
+//!
+//! Modules:
+//! - [`scalar`]: the [`scalar::Real`] trait and forward-mode dual numbers, so the closed forms
+//!   give exact derivatives.
+//! - [`elliptic`]: Jacobi elliptic functions and Legendre/Carlson integrals, accurate when the
+//!   complementary parameter m1 = 1 − m is passed directly.
+//! - [`planar`]: closed-form shape q(t), sensitivity J(t, a), stability and energy.
+//! - [`ode`]: numerical integrators (adaptive Dormand–Prince 8(5,3) and fixed-step RK4) and the
+//!   planar ODE reference with variational equations.
+//! - [`ig`]: planar inverse geometry (paper's Newton, robust solver, tracking).
+//! - [`spatial`]: the 3-D rod by numerical integration, and its inverse geometry.
+#![warn(missing_docs)]
+
+pub mod elliptic;
+mod error;
+pub mod ig;
+pub mod ode;
+pub mod planar;
+pub mod scalar;
+pub mod spatial;
+mod types;
+
+pub use error::RodError;
+pub use types::{wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, StabilityReport};

@@ -1,0 +1,80 @@
+//! Types shared by every module and by the adapters (CLI, ROS node).
+
+use serde::{Deserialize, Serialize};
+
+/// Planar rod parameters a = (a3, a4, a5) = μ(0): the base moment a3 and base force (a4, a5),
+/// in the paper's normalised units (unit length, unit bending stiffness).
+pub type PlanarParams = nalgebra::Vector3<f64>;
+
+/// Sensitivity J(t, a) = ∂(x, y, θ)(t) / ∂(a3, a4, a5).
+/// Rows are x, y, θ (the order of [`PlanarPose`]); columns a3, a4, a5.
+pub type PlanarJacobian = nalgebra::Matrix3<f64>;
+
+/// A pose q = (x, y, θ) of the planar rod at some t ∈ [0, 1], base frame.
+///
+/// `theta` is unwrapped when it comes from the rod (θ(t) = ∫₀ᵗ κ); compare targets modulo 2π
+/// with [`wrap_angle`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlanarPose {
+    /// Position along the base tangent.
+    pub x: f64,
+    /// Position normal to the base tangent.
+    pub y: f64,
+    /// Tangent angle (rad).
+    pub theta: f64,
+}
+
+impl PlanarPose {
+    /// A pose from its three coordinates.
+    pub const fn new(x: f64, y: f64, theta: f64) -> Self {
+        Self { x, y, theta }
+    }
+
+    /// True when all three coordinates are finite.
+    pub fn is_finite(&self) -> bool {
+        self.x.is_finite() && self.y.is_finite() && self.theta.is_finite()
+    }
+
+    /// As the column vector (x, y, θ).
+    pub fn to_vector(&self) -> nalgebra::Vector3<f64> {
+        nalgebra::Vector3::new(self.x, self.y, self.theta)
+    }
+}
+
+/// Verdict of the stability test (Bretl & McCarthy 2014; FINDINGS §5): the rod is a stable
+/// equilibrium iff det J(t, a) > 0 for every t ∈ (0, 1].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StabilityReport {
+    /// True iff no sign change (or zero) of det J(t, a) was found on (0, 1].
+    pub stable: bool,
+    /// Normalised margin: min over the scanned t of det J(t) divided by its small-t leading term
+    /// (FINDINGS §5 `det_min`); dimensionless, → 1 as t → 0, negative iff a sign change was seen.
+    pub margin: f64,
+    /// First t at which det J changes sign (a conjugate point), when unstable.
+    pub first_conjugate_t: Option<f64>,
+}
+
+/// Wraps an angle to (−π, π].
+pub fn wrap_angle(angle: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    let r = angle.rem_euclid(TAU); // [0, 2π)
+    if r > PI {
+        r - TAU
+    } else {
+        r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn wrap_angle_range() {
+        assert_eq!(wrap_angle(PI), PI);
+        assert!((wrap_angle(-PI) - PI).abs() < 1e-15);
+        assert!((wrap_angle(3.0 * PI / 2.0) + PI / 2.0).abs() < 1e-15);
+        assert!((wrap_angle(-12.740563317464874) - (-12.740563317464874 + 4.0 * PI)).abs() < 1e-12);
+    }
+}
