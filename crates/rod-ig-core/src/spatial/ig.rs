@@ -1,0 +1,1 @@
+//! 3-D inverse geometry (being written).
