@@ -414,9 +414,6 @@ pub fn pose_and_jacobian(
         t,
         &options(rtol, default_atol(rtol)),
     )?;
-    if std::env::var("ROD_DBG").is_ok() {
-        eprintln!("DBG {:?} {:?}", a.as_slice(), _st);
-    }
     finite(&s)?;
     Ok((pose_of(&s), jac_of(&s)))
 }
