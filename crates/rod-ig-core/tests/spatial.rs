@@ -4,7 +4,7 @@
 use nalgebra::{Rotation3, UnitQuaternion, Vector3, Vector6};
 use proptest::prelude::*;
 use rod_ig_core::ode::planar_reference as pr;
-use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
+use rod_ig_core::spatial::{self, ig, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
 
 const RTOL: f64 = 1e-12;
 
@@ -162,6 +162,33 @@ fn jacobian_matches_central_differences() {
 }
 
 #[test]
+fn reduced_formulation_matches_mu_form() {
+    let mut rng = Rng(13);
+    let (mut ep, mut ej) = (0.0f64, 0.0f64);
+    for i in 0..100 {
+        let k = if i % 2 == 0 {
+            Stiffness::default()
+        } else {
+            Stiffness {
+                c1: rng.uniform(0.5, 2.0),
+                c2: rng.uniform(0.5, 2.0),
+                c3: rng.uniform(0.5, 2.0),
+            }
+        };
+        let a = rng.params(5.0, 30.0);
+        let t = rng.uniform(0.1, 1.0);
+        let (p1, j1) = spatial::pose_and_jacobian(&a, &k, t, RTOL).unwrap();
+        let (p2, j2) = spatial::reference_pose_and_jacobian(&a, &k, t, RTOL).unwrap();
+        ep = ep
+            .max((p1.position - p2.position).amax())
+            .max(p1.rotation.angle_to(&p2.rotation));
+        ej = ej.max((j1 - j2).amax() / j2.amax());
+    }
+    println!("reduced vs mu-form: pose {ep:e}, J rel {ej:e}");
+    assert!(ep < 1e-10 && ej < 1e-9);
+}
+
+#[test]
 fn classical_conjugate_points() {
     let k = Stiffness::default();
     // Clamped twist: t* = 8.9868 / m1 (slightly bent so that det is not identically 0).
@@ -276,42 +303,97 @@ fn shape_and_energy() {
 }
 
 #[test]
-fn timing_probe() {
+fn ig_random_targets_robust() {
+    // Box |a1..3| <= 5, |a4..6| <= 30 (FINDINGS3D: ~70 % stable); targets = tips of stable a.
     let k = Stiffness::default();
-    let mut rng = Rng(5);
-    let a_list: Vec<SpatialParams> = (0..200).map(|_| rng.params(5.0, 30.0)).collect();
-    for (name, rtol) in [("1e-8", 1e-8), ("1e-12", 1e-12)] {
-        let t0 = std::time::Instant::now();
-        for a in &a_list {
-            let _ = spatial::tip_and_jacobian(a, &k, rtol).unwrap();
+    let targets = ig::random_targets(150, 2024, &k);
+    assert_eq!(targets.len(), 150);
+    let opts = ig::SolveOptions3d::default();
+    let mut ok = 0;
+    let mut worst_pos = 0.0f64;
+    for (_, target) in &targets {
+        match ig::solve(target, &opts) {
+            Ok(sol) => {
+                assert!(sol.stable && sol.residual <= 2.0 * opts.tolerance);
+                // Independent check at reference accuracy: tip and stability (full grid).
+                let tip = spatial::tip(&sol.a, &k, RTOL).unwrap();
+                let (pe, ang) = tip.distance_to(target);
+                worst_pos = worst_pos.max(pe).max(ang);
+                assert!(pe < 1e-5 && ang < 1e-5, "{pe} {ang}");
+                let st = spatial::stability_full_grid(&sol.a, &k).unwrap();
+                assert!(st.stable, "returned an unstable rod: {:?}", sol.a);
+                ok += 1;
+            }
+            Err(f) => println!("failure: {f}"),
         }
-        println!(
-            "tip+J rtol {name}: {:.1} us/eval",
-            t0.elapsed().as_secs_f64() * 1e6 / a_list.len() as f64
-        );
-    }
-    let t0 = std::time::Instant::now();
-    for a in &a_list {
-        let _ = spatial::evaluate(a, &k, &StabilityOptions::production()).unwrap();
     }
     println!(
-        "evaluate (production): {:.1} us/eval",
-        t0.elapsed().as_secs_f64() * 1e6 / a_list.len() as f64
+        "3-D robust IG: {ok}/{} solved, worst reference residual {worst_pos:e}",
+        targets.len()
     );
-    let t0 = std::time::Instant::now();
-    for a in &a_list {
-        let _ = spatial::stability(a, &k).unwrap();
+    assert!(ok as f64 >= 0.98 * targets.len() as f64);
+}
+
+#[test]
+fn ig_newton_and_failures() {
+    let k = Stiffness::default();
+    let targets = ig::random_targets(20, 99, &k);
+    // Paper's Newton from a nearby guess converges to the same rod.
+    let mut converged = 0;
+    for (a, target) in &targets {
+        let opts = ig::SolveOptions3d {
+            method: ig::Method3d::Newton,
+            initial_guess: Some(a + Vector6::repeat(0.05)),
+            ..Default::default()
+        };
+        if let Ok(sol) = ig::solve(target, &opts) {
+            assert!(sol.residual < 1e-5);
+            converged += 1;
+        }
     }
-    println!(
-        "stability (reference, fast scan): {:.1} us/eval",
-        t0.elapsed().as_secs_f64() * 1e6 / a_list.len() as f64
-    );
-    let t0 = std::time::Instant::now();
-    for a in &a_list {
-        let _ = spatial::stability_full_grid(a, &k).unwrap();
+    assert!(converged >= 18, "{converged}");
+    // Typed failures.
+    let far = SpatialPose {
+        position: Vector3::new(2.0, 0.0, 0.0),
+        rotation: UnitQuaternion::identity(),
+    };
+    let f = ig::solve(&far, &Default::default()).unwrap_err();
+    assert!(matches!(f.reason, ig::IgError3d::Unreachable { .. }));
+    let nan = SpatialPose {
+        position: Vector3::new(f64::NAN, 0.0, 0.0),
+        rotation: UnitQuaternion::identity(),
+    };
+    assert!(matches!(
+        ig::solve(&nan, &Default::default()).unwrap_err().reason,
+        ig::IgError3d::NonFiniteTarget
+    ));
+    let bad = ig::SolveOptions3d {
+        alpha: 0.0,
+        ..Default::default()
+    };
+    assert!(matches!(
+        ig::solve(&targets[0].1, &bad).unwrap_err().reason,
+        ig::IgError3d::InvalidOptions(_)
+    ));
+    // The straight target is only reached by an unstable (straight) rod: bounded failure.
+    let straight = SpatialPose {
+        position: Vector3::new(1.0, 0.0, 0.0),
+        rotation: UnitQuaternion::identity(),
+    };
+    let opts = ig::SolveOptions3d {
+        max_iterations: 30,
+        max_starts: 3,
+        ..Default::default()
+    };
+    if let Ok(sol) = ig::solve(&straight, &opts) {
+        assert!(sol.stable);
     }
-    println!(
-        "stability (full grid): {:.1} us/eval",
-        t0.elapsed().as_secs_f64() * 1e6 / a_list.len() as f64
-    );
+}
+
+#[test]
+fn ig_benchmark_report() {
+    let r = ig::benchmark_random_targets(30, 5);
+    println!("{r:?}");
+    assert_eq!(r.targets, 30);
+    assert!(r.success_rate >= 0.9 && r.median_us > 0.0);
 }

@@ -21,6 +21,7 @@
 //! in-plane and out-of-plane blocks are tested separately (their crossings could cancel in det).
 
 pub mod ig;
+mod reduced;
 mod stability;
 
 pub use stability::{
@@ -300,6 +301,7 @@ pub(crate) fn options(rtol: f64, atol: f64) -> OdeOptions {
         max_steps: MAX_STEPS,
         initial_step: None,
         max_step: f64::INFINITY,
+        error_components: usize::MAX,
     }
 }
 
@@ -376,24 +378,60 @@ fn check_t(t: f64) -> Result<(), RodError> {
     }
 }
 
-/// Tip pose q(1), by DOP853 at relative tolerance `rtol` (atol = max(1e-3·rtol, 1e-16)).
+/// Tip pose q(1), by DOP853 at relative tolerance `rtol` (atol = max(1e-3·rtol, 1e-16)),
+/// integrating (q, p) with μ recovered from the conserved world wrench (see `reduced`).
 pub fn tip(a: &SpatialParams, k: &Stiffness, rtol: f64) -> Result<SpatialPose, RodError> {
     check_params(a, k)?;
     check_rtol(rtol)?;
     let ci = k.inv();
+    let ap = reduced::params(a);
+    const M: usize = reduced::NRB;
     let (s, _) = solve(
-        |_, s: &[f64; NB], ds: &mut [f64; NB]| base_rhs(&ci, s, ds),
+        |_, s: &[f64; M], ds: &mut [f64; M]| reduced::rhs::<M, false>(&ci, &ap, s, ds),
         0.0,
-        initial_base(a),
+        reduced::initial::<M>(),
         1.0,
         &options(rtol, default_atol(rtol)),
     )?;
     finite(&s)?;
-    Ok(pose_of(&s))
+    Ok(reduced::pose(&s))
 }
 
-/// Pose q(t) and J(t, a) for t ∈ [0, 1] (module docs), DOP853 at relative tolerance `rtol`.
+/// Pose q(t) and J(t, a) for t ∈ [0, 1] (module docs), DOP853 at relative tolerance `rtol`,
+/// on the reduced formulation (q, p and 6 variational values per parameter; μ from the
+/// conserved world wrench — mathematically identical to the μ-form, see
+/// [`reference_pose_and_jacobian`]).
 pub fn pose_and_jacobian(
+    a: &SpatialParams,
+    k: &Stiffness,
+    t: f64,
+    rtol: f64,
+) -> Result<(SpatialPose, SpatialJacobian), RodError> {
+    check_params(a, k)?;
+    check_rtol(rtol)?;
+    check_t(t)?;
+    const M: usize = reduced::NR;
+    let s0 = reduced::initial::<M>();
+    if t == 0.0 {
+        return Ok((reduced::pose(&s0), reduced::jac(&s0)));
+    }
+    let ci = k.inv();
+    let ap = reduced::params(a);
+    let (s, _) = solve(
+        |_, s: &[f64; M], ds: &mut [f64; M]| reduced::rhs::<M, true>(&ci, &ap, s, ds),
+        0.0,
+        s0,
+        t,
+        &options(rtol, default_atol(rtol)),
+    )?;
+    finite(&s)?;
+    Ok((reduced::pose(&s), reduced::jac(&s)))
+}
+
+/// Pose q(t) and J(t, a) from the literal μ-form of FINDINGS3D: μ' equations in components,
+/// quaternion, p, and the variational equations δμ' = (∂μ'/∂μ)δμ, η' = δξ − ad_ξ η
+/// (86 values). Slower; kept as the cross-check of [`pose_and_jacobian`].
+pub fn reference_pose_and_jacobian(
     a: &SpatialParams,
     k: &Stiffness,
     t: f64,

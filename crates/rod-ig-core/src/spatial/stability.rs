@@ -9,10 +9,8 @@
 //! the crossing by bisection on the dense output. With `coarse_stride = 1` this is exactly the
 //! full-grid rule.
 
-use super::{
-    check_params, initial_var, jac_of, options, pose_of, var_rhs, Evaluation3d, SpatialParams,
-    Stiffness, NV,
-};
+use super::reduced::{self, jac as jac_of, pose as pose_of, ENERGY, NR as NV};
+use super::{check_params, options, Evaluation3d, SpatialParams, Stiffness};
 use crate::ode::{DenseStep, Dop853};
 use crate::{RodError, StabilityReport};
 
@@ -253,7 +251,9 @@ fn run(
         return Err(RodError::OutOfDomain("invalid stability tolerances".into()));
     }
     let ci = [1.0 / k.c1, 1.0 / k.c2, 1.0 / k.c3];
-    let mut f = |_: f64, s: &[f64; NV], ds: &mut [f64; NV]| var_rhs(&ci, s, ds);
+    let ap = reduced::params(a);
+    let mut f =
+        |_: f64, s: &[f64; NV], ds: &mut [f64; NV]| reduced::rhs::<NV, true>(&ci, &ap, s, ds);
     let straight = is_straight(a);
     if straight && early_exit {
         return Ok((None, straight_report()));
@@ -261,7 +261,7 @@ fn run(
     let mut st = Dop853::new(
         &mut f,
         0.0,
-        initial_var(a),
+        reduced::initial::<NV>(),
         1.0,
         &options(opts.rtol, opts.atol),
         !straight,
@@ -326,6 +326,25 @@ pub fn stability_full_grid(a: &SpatialParams, k: &Stiffness) -> Result<Stability
     stability_with(a, k, &StabilityOptions::full_grid())
 }
 
+/// One integration with the stability scan stopping at the first failure: `Some(evaluation)`
+/// when stable, `None` (with the report) when unstable.
+pub(crate) fn evaluate_if_stable(
+    a: &SpatialParams,
+    k: &Stiffness,
+    opts: &StabilityOptions,
+) -> Result<(Option<Evaluation3d>, StabilityReport), RodError> {
+    let (y, stability) = run(a, k, opts, true)?;
+    Ok((
+        y.map(|y| Evaluation3d {
+            tip: pose_of(&y),
+            jacobian: jac_of(&y),
+            energy: y[ENERGY],
+            stability,
+        }),
+        stability,
+    ))
+}
+
 pub(super) fn evaluate_impl(
     a: &SpatialParams,
     k: &Stiffness,
@@ -336,7 +355,7 @@ pub(super) fn evaluate_impl(
     Ok(Evaluation3d {
         tip: pose_of(&y),
         jacobian: jac_of(&y),
-        energy: y[13],
+        energy: y[ENERGY],
         stability,
     })
 }
