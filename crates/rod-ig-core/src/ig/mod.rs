@@ -102,6 +102,8 @@ pub struct Solution {
     pub residual: f64,
     /// Elastic energy ½∫κ² (FINDINGS §1 identity).
     pub energy: f64,
+    /// Evaluations of Υ(a) and J(1, a), line-search trials included (robust: over every start).
+    pub evaluations: u32,
     /// Number of starts tried (1 for Newton and for a tracker warm start).
     pub starts: u32,
     /// Wall time of the solve, µs.
@@ -292,6 +294,7 @@ pub fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Fa
             {
                 Some(mut s) => {
                     s.iterations = iterations;
+                    s.evaluations = all.evaluations;
                     s.starts = all.starts;
                     Ok(s)
                 }

@@ -77,6 +77,7 @@ pub(crate) fn make_solution(
         orientation_error: e.ang_err,
         residual: e.norm,
         energy: model::energy_from_tip(a, &e.tip),
+        evaluations: iterations + 1,
         starts: 1,
         elapsed_us: 0.0,
     }

@@ -22,9 +22,11 @@ pub(crate) fn try_start(
     options: &SolveOptions,
     budget: u32,
     iterations: &mut u32,
+    evaluations: &mut u32,
 ) -> Option<Solution> {
     let r = local::solve(target, a0, options.alpha, budget, options.tolerance);
     *iterations += r.iterations;
+    *evaluations += r.evaluations;
     let (a, e) = r.found?;
     let st = model::stability(&a).ok()?;
     if !st.stable {
@@ -86,14 +88,23 @@ impl<'t> Starts<'t> {
 
 pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Failure> {
     let mut iterations = 0;
+    let mut evaluations = 0;
     let mut starts = Starts::new(target, options);
     let budget = per_start_budget(options);
     let mut n = 0;
     while n < MAX_STARTS {
         let Some(a0) = starts.next() else { break };
         n += 1;
-        if let Some(mut s) = try_start(target, &a0, options, budget, &mut iterations) {
+        if let Some(mut s) = try_start(
+            target,
+            &a0,
+            options,
+            budget,
+            &mut iterations,
+            &mut evaluations,
+        ) {
             s.iterations = iterations;
+            s.evaluations = evaluations;
             s.starts = n as u32;
             return Ok(s);
         }
@@ -110,6 +121,7 @@ pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solut
 pub(crate) struct All {
     pub solutions: Vec<Solution>,
     pub iterations: u32,
+    pub evaluations: u32,
     pub starts: u32,
 }
 
@@ -123,6 +135,7 @@ fn distinct(a: &PlanarParams, b: &PlanarParams) -> bool {
 
 pub(crate) fn solve_all(target: &PlanarPose, options: &SolveOptions) -> All {
     let mut iterations = 0;
+    let mut evaluations = 0;
     let budget = per_start_budget(options);
     let mut list = Vec::new();
     if let Some(g) = options
@@ -138,6 +151,7 @@ pub(crate) fn solve_all(target: &PlanarPose, options: &SolveOptions) -> All {
         starts += 1;
         let r = local::solve(target, a0, options.alpha, budget, options.tolerance);
         iterations += r.iterations;
+        evaluations += r.evaluations;
         let Some((a, e)) = r.found else { continue };
         if solutions.iter().any(|s| !distinct(&s.a, &a)) {
             continue;
@@ -146,12 +160,15 @@ pub(crate) fn solve_all(target: &PlanarPose, options: &SolveOptions) -> All {
             continue;
         };
         if st.stable {
-            solutions.push(make_solution(&a, &e, true, st.margin, r.iterations));
+            let mut sol = make_solution(&a, &e, true, st.margin, r.iterations);
+            sol.evaluations = r.evaluations;
+            solutions.push(sol);
         }
     }
     All {
         solutions,
         iterations,
+        evaluations,
         starts,
     }
 }
