@@ -293,9 +293,11 @@ fn boundary_targets() {
     }
     // Reachable near-boundary targets: tips of stable, nearly straight rods.
     for a in [
-        PlanarParams::new(0.3, 20.0, 1.0),
+        PlanarParams::new(0.3, -20.0, 1.0),
         PlanarParams::new(-0.5, -5.0, 0.5),
-        PlanarParams::new(0.05, 50.0, -0.2),
+        PlanarParams::new(0.1, -5.0, 0.1),
+        PlanarParams::new(0.05, -35.0, 0.1),
+        PlanarParams::new(0.01, -39.0, 0.05),
     ] {
         let (b, _) = rod_ig_core::ode::planar_reference::tip_and_jacobian(&a, 1e-12).unwrap();
         assert!(b.x.hypot(b.y) > 0.97, "{b:?}");

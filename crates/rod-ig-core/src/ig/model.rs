@@ -4,7 +4,6 @@
 //! Everything here works on the unit rod in the paper's units: Υ(a) = q(1) (paper eq. 2.11 at
 //! t = 1), J(1, a) (paper §2.2.3), and the stability test of FINDINGS §5.
 
-use super::scan;
 use crate::{wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 use nalgebra::Vector3;
 
@@ -37,43 +36,18 @@ pub(crate) fn residual(tip: &PlanarPose, target: &PlanarPose) -> Vector3<f64> {
     )
 }
 
-#[cfg(any())]
 mod backend {
-    // Closed forms (crate::planar), the production backend.
+    // Closed forms (crate::planar): the production backend. The numerical reference
+    // (crate::ode::planar_reference, same signatures with an rtol) can be swapped in here.
     use super::*;
+    #[inline]
     pub(super) fn tip_and_jacobian(
         a: &PlanarParams,
     ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
         crate::planar::tip_and_jacobian(a)
     }
+    #[inline]
     pub(super) fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
         crate::planar::stability(a)
-    }
-}
-
-#[cfg(all())]
-mod backend {
-    // Development backend: fine fixed-step RK4 of the rod and its variational equations.
-    use super::*;
-    fn check(a: &PlanarParams) -> Result<(), RodError> {
-        RodError::check_finite("a", a.as_slice())
-    }
-    pub(super) fn tip_and_jacobian(
-        a: &PlanarParams,
-    ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-        check(a)?;
-        let s = scan::scan(a, scan::steps_for(a, 40.0))
-            .ok_or_else(|| RodError::Overflow("RK4 scan produced non-finite values".into()))?;
-        Ok((s.tip, s.jacobian))
-    }
-    pub(super) fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
-        check(a)?;
-        let s = scan::scan(a, scan::steps_for(a, 40.0).max(2000))
-            .ok_or_else(|| RodError::Overflow("RK4 scan produced non-finite values".into()))?;
-        Ok(StabilityReport {
-            stable: s.stable,
-            margin: s.margin,
-            first_conjugate_t: None,
-        })
     }
 }

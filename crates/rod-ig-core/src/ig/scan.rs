@@ -60,15 +60,8 @@ fn jac_of(y: &[f64; DIM]) -> PlanarJacobian {
 /// Result of one RK4 scan.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Scan {
-    /// Tip pose (θ unwrapped).
-    pub tip: PlanarPose,
-    /// J(1, a), rows (x, y, θ).
-    pub jacobian: PlanarJacobian,
     /// No sign change or zero of det J(t) was seen at the scanned steps t ≥ `T_MIN`.
     pub stable: bool,
-    /// Min over scanned t ≥ 0.05 of det J(t) / (t⁹(a3²/8640 + a5² t²/33600)) (FINDINGS §5
-    /// `det_min`), or the raw minimum sign indicator when that normaliser vanishes.
-    pub margin: f64,
     /// First scanned t with det J(t) ≤ 0, when unstable.
     pub first_conjugate_t: Option<f64>,
 }
@@ -153,43 +146,19 @@ where
 }
 
 /// Integrates the rod and its variational equations over [0, 1] with `n` RK4 steps, checking
-/// the sign of det J(t) at every step t ≥ 0.02 (FINDINGS §5 rule) and returning the tip and
-/// J(1). Returns `None` on non-finite input or if the integration produced non-finite values.
+/// the sign of det J(t) at every step t ≥ 0.02 (FINDINGS §5 rule), stopping at the first
+/// non-positive value. Returns `None` on non-finite input or values.
 pub(crate) fn scan(a: &PlanarParams, n: usize) -> Option<Scan> {
-    let mut stable = true;
     let mut first_conjugate_t = None;
-    let mut margin = f64::INFINITY;
-    let norm0 = a[0] * a[0] / 8640.0;
-    let norm1 = a[2] * a[2] / 33600.0;
-    let (tip, jacobian) = integrate(a, n, |t, _, _, _, det| {
-        if t >= T_MIN {
-            if det <= 0.0 && stable {
-                stable = false;
-                first_conjugate_t = Some(t);
-            }
-            if t >= 0.05 {
-                let t2 = t * t;
-                let t9 = t2 * t2 * t2 * t2 * t;
-                let den = t9 * (norm0 + norm1 * t2);
-                let g = if den > 0.0 {
-                    det / den
-                } else if det > 0.0 {
-                    0.0
-                } else {
-                    -1.0
-                };
-                if g < margin {
-                    margin = g;
-                }
-            }
+    integrate(a, n, |t, _, _, _, det| {
+        if t >= T_MIN && det <= 0.0 {
+            first_conjugate_t = Some(t);
+            return false;
         }
         true
     })?;
     Some(Scan {
-        tip,
-        jacobian,
-        stable,
-        margin,
+        stable: first_conjugate_t.is_none(),
         first_conjugate_t,
     })
 }
@@ -202,11 +171,11 @@ mod tests {
     fn circle_tip() {
         // a = (a3, 0, 0): a circle of curvature a3.
         let a = PlanarParams::new(1.3, 0.0, 0.0);
-        let s = scan(&a, 400).unwrap();
-        assert!((s.tip.x - (1.3f64).sin() / 1.3).abs() < 1e-10);
-        assert!((s.tip.y - 2.0 * (0.65f64).sin().powi(2) / 1.3).abs() < 1e-10);
-        assert!((s.tip.theta - 1.3).abs() < 1e-10);
-        assert!(s.stable);
+        let (tip, _) = integrate(&a, 400, |_, _, _, _, _| true).unwrap();
+        assert!(scan(&a, 400).unwrap().stable);
+        assert!((tip.x - (1.3f64).sin() / 1.3).abs() < 1e-10);
+        assert!((tip.y - 2.0 * (0.65f64).sin().powi(2) / 1.3).abs() < 1e-10);
+        assert!((tip.theta - 1.3).abs() < 1e-10);
     }
 
     #[test]
