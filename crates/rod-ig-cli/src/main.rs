@@ -54,12 +54,26 @@ enum Command {
         output: Option<PathBuf>,
     },
     /// Measures every speed figure in one run: forward map, J, stability, shape against the
-    /// paper's RK4 baseline (dt = 1e-4).
+    /// paper's RK4 baseline (dt = 1e-4); the paper's Table 1 protocol for Newton; the robust
+    /// solver and tracking.
     Bench {
         /// Fewer rounds and samples (a smoke run, not for quoting).
         #[arg(long)]
         quick: bool,
+        /// Inverse-geometry cases for the Table 1 protocol (JSON lines, as in the oracle).
+        #[arg(long, default_value = "../shared/oracle/ig_public.jsonl")]
+        ig_cases: PathBuf,
+        /// Which parts to run.
+        #[arg(long, value_enum, default_value = "all")]
+        only: BenchPart,
     },
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+enum BenchPart {
+    All,
+    Forward,
+    Ig,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq)]
@@ -75,7 +89,7 @@ fn parse_triple(text: &str, what: &str) -> Result<[f64; 3], String> {
             "{what} needs three comma-separated numbers, got {text:?}"
         ));
     }
-    let mut out = [0.0; 3];
+    let mut out = [0.0f64; 3];
     for (slot, part) in out.iter_mut().zip(&parts) {
         *slot = part
             .parse()
@@ -153,8 +167,17 @@ fn main() -> ExitCode {
             format,
             output,
         } => shape_command(&params, target.as_deref(), samples, format, output.as_ref()),
-        Command::Bench { quick } => {
-            bench::planar_forward(quick);
+        Command::Bench {
+            quick,
+            ig_cases,
+            only,
+        } => {
+            if matches!(only, BenchPart::All | BenchPart::Forward) {
+                bench::planar_forward(quick);
+            }
+            if matches!(only, BenchPart::All | BenchPart::Ig) {
+                bench::inverse_geometry(quick, &ig_cases);
+            }
             Ok(())
         }
     };

@@ -48,26 +48,6 @@ pub fn median(values: &mut [f64]) -> f64 {
     }
 }
 
-/// A small deterministic generator (SplitMix64) so that every run benchmarks the same inputs.
-pub struct SplitMix64(pub u64);
-
-impl SplitMix64 {
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [lo, hi).
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        let unit = (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
-        lo + (hi - lo) * unit
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -77,17 +57,6 @@ mod tests {
         assert_eq!(median(&mut [3.0, 1.0, 2.0]), 2.0);
         assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), 2.5);
         assert_eq!(median(&mut []), 0.0);
-    }
-
-    #[test]
-    fn uniform_stays_in_range_and_is_reproducible() {
-        let mut a = SplitMix64(7);
-        let mut b = SplitMix64(7);
-        for _ in 0..1000 {
-            let x = a.uniform(-2.0, 3.0);
-            assert!((-2.0..3.0).contains(&x));
-            assert_eq!(x, b.uniform(-2.0, 3.0));
-        }
     }
 
     #[test]
