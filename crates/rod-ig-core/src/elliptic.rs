@@ -47,7 +47,8 @@ pub fn carlson_rf<T: Real>(x: T, y: T, z: T) -> T {
             .abs()
             .max((m - y.re()).abs())
             .max((m - z.re()).abs());
-        if !(dev > CARLSON_TOL * m.abs()) {
+        // written so that NaN also ends the loop
+        if dev.partial_cmp(&(CARLSON_TOL * m.abs())) != Some(std::cmp::Ordering::Greater) {
             break;
         }
         let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
@@ -402,13 +403,19 @@ impl<T: Real> Landen<T> {
         let mut n = self.levels;
         while n > 0 {
             n -= 1;
-            let s = phi.sin();
+            // one sincos for dual numbers (their sin needs the cosine anyway); plain sin for f64
+            let (s, co) = if T::HAS_DERIVATIVES {
+                let (s, c) = phi.sin_cos();
+                (s, Some(c))
+            } else {
+                (phi.sin(), None)
+            };
             zm += self.dm[n] * s;
             let x = self.ca[n] * s;
             let asin_x = if x.re().abs() <= 0.5 {
                 x.asin()
             } else {
-                let co = phi.cos();
+                let co = co.unwrap_or_else(|| phi.cos());
                 // asin x = atan2(x, √((1 − |x|)(1 + |x|))) with
                 // 1 − |x| = (1 − cₙ/aₙ) + (cₙ/aₙ)(1 − |s|), 1 − |s| = cos²/(1 + |s|):
                 // no cancellation, so no loss near the separatrix (m1 → 0).

@@ -396,7 +396,9 @@ impl<T: Real> Closed<T> {
             s.phi, s.r, s.sqa3, s.chat, s.shat, s.lin, s.sqm, s.th0, s.e0, s.j0.sn, s.j0.cn,
             s.j0.dn, s.j0.zm,
         ];
-        if !fields.iter().all(|v| v.re().is_finite()) || !(s.r.re() > 0.0) {
+        if !fields.iter().all(|v| v.re().is_finite())
+            || s.r.re().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        {
             return None;
         }
         Some(s)
