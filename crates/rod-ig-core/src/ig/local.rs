@@ -57,7 +57,38 @@ pub(crate) fn solve(
     max_iterations: u32,
     tolerance: f64,
 ) -> Local {
-    let mut out = Local {
+    solve_predicted(target, a0, None, alpha, max_iterations, tolerance)
+}
+
+/// As [`solve`], with an optional predicted first iterate `(a1, r0)`: a Newton step from `a0`
+/// computed from an already known J(1, a0) (atlas seed, previous tracking solution), where `r0`
+/// is the known (or estimated) ‖f(a0)‖. It is taken when it is in A_stable's det J(1) > 0 side
+/// and decreases the residual below `r0`; otherwise the solve starts from `a0`. A taken
+/// prediction counts as one iteration.
+pub(crate) fn solve_predicted(
+    target: &PlanarPose,
+    a0: &PlanarParams,
+    predicted: Option<(PlanarParams, f64)>,
+    alpha: f64,
+    max_iterations: u32,
+    tolerance: f64,
+) -> Local {
+    if let Some((a1, r0)) = predicted {
+        if max_iterations > 0 {
+            if let Some(e1) = eval(&a1, target) {
+                if e1.jac.determinant() > 0.0 && e1.norm < (1.0 - 1e-4) * r0 {
+                    let mut out = run(target, a1, e1, alpha, max_iterations - 1, tolerance);
+                    out.iterations += 1;
+                    out.evaluations += 1;
+                    return out;
+                }
+            }
+            let mut out = solve(target, a0, alpha, max_iterations, tolerance);
+            out.evaluations += 1;
+            return out;
+        }
+    }
+    let out = Local {
         found: None,
         iterations: 0,
         evaluations: 1,
@@ -65,12 +96,35 @@ pub(crate) fn solve(
         last_a: *a0,
         stop: Stop::BadStart,
     };
-    let mut a = *a0;
-    let mut e = match eval(&a, target) {
-        Some(e) if e.jac.determinant() > 0.0 => e,
-        _ => return out,
+    match eval(a0, target) {
+        Some(e) if e.jac.determinant() > 0.0 => {
+            let mut out = run(target, *a0, e, alpha, max_iterations, tolerance);
+            out.evaluations += 1;
+            out
+        }
+        _ => out,
+    }
+}
+
+/// The iteration proper, from an evaluated start (`evaluations` excludes the start's).
+fn run(
+    target: &PlanarPose,
+    a0: PlanarParams,
+    e0: Eval,
+    alpha: f64,
+    max_iterations: u32,
+    tolerance: f64,
+) -> Local {
+    let mut out = Local {
+        found: None,
+        iterations: 0,
+        evaluations: 0,
+        residual: e0.norm,
+        last_a: a0,
+        stop: Stop::BadStart,
     };
-    out.residual = e.norm;
+    let mut a = a0;
+    let mut e = e0;
     let alpha = if alpha > 0.0 && alpha <= 1.0 {
         alpha
     } else {

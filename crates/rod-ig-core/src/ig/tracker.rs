@@ -4,9 +4,9 @@
 //! the path leaves the stable workspace), the tracker falls back to the robust solver.
 //!
 //! Predictor: the previous solve ended with J(1, a_prev) already evaluated at its solution, so
-//! the first-order prediction a_prev + J(1, a_prev)⁻¹ (b − b_prev) (the tangent of the solution
-//! branch) costs one 3×3 solve and no evaluation. It is not counted as an iteration; the
-//! `evaluations` field of [`Solution`] counts every evaluation of Υ and J.
+//! the first Newton step a_prev + J(1, a_prev)⁻¹ (b − b_prev) (the tangent of the solution
+//! branch) costs one 3×3 solve and no evaluation. It is counted as an iteration all the same;
+//! the `evaluations` field of [`Solution`] counts every evaluation of Υ and J.
 
 use super::{
     local, model, newton::make_solution, newton::solve3, robust, Failure, Solution, SolveOptions,
@@ -46,7 +46,7 @@ impl Tracker {
         self.last.map(|l| l.0)
     }
 
-    fn predict(&self, target: &PlanarPose) -> Option<PlanarParams> {
+    fn predict(&self, target: &PlanarPose) -> Option<(PlanarParams, f64)> {
         let (a, b, j) = self.last?;
         let j = j?;
         let db = Vector3::new(
@@ -58,7 +58,7 @@ impl Tracker {
         let size = (da[0].abs() / 4.0)
             .max(da[1].abs() / 40.0)
             .max(da[2].abs() / 40.0);
-        (size <= MAX_PREDICT).then(|| a + da)
+        (size <= MAX_PREDICT).then(|| (a + da, db.norm()))
     }
 
     /// Solves for `target`, warm-starting from the previous solution.
@@ -74,8 +74,9 @@ impl Tracker {
         let mut iterations = 0;
         let mut evaluations = 0;
         let budget = self.options.max_iterations.clamp(1, 20);
-        for a0 in [predicted, warm].into_iter().flatten() {
-            let r = local::solve(target, &a0, 1.0, budget, self.options.tolerance);
+        if let Some(a0) = warm {
+            let r =
+                local::solve_predicted(target, &a0, predicted, 1.0, budget, self.options.tolerance);
             iterations += r.iterations;
             evaluations += r.evaluations;
             if let Some((a, e)) = r.found {
