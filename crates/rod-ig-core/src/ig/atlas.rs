@@ -28,6 +28,8 @@ const K: usize = 4;
 const NEAR: usize = 6;
 /// Ray end-points.
 const RAYS: usize = 8000;
+/// Ray end-points near the separatrix λ4 = 0.
+const SEPARATRIX_RAYS: usize = 8000;
 /// RK4 steps per ray.
 const STEPS: usize = 200;
 /// Half-widths of the end-point box.
@@ -107,6 +109,28 @@ fn same_branch(a: &[f64; 3], b: &[f64; 3]) -> bool {
     (a[0] - b[0]).abs() / 2.0 + (a[1] - b[1]).abs() / 20.0 + (a[2] - b[2]).abs() / 20.0 < 1.0
 }
 
+/// A ray end-point near the separatrix λ4 = a5² − a3²(a3²/4 + a4) = 0 (FINDINGS §1–2:
+/// the boundary between cases I and II, where m → 1 and the tip depends on a so sharply that
+/// uniform sampling leaves its neighbourhood without seeds). λ4 scales as s⁴ along a ray, so the
+/// whole ray stays at the same relative offset from the separatrix. Offsets are log-uniform.
+fn separatrix_endpoint(i: u64) -> Option<PlanarParams> {
+    let a3 = (2.0 * halton(i, 2) - 1.0) * A3_MAX;
+    let a4 = (2.0 * halton(i, 3) - 1.0) * A45_MAX;
+    let base = a3 * a3 * (a3 * a3 / 4.0 + a4);
+    let u = halton(i, 5);
+    let v = halton(i, 7);
+    // Relative offset ±10^(−7..0) of the scale a3⁴/4 + |a4| a3² (+1 to stay away from 0).
+    let scale = a3 * a3 * (a3 * a3 / 4.0 + a4.abs()) + 1.0;
+    let sign = if v < 0.5 { -1.0 } else { 1.0 };
+    let l4 = sign * scale * 10f64.powf(-7.0 * u);
+    let a5sq = base + l4;
+    if !(a5sq > 0.0) {
+        return None;
+    }
+    let a5 = a5sq.sqrt() * if (2.0 * v).fract() < 0.5 { -1.0 } else { 1.0 };
+    (a5.abs() <= A45_MAX).then(|| PlanarParams::new(a3, a4, a5))
+}
+
 /// Radical inverse in base `b` (Halton sequence).
 fn halton(mut i: u64, b: u64) -> f64 {
     let mut f = 1.0;
@@ -124,12 +148,19 @@ fn build() -> Atlas {
     let ncells = NXY * NXY * NT;
     let mut cells: Vec<Vec<(Seed, f64)>> = vec![Vec::new(); ncells];
     let mut buf: Vec<(f64, f64, f64, f64, Matrix3<f64>)> = Vec::with_capacity(STEPS);
-    for i in 0..RAYS as u64 {
-        let a = PlanarParams::new(
-            (2.0 * halton(i + 1, 2) - 1.0) * A3_MAX,
-            (2.0 * halton(i + 1, 3) - 1.0) * A45_MAX,
-            (2.0 * halton(i + 1, 5) - 1.0) * A45_MAX,
-        );
+    for i in 0..(RAYS + SEPARATRIX_RAYS) as u64 {
+        let a = if (i as usize) < RAYS {
+            PlanarParams::new(
+                (2.0 * halton(i + 1, 2) - 1.0) * A3_MAX,
+                (2.0 * halton(i + 1, 3) - 1.0) * A45_MAX,
+                (2.0 * halton(i + 1, 5) - 1.0) * A45_MAX,
+            )
+        } else {
+            match separatrix_endpoint(i + 1) {
+                Some(a) => a,
+                None => continue,
+            }
+        };
         buf.clear();
         let mut t1 = f64::INFINITY;
         let ok = scan::integrate(&a, STEPS, |t, x, y, th, j, det| {
@@ -145,7 +176,7 @@ fn build() -> Atlas {
         }
         for &(t, x, y, th, j) in buf.iter() {
             // Keep a margin from the first conjugate point (seeds deep inside A_stable).
-            if t < 0.05 || t > 0.93 * t1 {
+            if t < 0.05 || t > 0.985 * t1 {
                 continue;
             }
             let tip = [x / t, y / t, wrap_angle(th)];
