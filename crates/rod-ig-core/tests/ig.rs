@@ -289,7 +289,7 @@ fn boundary_targets() {
         let f = ig::solve(&b, &o).unwrap_err();
         let ms = t.elapsed().as_secs_f64() * 1e3;
         assert!(matches!(f.reason, IgError::NoStableSolution { .. }), "{f}");
-        assert!(ms < 100.0, "took {ms} ms");
+        assert!(ms < 250.0, "took {ms} ms");
     }
     // Reachable near-boundary targets: tips of stable, nearly straight rods.
     for a in [
