@@ -57,7 +57,7 @@ fi
 # paths: point them at this venv's own.
 venv_py_include="$("$VENV/bin/python3" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')"
 venv_np_include="$("$VENV/bin/python3" -c 'import numpy; print(numpy.get_include())')"
-grep -rlZ --include='*.cmake' '/opt/python/cp311-cp311' "$VENV/share" 2>/dev/null \
+{ grep -rlZ --include='*.cmake' '/opt/python/cp311-cp311' "$VENV/share" 2>/dev/null || true; } \
     | xargs -0 -r sed -i \
         -e "s#/opt/python/cp311-cp311/lib/python3.11/site-packages/numpy/_core/include#$venv_np_include#g" \
         -e "s#/opt/python/cp311-cp311/include/python3.11#$venv_py_include#g"

@@ -269,6 +269,8 @@ pub struct SolveRodRequest {
     pub max_iterations: u32,
     /// Method override ("" = parameter).
     pub method: String,
+    /// Path poses override (0 = parameter).
+    pub path_samples: u32,
 }
 impl Message for SolveRodRequest {}
 
@@ -500,6 +502,7 @@ mod tests {
             tolerance: 1e-8,
             max_iterations: 50,
             method: "newton".into(),
+            path_samples: 9,
         }
     }
 

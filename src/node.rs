@@ -321,9 +321,10 @@ pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> 
     subscriber_task.abort();
     service_task.abort();
     solver_task.abort();
-    node.stop_spinner();
-    let _ = tokio::time::timeout(std::time::Duration::from_secs(2), spin_task).await;
+    // Dropping the node tells the spinner to stop (stop_spinner() too, but then the drop
+    // would log an error).
     drop(node);
+    let _ = tokio::time::timeout(std::time::Duration::from_secs(2), spin_task).await;
     drop(params_tx);
     Ok(())
 }

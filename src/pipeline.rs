@@ -36,6 +36,8 @@ pub struct Overrides {
     pub max_iterations: Option<u32>,
     /// Method instead of the parameter.
     pub method: Option<Method>,
+    /// Path poses instead of the parameter.
+    pub path_samples: Option<usize>,
 }
 
 impl Overrides {
@@ -60,6 +62,15 @@ impl Overrides {
         }
         if req.max_iterations != 0 {
             o.max_iterations = Some(req.max_iterations.min(100_000));
+        }
+        if req.path_samples != 0 {
+            if !(2..=100_000).contains(&req.path_samples) {
+                return Err(format!(
+                    "path_samples must be in [2, 100000], got {}",
+                    req.path_samples
+                ));
+            }
+            o.path_samples = Some(req.path_samples as usize);
         }
         if !req.method.trim().is_empty() {
             o.method = Some(Method::parse(&req.method).map_err(|e| e.to_string())?);
@@ -123,17 +134,19 @@ impl Processor {
                 }
             }
         };
-        let one_off = (!overrides.is_empty()).then(|| SolverSettings {
+        let samples = overrides.path_samples.unwrap_or(params.path_samples);
+        let solver_overrides = Overrides {
+            path_samples: None,
+            ..overrides.clone()
+        };
+        let one_off = (!solver_overrides.is_empty()).then(|| SolverSettings {
             method: overrides.method.unwrap_or(settings.method),
             tolerance: overrides.tolerance.unwrap_or(settings.tolerance),
             max_iterations: overrides.max_iterations.unwrap_or(settings.max_iterations),
         });
-        let result = self.solver.solve(
-            &planar,
-            overrides.initial_guess,
-            one_off,
-            params.path_samples,
-        );
+        let result = self
+            .solver
+            .solve(&planar, overrides.initial_guess, one_off, samples);
         let elapsed = started.elapsed().as_secs_f64();
         match result {
             Ok(solved) => {
@@ -306,6 +319,10 @@ mod tests {
         assert_eq!(o.tolerance, Some(1e-9));
         assert_eq!(o.max_iterations, Some(20));
         assert_eq!(o.initial_guess, Some(PlanarParams::new(0.1, 0.2, 0.3)));
+        req.path_samples = 1;
+        assert!(Overrides::from_request(&req).is_err());
+        req.path_samples = 8;
+        assert_eq!(Overrides::from_request(&req).unwrap().path_samples, Some(8));
         req.method = "bogus".into();
         assert!(Overrides::from_request(&req).is_err());
         req.method.clear();
