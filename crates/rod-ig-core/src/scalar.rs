@@ -1,1 +1,503 @@
-//! (being written)
+//! Scalars for the closed forms: the [`Real`] trait, implemented for `f64` and for the
+//! forward-mode dual number [`Dual3`] (value + gradient with respect to three inputs).
+//!
+//! The planar closed forms (FINDINGS §1–§3) are written once, generic over [`Real`]. Run with
+//! `f64` they give the pose; run with [`Dual3`] seeded with the identity on a = (a3, a4, a5)
+//! they give the pose and its exact Jacobian J = ∂q/∂a in one pass (no finite differences).
+//! Branch decisions inside generic code are taken on [`Real::re`], the f64 value.
+
+use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
+
+/// A real scalar usable by the closed forms: `f64` or a dual number.
+///
+/// Mixed arithmetic with `f64` on the right is part of the contract so that generic code can
+/// write `x * 2.0`.
+pub trait Real:
+    Copy
+    + std::fmt::Debug
+    + PartialEq
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + Add<f64, Output = Self>
+    + Sub<f64, Output = Self>
+    + Mul<f64, Output = Self>
+    + Div<f64, Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+{
+    /// True for scalars that carry derivatives (dual numbers), false for `f64`.
+    const HAS_DERIVATIVES: bool;
+    /// A constant (zero derivative).
+    fn from_f64(v: f64) -> Self;
+    /// The f64 value (the real part of a dual number).
+    fn re(self) -> f64;
+    /// Square root. For a dual number at value 0 the derivative is set to 0 (not ∞).
+    fn sqrt(self) -> Self;
+    /// Sine.
+    fn sin(self) -> Self;
+    /// Cosine.
+    fn cos(self) -> Self;
+    /// Sine and cosine together.
+    fn sin_cos(self) -> (Self, Self) {
+        (self.sin(), self.cos())
+    }
+    /// Arcsine; the argument is clamped to [−1, 1] (derivative capped at the ends).
+    fn asin(self) -> Self;
+    /// Arctangent.
+    fn atan(self) -> Self;
+    /// Two-argument arctangent atan2(self, x), in (−π, π].
+    fn atan2(self, x: Self) -> Self;
+    /// Exponential.
+    fn exp(self) -> Self;
+    /// Natural logarithm.
+    fn ln(self) -> Self;
+    /// Hyperbolic tangent.
+    fn tanh(self) -> Self;
+    /// Hyperbolic sine.
+    fn sinh(self) -> Self;
+    /// Hyperbolic cosine.
+    fn cosh(self) -> Self;
+    /// Inverse hyperbolic sine.
+    fn asinh(self) -> Self;
+    /// Absolute value (derivative sign taken from the value; +1 at 0).
+    fn abs(self) -> Self;
+    /// Reciprocal 1/self.
+    fn recip(self) -> Self {
+        Self::from_f64(1.0) / self
+    }
+    /// True when the value and every derivative are finite.
+    fn is_finite(self) -> bool;
+}
+
+impl Real for f64 {
+    const HAS_DERIVATIVES: bool = false;
+    #[inline]
+    fn from_f64(v: f64) -> Self {
+        v
+    }
+    #[inline]
+    fn re(self) -> f64 {
+        self
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline]
+    fn sin(self) -> Self {
+        f64::sin(self)
+    }
+    #[inline]
+    fn cos(self) -> Self {
+        f64::cos(self)
+    }
+    #[inline]
+    fn sin_cos(self) -> (Self, Self) {
+        f64::sin_cos(self)
+    }
+    #[inline]
+    fn asin(self) -> Self {
+        f64::asin(self.clamp(-1.0, 1.0))
+    }
+    #[inline]
+    fn atan(self) -> Self {
+        f64::atan(self)
+    }
+    #[inline]
+    fn atan2(self, x: Self) -> Self {
+        f64::atan2(self, x)
+    }
+    #[inline]
+    fn exp(self) -> Self {
+        f64::exp(self)
+    }
+    #[inline]
+    fn ln(self) -> Self {
+        f64::ln(self)
+    }
+    #[inline]
+    fn tanh(self) -> Self {
+        f64::tanh(self)
+    }
+    #[inline]
+    fn sinh(self) -> Self {
+        f64::sinh(self)
+    }
+    #[inline]
+    fn cosh(self) -> Self {
+        f64::cosh(self)
+    }
+    #[inline]
+    fn asinh(self) -> Self {
+        f64::asinh(self)
+    }
+    #[inline]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    #[inline]
+    fn recip(self) -> Self {
+        1.0 / self
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+}
+
+/// Forward-mode dual number: a value `v` and its gradient `g` with respect to three inputs.
+///
+/// Every operation applies the chain rule exactly; there is no heap allocation.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Dual3 {
+    /// Value.
+    pub v: f64,
+    /// Gradient ∂v/∂(p0, p1, p2).
+    pub g: [f64; 3],
+}
+
+impl Dual3 {
+    /// A dual number from its value and gradient.
+    #[inline]
+    pub const fn new(v: f64, g: [f64; 3]) -> Self {
+        Self { v, g }
+    }
+    /// A constant (zero gradient).
+    #[inline]
+    pub const fn constant(v: f64) -> Self {
+        Self { v, g: [0.0; 3] }
+    }
+    /// The i-th independent variable (gradient = i-th unit vector); `i` ≥ 3 gives a constant.
+    #[inline]
+    pub fn variable(v: f64, i: usize) -> Self {
+        let mut g = [0.0; 3];
+        if let Some(gi) = g.get_mut(i) {
+            *gi = 1.0;
+        }
+        Self { v, g }
+    }
+    /// Applies f with value `v` and derivative `d` (chain rule).
+    #[inline]
+    fn chain(self, v: f64, d: f64) -> Self {
+        Self {
+            v,
+            g: [d * self.g[0], d * self.g[1], d * self.g[2]],
+        }
+    }
+}
+
+impl Add for Dual3 {
+    type Output = Self;
+    #[inline]
+    fn add(self, o: Self) -> Self {
+        Self {
+            v: self.v + o.v,
+            g: [self.g[0] + o.g[0], self.g[1] + o.g[1], self.g[2] + o.g[2]],
+        }
+    }
+}
+impl Sub for Dual3 {
+    type Output = Self;
+    #[inline]
+    fn sub(self, o: Self) -> Self {
+        Self {
+            v: self.v - o.v,
+            g: [self.g[0] - o.g[0], self.g[1] - o.g[1], self.g[2] - o.g[2]],
+        }
+    }
+}
+impl Mul for Dual3 {
+    type Output = Self;
+    #[inline]
+    fn mul(self, o: Self) -> Self {
+        Self {
+            v: self.v * o.v,
+            g: [
+                self.g[0] * o.v + self.v * o.g[0],
+                self.g[1] * o.v + self.v * o.g[1],
+                self.g[2] * o.v + self.v * o.g[2],
+            ],
+        }
+    }
+}
+impl Div for Dual3 {
+    type Output = Self;
+    #[inline]
+    fn div(self, o: Self) -> Self {
+        let inv = 1.0 / o.v;
+        let v = self.v * inv;
+        Self {
+            v,
+            g: [
+                (self.g[0] - v * o.g[0]) * inv,
+                (self.g[1] - v * o.g[1]) * inv,
+                (self.g[2] - v * o.g[2]) * inv,
+            ],
+        }
+    }
+}
+impl Neg for Dual3 {
+    type Output = Self;
+    #[inline]
+    fn neg(self) -> Self {
+        Self {
+            v: -self.v,
+            g: [-self.g[0], -self.g[1], -self.g[2]],
+        }
+    }
+}
+impl Add<f64> for Dual3 {
+    type Output = Self;
+    #[inline]
+    fn add(self, o: f64) -> Self {
+        Self {
+            v: self.v + o,
+            g: self.g,
+        }
+    }
+}
+impl Sub<f64> for Dual3 {
+    type Output = Self;
+    #[inline]
+    fn sub(self, o: f64) -> Self {
+        Self {
+            v: self.v - o,
+            g: self.g,
+        }
+    }
+}
+impl Mul<f64> for Dual3 {
+    type Output = Self;
+    #[inline]
+    fn mul(self, o: f64) -> Self {
+        Self {
+            v: self.v * o,
+            g: [self.g[0] * o, self.g[1] * o, self.g[2] * o],
+        }
+    }
+}
+impl Div<f64> for Dual3 {
+    type Output = Self;
+    #[inline]
+    fn div(self, o: f64) -> Self {
+        let inv = 1.0 / o;
+        self * inv
+    }
+}
+impl AddAssign for Dual3 {
+    #[inline]
+    fn add_assign(&mut self, o: Self) {
+        *self = *self + o;
+    }
+}
+impl SubAssign for Dual3 {
+    #[inline]
+    fn sub_assign(&mut self, o: Self) {
+        *self = *self - o;
+    }
+}
+impl MulAssign for Dual3 {
+    #[inline]
+    fn mul_assign(&mut self, o: Self) {
+        *self = *self * o;
+    }
+}
+
+impl Real for Dual3 {
+    const HAS_DERIVATIVES: bool = true;
+    #[inline]
+    fn from_f64(v: f64) -> Self {
+        Self::constant(v)
+    }
+    #[inline]
+    fn re(self) -> f64 {
+        self.v
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        let s = self.v.sqrt();
+        let d = if s > 0.0 { 0.5 / s } else { 0.0 };
+        self.chain(s, d)
+    }
+    #[inline]
+    fn sin(self) -> Self {
+        let (s, c) = self.v.sin_cos();
+        self.chain(s, c)
+    }
+    #[inline]
+    fn cos(self) -> Self {
+        let (s, c) = self.v.sin_cos();
+        self.chain(c, -s)
+    }
+    #[inline]
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.v.sin_cos();
+        (self.chain(s, c), self.chain(c, -s))
+    }
+    #[inline]
+    fn asin(self) -> Self {
+        let x = self.v.clamp(-1.0, 1.0);
+        let w = (1.0 - x * x).sqrt();
+        let d = if w > 0.0 { 1.0 / w } else { 0.0 };
+        self.chain(x.asin(), d)
+    }
+    #[inline]
+    fn atan(self) -> Self {
+        self.chain(self.v.atan(), 1.0 / (1.0 + self.v * self.v))
+    }
+    #[inline]
+    fn atan2(self, x: Self) -> Self {
+        // d atan2(y, x) = (x dy − y dx) / (x² + y²)
+        let y = self;
+        let r2 = x.v * x.v + y.v * y.v;
+        let inv = if r2 > 0.0 { 1.0 / r2 } else { 0.0 };
+        Self {
+            v: y.v.atan2(x.v),
+            g: [
+                (x.v * y.g[0] - y.v * x.g[0]) * inv,
+                (x.v * y.g[1] - y.v * x.g[1]) * inv,
+                (x.v * y.g[2] - y.v * x.g[2]) * inv,
+            ],
+        }
+    }
+    #[inline]
+    fn exp(self) -> Self {
+        let e = self.v.exp();
+        self.chain(e, e)
+    }
+    #[inline]
+    fn ln(self) -> Self {
+        self.chain(self.v.ln(), 1.0 / self.v)
+    }
+    #[inline]
+    fn tanh(self) -> Self {
+        let t = self.v.tanh();
+        self.chain(t, 1.0 - t * t)
+    }
+    #[inline]
+    fn sinh(self) -> Self {
+        self.chain(self.v.sinh(), self.v.cosh())
+    }
+    #[inline]
+    fn cosh(self) -> Self {
+        self.chain(self.v.cosh(), self.v.sinh())
+    }
+    #[inline]
+    fn asinh(self) -> Self {
+        self.chain(self.v.asinh(), 1.0 / (1.0 + self.v * self.v).sqrt())
+    }
+    #[inline]
+    fn abs(self) -> Self {
+        if self.v < 0.0 {
+            -self
+        } else {
+            self
+        }
+    }
+    #[inline]
+    fn recip(self) -> Self {
+        let inv = 1.0 / self.v;
+        self.chain(inv, -inv * inv)
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        self.v.is_finite() && self.g.iter().all(|x| x.is_finite())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    type F1 = fn(Dual3) -> Dual3;
+    type G1 = fn(f64) -> f64;
+
+    fn check(name: &str, fd: F1, ff: G1, x: f64) {
+        let d = fd(Dual3::new(x, [1.0, -2.0, 0.5]));
+        let h = 1e-6 * x.abs().max(1.0);
+        let num = (ff(x + h) - ff(x - h)) / (2.0 * h);
+        let tol = 1e-7 * num.abs().max(1.0);
+        assert!(
+            (d.v - ff(x)).abs() <= 1e-15 * ff(x).abs().max(1.0),
+            "{name} value at {x}"
+        );
+        assert!(
+            (d.g[0] - num).abs() <= tol,
+            "{name}'({x}) = {} vs fd {num}",
+            d.g[0]
+        );
+        assert!((d.g[1] + 2.0 * num).abs() <= 2.0 * tol, "{name} grad[1]");
+        assert!((d.g[2] - 0.5 * num).abs() <= tol, "{name} grad[2]");
+    }
+
+    #[test]
+    fn unary_rules_match_finite_differences() {
+        for &x in &[-2.3, -0.7, -0.1, 0.3, 0.9, 1.7, 4.2] {
+            check("sin", |d| d.sin(), f64::sin, x);
+            check("cos", |d| d.cos(), f64::cos, x);
+            check("atan", |d| d.atan(), f64::atan, x);
+            check("exp", |d| d.exp(), f64::exp, x);
+            check("tanh", |d| d.tanh(), f64::tanh, x);
+            check("sinh", |d| d.sinh(), f64::sinh, x);
+            check("cosh", |d| d.cosh(), f64::cosh, x);
+            check("asinh", |d| d.asinh(), f64::asinh, x);
+            check("recip", |d| d.recip(), |v| 1.0 / v, x);
+            check("sq", |d| d * d, |v| v * v, x);
+            check("cube/3", |d| d * d * d / 3.0, |v| v * v * v / 3.0, x);
+            check(
+                "affine",
+                |d| (d + 1.5) * 2.0 - 0.25,
+                |v| (v + 1.5) * 2.0 - 0.25,
+                x,
+            );
+            check("abs", |d| d.abs(), f64::abs, x);
+        }
+        for &x in &[0.05, 0.3, 0.9, 1.7, 4.2] {
+            check("sqrt", |d| d.sqrt(), f64::sqrt, x);
+            check("ln", |d| d.ln(), f64::ln, x);
+        }
+        for &x in &[-0.95, -0.4, 0.0, 0.3, 0.9] {
+            check("asin", |d| d.asin(), f64::asin, x);
+        }
+    }
+
+    #[test]
+    fn binary_rules_match_finite_differences() {
+        let pts = [(0.3, 1.2), (-0.7, 0.4), (2.0, -1.5), (-1.0, -0.2)];
+        for &(y, x) in &pts {
+            let dy = Dual3::variable(y, 0);
+            let dx = Dual3::variable(x, 1);
+            let h = 1e-6;
+            type B = fn(f64, f64) -> f64;
+            let fs: [(Dual3, B); 5] = [
+                (dy.atan2(dx), f64::atan2),
+                (dy / dx, |a, b| a / b),
+                (dy * dx, |a, b| a * b),
+                (dy - dx, |a, b| a - b),
+                (dy + dx, |a, b| a + b),
+            ];
+            for (d, f) in fs {
+                let gy = (f(y + h, x) - f(y - h, x)) / (2.0 * h);
+                let gx = (f(y, x + h) - f(y, x - h)) / (2.0 * h);
+                assert!((d.v - f(y, x)).abs() < 1e-15);
+                assert!((d.g[0] - gy).abs() < 1e-7 * gy.abs().max(1.0));
+                assert!((d.g[1] - gx).abs() < 1e-7 * gx.abs().max(1.0));
+                assert_eq!(d.g[2], 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn degenerate_points_stay_finite() {
+        assert_eq!(Dual3::variable(0.0, 0).sqrt(), Dual3::constant(0.0));
+        assert!(Dual3::variable(1.0, 0).asin().is_finite());
+        assert!(Dual3::variable(0.0, 0)
+            .atan2(Dual3::variable(0.0, 1))
+            .is_finite());
+        assert!(Dual3::variable(2.0, 5).g.iter().all(|&g| g == 0.0));
+    }
+}

@@ -1,0 +1,151 @@
+//! Globalised Newton from one start (the robust solver's inner loop).
+//!
+//! Newton direction p = −J(1, a)⁻¹ f(a) (paper eq. 3.1), then backtracking on the merit ‖f‖
+//! (Armijo-type sufficient decrease), with two safeguards:
+//! - a trust box on the step in parameter space (|Δa3| ≤ 4, |Δa4|, |Δa5| ≤ 40), so that one
+//!   step cannot jump across several solution branches;
+//! - a trial is rejected when det J(1, a) ≤ 0. Along a continuous path in a, a conjugate point
+//!   can only enter (0, 1] through t = 1 (the index of the second variation changes only when
+//!   det J(1, a) = 0), so the sign of det J(1, a) — free with the Jacobian — is the cheap guard
+//!   that keeps short steps inside the stable set A_stable (paper §3.1). The full test of
+//!   FINDINGS §5 is applied to the converged point by the caller.
+//!
+//! The weighted scaling a ↦ (s a3, s² a4, s² a5) maps the rod on [0, s] to the unit rod, so
+//! det J(t, a(s)) has the sign of det J(s t, a): scaling by s < t₁ (the first conjugate time)
+//! brings any a into the stable set ([`pull_into_stable`]).
+
+use super::newton::{eval, solve3, Eval};
+use super::scan;
+use crate::{PlanarParams, PlanarPose};
+
+/// Outcome of one local solve.
+pub(crate) struct Local {
+    /// Converged point and its evaluation (not yet checked by the full stability test).
+    pub found: Option<(PlanarParams, Eval)>,
+    /// Accepted Newton steps.
+    pub iterations: u32,
+    /// Evaluations of Υ and J.
+    pub evaluations: u32,
+    /// ‖f‖ at the last accepted iterate.
+    pub residual: f64,
+    /// Last accepted iterate.
+    pub last_a: PlanarParams,
+    /// Why it stopped without converging.
+    pub stop: Stop,
+}
+
+/// Why a local solve stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Stop {
+    Converged,
+    /// Start is non-finite or not in the stable set (det J(1, a0) ≤ 0).
+    BadStart,
+    Singular,
+    /// Backtracking found no acceptable step.
+    Stalled,
+    MaxIterations,
+}
+
+const MAX_DA3: f64 = 4.0;
+const MAX_DA45: f64 = 40.0;
+
+/// Runs the globalised Newton from `a0` for at most `max_iterations` accepted steps.
+pub(crate) fn solve(
+    target: &PlanarPose,
+    a0: &PlanarParams,
+    alpha: f64,
+    max_iterations: u32,
+    tolerance: f64,
+) -> Local {
+    let mut out = Local {
+        found: None,
+        iterations: 0,
+        evaluations: 1,
+        residual: f64::INFINITY,
+        last_a: *a0,
+        stop: Stop::BadStart,
+    };
+    let mut a = *a0;
+    let mut e = match eval(&a, target) {
+        Some(e) if e.jac.determinant() > 0.0 => e,
+        _ => return out,
+    };
+    out.residual = e.norm;
+    let alpha = if alpha > 0.0 && alpha <= 1.0 {
+        alpha
+    } else {
+        1.0
+    };
+    loop {
+        if e.pos_err <= tolerance && e.ang_err <= tolerance {
+            out.stop = Stop::Converged;
+            out.found = Some((a, e));
+            return out;
+        }
+        if out.iterations >= max_iterations {
+            out.stop = Stop::MaxIterations;
+            return out;
+        }
+        let p = match solve3(&e.jac, &e.f) {
+            Ok(p) => p,
+            Err(_) => {
+                out.stop = Stop::Singular;
+                return out;
+            }
+        };
+        let size = (p[0].abs() / MAX_DA3)
+            .max(p[1].abs() / MAX_DA45)
+            .max(p[2].abs() / MAX_DA45);
+        let mut lambda = if size > 1.0 { alpha / size } else { alpha };
+        let mut accepted = None;
+        for _ in 0..12 {
+            let trial = a - lambda * p;
+            out.evaluations += 1;
+            if let Some(et) = eval(&trial, target) {
+                if et.jac.determinant() > 0.0 && et.norm <= (1.0 - 1e-4 * lambda) * e.norm {
+                    accepted = Some((trial, et));
+                    break;
+                }
+                // Quadratic model of ‖f‖² along the step: φ(λ) ≈ φ0 − 2λφ0 + cλ² (the
+                // Newton direction has slope −2φ0 for φ = ‖f‖²); pick its minimiser, bounded.
+                let phi0 = e.norm * e.norm;
+                let phil = et.norm * et.norm;
+                if phil.is_finite() && et.jac.determinant() > 0.0 {
+                    let c = (phil - phi0 + 2.0 * lambda * phi0) / (lambda * lambda);
+                    let lnew = if c > 0.0 { phi0 / c } else { 0.5 * lambda };
+                    lambda = lnew.clamp(0.1 * lambda, 0.5 * lambda);
+                    continue;
+                }
+            }
+            lambda *= 0.3;
+        }
+        match accepted {
+            Some((na, ne)) => {
+                a = na;
+                e = ne;
+                out.iterations += 1;
+                out.residual = e.norm;
+                out.last_a = a;
+            }
+            None => {
+                out.stop = Stop::Stalled;
+                return out;
+            }
+        }
+    }
+}
+
+/// Brings `a` into the stable set by the weighted scaling a ↦ (s a3, s² a4, s² a5) with
+/// s = 0.9 t₁, t₁ the first conjugate time of `a` (FINDINGS §5 rule on an RK4 scan).
+/// Returns `a` unchanged when it is already stable, `None` when the scan fails.
+pub(crate) fn pull_into_stable(a: &PlanarParams) -> Option<PlanarParams> {
+    let s = scan::scan(a, scan::steps_for(a, 8.0))?;
+    match s.first_conjugate_t {
+        None if s.stable => Some(*a),
+        Some(t1) => {
+            let s = 0.9 * t1;
+            Some(PlanarParams::new(s * a[0], s * s * a[1], s * s * a[2]))
+        }
+        None => None,
+    }
+}

@@ -1,0 +1,432 @@
+//! The closed-form planar rod, generic over [`Real`] (FINDINGS §1–§3).
+//!
+//! [`Closed::new`] does everything that depends on a only (case selection, m, m1, r, phase,
+//! Landen sequence, values at Γ0 = φ); [`Closed::pose`] then costs one descending-Landen
+//! evaluation. With `T = Dual3` seeded with the identity on a, the same code yields J(t, a).
+
+use crate::elliptic::{inverse_phase, JacobiValues, Landen};
+use crate::scalar::Real;
+
+/// Which closed form applies (decided on f64 values).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Case {
+    /// λ4 > 0: κ = ε√α3 cn(√F t + φ | m), m = α3/(4F), m1 = λ4/(F α3).
+    I,
+    /// λ4 < 0: κ = ε√α3 dn((√α3/2) t + φ | m), m = 4F/α3, m1 = −4λ4/α3².
+    II,
+    /// λ4 = 0 exactly, a3 ≠ 0: κ = ε√α3 sech(√F t + φ) (separatrix).
+    III,
+    /// a4 = a5 = 0, a3 ≠ 0: circle of curvature a3.
+    Circle,
+    /// a3 = a5 = 0: straight rod (any a4).
+    Straight,
+}
+
+/// Everything that depends on a only.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Closed<T: Real> {
+    pub case: Case,
+    eps: f64,
+    pub a3: T,
+    pub a4: T,
+    pub a5: T,
+    /// a4/F, a5/F.
+    chat: T,
+    shat: T,
+    /// Γ = r t + φ.
+    r: T,
+    phi: T,
+    /// √α3 (κ = ε √α3 cn/dn/sech Γ).
+    sqa3: T,
+    /// √m (case I), or 1 − δ/2 (case III).
+    sqm: T,
+    /// m (cases I, II) ; δ = 1 − m_I (case III; value 0, carries the derivative).
+    m: T,
+    /// Coefficient of t in ∫β1: m1 − m q (I), −q (II).
+    lin: T,
+    landen: Landen<T>,
+    /// Jacobi values at Γ0 = φ (cases I, II).
+    j0: JacobiValues<T>,
+    /// θ/(2ε) at t = 0: atan2(√m sn φ, dn φ) (I), am φ (II), gd φ (III).
+    th0: T,
+    /// Case III: E(am φ) and cn φ (first order in δ).
+    e0: T,
+    /// Straight rod / circle: nothing else needed.
+    _p: (),
+}
+
+/// First-order expansion of the Jacobi functions about m = 1 in δ = 1 − m (A&S 16.15.1–4),
+/// with E(am u|m) = tanh u + (δ/2)(u − tanh u/2 − u sech² u/2). At δ = 0 these are the
+/// separatrix forms of FINDINGS §3 case III; with a dual δ (value 0) they also carry the exact
+/// first derivative across λ4 = 0. Returns (sn, cn, dn, E(am u)).
+#[inline]
+fn near_one<T: Real>(u: T, delta: T) -> (T, T, T, T) {
+    let th = u.tanh();
+    let se = u.cosh().recip();
+    let sh = u.sinh();
+    let q = delta * 0.25;
+    let sn = th + q * (th - u * se * se);
+    let cn = se - q * th * (sh - u * se);
+    let dn = se + q * th * (sh + u * se);
+    let e = th + delta * 0.5 * (u - th * 0.5 - u * se * se * 0.5);
+    (sn, cn, dn, e)
+}
+
+/// Integrals S1 = ∫₀ᵗ C, S2 = ∫₀ᵗ S1, S3 = ∫₀ᵗ S2 of the linearised straight rod
+/// δμ3'' = a4 δμ3 (C = cosh(√a4 t) or cos(√−a4 t)); series for |a4 t²| < 1.
+fn straight_integrals<T: Real>(a4: T, t: f64) -> (T, T, T) {
+    let z = a4 * (t * t);
+    if z.re().abs() < 1.0 {
+        // S1 = t Σ z^k/(2k+1)!, S2 = t² Σ z^k/(2k+2)!, S3 = t³ Σ z^k/(2k+3)!
+        let one = T::from_f64(1.0);
+        let (mut f1, mut f2, mut f3) = (T::from_f64(0.0), T::from_f64(0.0), T::from_f64(0.0));
+        let mut zk = one;
+        let mut fact = 1.0; // (2k)!
+        for k in 0..20 {
+            let kk = k as f64;
+            let c1 = 1.0 / (fact * (2.0 * kk + 1.0));
+            let c2 = c1 / (2.0 * kk + 2.0);
+            let c3 = c2 / (2.0 * kk + 3.0);
+            f1 += zk * c1;
+            f2 += zk * c2;
+            f3 += zk * c3;
+            zk *= z;
+            fact *= (2.0 * kk + 1.0) * (2.0 * kk + 2.0);
+        }
+        (f1 * t, f2 * (t * t), f3 * (t * t * t))
+    } else if a4.re() > 0.0 {
+        let w = a4.sqrt();
+        let wt = w * t;
+        let s1 = wt.sinh() / w;
+        (s1, (wt.cosh() - 1.0) / a4, (s1 - t) / a4)
+    } else {
+        let w = (-a4).sqrt();
+        let wt = w * t;
+        let s1 = wt.sin() / w;
+        (s1, (wt.cos() - 1.0) / a4, (s1 - t) / a4)
+    }
+}
+
+/// First-order force terms about the circle κ ≡ c (a4 = a5 = 0):
+/// returns (θ4, θ5, x4, x5, y4, y5) = ∂(θ, x, y)/∂(a4, a5) at the circle, by the
+/// linearisation δμ3' = δa4 sin θ0 − δa5 cos θ0, θ0 = c t. Series in τ = c t for |τ| < 1.
+fn circle_force_terms<T: Real>(c: T, t: f64) -> [T; 6] {
+    let tau = c * t;
+    let t2 = t * t;
+    let t3 = t2 * t;
+    if tau.re().abs() < 1.0 {
+        let tt = tau * tau;
+        let zero = T::from_f64(0.0);
+        let (mut a, mut b, mut x4, mut y4, mut x5, mut y5) = (zero, zero, zero, zero, zero, zero);
+        // Σ over powers τ^{2j}, j = 0..; coefficients from the Taylor series (see docs).
+        let mut p = T::from_f64(1.0); // τ^{2j}
+        let mut f = [1.0f64; 40]; // factorials
+        for i in 1..40 {
+            f[i] = f[i - 1] * i as f64;
+        }
+        for j in 0..16usize {
+            let jf = j as f64;
+            let sgn = if j % 2 == 0 { 1.0 } else { -1.0 };
+            // A/τ = Σ_{k≥1} (−1)^{k+1} τ^{2k−2}/(2k+1)!, k = j+1
+            a += p * (sgn / f[2 * j + 3]);
+            // B = Σ_{k≥1} (−1)^{k+1} τ^{2k−2}/(2k)!, k = j+1
+            b += p * (sgn / f[2 * j + 2]);
+            // X4 = Σ_{k≥2} (−1)^k [(1 + 2^{2k−1})/(2k+1)! − 1/(2k)!] τ^{2k−2}, k = j+2 → τ^{2j+2}
+            {
+                let k = jf + 2.0;
+                let kk = j + 2;
+                let cf = (1.0 + 2f64.powf(2.0 * k - 1.0)) / f[2 * kk + 1] - 1.0 / f[2 * kk];
+                x4 += p * tt * (sgn * cf);
+            }
+            // Y4/τ = Σ_{j'≥2} (−1)^{j'} (1 + 4^{j'−1} − 2j')/(2j')! τ^{2j'−4}, j' = j+2
+            {
+                let jj = j + 2;
+                let jjf = jj as f64;
+                let cf = (1.0 + 4f64.powf(jjf - 1.0) - 2.0 * jjf) / f[2 * jj];
+                y4 += p * (sgn * cf);
+            }
+            // X5/τ = Σ_{j'≥2} (−1)^{j'+1}(1 − 4^{j'−1})/(2j')! τ^{2j'−4}
+            {
+                let jj = j + 2;
+                let jjf = jj as f64;
+                let cf = -(1.0 - 4f64.powf(jjf - 1.0)) / f[2 * jj];
+                x5 += p * (sgn * cf);
+            }
+            // Y5 = Σ_{k≥1} (−1)^k (1 − 2^{2k−1})/(2k+1)! τ^{2k−2}, k = j+1
+            {
+                let kk = j + 1;
+                let cf = -(1.0 - 2f64.powf(2.0 * kk as f64 - 1.0)) / f[2 * kk + 1];
+                y5 += p * (sgn * cf);
+            }
+            p *= tt;
+        }
+        [
+            tau * a * t2,
+            -b * t2,
+            -x4 * t3,
+            x5 * tau * t3,
+            y4 * tau * t3,
+            -y5 * t3,
+        ]
+    } else {
+        let (s, co) = tau.sin_cos();
+        let s2 = (tau * 2.0).sin();
+        let tau2 = tau * tau;
+        let tau3 = tau2 * tau;
+        let a = (tau - s) / tau2;
+        let b = (-co + 1.0) / tau2;
+        let x4 = (s - tau * co - tau * 0.5 + s2 * 0.25) / tau3;
+        let y4 = (tau * s + co - 1.0 - s * s * 0.5) / tau3;
+        let x5 = (-co + 1.0 - s * s * 0.5) / tau3;
+        let y5 = (s - tau * 0.5 - s2 * 0.25) / tau3;
+        [a * t2, -b * t2, -x4 * t3, x5 * t3, y4 * t3, -y5 * t3]
+    }
+}
+
+impl<T: Real> Closed<T> {
+    /// Precomputes the closed form for a = (a3, a4, a5) (FINDINGS §2 table and phase).
+    /// Returns None when an intermediate quantity is not finite (overflow).
+    pub fn new(a3: T, a4: T, a5: T) -> Option<Self> {
+        let zero = T::from_f64(0.0);
+        let one = T::from_f64(1.0);
+        let (a3r, a4r, a5r) = (a3.re(), a4.re(), a5.re());
+        let eps = if a3r < 0.0 { -1.0 } else { 1.0 };
+        let dummy_landen = Landen::new(zero, one);
+        let dummy_j = JacobiValues {
+            sn: zero,
+            cn: one,
+            dn: one,
+            am: zero,
+            zm: zero,
+        };
+        let mut s = Self {
+            case: Case::Straight,
+            eps,
+            a3,
+            a4,
+            a5,
+            chat: one,
+            shat: zero,
+            r: zero,
+            phi: zero,
+            sqa3: zero,
+            sqm: one,
+            m: zero,
+            lin: zero,
+            landen: dummy_landen,
+            j0: dummy_j,
+            th0: zero,
+            e0: zero,
+            _p: (),
+        };
+        if a3r == 0.0 && a5r == 0.0 {
+            return Some(s);
+        }
+        if a4r == 0.0 && a5r == 0.0 {
+            s.case = Case::Circle;
+            return Some(s);
+        }
+        // F without overflow of the squares.
+        let scale = a4r.abs().max(a5r.abs());
+        let (u4, u5) = (a4 / scale, a5 / scale);
+        let f = (u4 * u4 + u5 * u5).sqrt() * scale;
+        // F ± a4 without cancellation (FINDINGS §2).
+        let (fp, fm) = if a4r >= 0.0 {
+            let fp = f + a4;
+            (fp, a5 * a5 / fp)
+        } else {
+            let fm = f - a4;
+            (a5 * a5 / fm, fm)
+        };
+        let a3s = a3 * a3;
+        let alpha3 = a3s + fp * 2.0;
+        let lambda4 = a5 * a5 - a3s * (a3s * 0.25 + a4);
+        s.chat = a4 / f;
+        s.shat = a5 / f;
+        let sqa3 = alpha3.sqrt();
+        s.sqa3 = sqa3;
+        let l4 = lambda4.re();
+        if !(f.re().is_finite() && alpha3.re().is_finite() && l4.is_finite()) {
+            return None;
+        }
+        // Phase pair (s, c) of cases I and III: cn φ = |a3|/√α3, sn φ = sgn(ε a5)√(2(F+a4)/α3).
+        let phase_i = || {
+            let c = a3 * eps / sqa3;
+            let sn = if a4r < 0.0 {
+                a5 * eps * (fm * alpha3 / 2.0).sqrt().recip()
+            } else {
+                let sg = if a5r < 0.0 { -eps } else { eps };
+                (fp * 2.0 / alpha3).sqrt() * sg
+            };
+            (sn, c)
+        };
+        if l4 > 0.0 {
+            s.case = Case::I;
+            let m = alpha3 / (f * 4.0);
+            let m1 = lambda4 / (f * alpha3);
+            let landen = Landen::new(m, m1);
+            if !landen.converged() {
+                return None;
+            }
+            let (sn, cn) = phase_i();
+            let phi = inverse_phase(sn, cn, m, m1, landen.k());
+            s.r = f.sqrt();
+            s.phi = phi;
+            s.m = m;
+            s.sqm = m.sqrt();
+            s.lin = m1 - m * landen.q();
+            s.j0 = landen.eval(phi);
+            s.th0 = (s.sqm * s.j0.sn).atan2(s.j0.dn);
+            s.landen = landen;
+        } else if l4 < 0.0 {
+            s.case = Case::II;
+            let m = f * 4.0 / alpha3;
+            let m1 = -lambda4 * 4.0 / (alpha3 * alpha3);
+            let landen = Landen::new(m, m1);
+            if !landen.converged() {
+                return None;
+            }
+            let two_f = f * 2.0;
+            let (sn, cn) = if a4r <= 0.0 {
+                (a5 * eps / (two_f * fm).sqrt(), (fm / two_f).sqrt())
+            } else {
+                ((fp / two_f).sqrt(), a5 * eps / (two_f * fp).sqrt())
+            };
+            let phi = inverse_phase(sn, cn, m, m1, landen.k());
+            s.r = sqa3 * 0.5;
+            s.phi = phi;
+            s.m = m;
+            s.lin = -landen.q();
+            s.j0 = landen.eval(phi);
+            s.th0 = s.j0.am;
+            s.landen = landen;
+        } else {
+            s.case = Case::III;
+            // δ = 1 − m_I = λ4/(F α3): value 0, derivative carried (FINDINGS §2 table).
+            let delta = lambda4 / (f * alpha3);
+            let (sn, cn) = phase_i();
+            let ratio = sn / cn;
+            let phi0 = ratio.asinh();
+            // F(ψ|1 − δ) ≈ asinh(tan ψ) − (δ/4)(tan ψ sec ψ − asinh(tan ψ)).
+            let phi = phi0 - delta * 0.25 * (ratio / cn - phi0);
+            s.r = f.sqrt();
+            s.phi = phi;
+            s.m = delta;
+            s.sqm = one - delta * 0.5;
+            let (sn0, cn0, dn0, e0) = near_one(phi, delta);
+            s.j0 = JacobiValues {
+                sn: sn0,
+                cn: cn0,
+                dn: dn0,
+                am: zero,
+                zm: zero,
+            };
+            s.th0 = (s.sqm * sn0).atan2(dn0);
+            s.e0 = e0;
+        }
+        if !(s.phi.re().is_finite() && s.r.re().is_finite()) {
+            return None;
+        }
+        Some(s)
+    }
+
+    /// A length in t over which the shape (and det J) changes appreciably: the half-period
+    /// 2K/r of cn in Γ = r t + φ (I), the period 2K/r of dn (II), π/√F (III), π/|a3|
+    /// (circle); 1 for the straight rod.
+    pub fn wavelength(&self) -> f64 {
+        let l = match self.case {
+            Case::I | Case::II => 2.0 * self.landen.k().re() / self.r.re(),
+            Case::III => std::f64::consts::PI / self.r.re(),
+            Case::Circle => std::f64::consts::PI / self.a3.re().abs(),
+            Case::Straight => 1.0,
+        };
+        if l.is_finite() && l > 0.0 {
+            l
+        } else {
+            1.0
+        }
+    }
+
+    /// Curvature κ(t) = μ3(t) (FINDINGS §2 table).
+    pub fn curvature(&self, t: f64) -> T {
+        match self.case {
+            Case::Straight => self.a3 * 0.0,
+            Case::Circle => self.a3,
+            Case::I => {
+                let j = self.landen.eval(self.r * t + self.phi);
+                self.sqa3 * j.cn * self.eps
+            }
+            Case::II => {
+                let j = self.landen.eval(self.r * t + self.phi);
+                self.sqa3 * j.dn * self.eps
+            }
+            Case::III => {
+                let (_, cn, _, _) = near_one(self.r * t + self.phi, self.m);
+                self.sqa3 * cn * self.eps
+            }
+        }
+    }
+
+    /// Pose (x, y, θ)(t) with θ unwrapped (FINDINGS §1 position formulas, §3 integrals):
+    /// x = −(a4/F)∫β1 + 2ε(a5/F)∫β2, y = −(a5/F)∫β1 − 2ε(a4/F)∫β2.
+    pub fn pose(&self, t: f64) -> [T; 3] {
+        let eps = self.eps;
+        let (ib1, ib2, half_theta) = match self.case {
+            Case::Straight => {
+                let (s1, s2, s3) = straight_integrals(self.a4, t);
+                let zero = self.a3 * 0.0;
+                if !(s1.re().is_finite() && s2.re().is_finite() && s3.re().is_finite()) {
+                    // Values are exact (θ = y = 0, x = t); only derivatives overflow.
+                    let big = T::from_f64(f64::INFINITY);
+                    let th = if T::HAS_DERIVATIVES { zero + big } else { zero };
+                    return [zero + t, th, th];
+                }
+                let th = self.a3 * s1 - self.a5 * s2;
+                let y = self.a3 * s2 - self.a5 * s3;
+                return [zero + t, y, th];
+            }
+            Case::Circle => {
+                let c = self.a3;
+                let tau = c * t;
+                let (sn, _) = tau.sin_cos();
+                let h = (tau * 0.5).sin();
+                let x = sn / c;
+                let y = h * h * 2.0 / c;
+                let th = tau;
+                if T::HAS_DERIVATIVES {
+                    let d = circle_force_terms(c, t);
+                    return [
+                        x + self.a4 * d[2] + self.a5 * d[3],
+                        y + self.a4 * d[4] + self.a5 * d[5],
+                        th + self.a4 * d[0] + self.a5 * d[1],
+                    ];
+                }
+                return [x, y, th];
+            }
+            Case::I => {
+                let j = self.landen.eval(self.r * t + self.phi);
+                let ib1 = self.lin * t + self.m * (j.zm - self.j0.zm) * 2.0 / self.r;
+                let ib2 = -self.sqm * (j.cn - self.j0.cn) / self.r;
+                let ht = (self.sqm * j.sn).atan2(j.dn) - self.th0;
+                (ib1, ib2, ht)
+            }
+            Case::II => {
+                let j = self.landen.eval(self.r * t + self.phi);
+                let ib1 = self.lin * t + (j.zm - self.j0.zm) * 2.0 / self.r;
+                let ib2 = (j.sn * j.sn - self.j0.sn * self.j0.sn) / (self.r * (j.dn + self.j0.dn));
+                (ib1, ib2, j.am - self.th0)
+            }
+            Case::III => {
+                let u = self.r * t + self.phi;
+                let (sn, cn, dn, e) = near_one(u, self.m);
+                let ib1 = (e - self.e0) * 2.0 / self.r - t;
+                let ib2 = -self.sqm * (cn - self.j0.cn) / self.r;
+                let ht = (self.sqm * sn).atan2(dn) - self.th0;
+                (ib1, ib2, ht)
+            }
+        };
+        let x = -self.chat * ib1 + self.shat * ib2 * (2.0 * eps);
+        let y = -self.shat * ib1 - self.chat * ib2 * (2.0 * eps);
+        [x, y, half_theta * (2.0 * eps)]
+    }
+}
