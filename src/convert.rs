@@ -37,7 +37,7 @@ pub enum TargetError {
         tol: f64,
     },
     /// Farther from the base than the rod is long.
-    #[error("target out of reach: {distance} m from the base, rod length {length} m")]
+    #[error("target out of reach: {distance} m from the base, must be less than the rod length {length} m")]
     OutOfReach {
         /// Base–target distance (m).
         distance: f64,
@@ -108,7 +108,8 @@ pub fn target_to_planar(pose: &Pose, params: &Params) -> Result<PlanarPose, Targ
     }
     let l = params.rod_length;
     let distance = p.x.hypot(p.y);
-    if distance > l * (1.0 + 1e-12) {
+    // At exactly L only the straight rod fits, and it is not a stable equilibrium.
+    if distance >= l {
         return Err(TargetError::OutOfReach {
             distance,
             length: l,
@@ -409,8 +410,9 @@ mod tests {
             let e = target_to_planar(&pose, &p).unwrap_err();
             assert!(e.to_string().contains(what), "{e} vs {what}");
         }
-        // Exactly at full length, straight: accepted.
-        assert!(target_to_planar(&pose(0.5, 0.0, 0.0, id), &p).is_ok());
+        // Exactly at full length: only the straight rod, unstable: rejected too.
+        assert!(target_to_planar(&pose(0.5, 0.0, 0.0, id), &p).is_err());
+        assert!(target_to_planar(&pose(0.499, 0.0, 0.0, id), &p).is_ok());
         // Tiny z within tolerance: accepted.
         assert!(target_to_planar(&pose(0.3, 0.0, 1e-9, id), &p).is_ok());
     }

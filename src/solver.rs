@@ -1,10 +1,13 @@
 //! The one place where the node calls the math crate (`rod_ig_core`).
 //!
 //! Everything the node needs from the solver goes through [`RodSolver`]: warm-started
-//! tracking of consecutive targets, one-off solves from an explicit initial guess, and the
-//! sampled shape of the solution. Units here are the solver's normalised units (unit rod
-//! length, unit bending stiffness); scaling to metres happens in [`crate::convert`].
+//! tracking of consecutive targets (`ig::Tracker`), one-off solves with per-request options
+//! (`ig::solve`), and the sampled shape of the solution (`planar::PlanarRod`). Units here are
+//! the solver's normalised units (unit rod length, unit bending stiffness); scaling to metres
+//! happens in [`crate::convert`].
 
+use rod_ig_core::ig::{self, Failure, Solution, SolveOptions, Tracker};
+use rod_ig_core::planar::PlanarRod;
 pub use rod_ig_core::{PlanarParams, PlanarPose};
 
 use crate::params::Method;
@@ -14,7 +17,7 @@ use crate::params::Method;
 pub struct SolverSettings {
     /// Robust or Newton.
     pub method: Method,
-    /// Convergence tolerance.
+    /// Convergence tolerance (normalised position error and angle error).
     pub tolerance: f64,
     /// Iteration limit.
     pub max_iterations: u32,
@@ -25,7 +28,7 @@ pub struct SolverSettings {
 pub struct Solved {
     /// Base wrench a = (a3, a4, a5).
     pub a: PlanarParams,
-    /// Tip pose reached.
+    /// Tip pose reached (θ unwrapped).
     pub tip: PlanarPose,
     /// Stable equilibrium.
     pub stable: bool,
@@ -58,10 +61,34 @@ pub struct Failed {
     pub last_a: Option<PlanarParams>,
 }
 
-/// Inverse-geometry solver with warm start (TEMPORARY placeholder: see `solve`).
+impl From<Failure> for Failed {
+    fn from(f: Failure) -> Self {
+        Self {
+            reason: f.reason.to_string(),
+            iterations: f.iterations,
+            residual: f.residual,
+            last_a: f.last_a,
+        }
+    }
+}
+
+fn options(s: &SolverSettings, initial_guess: Option<PlanarParams>) -> SolveOptions {
+    SolveOptions {
+        method: match s.method {
+            Method::Robust => ig::Method::Robust,
+            Method::Newton => ig::Method::Newton,
+        },
+        tolerance: s.tolerance,
+        max_iterations: s.max_iterations,
+        initial_guess,
+        ..SolveOptions::default()
+    }
+}
+
+/// Inverse-geometry solver with warm start.
 pub struct RodSolver {
     settings: SolverSettings,
-    previous: Option<PlanarParams>,
+    tracker: Tracker,
 }
 
 impl RodSolver {
@@ -69,8 +96,13 @@ impl RodSolver {
     pub fn new(settings: SolverSettings) -> Self {
         Self {
             settings,
-            previous: None,
+            tracker: Tracker::new(options(&settings, None)),
         }
+    }
+
+    /// Builds the solver's tables now rather than on the first target.
+    pub fn warm_up() {
+        let _ = ig::warm_up();
     }
 
     /// Current settings.
@@ -78,83 +110,64 @@ impl RodSolver {
         self.settings
     }
 
-    /// Changes the settings (keeps the warm start).
+    /// Changes the settings, keeping the warm start.
     pub fn set_settings(&mut self, settings: SolverSettings) {
         self.settings = settings;
+        self.tracker = Tracker::new(options(&settings, self.tracker.last()));
     }
 
     /// Forgets the warm start.
     pub fn reset(&mut self) {
-        self.previous = None;
+        self.tracker.reset();
     }
 
-    /// Solves for `target` (normalised), warm-starting from the previous solution and keeping
-    /// this one as the next warm start; or, with `initial_guess`, starting there with
-    /// `settings` and leaving the warm start untouched. Samples `samples` shape poses.
+    /// Solves for `target` (normalised) and samples `samples` shape poses.
+    ///
+    /// Without `initial_guess` and `one_off` settings: warm-started from the previous solution
+    /// (`ig::Tracker` for the robust method; the paper's Newton from the previous solution for
+    /// `newton`), and this solution becomes the next warm start. With either: a one-off
+    /// `ig::solve` that leaves the warm start untouched.
     pub fn solve(
         &mut self,
         target: &PlanarPose,
         initial_guess: Option<PlanarParams>,
-        settings: Option<SolverSettings>,
+        one_off: Option<SolverSettings>,
         samples: usize,
     ) -> Result<Solved, Failed> {
-        // TEMPORARY placeholder until rod_ig_core::ig lands: a cubic Hermite curve from the
-        // base to the target (not an elastica; a = 0). Replaced by ig::Tracker / ig::solve.
-        let _ = (initial_guess, settings);
-        if !target.is_finite() {
-            return Err(Failed {
-                reason: "non-finite target".into(),
-                iterations: 0,
-                residual: f64::NAN,
-                last_a: None,
-            });
-        }
-        let d = (target.x * target.x + target.y * target.y).sqrt();
-        let (p0, p1) = ((0.0, 0.0), (target.x, target.y));
-        let (m0, m1) = ((d, 0.0), (d * target.theta.cos(), d * target.theta.sin()));
-        let n = samples.max(2);
-        let shape = (0..n)
-            .map(|i| {
-                let t = i as f64 / (n - 1) as f64;
-                let (h00, h10, h01, h11) = (
-                    2.0 * t * t * t - 3.0 * t * t + 1.0,
-                    t * t * t - 2.0 * t * t + t,
-                    -2.0 * t * t * t + 3.0 * t * t,
-                    t * t * t - t * t,
-                );
-                let (d00, d10, d01, d11) = (
-                    6.0 * t * t - 6.0 * t,
-                    3.0 * t * t - 4.0 * t + 1.0,
-                    -6.0 * t * t + 6.0 * t,
-                    3.0 * t * t - 2.0 * t,
-                );
-                let x = h00 * p0.0 + h10 * m0.0 + h01 * p1.0 + h11 * m1.0;
-                let y = h00 * p0.1 + h10 * m0.1 + h01 * p1.1 + h11 * m1.1;
-                let dx = d00 * p0.0 + d10 * m0.0 + d01 * p1.0 + d11 * m1.0;
-                let dy = d00 * p0.1 + d10 * m0.1 + d01 * p1.1 + d11 * m1.1;
-                let th = if i == 0 {
-                    0.0
-                } else if i == n - 1 {
-                    target.theta
-                } else {
-                    dy.atan2(dx)
-                };
-                PlanarPose::new(x, y, th)
-            })
-            .collect::<Vec<_>>();
-        let a = PlanarParams::zeros();
-        self.previous = Some(a);
-        Ok(Solved {
-            a,
-            tip: *target,
-            stable: true,
-            stability_margin: 1.0,
-            iterations: 0,
-            position_error: 0.0,
-            orientation_error: 0.0,
-            residual: 0.0,
-            energy: 0.0,
-            shape,
-        })
+        let solution = if initial_guess.is_some() || one_off.is_some() {
+            let s = one_off.unwrap_or(self.settings);
+            ig::solve(target, &options(&s, initial_guess))?
+        } else {
+            match self.settings.method {
+                Method::Robust => self.tracker.solve(target)?,
+                Method::Newton => {
+                    let s = ig::solve(target, &options(&self.settings, self.tracker.last()))?;
+                    self.tracker = Tracker::new(options(&self.settings, Some(s.a)));
+                    s
+                }
+            }
+        };
+        with_shape(&solution, samples)
     }
+}
+
+fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
+    let rod = PlanarRod::new(&s.a).map_err(|e| Failed {
+        reason: format!("cannot evaluate the solution's shape: {e}"),
+        iterations: s.iterations,
+        residual: s.residual,
+        last_a: Some(s.a),
+    })?;
+    Ok(Solved {
+        a: s.a,
+        tip: s.tip,
+        stable: s.stable,
+        stability_margin: s.stability_margin,
+        iterations: s.iterations,
+        position_error: s.position_error,
+        orientation_error: s.orientation_error,
+        residual: s.residual,
+        energy: s.energy,
+        shape: rod.shape(samples),
+    })
 }
