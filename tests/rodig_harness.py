@@ -7,6 +7,7 @@ target/release/ in the repository, built by `cargo build --release` when missing
 """
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import random
@@ -35,19 +36,29 @@ from visualization_msgs.msg import Marker  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 _used_domains: set[int] = set()
+_seq = itertools.count(1)
+
+
+def next_seq() -> int:
+    """A fresh sequence number; targets carry it in their stamp, answers copy the stamp."""
+    return next(_seq)
+
+
+_built = False
 
 
 def binary(name: str) -> Path:
-    """Path of a release binary of the root package, built if missing."""
+    """Path of a release binary of the root package. Unless ROD_IG_NODE_BIN / ROD_IG_ECHO_BIN
+    name one, `cargo build --release` runs once per test session (a no-op when up to date)."""
+    global _built
     override = os.environ.get(f"ROD_IG_{name.upper().removeprefix('ROD_IG_')}_BIN")
     if override:
         return Path(override)
+    if not _built:
+        subprocess.run(["cargo", "build", "--release", "-p", "rod-ig-node", "--bins"], cwd=REPO, check=True)
+        _built = True
     target_dir = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
-    path = target_dir / "release" / name
-    if not path.exists():
-        subprocess.run(["cargo", "build", "--release", "-p", "rod-ig-node", "--bin", name],
-                       cwd=REPO, check=True)
-    return path
+    return target_dir / "release" / name
 
 
 def free_domain() -> int:
@@ -91,6 +102,7 @@ class NodeProcess:
         self.log_path = log_dir / f"{binary_name}-domain{domain}-{int(time.time() * 1000)}.log"
         self._log = open(self.log_path, "wb")
         env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+                   ROS_DISTRO=os.environ.get("ROS_DISTRO", "kilted"),
                    RUST_LOG=os.environ.get("RUST_LOG", "info,rustdds=error,ros2_client=warn"))
         self.proc = subprocess.Popen([str(binary(binary_name)), *(args or [])], env=env,
                                      stdout=self._log, stderr=subprocess.STDOUT)
