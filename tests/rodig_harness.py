@@ -151,7 +151,10 @@ def topic_qos(depth: int = 10) -> QoSProfile:
 class Client:
     """An rclpy node on `domain` talking to rod_ig_node; callbacks run in a background thread."""
 
-    def __init__(self, domain: int, name: str = "rod_ig_test_client", keep: int = 100_000):
+    def __init__(self, domain: int, name: str = "rod_ig_test_client", keep: int = 100_000,
+                 path_only: bool = False):
+        """path_only: subscribe to /rod/path alone (the latency benchmark), so the client's
+        executor does not spend time on /rod/solution, /rod/marker and /rosout messages."""
         self.context = Context()
         self.context.init(domain_id=domain)
         self.node = rclpy.create_node(name, context=self.context)
@@ -165,9 +168,10 @@ class Client:
         self.on_path = None
         self.pub = self.node.create_publisher(PoseStamped, "/rod/target", topic_qos())
         self.node.create_subscription(PathMsg, "/rod/path", self._path_cb, topic_qos())
-        self.node.create_subscription(RodSolution, "/rod/solution", self._solution_cb, topic_qos())
-        self.node.create_subscription(Marker, "/rod/marker", self._marker_cb, topic_qos())
-        self.node.create_subscription(Log, "/rosout", self._log_cb, topic_qos(1000))
+        if not path_only:
+            self.node.create_subscription(RodSolution, "/rod/solution", self._solution_cb, topic_qos())
+            self.node.create_subscription(Marker, "/rod/marker", self._marker_cb, topic_qos())
+            self.node.create_subscription(Log, "/rosout", self._log_cb, topic_qos(1000))
         self.solve_client = self.node.create_client(SolveRod, "/rod/solve")
         self.set_client = self.node.create_client(SetParameters, "/rod_ig_node/set_parameters")
         self.get_client = self.node.create_client(GetParameters, "/rod_ig_node/get_parameters")
@@ -225,6 +229,16 @@ class Client:
                     and self.node.count_publishers("/rod/solution") > 0
                     and self.solve_client.service_is_ready()):
                 time.sleep(0.2)  # let the matching settle on both sides
+                return True
+            time.sleep(0.02)
+        return False
+
+    def wait_connected_topics(self, timeout: float = 15.0) -> bool:
+        """Until /rod/target and /rod/path are matched both ways (no service: for the echo)."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if self.pub.get_subscription_count() > 0 and self.node.count_publishers("/rod/path") > 0:
+                time.sleep(0.2)
                 return True
             time.sleep(0.02)
         return False
