@@ -130,26 +130,50 @@ pub fn ellip_k<T: Real>(m1: T) -> T {
     carlson_rf(T::from_f64(0.0), m1, T::from_f64(1.0))
 }
 
-/// Complete integrals (K(m), E(m), D(m)) with E = K − (m/3) R_D(0, m1, 1) and
-/// D = (K − E)/m = R_D(0, m1, 1)/3 (DLMF 19.25.1).
+/// Complete integrals (K(m), E(m), D(m)), D = (K − E)/m. For m ≤ ½: K = R_F(0, m1, 1),
+/// D = R_D(0, m1, 1)/3, E = K − mD (DLMF 19.25.1). For m > ½ the cancellation-free
+/// E = m1 R_F(0, m1, 1) + (m m1/3) R_D(0, 1, m1) (DLMF 19.25.10 at φ = π/2), D = (K − E)/m.
 #[inline]
 pub fn ellip_complete<T: Real>(m: T, m1: T) -> (T, T, T) {
-    let (rf, rd) = carlson_rf_rd(T::from_f64(0.0), m1, T::from_f64(1.0));
-    let d = rd / 3.0;
-    (rf, rf - m * d, d)
+    let zero = T::from_f64(0.0);
+    let one = T::from_f64(1.0);
+    if m.re() <= 0.5 {
+        let (rf, rd) = carlson_rf_rd(zero, m1, one);
+        let d = rd / 3.0;
+        (rf, rf - m * d, d)
+    } else {
+        let (rf, rd) = carlson_rf_rd(zero, one, m1);
+        let e = m1 * rf + m * m1 * rd / 3.0;
+        (rf, e, (rf - e) / m)
+    }
 }
 
-/// Legendre integrals (F, E, D)(ψ|m) for |ψ| ≤ π/2 given s = sin ψ and c = cos ψ ≥ 0:
-/// F = s R_F(c², Δ², 1), D = s³/3 R_D(c², Δ², 1), E = F − m D, with Δ² = c² + m1 s²
-/// (DLMF 19.25.5, 19.25.9; FINDINGS §4).
+/// Legendre integrals (F, E, D)(ψ|m) for |ψ| ≤ π/2 given s = sin ψ and c = cos ψ ≥ 0, with
+/// Δ² = c² + m1 s² (FINDINGS §4). F = s R_F(c², Δ², 1) (DLMF 19.25.5). For m ≤ ½:
+/// D = s³/3 R_D(c², Δ², 1), E = F − m D (DLMF 19.25.9). For m > ½, where F − mD cancels:
+/// E = m1 s R_F + (m m1/3) s³ R_D(c², 1, Δ²) + m s c/Δ (DLMF 19.25.10), D = (F − E)/m.
 #[inline]
 pub fn legendre_sc<T: Real>(s: T, c: T, m: T, m1: T) -> (T, T, T) {
     let c2 = c * c;
     let delta2 = c2 + m1 * s * s;
-    let (rf, rd) = carlson_rf_rd(c2, delta2, T::from_f64(1.0));
-    let f = s * rf;
-    let d = s * s * s * rd / 3.0;
-    (f, f - m * d, d)
+    let one = T::from_f64(1.0);
+    if m.re() <= 0.5 {
+        let (rf, rd) = carlson_rf_rd(c2, delta2, one);
+        let f = s * rf;
+        let d = s * s * s * rd / 3.0;
+        (f, f - m * d, d)
+    } else {
+        let (rf, rd) = carlson_rf_rd(c2, one, delta2);
+        let f = s * rf;
+        let delta = delta2.sqrt();
+        let last = if delta.re() > 0.0 {
+            m * s * c / delta
+        } else {
+            m * s
+        };
+        let e = m1 * f + m * m1 * s * s * s * rd / 3.0 + last;
+        (f, e, (f - e) / m)
+    }
 }
 
 /// Splits φ = ψ + kπ with ψ ∈ [−π/2, π/2]; returns (ψ, k) with k decided on the f64 value.
@@ -241,6 +265,8 @@ pub struct Landen<T> {
     scale: T,
     /// cₙ/aₙ, n = 1..=N (index n−1).
     ca: [T; MAX_LEVELS],
+    /// 1 − cₙ/aₙ = bₙ₋₁/aₙ, n = 1..=N (index n−1), for an accurate arcsine near ±1.
+    omca: [T; MAX_LEVELS],
     /// cₙ/m, n = 1..=N (index n−1).
     dm: [T; MAX_LEVELS],
     /// K(m) = π/(2a_N).
@@ -257,6 +283,7 @@ impl<T: Real> Landen<T> {
         let zero = T::from_f64(0.0);
         let mut ca = [zero; MAX_LEVELS];
         let mut dm = [zero; MAX_LEVELS];
+        let mut omca = [zero; MAX_LEVELS];
         let b0 = m1.sqrt();
         let mut a = T::from_f64(1.0);
         let mut b = b0;
@@ -272,6 +299,7 @@ impl<T: Real> Landen<T> {
             } else {
                 m * d * d / (a_new * 4.0)
             };
+            omca[n - 1] = b / a_new;
             b = (a * b).sqrt();
             a = a_new;
             let c = m * d;
@@ -293,6 +321,7 @@ impl<T: Real> Landen<T> {
             levels,
             scale: a * pow2,
             ca,
+            omca,
             dm,
             k,
             q,
@@ -329,9 +358,21 @@ impl<T: Real> Landen<T> {
         let mut n = self.levels;
         while n > 0 {
             n -= 1;
-            let s = phi.sin();
+            let (s, co) = phi.sin_cos();
             zm += self.dm[n] * s;
-            phi = (phi + (self.ca[n] * s).asin()) * 0.5;
+            let x = self.ca[n] * s;
+            let asin_x = if x.re().abs() <= 0.5 {
+                x.asin()
+            } else {
+                // asin x = atan2(x, √((1 − |x|)(1 + |x|))) with
+                // 1 − |x| = (1 − cₙ/aₙ) + (cₙ/aₙ)(1 − |s|), 1 − |s| = cos²/(1 + |s|):
+                // no cancellation, so no loss near the separatrix (m1 → 0).
+                let sa = s.abs();
+                let one_m = self.omca[n] + self.ca[n] * co * co / (sa + 1.0);
+                let w = (one_m * (x.abs() + 1.0)).sqrt();
+                x.atan2(w)
+            };
+            phi = (phi + asin_x) * 0.5;
         }
         let (sn, cn) = phi.sin_cos();
         let dn = (self.m1 + self.m * cn * cn).sqrt();

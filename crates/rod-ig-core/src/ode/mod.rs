@@ -70,6 +70,9 @@ pub struct OdeOptions {
     pub initial_step: Option<f64>,
     /// Largest allowed step size (> 0; infinity for none).
     pub max_step: f64,
+    /// Only the first `error_components` components enter the error norm (the rest, e.g.
+    /// variational equations, ride along on the same steps); `usize::MAX` = all.
+    pub error_components: usize,
 }
 
 impl Default for OdeOptions {
@@ -80,6 +83,7 @@ impl Default for OdeOptions {
             max_steps: 100_000,
             initial_step: None,
             max_step: f64::INFINITY,
+            error_components: usize::MAX,
         }
     }
 }

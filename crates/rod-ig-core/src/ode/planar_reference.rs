@@ -86,6 +86,7 @@ fn options(rtol: f64) -> Result<OdeOptions, RodError> {
         max_steps: MAX_STEPS,
         initial_step: None,
         max_step: f64::INFINITY,
+        error_components: usize::MAX,
     })
 }
 
@@ -314,6 +315,7 @@ pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
         max_steps: MAX_STEPS,
         initial_step: None,
         max_step: f64::INFINITY,
+        error_components: usize::MAX,
     };
     let grid = stability_grid();
     let mut scan = StabilityScan::new(a);

@@ -20,7 +20,14 @@ pub enum Case {
     Circle,
     /// a3 = a5 = 0: straight rod (any a4).
     Straight,
+    /// Tiny force, m = 4F/α3 < 4e-8 (a limit of case II): the circle plus its first-order force
+    /// terms. The neglected O(F²) terms are below 1e-16; J is exact to O(m), whereas the
+    /// elliptic form's J loses ≈ 1e-16/m to cancellation in ∂(a4/F, a5/F)/∂a ~ 1/F.
+    SmallForce,
 }
+
+/// Below this m = 4F/α3, case II is replaced by [`Case::SmallForce`].
+const SMALL_FORCE_M: f64 = 4e-8;
 
 /// Everything that depends on a only.
 #[derive(Clone, Copy, Debug)]
@@ -44,6 +51,8 @@ pub(crate) struct Closed<T: Real> {
     m: T,
     /// Coefficient of t in ∫β1: m1 − m q (I), −q (II).
     lin: T,
+    /// m1 = 1 − m (cases I, II), as computed from λ4.
+    pub m1: f64,
     landen: Landen<T>,
     /// Jacobi values at Γ0 = φ (cases I, II).
     j0: JacobiValues<T>,
@@ -183,7 +192,43 @@ fn circle_force_terms<T: Real>(c: T, t: f64) -> [T; 6] {
     }
 }
 
+/// Below this m1 the dual-number derivatives lose ≈ 1e-16/m1 (relative) to cancellation
+/// between the log-singular pieces of the Landen form (K, E/K, Z and the phase all behave like
+/// ln m1 while J is analytic across the separatrix).
+pub(crate) const SEPARATRIX_M1: f64 = 1e-7;
+/// Below this m (cases I and II, above the [`Case::SmallForce`] switch) the dual-number
+/// derivatives lose ≈ 1e-16/m to cancellation in ∂(a4/F, a5/F, √α3)/∂a (near-straight rods
+/// under compression, near-circles); det J, whose x-row is then O(√m), cannot be trusted.
+pub(crate) const SMALL_M: f64 = 1e-6;
+/// Beyond max(a3², |a4|, |a5|) > 1e6 the ODE fallback is too slow (≈ √1e6 wavelengths) and the
+/// closed form's J is kept in every regime.
+const REFERENCE_MAX_SCALE: f64 = 1e6;
+/// Case III: the first-order δ terms grow like e^|Γ|; beyond this |Γ| they cancel badly.
+const SEPARATRIX_GAMMA: f64 = 8.0;
+
 impl<T: Real> Closed<T> {
+    /// True when J (and det J) from this closed form may be off by more than ≈ 1e-9 relative:
+    /// near the separatrix (0 < m1 < 1e-7, including near-straight rods under tension), small
+    /// m (1e-6 > m, near-straight rods under compression, near-circles above the small-force
+    /// switch) and case III with |Γ| > 8 somewhere on [0, 1]. Callers then take J and the
+    /// stability test from the ODE reference (FINDINGS §4: "fall back to an ODE"), unless
+    /// max(a3², |a4|, |a5|) > 1e6.
+    pub fn needs_reference(&self) -> bool {
+        let (a3, a4, a5) = (self.a3.re(), self.a4.re(), self.a5.re());
+        if (a3 * a3).max(a4.abs()).max(a5.abs()) > REFERENCE_MAX_SCALE {
+            // the ODE would need too many steps; keep the closed form's J
+            return false;
+        }
+        match self.case {
+            Case::I | Case::II => self.m1 < SEPARATRIX_M1 || self.m.re() < SMALL_M,
+            Case::III => {
+                let (p, r) = (self.phi.re(), self.r.re());
+                p.abs().max((p + r).abs()) > SEPARATRIX_GAMMA
+            }
+            _ => false,
+        }
+    }
+
     /// Precomputes the closed form for a = (a3, a4, a5) (FINDINGS §2 table and phase).
     /// Returns None when an intermediate quantity is not finite (overflow).
     pub fn new(a3: T, a4: T, a5: T) -> Option<Self> {
@@ -213,6 +258,7 @@ impl<T: Real> Closed<T> {
             sqm: one,
             m: zero,
             lin: zero,
+            m1: 1.0,
             landen: dummy_landen,
             j0: dummy_j,
             th0: zero,
@@ -273,6 +319,7 @@ impl<T: Real> Closed<T> {
             s.r = f.sqrt();
             s.phi = phi;
             s.m = m;
+            s.m1 = m1.re();
             s.sqm = m.sqrt();
             s.lin = m1 - m * landen.q();
             s.j0 = landen.eval(phi);
@@ -281,6 +328,10 @@ impl<T: Real> Closed<T> {
         } else if l4 < 0.0 {
             s.case = Case::II;
             let m = f * 4.0 / alpha3;
+            if m.re() < SMALL_FORCE_M {
+                s.case = Case::SmallForce;
+                return Some(s);
+            }
             let m1 = -lambda4 * 4.0 / (alpha3 * alpha3);
             let landen = Landen::new(m, m1);
             if !landen.converged() {
@@ -296,6 +347,7 @@ impl<T: Real> Closed<T> {
             s.r = sqa3 * 0.5;
             s.phi = phi;
             s.m = m;
+            s.m1 = m1.re();
             s.lin = -landen.q();
             s.j0 = landen.eval(phi);
             s.th0 = s.j0.am;
@@ -337,7 +389,7 @@ impl<T: Real> Closed<T> {
         let l = match self.case {
             Case::I | Case::II => 2.0 * self.landen.k().re() / self.r.re(),
             Case::III => std::f64::consts::PI / self.r.re(),
-            Case::Circle => std::f64::consts::PI / self.a3.re().abs(),
+            Case::Circle | Case::SmallForce => std::f64::consts::PI / self.a3.re().abs(),
             Case::Straight => 1.0,
         };
         if l.is_finite() && l > 0.0 {
@@ -352,6 +404,12 @@ impl<T: Real> Closed<T> {
         match self.case {
             Case::Straight => self.a3 * 0.0,
             Case::Circle => self.a3,
+            Case::SmallForce => {
+                // δμ3 = a4 (1 − cos τ)/c − a5 sin τ/c, τ = c t
+                let c = self.a3;
+                let (sn, cs) = (c * t).sin_cos();
+                c + (self.a4 * (-cs + 1.0) - self.a5 * sn) / c
+            }
             Case::I => {
                 let j = self.landen.eval(self.r * t + self.phi);
                 self.sqa3 * j.cn * self.eps
@@ -385,7 +443,7 @@ impl<T: Real> Closed<T> {
                 let y = self.a3 * s2 - self.a5 * s3;
                 return [zero + t, y, th];
             }
-            Case::Circle => {
+            Case::Circle | Case::SmallForce => {
                 let c = self.a3;
                 let tau = c * t;
                 let (sn, _) = tau.sin_cos();
@@ -393,7 +451,7 @@ impl<T: Real> Closed<T> {
                 let x = sn / c;
                 let y = h * h * 2.0 / c;
                 let th = tau;
-                if T::HAS_DERIVATIVES {
+                if T::HAS_DERIVATIVES || self.case == Case::SmallForce {
                     let d = circle_force_terms(c, t);
                     return [
                         x + self.a4 * d[2] + self.a5 * d[3],

@@ -40,7 +40,21 @@ fn seeded(a: &PlanarParams) -> Result<Closed<Dual3>, RodError> {
     .ok_or_else(overflow)
 }
 
-fn pose_and_jac_of(c: &Closed<Dual3>, t: f64) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+/// Relative tolerance of the ODE reference used for J near the separatrix.
+const REFERENCE_RTOL: f64 = 1e-12;
+
+fn pose_and_jac_of(
+    c: &Closed<Dual3>,
+    a: &PlanarParams,
+    t: f64,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    if c.needs_reference() {
+        // FINDINGS §4: fall back to the ODE where the closed form's derivatives are poor;
+        // the pose itself stays the closed form's.
+        let (_, j) = crate::ode::planar_reference::pose_and_jacobian(a, t, REFERENCE_RTOL)?;
+        let [x, y, th] = c.pose(t);
+        return Ok((PlanarPose::new(x.v, y.v, th.v), j));
+    }
     let [x, y, th] = c.pose(t);
     let pose = PlanarPose::new(x.v, y.v, th.v);
     let j = PlanarJacobian::new(
@@ -119,6 +133,7 @@ impl PlanarRod {
     }
 
     /// Elastic energy ½∫₀¹κ² = λ2/2 − a4 x(1) − a5 y(1), λ2 = a3² + 2a4 (FINDINGS §1).
+    /// May be +∞ when a3² overflows (the free function [`energy`] reports that as an error).
     pub fn energy(&self) -> f64 {
         let tip = self.tip();
         energy_from_tip(&self.a, &tip)
@@ -136,14 +151,18 @@ pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
 }
 
 /// Pose q(t, a) and J(t, a) = ∂q(t)/∂a (rows x, y, θ; columns a3, a4, a5), exact up to
-/// rounding: the closed form evaluated in forward-mode dual numbers.
+/// rounding: the closed form evaluated in forward-mode dual numbers. In the thin regimes where
+/// those derivatives lose accuracy to cancellation (1 − m < 1e-7 near the separatrix, m < 1e-6
+/// for near-straight rods under compression, see `Closed::needs_reference`), J comes from the
+/// ODE reference (variational equations, rtol 1e-12) instead (FINDINGS §4); the pose is
+/// always the closed form's.
 pub fn pose_and_jacobian(
     a: &PlanarParams,
     t: f64,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     RodError::check_finite("t", &[t])?;
     let c = seeded(a)?;
-    pose_and_jac_of(&c, t)
+    pose_and_jac_of(&c, a, t)
 }
 
 /// Tip pose q(1, a) and J(1, a) (see [`pose_and_jacobian`]).
@@ -165,7 +184,12 @@ pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
 
 /// Elastic energy ½∫₀¹κ² (FINDINGS §1 identity λ2/2 − a4 x(1) − a5 y(1)).
 pub fn energy(a: &PlanarParams) -> Result<f64, RodError> {
-    Ok(PlanarRod::new(a)?.energy())
+    let e = PlanarRod::new(a)?.energy();
+    if e.is_finite() {
+        Ok(e)
+    } else {
+        Err(overflow())
+    }
 }
 
 /// Everything `rod-ig forward` reports for one a.
@@ -184,8 +208,11 @@ pub struct Evaluation {
 /// Tip, J(1, a), energy and stability in one call (one precomputation shared by all).
 pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
     let c = seeded(a)?;
-    let (tip, jacobian) = pose_and_jac_of(&c, 1.0)?;
+    let (tip, jacobian) = pose_and_jac_of(&c, a, 1.0)?;
     let energy = energy_from_tip(a, &tip);
+    if !energy.is_finite() {
+        return Err(overflow());
+    }
     let stability = stability::stability_of(&c, a)?;
     Ok(Evaluation {
         tip,

@@ -34,16 +34,23 @@ pub(crate) fn stability_of(
             first_conjugate_t: None,
         });
     }
+    if c.needs_reference() {
+        return crate::ode::planar_reference::stability(a);
+    }
     let (a3, a5) = (a[0], a[2]);
     let g = |t: f64| normalised_det(c, a3, a5, t);
-    let h_target = (0.25 * c.wavelength()).clamp(0.01, 0.1);
-    let n = ((1.0 - T_MIN) / h_target).ceil().max(1.0) as usize;
-    let h = (1.0 - T_MIN) / n as f64;
+    let wl = c.wavelength();
+    // No conjugate point comes before a fraction of the half-wavelength, and there the
+    // closed-form det J (≈ t⁹) is swamped by rounding: start the scan at t0.
+    let t0 = (0.1 * wl).clamp(T_MIN, T_MARGIN);
+    let h_target = (0.25 * wl).clamp(0.01, 0.1);
+    let n = ((1.0 - t0) / h_target).ceil().max(1.0) as usize;
+    let h = (1.0 - t0) / n as f64;
     let mut ts = [0.0f64; 104];
     let mut gs = [0.0f64; 104];
     let np = n + 1;
     for i in 0..np {
-        let t = if i == n { 1.0 } else { T_MIN + i as f64 * h };
+        let t = if i == n { 1.0 } else { t0 + i as f64 * h };
         ts[i] = t;
         gs[i] = g(t);
         if !gs[i].is_finite() {

@@ -1,0 +1,155 @@
+//! The production formulation: the rod integrated on (q, p) only, μ recovered from the
+//! conserved world wrench, with 6-dimensional variational equations per parameter.
+//!
+//! Equilibrium (m' = m × ω + f × e1, f' = f × ω) is equivalent to the conservation of the
+//! world wrench: R f = a_f and R m + p × R f = a_m (FINDINGS3D, checked first integrals). Hence
+//! f = Rᵀ a_f, m = Rᵀ(a_m − p × a_f), and only q' = ½ q ⊗ (0, ω), p' = R e1 are integrated.
+//! Differentiating with δR = R[η_ω]×, δp = R η_v (η = q⁻¹ δq, the columns of J):
+//! δm = −η_ω × m − η_v × f + Rᵀ δa_m − Rᵀ(p × δa_f), δω = δm / c, and
+//! η' = δξ − ad_ξ η, i.e. η_ω' = δω − ω × η_ω, η_v' = −ω × η_v + η_ω × e1 (δf is not needed).
+//! State: q (w, x, y, z), p, energy, then η for a1..a6: 8 + 36 = 44 values (the literal
+//! μ-form of [`super`] needs 86).
+
+use super::{SpatialJacobian, SpatialParams, SpatialPose};
+use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+
+/// Base state size (q, p, energy).
+pub(crate) const NRB: usize = 8;
+/// Base + variational state size.
+pub(crate) const NR: usize = NRB + 36;
+/// Index of the energy quadrature.
+pub(crate) const ENERGY: usize = 7;
+
+#[inline(always)]
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Rotation matrix (row-major r[i][j] = R_ij) of the quaternion, normalised on the fly.
+#[inline(always)]
+fn rotmat(w: f64, x: f64, y: f64, z: f64) -> [[f64; 3]; 3] {
+    let n2 = w * w + x * x + y * y + z * z;
+    let s = if n2 > 0.0 { 2.0 / n2 } else { 0.0 };
+    [
+        [
+            1.0 - s * (y * y + z * z),
+            s * (x * y - w * z),
+            s * (x * z + w * y),
+        ],
+        [
+            s * (x * y + w * z),
+            1.0 - s * (x * x + z * z),
+            s * (y * z - w * x),
+        ],
+        [
+            s * (x * z - w * y),
+            s * (y * z + w * x),
+            1.0 - s * (x * x + y * y),
+        ],
+    ]
+}
+
+#[inline(always)]
+fn rt_mul(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    [
+        r[0][0] * v[0] + r[1][0] * v[1] + r[2][0] * v[2],
+        r[0][1] * v[0] + r[1][1] * v[1] + r[2][1] * v[2],
+        r[0][2] * v[0] + r[1][2] * v[1] + r[2][2] * v[2],
+    ]
+}
+
+/// Right-hand side of the reduced rod (+ variational equations when `VAR`), module docs.
+#[inline(always)]
+pub(crate) fn rhs<const N: usize, const VAR: bool>(
+    ci: &[f64; 3],
+    a: &[f64; 6],
+    s: &[f64; N],
+    ds: &mut [f64; N],
+) {
+    let (w, x, y, z) = (s[0], s[1], s[2], s[3]);
+    let p = [s[4], s[5], s[6]];
+    let r = rotmat(w, x, y, z);
+    let am = [a[0], a[1], a[2]];
+    let af = [a[3], a[4], a[5]];
+    let f = rt_mul(&r, af);
+    let pxf = cross(p, af);
+    let m = rt_mul(&r, [am[0] - pxf[0], am[1] - pxf[1], am[2] - pxf[2]]);
+    let om = [m[0] * ci[0], m[1] * ci[1], m[2] * ci[2]];
+    ds[0] = -0.5 * (x * om[0] + y * om[1] + z * om[2]);
+    ds[1] = 0.5 * (w * om[0] + y * om[2] - z * om[1]);
+    ds[2] = 0.5 * (w * om[1] + z * om[0] - x * om[2]);
+    ds[3] = 0.5 * (w * om[2] + x * om[1] - y * om[0]);
+    ds[4] = r[0][0];
+    ds[5] = r[1][0];
+    ds[6] = r[2][0];
+    ds[7] = 0.5 * (m[0] * om[0] + m[1] * om[1] + m[2] * om[2]);
+    if !VAR {
+        return;
+    }
+    for j in 0..6 {
+        let o = NRB + 6 * j;
+        let eo = [s[o], s[o + 1], s[o + 2]];
+        let ev = [s[o + 3], s[o + 4], s[o + 5]];
+        // g = Rᵀ δa_m − Rᵀ (p × δa_f) for δa = e_j.
+        let g = if j < 3 {
+            [r[j][0], r[j][1], r[j][2]]
+        } else {
+            let mut e = [0.0; 3];
+            e[j - 3] = 1.0;
+            let pe = cross(p, e);
+            let v = rt_mul(&r, pe);
+            [-v[0], -v[1], -v[2]]
+        };
+        let c1 = cross(eo, m);
+        let c2 = cross(ev, f);
+        let dw = [
+            (g[0] - c1[0] - c2[0]) * ci[0],
+            (g[1] - c1[1] - c2[1]) * ci[1],
+            (g[2] - c1[2] - c2[2]) * ci[2],
+        ];
+        let we = cross(om, eo);
+        let wv = cross(om, ev);
+        ds[o] = dw[0] - we[0];
+        ds[o + 1] = dw[1] - we[1];
+        ds[o + 2] = dw[2] - we[2];
+        // η_v' = −ω × η_v + η_ω × e1, with η_ω × e1 = (0, η_ω3, −η_ω2).
+        ds[o + 3] = -wv[0];
+        ds[o + 4] = -wv[1] + eo[2];
+        ds[o + 5] = -wv[2] - eo[1];
+    }
+}
+
+/// Initial state: q = identity, p = 0, energy 0, η = 0.
+pub(crate) fn initial<const N: usize>() -> [f64; N] {
+    let mut s = [0.0; N];
+    s[0] = 1.0;
+    s
+}
+
+pub(crate) fn params(a: &SpatialParams) -> [f64; 6] {
+    [a[0], a[1], a[2], a[3], a[4], a[5]]
+}
+
+/// Pose from a reduced state (quaternion renormalised).
+pub(crate) fn pose(s: &[f64]) -> SpatialPose {
+    let q = Quaternion::new(s[0], s[1], s[2], s[3]);
+    let n = q.norm();
+    let rotation = if n.is_finite() && n > 0.0 {
+        UnitQuaternion::new_unchecked(q / n)
+    } else {
+        UnitQuaternion::identity()
+    };
+    SpatialPose {
+        position: Vector3::new(s[4], s[5], s[6]),
+        rotation,
+    }
+}
+
+/// J from a reduced state.
+pub(crate) fn jac(s: &[f64]) -> SpatialJacobian {
+    SpatialJacobian::from_fn(|r, c| s[NRB + 6 * c + r])
+}

@@ -1,0 +1,361 @@
+//! Stability of the 3-D rod (Bretl & McCarthy 2014; rule of `FINDINGS3D.md`): the equilibrium
+//! is stable iff det J(t, a) > 0 at every t = i/2000 in [0.02, 1]. Straight rods
+//! (a2 = a3 = a5 = a6 = 0) have det ≡ 0 and are classified unstable. For exact planar-subset
+//! inputs (a1 = a2 = a6 = 0) J is block-diagonal and both 3×3 blocks must have det > 0.
+//!
+//! Fast scan: det is evaluated (dense output) on a coarse sub-grid of the rule's grid (every
+//! `coarse_stride`-th point, plus every step end); where it is ≤ 0 the rule's grid points since
+//! the last positive sample are checked one by one, and the first failing one is refined to
+//! the crossing by bisection on the dense output. With `coarse_stride = 1` this is exactly the
+//! full-grid rule.
+
+use super::reduced::{self, jac as jac_of, pose as pose_of, ENERGY, NR as NV};
+use super::{check_params, options, Evaluation3d, SpatialParams, Stiffness};
+use crate::ode::{DenseStep, Dop853};
+use crate::{RodError, StabilityReport};
+
+/// Start of the scanned range (FINDINGS3D trap 2: atol 1e-16 cannot resolve det below 0.01).
+pub const STABILITY_T_MIN: f64 = 0.02;
+/// Number of intervals of the rule's grid on [0, 1].
+pub const GRID_N: u32 = 2000;
+/// Smallest t entering the normalised margin.
+pub const MARGIN_T_MIN: f64 = 0.05;
+const GRID_START: u32 = 40; // 0.02 · 2000
+
+/// Integration and scan settings of the stability test.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StabilityOptions {
+    /// Relative tolerance of the integration.
+    pub rtol: f64,
+    /// Absolute tolerance (FINDINGS3D trap 1: 1e-16, not 1e-30).
+    pub atol: f64,
+    /// Coarse sampling stride in grid points (1 = every i/2000; 40 = every 0.02).
+    pub coarse_stride: u32,
+}
+
+impl Default for StabilityOptions {
+    /// Reference accuracy: rtol 1e-12, atol 1e-16, coarse stride 20 (every 0.01).
+    fn default() -> Self {
+        Self {
+            rtol: 1e-12,
+            atol: 1e-16,
+            coarse_stride: 20,
+        }
+    }
+}
+
+impl StabilityOptions {
+    /// Solver accuracy: rtol 1e-8, atol 1e-12, coarse stride 20.
+    pub fn production() -> Self {
+        Self {
+            rtol: 1e-8,
+            atol: 1e-12,
+            coarse_stride: 20,
+        }
+    }
+    /// The full-grid rule at reference accuracy (stride 1).
+    pub fn full_grid() -> Self {
+        Self {
+            coarse_stride: 1,
+            ..Self::default()
+        }
+    }
+}
+
+/// Leading small-t term of det J for c = 1 (FINDINGS3D, fitted):
+/// (a2² + a3²) t¹⁴/103680, or (a5² + a6²) t¹⁶/403200 when a2 = a3 = 0.
+pub fn det_leading_term(a: &SpatialParams, t: f64) -> f64 {
+    let b = a[1] * a[1] + a[2] * a[2];
+    if b > 0.0 {
+        b * t.powi(14) / 103680.0
+    } else {
+        (a[4] * a[4] + a[5] * a[5]) * t.powi(16) / 403200.0
+    }
+}
+
+fn is_straight(a: &SpatialParams) -> bool {
+    a[1] == 0.0 && a[2] == 0.0 && a[4] == 0.0 && a[5] == 0.0
+}
+
+fn is_planar_subset(a: &SpatialParams) -> bool {
+    a[0] == 0.0 && a[1] == 0.0 && a[5] == 0.0
+}
+
+fn det3(j: &super::SpatialJacobian, rows: [usize; 3], cols: [usize; 3]) -> f64 {
+    let m = nalgebra::Matrix3::from_fn(|r, c| j[(rows[r], cols[c])]);
+    m.determinant()
+}
+
+/// (sign function g, full det): g > 0 ⇔ the sample passes the rule.
+fn sample(planar: bool, s: &[f64]) -> (f64, f64) {
+    let j = jac_of(s);
+    if planar {
+        let din = det3(&j, [2, 3, 4], [2, 3, 4]);
+        let dout = det3(&j, [0, 1, 5], [0, 1, 5]);
+        (din.min(dout), din * dout)
+    } else {
+        let d = j.determinant();
+        (d, d)
+    }
+}
+
+struct Scan {
+    a: SpatialParams,
+    planar: bool,
+    stride: u32,
+    next_coarse: u32,
+    last_pos: f64,
+    margin: f64,
+    failed: Option<f64>,
+    nonfinite: bool,
+}
+
+impl Scan {
+    fn grid_t(i: u32) -> f64 {
+        i as f64 / GRID_N as f64
+    }
+
+    fn note_margin(&mut self, t: f64, det: f64) {
+        if t >= MARGIN_T_MIN - 1e-12 {
+            let lead = det_leading_term(&self.a, t);
+            if lead > 0.0 {
+                self.margin = self.margin.min(det / lead);
+            }
+        }
+    }
+
+    /// Checks grid points in (last_pos, t_bad] one by one; on failure refines the crossing.
+    fn refine(&mut self, d: &DenseStep<NV>, t_bad: f64) {
+        let lo_i = ((self.last_pos * GRID_N as f64).floor() as u32 + 1).max(GRID_START);
+        let mut prev_t = self.last_pos;
+        let mut i = lo_i;
+        while i <= GRID_N {
+            let t = Self::grid_t(i);
+            if t > t_bad + 1e-15 {
+                break;
+            }
+            let s = d.eval(t);
+            let (g, det) = sample(self.planar, &s);
+            if !g.is_finite() {
+                self.nonfinite = true;
+                return;
+            }
+            if g <= 0.0 {
+                // Bisection for the crossing on (prev_t, t].
+                let (mut lo, mut hi) = (prev_t.max(STABILITY_T_MIN.min(t)), t);
+                if lo < hi {
+                    for _ in 0..40 {
+                        let mid = 0.5 * (lo + hi);
+                        let (gm, _) = sample(self.planar, &d.eval(mid));
+                        if gm > 0.0 {
+                            lo = mid;
+                        } else {
+                            hi = mid;
+                        }
+                        if hi - lo < 1e-10 {
+                            break;
+                        }
+                    }
+                }
+                self.failed = Some(hi);
+                let lead = det_leading_term(&self.a, t);
+                let m = if lead > 0.0 { -(det / lead).abs() } else { 0.0 };
+                self.margin = self.margin.min(m).min(0.0);
+                return;
+            }
+            self.note_margin(t, det);
+            prev_t = t;
+            i += 1;
+        }
+        // The excursion lies between grid points: the rule still holds.
+        self.last_pos = t_bad;
+    }
+
+    /// Processes the accepted step (t0, t1] with its dense output.
+    fn step(&mut self, d: &DenseStep<NV>, t1: f64, y1: &[f64; NV]) {
+        if self.failed.is_some() || self.nonfinite || t1 < STABILITY_T_MIN {
+            return;
+        }
+        // Coarse grid points inside the step, then the step end.
+        loop {
+            if self.next_coarse > GRID_N {
+                break;
+            }
+            let t = Self::grid_t(self.next_coarse);
+            if t > t1 {
+                break;
+            }
+            self.next_coarse = if self.next_coarse == GRID_N {
+                GRID_N + 1
+            } else {
+                (self.next_coarse + self.stride).min(GRID_N)
+            };
+            let s = if t == t1 { *y1 } else { d.eval(t) };
+            if !self.check(d, t, &s) {
+                return;
+            }
+        }
+        if self.last_pos < t1 {
+            self.check(d, t1, y1);
+        }
+    }
+
+    /// Returns false when the scan is over (failure or non-finite).
+    fn check(&mut self, d: &DenseStep<NV>, t: f64, s: &[f64; NV]) -> bool {
+        let (g, det) = sample(self.planar, s);
+        if !g.is_finite() {
+            self.nonfinite = true;
+            return false;
+        }
+        if g > 0.0 {
+            self.note_margin(t, det);
+            self.last_pos = t;
+            true
+        } else {
+            self.refine(d, t);
+            self.failed.is_none() && !self.nonfinite
+        }
+    }
+
+    fn report(&self) -> StabilityReport {
+        StabilityReport {
+            stable: self.failed.is_none(),
+            margin: if self.margin.is_finite() {
+                self.margin
+            } else {
+                0.0
+            },
+            first_conjugate_t: self.failed,
+        }
+    }
+}
+
+fn straight_report() -> StabilityReport {
+    StabilityReport {
+        stable: false,
+        margin: 0.0,
+        first_conjugate_t: None,
+    }
+}
+
+/// Integrates rod + variational equations once with dense output, scanning det J on the way.
+/// With `early_exit`, stops as soon as the verdict is "unstable" (final state then None).
+fn run(
+    a: &SpatialParams,
+    k: &Stiffness,
+    opts: &StabilityOptions,
+    early_exit: bool,
+) -> Result<(Option<[f64; NV]>, StabilityReport), RodError> {
+    check_params(a, k)?;
+    if !(opts.rtol.is_finite() && opts.rtol > 0.0 && opts.atol.is_finite() && opts.atol >= 0.0) {
+        return Err(RodError::OutOfDomain("invalid stability tolerances".into()));
+    }
+    let ci = [1.0 / k.c1, 1.0 / k.c2, 1.0 / k.c3];
+    let ap = reduced::params(a);
+    let mut f =
+        |_: f64, s: &[f64; NV], ds: &mut [f64; NV]| reduced::rhs::<NV, true>(&ci, &ap, s, ds);
+    let straight = is_straight(a);
+    if straight && early_exit {
+        return Ok((None, straight_report()));
+    }
+    let mut st = Dop853::new(
+        &mut f,
+        0.0,
+        reduced::initial::<NV>(),
+        1.0,
+        &options(opts.rtol, opts.atol),
+        !straight,
+    )?;
+    let mut scan = Scan {
+        a: *a,
+        planar: is_planar_subset(a),
+        stride: opts.coarse_stride.clamp(1, GRID_N),
+        next_coarse: GRID_START,
+        last_pos: STABILITY_T_MIN - 0.5 / GRID_N as f64,
+        margin: f64::INFINITY,
+        failed: None,
+        nonfinite: false,
+    };
+    while !st.finished() {
+        st.step(&mut f)?;
+        if !straight {
+            let t1 = st.t();
+            let y1 = *st.y();
+            if let Some(d) = st.dense() {
+                scan.step(d, t1, &y1);
+            }
+            if scan.nonfinite {
+                return Err(RodError::Overflow("non-finite Jacobian".into()));
+            }
+            if early_exit && scan.failed.is_some() {
+                return Ok((None, scan.report()));
+            }
+        }
+    }
+    let y = *st.y();
+    if y.iter().any(|v| !v.is_finite()) {
+        return Err(RodError::Overflow("non-finite rod state".into()));
+    }
+    let report = if straight {
+        straight_report()
+    } else {
+        scan.report()
+    };
+    Ok((Some(y), report))
+}
+
+/// Stability verdict by the FINDINGS3D rule, fast scan at reference accuracy
+/// ([`StabilityOptions::default`]: rtol 1e-12, atol 1e-16, coarse stride 0.01 with refinement).
+/// The margin is min over scanned t ≥ 0.05 of det J(t) / leading term ([`det_leading_term`];
+/// a weak margin, FINDINGS3D), ≤ 0 when unstable.
+pub fn stability(a: &SpatialParams, k: &Stiffness) -> Result<StabilityReport, RodError> {
+    stability_with(a, k, &StabilityOptions::default())
+}
+
+/// Stability verdict with explicit options; stops integrating at the first failure.
+pub fn stability_with(
+    a: &SpatialParams,
+    k: &Stiffness,
+    opts: &StabilityOptions,
+) -> Result<StabilityReport, RodError> {
+    Ok(run(a, k, opts, true)?.1)
+}
+
+/// The FINDINGS3D rule checked at every t = i/2000 in [0.02, 1] (reference; slower).
+pub fn stability_full_grid(a: &SpatialParams, k: &Stiffness) -> Result<StabilityReport, RodError> {
+    stability_with(a, k, &StabilityOptions::full_grid())
+}
+
+/// One integration with the stability scan stopping at the first failure: `Some(evaluation)`
+/// when stable, `None` (with the report) when unstable.
+pub(crate) fn evaluate_if_stable(
+    a: &SpatialParams,
+    k: &Stiffness,
+    opts: &StabilityOptions,
+) -> Result<(Option<Evaluation3d>, StabilityReport), RodError> {
+    let (y, stability) = run(a, k, opts, true)?;
+    Ok((
+        y.map(|y| Evaluation3d {
+            tip: pose_of(&y),
+            jacobian: jac_of(&y),
+            energy: y[ENERGY],
+            stability,
+        }),
+        stability,
+    ))
+}
+
+pub(super) fn evaluate_impl(
+    a: &SpatialParams,
+    k: &Stiffness,
+    opts: &StabilityOptions,
+) -> Result<Evaluation3d, RodError> {
+    let (y, stability) = run(a, k, opts, false)?;
+    let y = y.ok_or_else(|| RodError::Integration("no final state".into()))?;
+    Ok(Evaluation3d {
+        tip: pose_of(&y),
+        jacobian: jac_of(&y),
+        energy: y[ENERGY],
+        stability,
+    })
+}
