@@ -41,6 +41,6 @@ pytest_rc=${PIPESTATUS[0]}
 [ "$pytest_rc" = 0 ] || { echo "pytest FAILED (full log: $LOGS/pytest.log; node logs in $LOGS)"; status=1; }
 
 echo "== summary"
-grep -E '^test result:' "$LOGS/cargo-test.log" | awk '{p+=$4; f+=$6} END {printf "cargo test: %d passed, %d failed\n", p, f}'
+grep -E '^test result:' "$LOGS/cargo-test.log" | awk '{p+=$4; f+=$6} END {printf "cargo: %d passed, %d failed\n", p, f}'
 tail -n 1 "$LOGS/pytest.log"
 exit $status
