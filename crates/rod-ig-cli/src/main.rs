@@ -1,4 +1,216 @@
-fn main() {
-    eprintln!("rod-ig: being written");
-    std::process::exit(2);
+//! `rod-ig`: the command-line face of rod-ig-core. JSON lines in, JSON lines out; benchmarks;
+//! SVG pictures. A thin adapter: every number comes from the solver crate.
+
+mod bench;
+mod jsonl;
+mod planar_cmds;
+mod svg;
+mod timing;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use std::io::{self, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Planar Kirchhoff elastic rods held by two grippers: shape, sensitivity, stability and
+/// inverse geometry (unit rod, unit stiffness, base at the identity).
+#[derive(Parser)]
+#[command(name = "rod-ig", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Forward map. Reads JSON lines {"a": [a3, a4, a5]} on stdin; writes one line each:
+    /// {"tip": {"x", "y", "theta"}, "jacobian": [[dx/da3, dx/da4, dx/da5], [dy/..], [dθ/..]],
+    /// "stable", "energy", "stability_margin"}. theta is unwrapped (∫κ). A line that cannot be
+    /// parsed or evaluated gets {"error": "why"}; the stream goes on.
+    Forward,
+    /// Inverse geometry. Reads JSON lines {"target": {"x", "y", "theta"}, "a0"?: [..],
+    /// "method"?: "robust"|"newton", "alpha"?, "max_iterations"?, "tolerance"?,
+    /// "objective"?: "first"|"least_energy", "all"?: bool}; writes one line each:
+    /// {"success", "a", "tip", "stable", "iterations", "residual", "energy", "position_error",
+    /// "orientation_error", "stability_margin", "reason" (on failure), "solutions" (with all)}.
+    Solve,
+    /// Samples or draws rods: given parameters (--a, repeatable) or a target pose (--target:
+    /// every distinct stable solution found). JSON lines of poses, or an SVG picture.
+    Shape {
+        /// Rod parameters "a3,a4,a5" (repeat to draw several rods).
+        #[arg(long = "a", allow_hyphen_values = true)]
+        params: Vec<String>,
+        /// Target tip pose "x,y,theta": draw every stable solution found for it.
+        #[arg(long, allow_hyphen_values = true)]
+        target: Option<String>,
+        /// Number of samples from base to tip (≥ 2).
+        #[arg(long, default_value_t = 100)]
+        samples: usize,
+        /// Output format (default: svg when --output ends in .svg, else json).
+        #[arg(long, value_enum)]
+        format: Option<Format>,
+        /// Write to this file instead of stdout.
+        #[arg(long, short)]
+        output: Option<PathBuf>,
+    },
+    /// Measures every speed figure in one run: forward map, J, stability, shape against the
+    /// paper's RK4 baseline (dt = 1e-4); the paper's Table 1 protocol for Newton; the robust
+    /// solver and tracking.
+    Bench {
+        /// Fewer rounds and samples (a smoke run, not for quoting).
+        #[arg(long)]
+        quick: bool,
+        /// Inverse-geometry cases for the Table 1 protocol (JSON lines, as in the oracle).
+        #[arg(long, default_value = "../shared/oracle/ig_public.jsonl")]
+        ig_cases: PathBuf,
+        /// Which parts to run.
+        #[arg(long, value_enum, default_value = "all")]
+        only: BenchPart,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+enum BenchPart {
+    All,
+    Forward,
+    Ig,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq)]
+enum Format {
+    Json,
+    Svg,
+}
+
+fn parse_triple(text: &str, what: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "{what} needs three comma-separated numbers, got {text:?}"
+        ));
+    }
+    let mut out = [0.0f64; 3];
+    for (slot, part) in out.iter_mut().zip(&parts) {
+        *slot = part
+            .parse()
+            .map_err(|_| format!("{what}: {part:?} is not a number"))?;
+        if !slot.is_finite() {
+            return Err(format!("{what}: {part:?} is not finite"));
+        }
+    }
+    Ok(out)
+}
+
+fn shape_command(
+    params: &[String],
+    target: Option<&str>,
+    samples: usize,
+    format: Option<Format>,
+    output: Option<&PathBuf>,
+) -> Result<(), String> {
+    let mut rods = Vec::new();
+    for text in params {
+        let a = parse_triple(text, "--a")?;
+        rods.push((a, planar_cmds::sample_shape(a, samples)?));
+    }
+    let mut title = String::from("rod-ig: planar Kirchhoff rods");
+    if let Some(text) = target {
+        let [x, y, theta] = parse_triple(text, "--target")?;
+        title = format!("Stable rods reaching x = {x}, y = {y}, θ = {theta}");
+        for a in planar_cmds::all_stable_solutions(x, y, theta)? {
+            rods.push((a, planar_cmds::sample_shape(a, samples)?));
+        }
+    }
+    if rods.is_empty() {
+        return Err("give --a a3,a4,a5 (repeatable) or --target x,y,theta".to_string());
+    }
+    let format = format.unwrap_or(match output {
+        Some(p) if p.extension().is_some_and(|e| e == "svg") => Format::Svg,
+        _ => Format::Json,
+    });
+    let text = match format {
+        Format::Json => rods
+            .iter()
+            .map(|(a, poses)| serde_json::json!({ "a": a, "poses": poses }).to_string() + "\n")
+            .collect::<String>(),
+        Format::Svg => {
+            let drawn: Vec<svg::DrawnRod> = rods
+                .into_iter()
+                .map(|(a, poses)| planar_cmds::drawn_rod(a, poses))
+                .collect();
+            svg::draw(&drawn, &title)
+        }
+    };
+    match output {
+        Some(path) => std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display())),
+        None => io::stdout()
+            .write_all(text.as_bytes())
+            .map_err(|e| e.to_string()),
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let stdin = io::stdin().lock();
+    let stdout = io::stdout().lock();
+    let result = match cli.command {
+        Command::Forward => {
+            jsonl::run(stdin, stdout, planar_cmds::forward_line).map_err(|e| e.to_string())
+        }
+        Command::Solve => {
+            jsonl::run(stdin, stdout, planar_cmds::solve_line).map_err(|e| e.to_string())
+        }
+        Command::Shape {
+            params,
+            target,
+            samples,
+            format,
+            output,
+        } => shape_command(&params, target.as_deref(), samples, format, output.as_ref()),
+        Command::Bench {
+            quick,
+            ig_cases,
+            only,
+        } => {
+            if matches!(only, BenchPart::All | BenchPart::Forward) {
+                bench::planar_forward(quick);
+            }
+            if matches!(only, BenchPart::All | BenchPart::Ig) {
+                bench::inverse_geometry(quick, &ig_cases);
+            }
+            Ok(())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        // A closed pipe (e.g. `| head`) is not an error worth a message.
+        Err(e) if e.contains("Broken pipe") => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("rod-ig: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triples_parse_and_reject() {
+        assert_eq!(parse_triple("1, -2,3e1", "x").unwrap(), [1.0, -2.0, 30.0]);
+        assert!(parse_triple("1,2", "x").is_err());
+        assert!(parse_triple("1,b,3", "x")
+            .unwrap_err()
+            .contains("not a number"));
+        assert!(parse_triple("1,inf,3", "x")
+            .unwrap_err()
+            .contains("not finite"));
+    }
+
+    #[test]
+    fn cli_definition_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
+    }
 }

@@ -19,11 +19,15 @@ use crate::scalar::Real;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Maximum number of Landen (AGM) levels. The AGM started at b0 = √m1 converges in ≤ 12 levels
-/// for every positive f64 m1; the cap only guards against m1 = 0 or NaN.
-pub const MAX_LEVELS: usize = 24;
+/// for every positive f64 m1 (b0 ≥ 2e-162: ~8 levels to reach b ~ a, 5 more to converge);
+/// the cap only guards against m1 = 0 or NaN.
+pub const MAX_LEVELS: usize = 16;
 
-/// Relative tolerance on c_N / a_N that ends the descending AGM.
-const AGM_TOL: f64 = 1.0e-18;
+/// The descending AGM stops at the first level N with c_N/a_N ≤ 1e-9 and
+/// c_N²/(4 a_N² m) ≤ 1e-17 (the next term of Z/m): the neglected arcsine term is then
+/// ≈ (c_N/a_N)²/4 ≤ 2.5e-19 and the neglected Z/m term ≤ 1e-17.
+const AGM_TOL: f64 = 1.0e-9;
+const ZETA_TOL: f64 = 1.0e-17;
 
 /// Deviation tolerance of the Carlson duplication (the 5th-order series then has relative
 /// truncation error below 1e-17 for both R_F and R_D).
@@ -43,7 +47,8 @@ pub fn carlson_rf<T: Real>(x: T, y: T, z: T) -> T {
             .abs()
             .max((m - y.re()).abs())
             .max((m - z.re()).abs());
-        if !(dev > CARLSON_TOL * m.abs()) {
+        // written so that NaN also ends the loop
+        if dev.partial_cmp(&(CARLSON_TOL * m.abs())) != Some(std::cmp::Ordering::Greater) {
             break;
         }
         let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
@@ -237,6 +242,40 @@ pub fn inverse_phase<T: Real>(s: T, c: T, m: T, m1: T, kk: T) -> T {
     }
 }
 
+/// The phase inverse of [`inverse_phase`] together with the Jacobi zeta function at the phase,
+/// divided by m: returns (φ, Z(φ|m)/m) with φ = F(ψ|m), ψ = atan2(s, c) ∈ (−π, π).
+///
+/// `kk` = K(m), `dk` = D(m)/K(m). With Z(φ) = E(ψ) − (E/K)φ and E = F − mD:
+/// * |ψ| ≤ π/4: Z/m = φ D(m)/K − D(ψ), D(ψ) = s³/3 R_D(c², Δ², 1);
+/// * otherwise, with the complementary amplitude χ (F(ψ) + F(χ) = K, sin χ = c/Δ) and
+///   Legendre's relation E(ψ) + E(χ) = E(m) + m sin ψ sin χ:
+///   Z/m = sgn(s)[|s| c/Δ + D(χ) − F(χ) D(m)/K], F(χ) = c R_F(m1s², m1, Δ²),
+///   D(χ) = c³/3 R_D(m1s², m1, Δ²).
+///
+/// This replaces a Jacobi evaluation at u = φ (one Carlson pair instead of a Landen descent).
+#[inline]
+pub fn inverse_phase_zeta<T: Real>(s: T, c: T, m1: T, kk: T, dk: T) -> (T, T) {
+    let c2 = c * c;
+    let ms2 = m1 * s * s;
+    let delta2 = c2 + ms2;
+    if c.re() >= s.re().abs() {
+        let (rf, rd) = carlson_rf_rd(c2, delta2, T::from_f64(1.0));
+        let phi = s * rf;
+        let d = s * s * s * rd / 3.0;
+        (phi, phi * dk - d)
+    } else {
+        let (rf, rd) = carlson_rf_rd(ms2, m1, delta2);
+        let f_chi = c * rf;
+        let d_chi = c * c2 * rd / 3.0;
+        let g = s.abs() * c / delta2.sqrt() + d_chi - f_chi * dk;
+        if s.re() < 0.0 {
+            (f_chi - kk, -g)
+        } else {
+            (kk - f_chi, g)
+        }
+    }
+}
+
 /// Values of the Jacobi functions at one argument u, from [`Landen::eval`].
 #[derive(Clone, Copy, Debug)]
 pub struct JacobiValues<T> {
@@ -308,8 +347,9 @@ impl<T: Real> Landen<T> {
             pow2 *= 2.0;
             q += m * d * d * pow2;
             levels = n;
-            let (cr, ar) = (c.re(), a.re());
-            if cr.abs() <= AGM_TOL * ar.abs() {
+            let (cr, ar, mr) = (c.re(), a.re(), m.re());
+            let ratio = cr.abs() / ar.abs();
+            if ratio <= AGM_TOL && ratio * cr.abs() <= 4.0 * ZETA_TOL * ar.abs() * mr.abs() {
                 converged = ar.is_finite() && ar > 0.0;
                 break;
             }
@@ -344,6 +384,11 @@ impl<T: Real> Landen<T> {
         self.q
     }
 
+    /// D(m)/K(m) = (1 + q)/2 (A&S 17.6.4), D = (K − E)/m.
+    pub fn d_over_k(&self) -> T {
+        (self.q + 1.0) * 0.5
+    }
+
     /// E(m)/K(m) = 1 − m D/K = m1 − m q/2... computed as 1 − m(1 + q)/2.
     pub fn e_over_k(&self) -> T {
         T::from_f64(1.0) - self.m * (self.q + 1.0) * 0.5
@@ -358,12 +403,19 @@ impl<T: Real> Landen<T> {
         let mut n = self.levels;
         while n > 0 {
             n -= 1;
-            let (s, co) = phi.sin_cos();
+            // one sincos for dual numbers (their sin needs the cosine anyway); plain sin for f64
+            let (s, co) = if T::HAS_DERIVATIVES {
+                let (s, c) = phi.sin_cos();
+                (s, Some(c))
+            } else {
+                (phi.sin(), None)
+            };
             zm += self.dm[n] * s;
             let x = self.ca[n] * s;
             let asin_x = if x.re().abs() <= 0.5 {
                 x.asin()
             } else {
+                let co = co.unwrap_or_else(|| phi.cos());
                 // asin x = atan2(x, √((1 − |x|)(1 + |x|))) with
                 // 1 − |x| = (1 − cₙ/aₙ) + (cₙ/aₙ)(1 − |s|), 1 − |s| = cos²/(1 + |s|):
                 // no cancellation, so no loss near the separatrix (m1 → 0).

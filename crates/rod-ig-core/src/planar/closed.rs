@@ -4,7 +4,7 @@
 //! Landen sequence, values at Γ0 = φ); [`Closed::pose`] then costs one descending-Landen
 //! evaluation. With `T = Dual3` seeded with the identity on a, the same code yields J(t, a).
 
-use crate::elliptic::{inverse_phase, JacobiValues, Landen};
+use crate::elliptic::{inverse_phase_zeta, JacobiValues, Landen};
 use crate::scalar::Real;
 
 /// Which closed form applies (decided on f64 values).
@@ -315,15 +315,22 @@ impl<T: Real> Closed<T> {
                 return None;
             }
             let (sn, cn) = phase_i();
-            let phi = inverse_phase(sn, cn, m, m1, landen.k());
+            let (phi, zm0) = inverse_phase_zeta(sn, cn, m1, landen.k(), landen.d_over_k());
             s.r = f.sqrt();
             s.phi = phi;
             s.m = m;
             s.m1 = m1.re();
             s.sqm = m.sqrt();
             s.lin = m1 - m * landen.q();
-            s.j0 = landen.eval(phi);
-            s.th0 = (s.sqm * s.j0.sn).atan2(s.j0.dn);
+            let dn = (m1 + m * cn * cn).sqrt();
+            s.j0 = JacobiValues {
+                sn,
+                cn,
+                dn,
+                am: sn.atan2(cn),
+                zm: zm0,
+            };
+            s.th0 = (s.sqm * sn).atan2(dn);
             s.landen = landen;
         } else if l4 < 0.0 {
             s.case = Case::II;
@@ -343,14 +350,23 @@ impl<T: Real> Closed<T> {
             } else {
                 ((fp / two_f).sqrt(), a5 * eps / (two_f * fp).sqrt())
             };
-            let phi = inverse_phase(sn, cn, m, m1, landen.k());
+            let (phi, zm0) = inverse_phase_zeta(sn, cn, m1, landen.k(), landen.d_over_k());
             s.r = sqa3 * 0.5;
             s.phi = phi;
             s.m = m;
             s.m1 = m1.re();
             s.lin = -landen.q();
-            s.j0 = landen.eval(phi);
-            s.th0 = s.j0.am;
+            let dn = (m1 + m * cn * cn).sqrt();
+            // φ ∈ (−2K, 2K) ⇒ am φ = atan2(sn, cn) ∈ (−π, π)
+            let am = sn.atan2(cn);
+            s.j0 = JacobiValues {
+                sn,
+                cn,
+                dn,
+                am,
+                zm: zm0,
+            };
+            s.th0 = am;
             s.landen = landen;
         } else {
             s.case = Case::III;
@@ -376,7 +392,13 @@ impl<T: Real> Closed<T> {
             s.th0 = (s.sqm * sn0).atan2(dn0);
             s.e0 = e0;
         }
-        if !(s.phi.re().is_finite() && s.r.re().is_finite()) {
+        let fields = [
+            s.phi, s.r, s.sqa3, s.chat, s.shat, s.lin, s.sqm, s.th0, s.e0, s.j0.sn, s.j0.cn,
+            s.j0.dn, s.j0.zm,
+        ];
+        if !fields.iter().all(|v| v.re().is_finite())
+            || s.r.re().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        {
             return None;
         }
         Some(s)
@@ -428,6 +450,11 @@ impl<T: Real> Closed<T> {
     /// Pose (x, y, θ)(t) with θ unwrapped (FINDINGS §1 position formulas, §3 integrals):
     /// x = −(a4/F)∫β1 + 2ε(a5/F)∫β2, y = −(a5/F)∫β1 − 2ε(a4/F)∫β2.
     pub fn pose(&self, t: f64) -> [T; 3] {
+        if t == 0.0 {
+            // the base is clamped at the identity: q(0) = 0 and J(0) = 0 exactly
+            let zero = T::from_f64(0.0);
+            return [zero, zero, zero];
+        }
         let eps = self.eps;
         let (ib1, ib2, half_theta) = match self.case {
             Case::Straight => {

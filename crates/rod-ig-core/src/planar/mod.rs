@@ -81,11 +81,7 @@ impl PlanarRod {
     pub fn new(a: &PlanarParams) -> Result<Self, RodError> {
         check_params(a)?;
         let closed = Closed::new(a[0], a[1], a[2]).ok_or_else(overflow)?;
-        let rod = Self { a: *a, closed };
-        if !rod.tip().is_finite() {
-            return Err(overflow());
-        }
-        Ok(rod)
+        Ok(Self { a: *a, closed })
     }
 
     /// The parameters a = μ(0) this rod was built from.
@@ -147,7 +143,12 @@ fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
 
 /// Tip pose q(1, a) by the closed form (FINDINGS §1–§3).
 pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
-    Ok(PlanarRod::new(a)?.tip())
+    let q = PlanarRod::new(a)?.tip();
+    if q.is_finite() {
+        Ok(q)
+    } else {
+        Err(overflow())
+    }
 }
 
 /// Pose q(t, a) and J(t, a) = ∂q(t)/∂a (rows x, y, θ; columns a3, a4, a5), exact up to

@@ -46,12 +46,32 @@ pub(crate) fn stability_of(
     let h_target = (0.25 * wl).clamp(0.01, 0.1);
     let n = ((1.0 - t0) / h_target).ceil().max(1.0) as usize;
     let h = (1.0 - t0) / n as f64;
-    let mut ts = [0.0f64; 104];
-    let mut gs = [0.0f64; 104];
-    let np = n + 1;
+    let mut ts = [0.0f64; 112];
+    let mut gs = [0.0f64; 112];
+    let mut np = n + 1;
+    for (i, t) in ts.iter_mut().enumerate().take(np) {
+        *t = if i == n { 1.0 } else { t0 + i as f64 * h };
+    }
+    // The normalisation t⁹(a3²/8640 + a5²t²/33600) changes regime at t* = √(33600/8640)|a3/a5|,
+    // where g often has a narrow dip: sample around it too (for the margin).
+    if a5 != 0.0 {
+        let ts_star = (33600.0f64 / 8640.0).sqrt() * (a3 / a5).abs();
+        for f in [0.7, 1.0, 1.4] {
+            let t = ts_star * f;
+            if t > t0 && t < 1.0 && np < ts.len() {
+                // insert keeping ts sorted
+                let mut k = np;
+                while k > 0 && ts[k - 1] > t {
+                    ts[k] = ts[k - 1];
+                    k -= 1;
+                }
+                ts[k] = t;
+                np += 1;
+            }
+        }
+    }
     for i in 0..np {
-        let t = if i == n { 1.0 } else { t0 + i as f64 * h };
-        ts[i] = t;
+        let t = ts[i];
         gs[i] = g(t);
         if !gs[i].is_finite() {
             return Err(RodError::Overflow(
@@ -80,8 +100,16 @@ pub(crate) fn stability_of(
             margin = margin.min(gs[i]);
         }
     }
+    // Refine the coarse minima that matter: those low enough to hide a dip below zero or to
+    // be the global minimum (only the global one once a sign change is known).
+    let coarse_min = margin;
+    let cutoff = if first.is_some() {
+        coarse_min
+    } else {
+        2.0 * coarse_min.max(0.0) + 0.05
+    };
     for i in 1..np.saturating_sub(1) {
-        if gs[i] <= gs[i - 1] && gs[i] <= gs[i + 1] && ts[i - 1] >= T_MARGIN - h {
+        if gs[i] <= gs[i - 1] && gs[i] <= gs[i + 1] && ts[i + 1] >= T_MARGIN && gs[i] <= cutoff {
             let (tm, gm) = refine_min(&g, ts[i - 1], ts[i], ts[i + 1], gs[i - 1], gs[i], gs[i + 1]);
             if tm >= T_MARGIN {
                 margin = margin.min(gm);
@@ -115,8 +143,8 @@ pub(crate) fn stability_of(
 fn regula_falsi(g: &impl Fn(f64) -> f64, t0: f64, g0: f64, t1: f64, g1: f64) -> f64 {
     let (mut lo, mut glo, mut hi, mut ghi) = (t0, g0, t1, g1);
     let mut side = 0i8;
-    for _ in 0..40 {
-        if hi - lo <= 1e-12 {
+    for _ in 0..24 {
+        if hi - lo <= 1e-7 {
             break;
         }
         let mut t = (lo * ghi - hi * glo) / (ghi - glo);
@@ -158,7 +186,10 @@ fn refine_min(
 ) -> (f64, f64) {
     let (mut a, mut b, mut c) = (t0, t1, t2);
     let (mut fa, mut fb, mut fc) = (g0, g1, g2);
-    for _ in 0..3 {
+    for _ in 0..6 {
+        if c - a < 1e-4 {
+            break;
+        }
         let p = (b - a) * (b - a) * (fb - fc) - (b - c) * (b - c) * (fb - fa);
         let q = (b - a) * (fb - fc) - (b - c) * (fb - fa);
         if q == 0.0 {

@@ -1,0 +1,256 @@
+//! `rod-ig bench`: every speed figure of the README, measured in one run on this machine.
+
+use crate::timing::{measure, Timing};
+use rod_ig_core::ig::bench::{self as ig_bench, IgCase, ParamBox, SplitMix64};
+use rod_ig_core::ig::SolveOptions;
+use rod_ig_core::ode::planar_reference as reference;
+use rod_ig_core::{planar, PlanarParams};
+use std::path::Path;
+
+/// The paper's fixed RK4 step (the baseline of its speed claim).
+pub const RK4_STEP: f64 = 1e-4;
+
+/// Random parameters in the public test box a3 ∈ [−10, 10], a4, a5 ∈ [−100, 100] (FINDINGS §7).
+pub fn sample_box(n: usize, seed: u64) -> Vec<PlanarParams> {
+    let mut rng = SplitMix64::new(seed);
+    (0..n)
+        .map(|_| {
+            PlanarParams::new(
+                rng.range(-10.0, 10.0),
+                rng.range(-100.0, 100.0),
+                rng.range(-100.0, 100.0),
+            )
+        })
+        .collect()
+}
+
+fn row(name: &str, closed: Timing, rk4: Option<Timing>, goal: &str) {
+    let (rk4_text, ratio) = match rk4 {
+        Some(r) => (
+            format!("{:>12.0}", r.median_ns),
+            format!("{:>9.0}×", r.median_ns / closed.median_ns),
+        ),
+        None => (format!("{:>12}", "—"), format!("{:>10}", "—")),
+    };
+    println!(
+        "{name:<28} {:>10.0} {:>10.0} {rk4_text} {ratio}   {goal}",
+        closed.median_ns, closed.mean_ns
+    );
+}
+
+/// Forward map, Jacobian, stability and shape: closed form against the paper's RK4 baseline.
+pub fn planar_forward(quick: bool) {
+    let (n, rounds, rk4_n, rk4_rounds) = if quick {
+        (128, 5, 4, 3)
+    } else {
+        (512, 21, 16, 5)
+    };
+    let inputs = sample_box(n, 1);
+    let rk4_inputs = &inputs[..rk4_n];
+    println!("## Planar forward map (box a3 ∈ [−10, 10], a4, a5 ∈ [−100, 100]; {n} parameter sets, {rounds} rounds; single thread)");
+    println!(
+        "{:<28} {:>10} {:>10} {:>12} {:>10}   goal",
+        "ns per call", "median", "mean", "RK4 median", "ratio"
+    );
+    let tip = measure(&inputs, rounds, |a| planar::tip(a).map(|p| p.x));
+    let rk4_tip = measure(rk4_inputs, rk4_rounds, |a| {
+        reference::rk4_tip(a, RK4_STEP).map(|p| p.x)
+    });
+    row(
+        "forward q(1)",
+        tip,
+        Some(rk4_tip),
+        "≤ 200 ns, ratio ≥ 1000×",
+    );
+    let tj = measure(&inputs, rounds, |a| {
+        planar::tip_and_jacobian(a).map(|(_, j)| j[(0, 0)])
+    });
+    let rk4_tj = measure(rk4_inputs, rk4_rounds, |a| {
+        reference::rk4_tip_and_jacobian(a, RK4_STEP).map(|(_, j)| j[(0, 0)])
+    });
+    row("forward + J(1)", tj, Some(rk4_tj), "≤ 500 ns");
+    let st = measure(&inputs, rounds, |a| planar::stability(a).map(|s| s.stable));
+    let rk4_st = measure(rk4_inputs, rk4_rounds, |a| {
+        reference::rk4_stability(a, RK4_STEP).map(|s| s.stable)
+    });
+    row("stability test", st, Some(rk4_st), "≤ 10 µs");
+    let shape = measure(&inputs, rounds, |a| {
+        planar::PlanarRod::new(a).map(|rod| rod.shape(100).len())
+    });
+    // RK4 visits every t on its 1e-4 grid anyway: 100 samples cost what the tip costs.
+    row(
+        "shape, 100 samples",
+        shape,
+        Some(rk4_tip),
+        "≈ 100 elliptic evaluations",
+    );
+    let energy = measure(&inputs, rounds, |a| planar::energy(a));
+    row("elastic energy", energy, None, "");
+    println!();
+}
+
+/// The paper's Table 1 (α, success %, µs per solve, iterations), for comparison.
+const PAPER_TABLE1: [(f64, f64, f64, f64); 6] = [
+    (1.0, 81.5, 71.2, 8.1),
+    (0.9, 86.9, 92.2, 10.6),
+    (0.7, 92.8, 130.7, 14.9),
+    (0.5, 95.7, 197.9, 22.8),
+    (0.3, 97.3, 361.7, 41.6),
+    (0.2, 97.4, 564.8, 64.9),
+];
+/// The independent reference of FINDINGS §8 on ig_public.jsonl (success %, iterations).
+const FINDINGS_TABLE1: [(f64, f64); 6] = [
+    (34.7, 7.6),
+    (38.4, 9.8),
+    (46.9, 14.7),
+    (56.2, 23.1),
+    (65.6, 42.0),
+    (60.9, 65.2),
+];
+
+/// Reads inverse-geometry cases (`shared/oracle/ig_public.jsonl` format).
+pub fn read_cases(path: &Path) -> Result<Vec<IgCase>, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    text.lines()
+        .filter(|l| !l.trim().is_empty())
+        .enumerate()
+        .map(|(i, l)| {
+            serde_json::from_str(l).map_err(|e| format!("{}:{}: {e}", path.display(), i + 1))
+        })
+        .collect()
+}
+
+fn robust_row(r: &ig_bench::RobustRow) {
+    println!(
+        "{:<72} {:>6} {:>8.2} {:>9.1} {:>8.2} {:>6} {:>9.2} {:>9.2}",
+        r.label,
+        r.runs,
+        r.success_pct,
+        r.verified_pct,
+        r.mean_iterations,
+        r.max_iterations,
+        r.median_us,
+        r.mean_us
+    );
+    for (target, why) in r.failures.iter().take(5) {
+        println!(
+            "    failed: x = {:.6}, y = {:.6}, θ = {:.6}: {why}",
+            target.x, target.y, target.theta
+        );
+    }
+}
+
+/// Table 1 of the paper (Newton at fixed α) on `cases`, then the robust solver and tracking.
+pub fn inverse_geometry(quick: bool, cases_path: &Path) {
+    let options = SolveOptions::default();
+    match read_cases(cases_path) {
+        Ok(cases) => {
+            let runs: usize = cases.iter().map(|c| c.a0_list.len()).sum();
+            println!(
+                "## Inverse geometry: the paper's Newton (Table 1 protocol) on {} ({} targets, {runs} solves per α, ≤ 100 iterations, tolerance 1e-6)",
+                cases_path.display(),
+                cases.len()
+            );
+            println!(
+                "{:>5} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>8} {:>9}",
+                "α",
+                "success%",
+                "unstable%",
+                "max-it%",
+                "singular%",
+                "iter",
+                "median µs",
+                "mean µs",
+                "ref succ%",
+                "ref iter",
+                "paper s%",
+                "paper it",
+                "paper µs"
+            );
+            let alphas: Vec<f64> = PAPER_TABLE1.iter().map(|r| r.0).collect();
+            let rows = ig_bench::table1(&cases, &alphas, 100, 1e-6);
+            for ((row, paper), reference) in rows.iter().zip(PAPER_TABLE1).zip(FINDINGS_TABLE1) {
+                println!(
+                    "{:>5.1} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>8.1} {:>9.2} {:>9.2} | {:>9.1} {:>9.1} | {:>9.1} {:>8.1} {:>9.1}",
+                    row.alpha, row.success_pct, row.instability_pct, row.max_iterations_pct,
+                    row.singular_pct, row.mean_iterations, row.median_us, row.mean_us,
+                    reference.0, reference.1, paper.1, paper.3, paper.2
+                );
+            }
+            println!("(ref = the independent reference of FINDINGS §8 on this file; paper = its Table 1, on its own unstated box and test)");
+            println!();
+            println!(
+                "{:<72} {:>6} {:>8} {:>9} {:>8} {:>6} {:>9} {:>9}",
+                "## Robust solver",
+                "runs",
+                "success%",
+                "verified%",
+                "iter",
+                "max it",
+                "median µs",
+                "mean µs"
+            );
+            robust_row(&ig_bench::robust_from_starts(&cases, &options));
+            robust_row(&ig_bench::robust_no_start(&cases, &options));
+        }
+        Err(e) => {
+            println!("## Inverse geometry: Table 1 skipped ({e}); pass --ig-cases FILE");
+            println!(
+                "{:<72} {:>6} {:>8} {:>9} {:>8} {:>6} {:>9} {:>9}",
+                "## Robust solver",
+                "runs",
+                "success%",
+                "verified%",
+                "iter",
+                "max it",
+                "median µs",
+                "mean µs"
+            );
+        }
+    }
+    let n = if quick { 200 } else { 2000 };
+    robust_row(&ig_bench::robust_random(n, 7, ParamBox::PAPER, &options));
+    robust_row(&ig_bench::robust_random(n, 8, ParamBox::PUBLIC, &options));
+    println!(
+        "(verified% = solutions re-checked independently: forward map within tolerance and stable)"
+    );
+    println!();
+    println!(
+        "{:<60} {:>6} {:>8} {:>9} {:>10} {:>6} {:>9} {:>9}",
+        "## Tracking (warm start from the previous solution)",
+        "steps",
+        "success%",
+        "verified%",
+        "iter/step",
+        "max it",
+        "median µs",
+        "mean µs"
+    );
+    let steps = if quick { 200 } else { 1000 };
+    let paths = [
+        (
+            "ellipse x = 0.5 + 0.2 cos φ, y = 0.3 sin φ, θ = 0.5 sin φ".to_string(),
+            ig_bench::ellipse_path(0.5, 0.2, 0.3, 0.0, 0.5, steps),
+        ),
+        (
+            "tips of a straight path of stable rods".to_string(),
+            ig_bench::random_stable_path(11, ParamBox::PAPER, steps, 2e-3),
+        ),
+    ];
+    for (label, path) in paths {
+        let t = ig_bench::tracking(&label, &path, &options);
+        println!(
+            "{:<60} {:>6} {:>8.2} {:>9.1} {:>10.2} {:>6} {:>9.2} {:>9.2}",
+            t.label,
+            t.steps,
+            t.success_pct,
+            t.verified_pct,
+            t.mean_iterations,
+            t.max_iterations,
+            t.median_us,
+            t.mean_us
+        );
+    }
+    println!("(goals: robust ≥ 99.9 % success, every success stable, median ≤ 10 µs; tracking ≤ 3 iterations per step)");
+    println!();
+}

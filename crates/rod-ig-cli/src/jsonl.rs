@@ -1,0 +1,89 @@
+//! The JSON-lines loop shared by every streaming subcommand: one answer line per input line,
+//! in order; a line that cannot be handled gets `{"error": "why"}` and the stream goes on.
+
+use serde::Serialize;
+use serde_json::Value;
+use std::io::{BufRead, Write};
+
+/// Reads `input` line by line, answers each with `handle`, and writes one JSON line per input
+/// line to `output`, flushing after each so that a client can drive the tool interactively.
+pub fn run<R: BufRead, W: Write>(
+    mut input: R,
+    mut output: W,
+    mut handle: impl FnMut(&str) -> Result<Value, String>,
+) -> std::io::Result<()> {
+    let mut raw = Vec::new();
+    loop {
+        raw.clear();
+        if input.read_until(b'\n', &mut raw)? == 0 {
+            return Ok(());
+        }
+        let answer = match std::str::from_utf8(&raw) {
+            Err(e) => error_value(format!("line is not UTF-8: {e}")),
+            Ok(line) if line.trim().is_empty() => error_value("empty line".to_string()),
+            Ok(line) => handle(line.trim()).unwrap_or_else(error_value),
+        };
+        serde_json::to_writer(&mut output, &answer)?;
+        output.write_all(b"\n")?;
+        output.flush()?;
+    }
+}
+
+/// `{"error": message}`.
+pub fn error_value(message: String) -> Value {
+    serde_json::json!({ "error": message })
+}
+
+/// Parses one request line into `T`, with serde's message (field, column) on failure.
+pub fn parse<T: serde::de::DeserializeOwned>(line: &str) -> Result<T, String> {
+    serde_json::from_str(line).map_err(|e| format!("malformed request: {e}"))
+}
+
+/// Serialises an answer; non-finite floats become `null` (JSON has no NaN).
+pub fn to_value<T: Serialize>(answer: &T) -> Result<Value, String> {
+    serde_json::to_value(answer).map_err(|e| format!("cannot encode answer: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn answers(input: &str) -> Vec<Value> {
+        let mut out = Vec::new();
+        run(input.as_bytes(), &mut out, |line| {
+            let v: Value = parse(line)?;
+            Ok(serde_json::json!({ "echo": v }))
+        })
+        .expect("in-memory I/O");
+        String::from_utf8(out)
+            .expect("utf8")
+            .lines()
+            .map(|l| serde_json::from_str(l).expect("valid JSON out"))
+            .collect()
+    }
+
+    #[test]
+    fn one_answer_per_line_and_errors_do_not_stop_the_stream() {
+        let out = answers("{\"a\":1}\nnot json\n\n{\"b\":2}\n");
+        assert_eq!(out.len(), 4);
+        assert_eq!(out[0]["echo"]["a"], 1);
+        assert!(out[1]["error"].as_str().unwrap().contains("malformed"));
+        assert_eq!(out[2]["error"], "empty line");
+        assert_eq!(out[3]["echo"]["b"], 2);
+    }
+
+    #[test]
+    fn last_line_without_newline_is_answered() {
+        assert_eq!(answers("{\"a\":1}").len(), 1);
+    }
+
+    #[test]
+    fn invalid_utf8_is_an_error_line() {
+        let mut out = Vec::new();
+        run(&b"\xff\xfe\n{}\n"[..], &mut out, |_| Ok(Value::Null)).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 2);
+        assert!(lines[0].contains("UTF-8"));
+    }
+}

@@ -1,0 +1,234 @@
+//! `rod-ig forward`, `rod-ig solve` and `rod-ig shape`: JSON in, JSON out, no math here.
+
+use crate::jsonl;
+use rod_ig_core::ig::{self, Method, Objective, SolveOptions};
+use rod_ig_core::{planar, PlanarParams, PlanarPose};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// One `rod-ig forward` request.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ForwardRequest {
+    a: [f64; 3],
+}
+
+/// One `rod-ig forward` answer (the CLI contract of issue #2, plus the stability margin).
+#[derive(Serialize)]
+struct ForwardAnswer {
+    tip: PlanarPose,
+    /// Rows x, y, θ; columns a3, a4, a5.
+    jacobian: [[f64; 3]; 3],
+    stable: bool,
+    energy: f64,
+    stability_margin: f64,
+}
+
+fn rows(j: &rod_ig_core::PlanarJacobian) -> [[f64; 3]; 3] {
+    std::array::from_fn(|r| std::array::from_fn(|c| j[(r, c)]))
+}
+
+/// Answers one `forward` line.
+pub fn forward_line(line: &str) -> Result<Value, String> {
+    let request: ForwardRequest = jsonl::parse(line)?;
+    let a = PlanarParams::from(request.a);
+    let e = planar::evaluate(&a).map_err(|e| e.to_string())?;
+    jsonl::to_value(&ForwardAnswer {
+        tip: e.tip,
+        jacobian: rows(&e.jacobian),
+        stable: e.stability.stable,
+        energy: e.energy,
+        stability_margin: e.stability.margin,
+    })
+}
+
+/// Solver choice as spelled in requests.
+#[derive(Deserialize, Clone, Copy, Default)]
+#[serde(rename_all = "snake_case")]
+enum MethodName {
+    #[default]
+    Robust,
+    Newton,
+}
+
+/// Objective as spelled in requests.
+#[derive(Deserialize, Clone, Copy, Default)]
+#[serde(rename_all = "snake_case")]
+enum ObjectiveName {
+    #[default]
+    First,
+    LeastEnergy,
+}
+
+/// One `rod-ig solve` request.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SolveRequest {
+    target: PlanarPose,
+    a0: Option<[f64; 3]>,
+    #[serde(default)]
+    method: MethodName,
+    alpha: Option<f64>,
+    max_iterations: Option<u32>,
+    tolerance: Option<f64>,
+    #[serde(default)]
+    objective: ObjectiveName,
+    /// When true, also list every distinct stable solution found (`solutions`).
+    #[serde(default)]
+    all: bool,
+}
+
+/// One solution as printed by `solve` (the CLI contract of issue #3, plus error split and margin).
+#[derive(Serialize)]
+struct SolveAnswer {
+    success: bool,
+    a: Option<[f64; 3]>,
+    tip: Option<PlanarPose>,
+    stable: bool,
+    iterations: u32,
+    residual: f64,
+    energy: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    position_error: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    orientation_error: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    stability_margin: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    solutions: Option<Vec<SolveAnswer>>,
+}
+
+impl SolveAnswer {
+    fn from_solution(s: &ig::Solution) -> Self {
+        SolveAnswer {
+            success: true,
+            a: Some([s.a[0], s.a[1], s.a[2]]),
+            tip: Some(s.tip),
+            stable: s.stable,
+            iterations: s.iterations,
+            residual: s.residual,
+            energy: Some(s.energy),
+            position_error: Some(s.position_error),
+            orientation_error: Some(s.orientation_error),
+            stability_margin: Some(s.stability_margin),
+            reason: None,
+            solutions: None,
+        }
+    }
+
+    fn from_failure(f: &ig::Failure) -> Self {
+        SolveAnswer {
+            success: false,
+            a: None,
+            tip: None,
+            stable: false,
+            iterations: f.iterations,
+            residual: f.residual,
+            energy: None,
+            position_error: None,
+            orientation_error: None,
+            stability_margin: None,
+            reason: Some(f.reason.to_string()),
+            solutions: None,
+        }
+    }
+}
+
+fn options(request: &SolveRequest) -> Result<SolveOptions, String> {
+    let mut options = SolveOptions::default();
+    options.method = match request.method {
+        MethodName::Robust => Method::Robust,
+        MethodName::Newton => Method::Newton,
+    };
+    options.objective = match request.objective {
+        ObjectiveName::First => Objective::FirstFound,
+        ObjectiveName::LeastEnergy => Objective::LeastEnergy,
+    };
+    if let Some(alpha) = request.alpha {
+        if !(alpha.is_finite() && alpha > 0.0 && alpha <= 1.0) {
+            return Err(format!("alpha must be in (0, 1], got {alpha}"));
+        }
+        options.alpha = alpha;
+    }
+    if let Some(n) = request.max_iterations {
+        options.max_iterations = n;
+    }
+    if let Some(tol) = request.tolerance {
+        if !(tol.is_finite() && tol > 0.0) {
+            return Err(format!("tolerance must be positive and finite, got {tol}"));
+        }
+        options.tolerance = tol;
+    }
+    if let Some(a0) = request.a0 {
+        options.initial_guess = Some(PlanarParams::from(a0));
+    }
+    if matches!(options.method, Method::Newton) && options.initial_guess.is_none() {
+        return Err("method \"newton\" needs an initial guess \"a0\"".to_string());
+    }
+    Ok(options)
+}
+
+/// Answers one `solve` line.
+pub fn solve_line(line: &str) -> Result<Value, String> {
+    let request: SolveRequest = jsonl::parse(line)?;
+    let options = options(&request)?;
+    let mut answer = match ig::solve(&request.target, &options) {
+        Ok(s) => SolveAnswer::from_solution(&s),
+        Err(f) => SolveAnswer::from_failure(&f),
+    };
+    if request.all {
+        let all = ig::solve_all(&request.target, &options);
+        answer.solutions = Some(all.iter().map(SolveAnswer::from_solution).collect());
+    }
+    jsonl::to_value(&answer)
+}
+
+/// Samples the rod `a` at `samples` points from the base to the tip.
+pub fn sample_shape(a: [f64; 3], samples: usize) -> Result<Vec<PlanarPose>, String> {
+    if samples < 2 {
+        return Err("at least 2 samples are needed".to_string());
+    }
+    let rod = planar::PlanarRod::new(&PlanarParams::from(a)).map_err(|e| e.to_string())?;
+    Ok(rod.shape(samples))
+}
+
+/// Every distinct stable solution found for the target (x, y, θ), least energy first.
+pub fn all_stable_solutions(x: f64, y: f64, theta: f64) -> Result<Vec<[f64; 3]>, String> {
+    let target = PlanarPose::new(x, y, theta);
+    let mut found = ig::solve_all(&target, &SolveOptions::default());
+    if found.is_empty() {
+        return match ig::solve(&target, &SolveOptions::default()) {
+            Ok(s) => Ok(vec![[s.a[0], s.a[1], s.a[2]]]),
+            Err(f) => Err(format!("no stable rod reaches the target: {}", f.reason)),
+        };
+    }
+    found.sort_by(|p, q| p.energy.total_cmp(&q.energy));
+    Ok(found.iter().map(|s| [s.a[0], s.a[1], s.a[2]]).collect())
+}
+
+/// A rod ready to draw, labelled with its parameters, energy and stability.
+pub fn drawn_rod(a: [f64; 3], poses: Vec<PlanarPose>) -> crate::svg::DrawnRod {
+    let params = PlanarParams::from(a);
+    let (energy, stable) = match planar::evaluate(&params) {
+        Ok(e) => (e.energy, e.stability.stable),
+        Err(_) => (f64::NAN, false),
+    };
+    crate::svg::DrawnRod {
+        poses,
+        label: format!(
+            "a = ({:.3}, {:.3}, {:.3})   energy {:.3}   {}",
+            a[0],
+            a[1],
+            a[2],
+            energy,
+            if stable {
+                "stable"
+            } else {
+                "unstable (dashed)"
+            }
+        ),
+        dashed: !stable,
+    }
+}

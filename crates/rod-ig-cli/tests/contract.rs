@@ -1,0 +1,113 @@
+//! The CLI contracts of issues #2 and #3, checked on the built binary: field names, one answer
+//! per line in order, errors that do not stop the stream.
+
+use serde_json::Value;
+use std::io::Write;
+use std::process::{Command, Stdio};
+
+fn run(args: &[&str], stdin: &str) -> Vec<Value> {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("rod-ig starts");
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(stdin.as_bytes())
+        .expect("write stdin");
+    let out = child.wait_with_output().expect("rod-ig exits");
+    assert!(out.status.success(), "exit status {:?}", out.status);
+    String::from_utf8(out.stdout)
+        .expect("UTF-8 output")
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("each output line is JSON"))
+        .collect()
+}
+
+#[test]
+fn forward_contract() {
+    // An oracle line (cases_public.jsonl #2): tip [θ, x, y] and J rows θ, x, y there.
+    let out = run(
+        &["forward"],
+        "{\"a\": [8.972988942744877, -37.63370959790291, -15.33471020548487]}\n{\"a\": [1, 2]}\nnot json\n{\"a\": [0, 0, 0]}\n",
+    );
+    assert_eq!(out.len(), 4);
+    let first = &out[0];
+    assert!((first["tip"]["x"].as_f64().unwrap() - 0.3224172897011997).abs() < 1e-11);
+    assert!((first["tip"]["y"].as_f64().unwrap() - 0.2921048196081635).abs() < 1e-11);
+    assert!((first["tip"]["theta"].as_f64().unwrap() + 1.1432055279122757).abs() < 1e-11);
+    let jac = first["jacobian"].as_array().unwrap();
+    assert_eq!(jac.len(), 3);
+    // Row θ of the oracle is the third row here.
+    assert!((jac[2][0].as_f64().unwrap() + 0.34773503102031716).abs() < 1e-8);
+    assert!((jac[0][1].as_f64().unwrap() + 0.0196286100843422).abs() < 1e-8);
+    assert_eq!(first["stable"], true);
+    assert!((first["energy"].as_f64().unwrap() - 19.23665709368305).abs() < 1e-9);
+    assert!(out[1]["error"].as_str().unwrap().contains("length 3"));
+    assert!(out[2]["error"].is_string());
+    // Straight rod: singular J, classified unstable (FINDINGS §5).
+    assert_eq!(out[3]["stable"], false);
+    assert_eq!(out[3]["tip"]["x"], 1.0);
+}
+
+#[test]
+fn solve_contract() {
+    let target =
+        "{\"x\": 0.3134187265422321, \"y\": -0.587006393473652, \"theta\": -2.1624511539781346}";
+    let input = format!(
+        "{{\"target\": {target}}}\n\
+         {{\"target\": {target}, \"method\": \"newton\", \"alpha\": 1.0, \"a0\": [-5.4, -39.9, 74.7], \"max_iterations\": 100, \"tolerance\": 1e-8}}\n\
+         {{\"target\": {{\"x\": 1.5, \"y\": 0, \"theta\": 0}}}}\n\
+         {{\"target\": {target}, \"method\": \"nope\"}}\n\
+         {{\"target\": {target}, \"alpah\": 1}}\n"
+    );
+    let out = run(&["solve"], &input);
+    assert_eq!(out.len(), 5);
+    for answer in &out[..2] {
+        assert_eq!(answer["success"], true, "{answer}");
+        assert_eq!(answer["stable"], true);
+        for key in ["a", "tip", "iterations", "residual", "energy"] {
+            assert!(!answer[key].is_null(), "{key} missing in {answer}");
+        }
+        let tip = &answer["tip"];
+        assert!((tip["x"].as_f64().unwrap() - 0.3134187265422321).abs() < 1e-6);
+        assert!((tip["y"].as_f64().unwrap() + 0.587006393473652).abs() < 1e-6);
+    }
+    assert_eq!(out[2]["success"], false);
+    assert!(out[2]["a"].is_null());
+    assert!(out[2]["reason"].as_str().unwrap().contains("unreachable"));
+    assert!(out[3]["error"]
+        .as_str()
+        .unwrap()
+        .contains("unknown variant"));
+    assert!(out[4]["error"].as_str().unwrap().contains("unknown field"));
+}
+
+#[test]
+fn shape_svg_and_json() {
+    let dir = std::env::temp_dir().join(format!("rod-ig-cli-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("rod.svg");
+    let status = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
+        .args(["shape", "--a", "1,-5,3", "--a", "-2,10,-20", "-o"])
+        .arg(&svg)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert_eq!(text.matches("<polyline").count(), 2);
+    let out = run(&["shape", "--a", "1,-5,3", "--samples", "5"], "");
+    let poses = out[0]["poses"].as_array().unwrap();
+    assert_eq!(poses.len(), 5);
+    assert_eq!(poses[0]["x"], 0.0);
+    let bad = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
+        .args(["shape", "--a", "1,nan,3"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("not"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
