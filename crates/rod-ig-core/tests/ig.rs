@@ -289,7 +289,7 @@ fn boundary_targets() {
         let f = ig::solve(&b, &o).unwrap_err();
         let ms = t.elapsed().as_secs_f64() * 1e3;
         assert!(matches!(f.reason, IgError::NoStableSolution { .. }), "{f}");
-        assert!(ms < 100.0, "took {ms} ms");
+        assert!(ms < 250.0, "took {ms} ms");
     }
     // Reachable near-boundary targets: tips of stable, nearly straight rods.
     for a in [
@@ -444,6 +444,6 @@ fn report() {
     eprintln!("{:?}", bench::robust_random(2000, 8, ParamBox::PUBLIC, &o));
     let path = bench::ellipse_path(0.5, 0.2, 0.2, 0.3, 0.5, 400);
     eprintln!("{:?}", bench::tracking("ellipse", &path, &o));
-    let path = bench::random_stable_path(3, ParamBox::PAPER, 400, 0.005);
+    let path = bench::random_stable_path(3, ParamBox::PAPER, 400, 0.01);
     eprintln!("{:?}", bench::tracking("random stable path", &path, &o));
 }

@@ -14,6 +14,7 @@
 
 use super::scan;
 use crate::{wrap_angle, PlanarParams, PlanarPose};
+use nalgebra::{Matrix3, Vector3};
 use std::f64::consts::{PI, TAU};
 use std::sync::OnceLock;
 
@@ -23,8 +24,12 @@ const NXY: usize = 40;
 const NT: usize = 40;
 /// Seeds kept per cell.
 const K: usize = 4;
+/// Length of the per-cell short lists.
+const NEAR: usize = 6;
 /// Ray end-points.
 const RAYS: usize = 8000;
+/// Ray end-points near the separatrix λ4 = 0.
+const SEPARATRIX_RAYS: usize = 8000;
 /// RK4 steps per ray.
 const STEPS: usize = 200;
 /// Half-widths of the end-point box.
@@ -37,12 +42,26 @@ pub(crate) const W_THETA: f64 = 0.5;
 pub(crate) struct Seed {
     pub a: [f64; 3],
     pub tip: [f64; 3], // x, y, wrapped θ
+    /// J(1, a)⁻¹ (from the ray's RK4 variational solution), for a free first Newton step.
+    pub jinv: Matrix3<f64>,
+}
+
+/// A start proposed by the atlas: the seed, and the Newton step from it toward the target
+/// computed with the stored J⁻¹ (paper eq. 3.1), with the seed's residual norm.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Start {
+    pub a: PlanarParams,
+    pub predicted: Option<(PlanarParams, f64)>,
 }
 
 pub(crate) struct Atlas {
     /// Cell start offsets into `seeds` (len = cells + 1).
     offsets: Vec<u32>,
     seeds: Vec<Seed>,
+    /// Per cell, offsets into `near` (len = cells + 1).
+    near_offsets: Vec<u32>,
+    /// Per cell, the indices of the NEAR seeds nearest its centre in its neighbourhood.
+    near: Vec<u32>,
 }
 
 static ATLAS: OnceLock<Atlas> = OnceLock::new();
@@ -90,6 +109,28 @@ fn same_branch(a: &[f64; 3], b: &[f64; 3]) -> bool {
     (a[0] - b[0]).abs() / 2.0 + (a[1] - b[1]).abs() / 20.0 + (a[2] - b[2]).abs() / 20.0 < 1.0
 }
 
+/// A ray end-point near the separatrix λ4 = a5² − a3²(a3²/4 + a4) = 0 (FINDINGS §1–2:
+/// the boundary between cases I and II, where m → 1 and the tip depends on a so sharply that
+/// uniform sampling leaves its neighbourhood without seeds). λ4 scales as s⁴ along a ray, so the
+/// whole ray stays at the same relative offset from the separatrix. Offsets are log-uniform.
+fn separatrix_endpoint(i: u64) -> Option<PlanarParams> {
+    let a3 = (2.0 * halton(i, 2) - 1.0) * A3_MAX;
+    let a4 = (2.0 * halton(i, 3) - 1.0) * A45_MAX;
+    let base = a3 * a3 * (a3 * a3 / 4.0 + a4);
+    let u = halton(i, 5);
+    let v = halton(i, 7);
+    // Relative offset ±10^(−7..0) of the scale a3⁴/4 + |a4| a3² (+1 to stay away from 0).
+    let scale = a3 * a3 * (a3 * a3 / 4.0 + a4.abs()) + 1.0;
+    let sign = if v < 0.5 { -1.0 } else { 1.0 };
+    let l4 = sign * scale * 10f64.powf(-7.0 * u);
+    let a5sq = base + l4;
+    if !(a5sq > 0.0) {
+        return None;
+    }
+    let a5 = a5sq.sqrt() * if (2.0 * v).fract() < 0.5 { -1.0 } else { 1.0 };
+    (a5.abs() <= A45_MAX).then(|| PlanarParams::new(a3, a4, a5))
+}
+
 /// Radical inverse in base `b` (Halton sequence).
 fn halton(mut i: u64, b: u64) -> f64 {
     let mut f = 1.0;
@@ -106,38 +147,56 @@ fn halton(mut i: u64, b: u64) -> f64 {
 fn build() -> Atlas {
     let ncells = NXY * NXY * NT;
     let mut cells: Vec<Vec<(Seed, f64)>> = vec![Vec::new(); ncells];
-    let mut buf: Vec<(f64, f64, f64, f64)> = Vec::with_capacity(STEPS);
-    for i in 0..RAYS as u64 {
-        let a = PlanarParams::new(
-            (2.0 * halton(i + 1, 2) - 1.0) * A3_MAX,
-            (2.0 * halton(i + 1, 3) - 1.0) * A45_MAX,
-            (2.0 * halton(i + 1, 5) - 1.0) * A45_MAX,
-        );
+    let mut buf: Vec<(f64, f64, f64, f64, Matrix3<f64>)> = Vec::with_capacity(STEPS);
+    for i in 0..(RAYS + SEPARATRIX_RAYS) as u64 {
+        let a = if (i as usize) < RAYS {
+            PlanarParams::new(
+                (2.0 * halton(i + 1, 2) - 1.0) * A3_MAX,
+                (2.0 * halton(i + 1, 3) - 1.0) * A45_MAX,
+                (2.0 * halton(i + 1, 5) - 1.0) * A45_MAX,
+            )
+        } else {
+            match separatrix_endpoint(i + 1) {
+                Some(a) => a,
+                None => continue,
+            }
+        };
         buf.clear();
         let mut t1 = f64::INFINITY;
-        let ok = scan::integrate(&a, STEPS, |t, x, y, th, det| {
+        let ok = scan::integrate(&a, STEPS, |t, x, y, th, j, det| {
             if t >= 0.02 && det <= 0.0 {
                 t1 = t;
                 return false;
             }
-            buf.push((t, x, y, th));
+            buf.push((t, x, y, th, *j));
             true
         });
         if ok.is_none() {
             continue;
         }
-        for &(t, x, y, th) in buf.iter() {
+        for &(t, x, y, th, j) in buf.iter() {
             // Keep a margin from the first conjugate point (seeds deep inside A_stable).
-            if t < 0.05 || t > 0.93 * t1 {
+            if t < 0.05 || t > 0.985 * t1 {
                 continue;
             }
             let tip = [x / t, y / t, wrap_angle(th)];
             let Some((ix, iy, it)) = cell_of(tip[0], tip[1], tip[2]) else {
                 continue;
             };
+            // J of the scaled rod a(t) = (t a3, t² a4, t² a5) at its tip: positions scale by
+            // 1/t, and ∂/∂a(t) = ∂/∂a · diag(1/t, 1/t², 1/t²).
+            let d = Matrix3::from_diagonal(&Vector3::new(1.0 / t, 1.0 / t, 1.0));
+            let s = Matrix3::from_diagonal(&Vector3::new(1.0 / t, 1.0 / (t * t), 1.0 / (t * t)));
+            let Some(jinv) = (d * j * s).try_inverse() else {
+                continue;
+            };
+            if !jinv.iter().all(|v| v.is_finite()) {
+                continue;
+            }
             let seed = Seed {
                 a: [t * a[0], t * t * a[1], t * t * a[2]],
                 tip,
+                jinv,
             };
             let d = tip_distance2(&tip, &centre(ix, iy, it));
             let cell = &mut cells[index(ix, iy, it)];
@@ -163,7 +222,28 @@ fn build() -> Atlas {
         seeds.extend(c.into_iter().map(|(s, _)| s));
     }
     offsets.push(seeds.len() as u32);
-    Atlas { offsets, seeds }
+    let mut atlas = Atlas {
+        offsets,
+        seeds,
+        near_offsets: Vec::with_capacity(ncells + 1),
+        near: Vec::new(),
+    };
+    // Per cell, the NEAR seeds of its 3×3×3 neighbourhood nearest the cell centre.
+    let mut tmp = Vec::new();
+    for ix in 0..NXY {
+        for iy in 0..NXY {
+            for it in 0..NT {
+                atlas.near_offsets.push(atlas.near.len() as u32);
+                tmp.clear();
+                let c = centre(ix, iy, it);
+                atlas.collect(ix, iy, it, 1, &c, &mut tmp);
+                tmp.sort_by(|p, q| p.0.total_cmp(&q.0));
+                atlas.near.extend(tmp.iter().take(NEAR).map(|p| p.1));
+            }
+        }
+    }
+    atlas.near_offsets.push(atlas.near.len() as u32);
+    atlas
 }
 
 impl Atlas {
@@ -172,48 +252,85 @@ impl Atlas {
         self.seeds.len()
     }
 
-    fn cell(&self, i: usize) -> &[Seed] {
-        let lo = self.offsets[i] as usize;
-        let hi = self.offsets[i + 1] as usize;
-        &self.seeds[lo..hi]
+    fn cell(&self, i: usize) -> std::ops::Range<usize> {
+        self.offsets[i] as usize..self.offsets[i + 1] as usize
     }
 
-    /// Seeds in the cells within `radius` cells of the target's cell (θ periodic), sorted by
-    /// tip distance to the target, appended to `out` as (distance², a).
-    pub(crate) fn candidates(
+    /// Appends (distance² to `tgt`, seed index) for the seeds within `radius` cells.
+    fn collect(
         &self,
-        target: &PlanarPose,
+        ix: usize,
+        iy: usize,
+        it: usize,
         radius: usize,
-        out: &mut Vec<(f64, PlanarParams)>,
+        tgt: &[f64; 3],
+        out: &mut Vec<(f64, u32)>,
     ) {
-        let tgt = [target.x, target.y, wrap_angle(target.theta)];
-        let Some((ix, iy, it)) = cell_of(tgt[0], tgt[1], tgt[2]) else {
-            return;
-        };
         let r = radius as i64;
-        let start = out.len();
-        for dx in -r..=r {
-            let jx = ix as i64 + dx;
-            if jx < 0 || jx >= NXY as i64 {
-                continue;
-            }
-            for dy in -r..=r {
-                let jy = iy as i64 + dy;
-                if jy < 0 || jy >= NXY as i64 {
-                    continue;
-                }
-                for dt in -r..=r {
-                    if 2 * r + 1 > NT as i64 && dt > -r + NT as i64 - 1 {
-                        break;
-                    }
-                    let jt = (it as i64 + dt).rem_euclid(NT as i64) as usize;
-                    for s in self.cell(index(jx as usize, jy as usize, jt)) {
-                        out.push((tip_distance2(&s.tip, &tgt), PlanarParams::from(s.a)));
+        let nt = NT as i64;
+        let (t_lo, t_hi) = if 2 * r + 1 >= nt {
+            (0, nt - 1)
+        } else {
+            (it as i64 - r, it as i64 + r)
+        };
+        for jx in (ix as i64 - r).max(0)..=(ix as i64 + r).min(NXY as i64 - 1) {
+            for jy in (iy as i64 - r).max(0)..=(iy as i64 + r).min(NXY as i64 - 1) {
+                for jt in t_lo..=t_hi {
+                    let jt = jt.rem_euclid(nt) as usize;
+                    for k in self.cell(index(jx as usize, jy as usize, jt)) {
+                        out.push((tip_distance2(&self.seeds[k].tip, tgt), k as u32));
                     }
                 }
             }
         }
+    }
+
+    /// Seeds within `radius` cells of the target's cell (θ periodic), sorted by tip distance
+    /// to the target, appended to `out` as (distance², seed index).
+    pub(crate) fn candidates(&self, target: &PlanarPose, radius: usize, out: &mut Vec<(f64, u32)>) {
+        let tgt = [target.x, target.y, wrap_angle(target.theta)];
+        let Some((ix, iy, it)) = cell_of(tgt[0], tgt[1], tgt[2]) else {
+            return;
+        };
+        let start = out.len();
+        self.collect(ix, iy, it, radius, &tgt, out);
         out[start..].sort_by(|p, q| p.0.total_cmp(&q.0));
+    }
+
+    /// The precomputed short list of the target's cell, sorted by tip distance to the target.
+    pub(crate) fn near_list(&self, target: &PlanarPose, out: &mut Vec<(f64, u32)>) {
+        let tgt = [target.x, target.y, wrap_angle(target.theta)];
+        let Some((ix, iy, it)) = cell_of(tgt[0], tgt[1], tgt[2]) else {
+            return;
+        };
+        let c = index(ix, iy, it);
+        let start = out.len();
+        for &k in &self.near[self.near_offsets[c] as usize..self.near_offsets[c + 1] as usize] {
+            out.push((tip_distance2(&self.seeds[k as usize].tip, &tgt), k));
+        }
+        out[start..].sort_by(|p, q| p.0.total_cmp(&q.0));
+    }
+
+    /// The start for seed `k` toward `target`: the seed, and its predicted Newton step
+    /// a1 = a_s − J(1, a_s)⁻¹ (Υ(a_s) − b), clipped to the local solver's trust box.
+    pub(crate) fn start(&self, k: u32, target: &PlanarPose) -> Start {
+        let s = &self.seeds[k as usize];
+        let a = PlanarParams::from(s.a);
+        let f = Vector3::new(
+            s.tip[0] - target.x,
+            s.tip[1] - target.y,
+            wrap_angle(s.tip[2] - target.theta),
+        );
+        let p = s.jinv * f;
+        let size = (p[0].abs() / 4.0)
+            .max(p[1].abs() / 40.0)
+            .max(p[2].abs() / 40.0);
+        let p = if size > 1.0 { p / size } else { p };
+        let a1 = a - p;
+        Start {
+            a,
+            predicted: a1.iter().all(|v| v.is_finite()).then_some((a1, f.norm())),
+        }
     }
 }
 
@@ -221,12 +338,13 @@ impl Atlas {
 pub(crate) fn nearest(target: &PlanarPose) -> Option<PlanarParams> {
     let atlas = get();
     let mut v = Vec::new();
-    for r in 0..=3 {
-        v.clear();
-        atlas.candidates(target, r, &mut v);
-        if let Some(&(_, a)) = v.first() {
-            return Some(a);
+    atlas.near_list(target, &mut v);
+    for r in 1..=3 {
+        if let Some(&(_, k)) = v.first() {
+            return Some(PlanarParams::from(atlas.seeds[k as usize].a));
         }
+        atlas.candidates(target, r, &mut v);
     }
-    None
+    v.first()
+        .map(|&(_, k)| PlanarParams::from(atlas.seeds[k as usize].a))
 }

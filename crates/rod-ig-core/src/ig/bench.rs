@@ -375,14 +375,22 @@ pub fn ellipse_path(
         .collect()
 }
 
-/// A smooth target path through tips of stable rods: a(τ) moves on a straight segment from a
-/// random stable rod in `bx` with a random direction; the path stops before it leaves the
-/// stable set. `steps` targets, parameter step `da` (scaled: a3 moves by da, a4, a5 by 10 da).
-pub fn random_stable_path(seed: u64, bx: ParamBox, steps: usize, da: f64) -> Vec<PlanarPose> {
+/// A smooth target path through tips of stable rods, with (nearly) uniform steps `db` in tip
+/// space (‖Δ(x, y, θ)‖₂): a(τ) moves on a straight line from a random stable rod in `bx` in a
+/// random direction (a3 component in [−1, 1], a4 and a5 in [−10, 10]), with the parameter step
+/// adapted so that the tip moves by about `db` per target; the path ends before it leaves the
+/// stable set (margin > 1e-3). Returns the first path of `steps` targets found (at most 1000
+/// tries), or an empty vector.
+pub fn random_stable_path(seed: u64, bx: ParamBox, steps: usize, db: f64) -> Vec<PlanarPose> {
     let mut rng = SplitMix64::new(seed);
+    let tip_of = |a: &PlanarParams| -> Option<PlanarPose> {
+        let st = model::stability(a).ok()?;
+        let (tip, _) = model::tip_and_jacobian(a).ok()?;
+        (st.stable && st.margin > 1e-3).then_some(tip)
+    };
     for _ in 0..1000 {
         let starts = random_stable_targets(1, rng.next_u64(), bx);
-        let Some(&(a0, _)) = starts.first() else {
+        let Some(&(a0, b0)) = starts.first() else {
             continue;
         };
         let d = PlanarParams::new(
@@ -391,12 +399,30 @@ pub fn random_stable_path(seed: u64, bx: ParamBox, steps: usize, da: f64) -> Vec
             10.0 * rng.range(-1.0, 1.0),
         );
         let mut path = Vec::with_capacity(steps);
-        for i in 0..steps {
-            let a = a0 + d * (da * i as f64);
-            match (model::stability(&a), model::tip_and_jacobian(&a)) {
-                (Ok(st), Ok((tip, _))) if st.stable && st.margin > 1e-3 => path.push(tip),
-                _ => break,
+        path.push(b0);
+        let mut a = a0;
+        let mut b = b0;
+        let mut h = 1e-3;
+        'walk: while path.len() < steps {
+            // Adapt h so that the tip step is within [0.7, 1.3] db (a few secant tries).
+            for _ in 0..8 {
+                let an = a + d * h;
+                let Some(bn) = tip_of(&an) else {
+                    break 'walk;
+                };
+                let step = (bn.to_vector() - b.to_vector()).norm();
+                if !(step.is_finite() && step > 0.0) {
+                    break 'walk;
+                }
+                if (0.7 * db..=1.3 * db).contains(&step) {
+                    a = an;
+                    b = bn;
+                    path.push(bn);
+                    continue 'walk;
+                }
+                h *= (db / step).clamp(0.1, 10.0);
             }
+            break;
         }
         if path.len() == steps {
             return path;

@@ -40,13 +40,16 @@ pub(crate) enum Stop {
     Converged,
     /// Start is non-finite or not in the stable set (det J(1, a0) ≤ 0).
     BadStart,
-    Singular,
     /// Backtracking found no acceptable step.
     Stalled,
     MaxIterations,
 }
 
 const MAX_DA3: f64 = 4.0;
+/// Trials of the backtracking on the Newton direction before switching to LM steps.
+const NEWTON_TRIALS: usize = 5;
+/// LM trials (μ × 10 each) per iteration.
+const LM_TRIALS: usize = 10;
 const MAX_DA45: f64 = 40.0;
 
 /// Runs the globalised Newton from `a0` for at most `max_iterations` accepted steps.
@@ -57,7 +60,38 @@ pub(crate) fn solve(
     max_iterations: u32,
     tolerance: f64,
 ) -> Local {
-    let mut out = Local {
+    solve_predicted(target, a0, None, alpha, max_iterations, tolerance)
+}
+
+/// As [`solve`], with an optional predicted first iterate `(a1, r0)`: a Newton step from `a0`
+/// computed from an already known J(1, a0) (atlas seed, previous tracking solution), where `r0`
+/// is the known (or estimated) ‖f(a0)‖. It is taken when it is in A_stable's det J(1) > 0 side
+/// and decreases the residual below `r0`; otherwise the solve starts from `a0`. A taken
+/// prediction counts as one iteration.
+pub(crate) fn solve_predicted(
+    target: &PlanarPose,
+    a0: &PlanarParams,
+    predicted: Option<(PlanarParams, f64)>,
+    alpha: f64,
+    max_iterations: u32,
+    tolerance: f64,
+) -> Local {
+    if let Some((a1, r0)) = predicted {
+        if max_iterations > 0 {
+            if let Some(e1) = eval(&a1, target) {
+                if e1.jac.determinant() > 0.0 && e1.norm < (1.0 - 1e-4) * r0 {
+                    let mut out = run(target, a1, e1, alpha, max_iterations - 1, tolerance);
+                    out.iterations += 1;
+                    out.evaluations += 1;
+                    return out;
+                }
+            }
+            let mut out = solve(target, a0, alpha, max_iterations, tolerance);
+            out.evaluations += 1;
+            return out;
+        }
+    }
+    let out = Local {
         found: None,
         iterations: 0,
         evaluations: 1,
@@ -65,12 +99,36 @@ pub(crate) fn solve(
         last_a: *a0,
         stop: Stop::BadStart,
     };
-    let mut a = *a0;
-    let mut e = match eval(&a, target) {
-        Some(e) if e.jac.determinant() > 0.0 => e,
-        _ => return out,
+    match eval(a0, target) {
+        Some(e) if e.jac.determinant() > 0.0 => {
+            let mut out = run(target, *a0, e, alpha, max_iterations, tolerance);
+            out.evaluations += 1;
+            out
+        }
+        _ => out,
+    }
+}
+
+/// The iteration proper, from an evaluated start (`evaluations` excludes the start's).
+fn run(
+    target: &PlanarPose,
+    a0: PlanarParams,
+    e0: Eval,
+    alpha: f64,
+    max_iterations: u32,
+    tolerance: f64,
+) -> Local {
+    let mut out = Local {
+        found: None,
+        iterations: 0,
+        evaluations: 0,
+        residual: e0.norm,
+        last_a: a0,
+        stop: Stop::BadStart,
     };
-    out.residual = e.norm;
+    let mut a = a0;
+    let mut e = e0;
+    let mut mu = 0.0f64;
     let alpha = if alpha > 0.0 && alpha <= 1.0 {
         alpha
     } else {
@@ -86,38 +144,70 @@ pub(crate) fn solve(
             out.stop = Stop::MaxIterations;
             return out;
         }
-        let p = match solve3(&e.jac, &e.f) {
-            Ok(p) => p,
-            Err(_) => {
-                out.stop = Stop::Singular;
-                return out;
-            }
-        };
-        let size = (p[0].abs() / MAX_DA3)
-            .max(p[1].abs() / MAX_DA45)
-            .max(p[2].abs() / MAX_DA45);
-        let mut lambda = if size > 1.0 { alpha / size } else { alpha };
         let mut accepted = None;
-        for _ in 0..12 {
-            let trial = a - lambda * p;
-            out.evaluations += 1;
-            if let Some(et) = eval(&trial, target) {
-                if et.jac.determinant() > 0.0 && et.norm <= (1.0 - 1e-4 * lambda) * e.norm {
-                    accepted = Some((trial, et));
-                    break;
+        // 1. Newton direction with backtracking (paper eq. 3.1, globalised).
+        if let Ok(p) = solve3(&e.jac, &e.f) {
+            let size = (p[0].abs() / MAX_DA3)
+                .max(p[1].abs() / MAX_DA45)
+                .max(p[2].abs() / MAX_DA45);
+            let mut lambda = if size > 1.0 { alpha / size } else { alpha };
+            for _ in 0..NEWTON_TRIALS {
+                let trial = a - lambda * p;
+                out.evaluations += 1;
+                if let Some(et) = eval(&trial, target) {
+                    if et.jac.determinant() > 0.0 && et.norm <= (1.0 - 1e-4 * lambda) * e.norm {
+                        accepted = Some((trial, et));
+                        break;
+                    }
+                    // Quadratic model of ‖f‖² along the step: φ(λ) ≈ φ0 − 2λφ0 + cλ² (the
+                    // Newton direction has slope −2φ0 for φ = ‖f‖²); its minimiser, bounded.
+                    let phi0 = e.norm * e.norm;
+                    let phil = et.norm * et.norm;
+                    if phil.is_finite() && et.jac.determinant() > 0.0 {
+                        let c = (phil - phi0 + 2.0 * lambda * phi0) / (lambda * lambda);
+                        let lnew = if c > 0.0 { phi0 / c } else { 0.5 * lambda };
+                        lambda = lnew.clamp(0.1 * lambda, 0.5 * lambda);
+                        continue;
+                    }
                 }
-                // Quadratic model of ‖f‖² along the step: φ(λ) ≈ φ0 − 2λφ0 + cλ² (the
-                // Newton direction has slope −2φ0 for φ = ‖f‖²); pick its minimiser, bounded.
-                let phi0 = e.norm * e.norm;
-                let phil = et.norm * et.norm;
-                if phil.is_finite() && et.jac.determinant() > 0.0 {
-                    let c = (phil - phi0 + 2.0 * lambda * phi0) / (lambda * lambda);
-                    let lnew = if c > 0.0 { phi0 / c } else { 0.5 * lambda };
-                    lambda = lnew.clamp(0.1 * lambda, 0.5 * lambda);
-                    continue;
-                }
+                lambda *= 0.3;
             }
-            lambda *= 0.3;
+        }
+        // 2. Levenberg–Marquardt steps (JᵀJ + μ diag(JᵀJ)) p = Jᵀf when the Newton direction
+        //    fails (ill-conditioned J near the fold det J(1, a) = 0, where Newton steps point
+        //    across the stability boundary): μ grows until a step is accepted.
+        if accepted.is_none() {
+            let jtj = e.jac.transpose() * e.jac;
+            let g = e.jac.transpose() * e.f;
+            let dmax = jtj.diagonal().max();
+            let diag = jtj.diagonal().map(|v| v.max(1e-12 * dmax));
+            if !(mu > 0.0) {
+                mu = 1e-3;
+            }
+            for _ in 0..LM_TRIALS {
+                let mut m = jtj;
+                for q in 0..3 {
+                    m[(q, q)] += mu * diag[q];
+                }
+                let Ok(p) = solve3(&m, &g) else {
+                    mu *= 10.0;
+                    continue;
+                };
+                let size = (p[0].abs() / MAX_DA3)
+                    .max(p[1].abs() / MAX_DA45)
+                    .max(p[2].abs() / MAX_DA45);
+                let p = if size > 1.0 { p / size } else { p };
+                let trial = a - p;
+                out.evaluations += 1;
+                if let Some(et) = eval(&trial, target) {
+                    if et.jac.determinant() > 0.0 && et.norm <= (1.0 - 1e-4) * e.norm {
+                        accepted = Some((trial, et));
+                        mu *= 0.1;
+                        break;
+                    }
+                }
+                mu *= 10.0;
+            }
         }
         match accepted {
             Some((na, ne)) => {

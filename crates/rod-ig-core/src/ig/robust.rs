@@ -8,42 +8,62 @@ use crate::{PlanarParams, PlanarPose};
 
 /// Total start budget of one robust solve.
 const MAX_STARTS: usize = 48;
+/// Iteration budget for the caller's initial guess, which may be far from the target: beyond
+/// it, the atlas starts (a few iterations each) are the better bet.
+const GUESS_BUDGET: u32 = 12;
 
-/// Iteration budget per start (the atlas seeds are close: a few iterations suffice, and a start
+/// Iteration budget per atlas start (the seeds are close: a few iterations suffice, and a start
 /// that needs many is better replaced by the next one).
 fn per_start_budget(options: &SolveOptions) -> u32 {
     options.max_iterations.clamp(1, 30)
 }
 
-/// Runs one start; returns the verified stable solution, if any.
-pub(crate) fn try_start(
+/// Counters accumulated over the starts of one solve.
+#[derive(Default)]
+struct Counts {
+    iterations: u32,
+    evaluations: u32,
+}
+
+/// Runs one start (with its optional predicted first step); returns the verified stable
+/// solution, if any.
+fn try_start(
     target: &PlanarPose,
-    a0: &PlanarParams,
+    start: &atlas::Start,
     options: &SolveOptions,
     budget: u32,
-    iterations: &mut u32,
-    evaluations: &mut u32,
+    counts: &mut Counts,
 ) -> Option<Solution> {
-    let r = local::solve(target, a0, options.alpha, budget, options.tolerance);
-    *iterations += r.iterations;
-    *evaluations += r.evaluations;
+    let r = local::solve_predicted(
+        target,
+        &start.a,
+        start.predicted,
+        options.alpha,
+        budget,
+        options.tolerance,
+    );
+    counts.iterations += r.iterations;
+    counts.evaluations += r.evaluations;
     let (a, e) = r.found?;
     let st = model::stability(&a).ok()?;
     if !st.stable {
         return None;
     }
-    Some(make_solution(&a, &e, true, st.margin, r.iterations))
+    let mut s = make_solution(&a, &e, true, st.margin, r.iterations);
+    s.evaluations = r.evaluations;
+    Some(s)
 }
 
-/// Starts in order: the initial guess, then atlas seeds by increasing tip distance, widening the
-/// search radius when the near cells are exhausted.
+/// Starts in order: the initial guess (brought into the stable set), then the target cell's
+/// short list of atlas seeds, then seeds in widening neighbourhoods, nearest first.
 struct Starts<'t> {
     target: &'t PlanarPose,
     guess: Option<PlanarParams>,
-    buf: Vec<(f64, PlanarParams)>,
+    buf: Vec<(f64, u32)>,
     pos: usize,
-    radius: usize,
-    served: Vec<PlanarParams>,
+    /// 0: short list not yet loaded; r ≥ 1: neighbourhood radius loaded.
+    stage: usize,
+    served: Vec<u32>,
 }
 
 impl<'t> Starts<'t> {
@@ -56,62 +76,72 @@ impl<'t> Starts<'t> {
             guess,
             buf: Vec::new(),
             pos: 0,
-            radius: 0,
+            stage: 0,
             served: Vec::new(),
         }
     }
 
-    fn next(&mut self) -> Option<PlanarParams> {
+    /// Next start, and whether it is the caller's guess.
+    fn next(&mut self) -> Option<(atlas::Start, bool)> {
         if let Some(g) = self.guess.take() {
-            return Some(g);
+            return Some((
+                atlas::Start {
+                    a: g,
+                    predicted: None,
+                },
+                true,
+            ));
         }
+        let atlas = atlas::get();
         loop {
             while self.pos < self.buf.len() {
-                let a = self.buf[self.pos].1;
+                let k = self.buf[self.pos].1;
                 self.pos += 1;
-                if !self.served.contains(&a) {
-                    self.served.push(a);
-                    return Some(a);
+                if !self.served.contains(&k) {
+                    self.served.push(k);
+                    return Some((atlas.start(k, self.target), false));
                 }
             }
-            if self.radius >= 3 {
+            if self.stage >= 3 {
                 return None;
             }
-            // Widen the search (the wider list contains the served seeds again: skipped).
-            self.radius += 1;
             self.buf.clear();
-            atlas::get().candidates(self.target, self.radius, &mut self.buf);
+            if self.stage == 0 {
+                atlas.near_list(self.target, &mut self.buf);
+            } else {
+                atlas.candidates(self.target, self.stage, &mut self.buf);
+            }
+            self.stage += 1;
             self.pos = 0;
         }
     }
 }
 
 pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Failure> {
-    let mut iterations = 0;
-    let mut evaluations = 0;
+    let mut counts = Counts::default();
     let mut starts = Starts::new(target, options);
     let budget = per_start_budget(options);
     let mut n = 0;
     while n < MAX_STARTS {
-        let Some(a0) = starts.next() else { break };
+        let Some((start, is_guess)) = starts.next() else {
+            break;
+        };
         n += 1;
-        if let Some(mut s) = try_start(
-            target,
-            &a0,
-            options,
-            budget,
-            &mut iterations,
-            &mut evaluations,
-        ) {
-            s.iterations = iterations;
-            s.evaluations = evaluations;
+        let b = if is_guess {
+            budget.min(GUESS_BUDGET)
+        } else {
+            budget
+        };
+        if let Some(mut s) = try_start(target, &start, options, b, &mut counts) {
+            s.iterations = counts.iterations;
+            s.evaluations = counts.evaluations;
             s.starts = n as u32;
             return Ok(s);
         }
     }
     Err(Failure {
         reason: IgError::NoStableSolution { starts: n as u32 },
-        iterations,
+        iterations: counts.iterations,
         residual: f64::INFINITY,
         last_a: None,
         elapsed_us: 0.0,
@@ -133,25 +163,39 @@ fn distinct(a: &PlanarParams, b: &PlanarParams) -> bool {
     d > 1e-4
 }
 
+/// Every start of the initial guess and of the atlas seeds within one cell of the target (at
+/// most 200); the distinct stable solutions.
 pub(crate) fn solve_all(target: &PlanarPose, options: &SolveOptions) -> All {
-    let mut iterations = 0;
-    let mut evaluations = 0;
+    let mut counts = Counts::default();
     let budget = per_start_budget(options);
-    let mut list = Vec::new();
+    let atlas = atlas::get();
+    let mut list: Vec<atlas::Start> = Vec::new();
     if let Some(g) = options
         .initial_guess
         .and_then(|g| local::pull_into_stable(&g))
     {
-        list.push((0.0, g));
+        list.push(atlas::Start {
+            a: g,
+            predicted: None,
+        });
     }
-    atlas::get().candidates(target, 1, &mut list);
+    let mut idx = Vec::new();
+    atlas.candidates(target, 1, &mut idx);
+    list.extend(idx.iter().take(200).map(|&(_, k)| atlas.start(k, target)));
     let mut solutions: Vec<Solution> = Vec::new();
     let mut starts = 0;
-    for (_, a0) in list.iter().take(200) {
+    for start in &list {
         starts += 1;
-        let r = local::solve(target, a0, options.alpha, budget, options.tolerance);
-        iterations += r.iterations;
-        evaluations += r.evaluations;
+        let r = local::solve_predicted(
+            target,
+            &start.a,
+            start.predicted,
+            options.alpha,
+            budget,
+            options.tolerance,
+        );
+        counts.iterations += r.iterations;
+        counts.evaluations += r.evaluations;
         let Some((a, e)) = r.found else { continue };
         if solutions.iter().any(|s| !distinct(&s.a, &a)) {
             continue;
@@ -167,8 +211,8 @@ pub(crate) fn solve_all(target: &PlanarPose, options: &SolveOptions) -> All {
     }
     All {
         solutions,
-        iterations,
-        evaluations,
+        iterations: counts.iterations,
+        evaluations: counts.evaluations,
         starts,
     }
 }

@@ -85,7 +85,7 @@ pub(crate) fn steps_for(a: &PlanarParams, per_rad: f64) -> usize {
 }
 
 /// Integrates the rod and its variational equations over [0, 1] with `n` RK4 steps and calls
-/// `visit(t, x, y, θ, det J(t))` after every step (θ unwrapped); stops early when `visit`
+/// `visit(t, x, y, θ, J(t), det J(t))` after every step (θ unwrapped); stops early when `visit`
 /// returns false. Returns the final state's tip and J, or `None` on non-finite input or values.
 pub(crate) fn integrate<V>(
     a: &PlanarParams,
@@ -93,7 +93,7 @@ pub(crate) fn integrate<V>(
     mut visit: V,
 ) -> Option<(PlanarPose, PlanarJacobian)>
 where
-    V: FnMut(f64, f64, f64, f64, f64) -> bool,
+    V: FnMut(f64, f64, f64, f64, &PlanarJacobian, f64) -> bool,
 {
     if !(a[0].is_finite() && a[1].is_finite() && a[2].is_finite()) {
         return None;
@@ -131,11 +131,12 @@ where
         y[0] /= r;
         y[1] /= r;
         let t = (i + 1) as f64 * h;
-        let det = jac_of(&y).determinant();
+        let jac = jac_of(&y);
+        let det = jac.determinant();
         if !det.is_finite() {
             return None;
         }
-        if !visit(t, y[3], y[4], y[17], det) {
+        if !visit(t, y[3], y[4], y[17], &jac, det) {
             break;
         }
     }
@@ -150,7 +151,7 @@ where
 /// non-positive value. Returns `None` on non-finite input or values.
 pub(crate) fn scan(a: &PlanarParams, n: usize) -> Option<Scan> {
     let mut first_conjugate_t = None;
-    integrate(a, n, |t, _, _, _, det| {
+    integrate(a, n, |t, _, _, _, _, det| {
         if t >= T_MIN && det <= 0.0 {
             first_conjugate_t = Some(t);
             return false;
@@ -171,7 +172,7 @@ mod tests {
     fn circle_tip() {
         // a = (a3, 0, 0): a circle of curvature a3.
         let a = PlanarParams::new(1.3, 0.0, 0.0);
-        let (tip, _) = integrate(&a, 400, |_, _, _, _, _| true).unwrap();
+        let (tip, _) = integrate(&a, 400, |_, _, _, _, _, _| true).unwrap();
         assert!(scan(&a, 400).unwrap().stable);
         assert!((tip.x - (1.3f64).sin() / 1.3).abs() < 1e-10);
         assert!((tip.y - 2.0 * (0.65f64).sin().powi(2) / 1.3).abs() < 1e-10);

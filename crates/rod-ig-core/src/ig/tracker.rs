@@ -4,9 +4,9 @@
 //! the path leaves the stable workspace), the tracker falls back to the robust solver.
 //!
 //! Predictor: the previous solve ended with J(1, a_prev) already evaluated at its solution, so
-//! the first-order prediction a_prev + J(1, a_prev)⁻¹ (b − b_prev) (the tangent of the solution
-//! branch) costs one 3×3 solve and no evaluation. It is not counted as an iteration; the
-//! `evaluations` field of [`Solution`] counts every evaluation of Υ and J.
+//! the first Newton step a_prev + J(1, a_prev)⁻¹ (b − b_prev) (the tangent of the solution
+//! branch) costs one 3×3 solve and no evaluation. It is counted as an iteration all the same;
+//! the `evaluations` field of [`Solution`] counts every evaluation of Υ and J.
 
 use super::{
     local, model, newton::make_solution, newton::solve3, robust, Failure, Solution, SolveOptions,
@@ -21,6 +21,8 @@ pub struct Tracker {
     options: SolveOptions,
     /// Last solution, its target, and J(1, a) there when known.
     last: Option<(PlanarParams, PlanarPose, Option<PlanarJacobian>)>,
+    /// The solution and target before it (for the second-order predictor term).
+    prev: Option<(PlanarParams, PlanarPose)>,
 }
 
 /// Largest predictor step accepted (scaled like the trust box of the local solver).
@@ -33,12 +35,14 @@ impl Tracker {
         Self {
             options,
             last: None,
+            prev: None,
         }
     }
 
     /// Forgets the previous solution (the next solve is a cold robust solve).
     pub fn reset(&mut self) {
         self.last = None;
+        self.prev = None;
     }
 
     /// The last solution's parameters, if any.
@@ -46,19 +50,37 @@ impl Tracker {
         self.last.map(|l| l.0)
     }
 
-    fn predict(&self, target: &PlanarPose) -> Option<PlanarParams> {
+    /// Predicted solution for `target` on the branch of the last solution: with g the local
+    /// inverse of Υ (g' = J⁻¹), g(b + Δ) ≈ g(b) + J⁻¹Δ + ½g''[Δ, Δ]; the second-order term is
+    /// estimated from the previous step when the target moves on (nearly) straight: from
+    /// g(b_prev) = a_prev, ½g''[Δp, Δp] ≈ a_prev − a + J⁻¹Δp, scaled by ρ² (Δ ≈ ρ Δp).
+    /// Returns the prediction and ‖Δ‖ (the residual at the last solution, estimated).
+    fn predict(&self, target: &PlanarPose) -> Option<(PlanarParams, f64)> {
         let (a, b, j) = self.last?;
         let j = j?;
-        let db = Vector3::new(
-            target.x - b.x,
-            target.y - b.y,
-            wrap_angle(target.theta - b.theta),
-        );
-        let da = solve3(&j, &db).ok()?;
+        let diff = |p: &PlanarPose, q: &PlanarPose| {
+            Vector3::new(p.x - q.x, p.y - q.y, wrap_angle(p.theta - q.theta))
+        };
+        let db = diff(target, &b);
+        let mut da = solve3(&j, &db).ok()?;
+        if let Some((ap, bp)) = self.prev {
+            let dp = diff(&bp, &b);
+            let n2 = dp.norm_squared();
+            if n2 > 0.0 {
+                let rho = -db.dot(&dp) / n2;
+                let cos = -db.dot(&dp) / (db.norm() * n2.sqrt());
+                if cos > 0.95 && rho > 0.0 && rho < 2.0 {
+                    if let Ok(lin) = solve3(&j, &dp) {
+                        let second = ap - a + lin;
+                        da += rho * rho * second;
+                    }
+                }
+            }
+        }
         let size = (da[0].abs() / 4.0)
             .max(da[1].abs() / 40.0)
             .max(da[2].abs() / 40.0);
-        (size <= MAX_PREDICT).then(|| a + da)
+        (size <= MAX_PREDICT && da.iter().all(|v| v.is_finite())).then(|| (a + da, db.norm()))
     }
 
     /// Solves for `target`, warm-starting from the previous solution.
@@ -74,8 +96,9 @@ impl Tracker {
         let mut iterations = 0;
         let mut evaluations = 0;
         let budget = self.options.max_iterations.clamp(1, 20);
-        for a0 in [predicted, warm].into_iter().flatten() {
-            let r = local::solve(target, &a0, 1.0, budget, self.options.tolerance);
+        if let Some(a0) = warm {
+            let r =
+                local::solve_predicted(target, &a0, predicted, 1.0, budget, self.options.tolerance);
             iterations += r.iterations;
             evaluations += r.evaluations;
             if let Some((a, e)) = r.found {
@@ -84,6 +107,7 @@ impl Tracker {
                         let mut s = make_solution(&a, &e, true, st.margin, iterations);
                         s.evaluations = evaluations;
                         s.elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
+                        self.prev = self.last.map(|l| (l.0, l.1));
                         self.last = Some((a, *target, Some(e.jac)));
                         return Ok(s);
                     }
@@ -98,6 +122,7 @@ impl Tracker {
                 s.iterations += iterations;
                 s.evaluations += evaluations;
                 s.elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
+                self.prev = None;
                 self.last = Some((s.a, *target, None));
                 Ok(s)
             }

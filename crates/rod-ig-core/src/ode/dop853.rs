@@ -9,6 +9,8 @@
 //!
 //! The state is a fixed-size array `[f64; N]`; the stepper allocates nothing.
 
+#![allow(clippy::excessive_precision)] // published coefficients, kept digit for digit
+
 use super::{OdeError, OdeOptions, OdeStats};
 use std::ops::ControlFlow;
 

@@ -197,7 +197,7 @@ impl Ctx<'_> {
         } else {
             StabilityOptions {
                 rtol,
-                atol: (rtol * 1e-4).max(1e-12),
+                atol: (rtol * 1e-2).max(1e-12),
                 coarse_stride: ITERATE_STRIDE,
             }
         }

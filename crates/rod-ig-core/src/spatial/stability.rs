@@ -10,7 +10,7 @@
 //! full-grid rule.
 
 use super::reduced::{self, jac as jac_of, pose as pose_of, ENERGY, NR as NV};
-use super::{check_params, options, Evaluation3d, SpatialParams, Stiffness};
+use super::{check_params, options_for, Evaluation3d, SpatialParams, Stiffness};
 use crate::ode::{DenseStep, Dop853};
 use crate::{RodError, StabilityReport};
 
@@ -263,7 +263,7 @@ fn run(
         0.0,
         reduced::initial::<NV>(),
         1.0,
-        &options(opts.rtol, opts.atol),
+        &options_for(a, opts.rtol, opts.atol),
         !straight,
     )?;
     let mut scan = Scan {
