@@ -163,6 +163,10 @@ impl std::error::Error for Failure3d {}
 
 struct Ctx<'a> {
     target: &'a SpatialPose,
+    /// Current goal: the target, or an intermediate pose of the continuation.
+    goal: SpatialPose,
+    /// Tolerance on the current goal.
+    goal_tol: f64,
     opts: &'a SolveOptions3d,
     evaluations: u32,
     iterations: u32,
@@ -174,9 +178,9 @@ enum EvalOutcome {
     Unstable,
 }
 
-/// Coarse stride of the stability scan on intermediate iterates: step ends only (the final
-/// answer is always re-checked with [`StabilityOptions::production`]'s finer scan).
-const ITERATE_STRIDE: u32 = 2000;
+/// Coarse stride of the stability scan on intermediate iterates: step ends only, no dense
+/// output (the final answer is always re-checked with [`StabilityOptions::production`]).
+const ITERATE_STRIDE: u32 = 0;
 /// Loosest integration tolerance used far from the solution.
 const LOOSE_RTOL: f64 = 1e-5;
 
@@ -228,8 +232,18 @@ impl Ctx<'_> {
     }
 
     fn converged(&self, ev: &Evaluation3d) -> Option<(f64, f64)> {
-        let (pe, ang) = ev.tip.distance_to(self.target);
-        (pe <= self.opts.tolerance && ang <= self.opts.tolerance).then_some((pe, ang))
+        let (pe, ang) = ev.tip.distance_to(&self.goal);
+        (pe <= self.goal_tol && ang <= self.goal_tol).then_some((pe, ang))
+    }
+
+    fn set_goal(&mut self, goal: SpatialPose, tol: f64) {
+        self.goal = goal;
+        self.goal_tol = tol;
+    }
+
+    fn final_goal(&mut self) {
+        self.goal = *self.target;
+        self.goal_tol = self.opts.tolerance;
     }
 
     fn solution(&self, a: SpatialParams, ev: &Evaluation3d, it: u32, start: u32) -> Solution3d {
@@ -319,6 +333,8 @@ fn validate(target: &SpatialPose, opts: &SolveOptions3d) -> Result<(), IgError3d
 pub fn solve(target: &SpatialPose, options: &SolveOptions3d) -> Result<Solution3d, Failure3d> {
     let mut ctx = Ctx {
         target,
+        goal: *target,
+        goal_tol: options.tolerance,
         opts: options,
         evaluations: 0,
         iterations: 0,
@@ -371,31 +387,36 @@ const MAX_BACKTRACK: u32 = 12;
 /// Evaluations one start may use before the robust method moves on to the next seed.
 const START_BUDGET: u32 = 40;
 
-/// Damped Newton from one stable start (module docs). Iterates are integrated at a tolerance
-/// adapted to their residual; a converged iterate is re-evaluated and re-checked for stability
-/// at the requested accuracy before it is returned.
+/// Damped Newton towards `ctx.goal` from one stable start (module docs), using at most
+/// `budget` evaluations. Iterates are integrated at a tolerance adapted to their residual. With
+/// `verify`, a converged iterate is re-evaluated and re-checked for stability at the requested
+/// accuracy before it is returned (iterations continue if it no longer meets the tolerance).
 fn damped_newton(
     ctx: &mut Ctx,
     a0: SpatialParams,
     ev0: Box<Evaluation3d>,
-    start: u32,
-) -> Result<Solution3d, IgError3d> {
+    budget: u32,
+    verify: bool,
+) -> Result<(SpatialParams, Box<Evaluation3d>, u32), IgError3d> {
     let mut a = a0;
     let mut ev = ev0;
-    let mut e = ev.tip.body_error_to(ctx.target);
+    let mut e = ev.tip.body_error_to(&ctx.goal);
     let mut merit = e.norm_squared();
     let mut it = 0;
-    let budget_end = ctx.evaluations.saturating_add(START_BUDGET);
+    let budget_end = ctx.evaluations.saturating_add(budget);
     loop {
         if ctx.converged(&ev).is_some() {
+            if !verify {
+                return Ok((a, ev, it));
+            }
             // Verify at the requested accuracy with the fine stability scan.
             match ctx.eval(&a, ctx.opts.rtol, true)? {
                 EvalOutcome::Stable(vev) => {
                     if ctx.converged(&vev).is_some() {
-                        return Ok(ctx.solution(a, &vev, it, start));
+                        return Ok((a, vev, it));
                     }
                     ev = vev;
-                    e = ev.tip.body_error_to(ctx.target);
+                    e = ev.tip.body_error_to(&ctx.goal);
                     merit = e.norm_squared();
                 }
                 EvalOutcome::Unstable => return Err(IgError3d::LeftStableSet),
@@ -423,7 +444,7 @@ fn damped_newton(
             let trial = a + alpha * d;
             match ctx.eval(&trial, trial_rtol, false)? {
                 EvalOutcome::Stable(tev) => {
-                    let te = tev.tip.body_error_to(ctx.target);
+                    let te = tev.tip.body_error_to(&ctx.goal);
                     let tm = te.norm_squared();
                     if tm < (1.0 - 1e-4 * alpha) * merit || ctx.converged(&tev).is_some() {
                         accepted = Some((trial, tev, te, tm));
@@ -432,6 +453,9 @@ fn damped_newton(
                     last_unstable = false;
                 }
                 EvalOutcome::Unstable => last_unstable = true,
+            }
+            if ctx.evaluations >= budget_end {
+                break;
             }
             alpha *= 0.5;
         }
@@ -453,33 +477,140 @@ fn damped_newton(
     }
 }
 
+/// Evaluations one continuation sub-step may use.
+const SUBSTEP_BUDGET: u32 = 10;
+/// Tolerance on the intermediate goals of the continuation.
+const SUBSTEP_TOL: f64 = 1e-3;
+/// Smallest continuation step before giving up.
+const MIN_DS: f64 = 1.0 / 256.0;
+
+/// Continuation (homotopy) in the target: from the stable rod `a0` with tip q0, track
+/// q(s) = (p0 + s (p* − p0), R0 exp(s log(R0ᵀ R*))) for s: 0 → 1 with damped Newton on each
+/// intermediate goal, halving the s-step on failure and doubling it on success. It follows a
+/// path of stable rods, which plain Newton from a distant seed may jump off.
+fn continuation(
+    ctx: &mut Ctx,
+    a0: SpatialParams,
+    ev0: Box<Evaluation3d>,
+) -> Result<(SpatialParams, Box<Evaluation3d>, u32), IgError3d> {
+    let q0 = ev0.tip;
+    let dp = ctx.target.position - q0.position;
+    let dr = (q0.rotation.inverse() * ctx.target.rotation).scaled_axis();
+    let (mut a, mut ev) = (a0, ev0);
+    let (mut s, mut ds) = (0.0f64, 0.25f64);
+    let mut its = 0;
+    let mut last = IgError3d::Stalled;
+    for _ in 0..64 {
+        let s_new = (s + ds).min(1.0);
+        let last_step = s_new >= 1.0;
+        if last_step {
+            ctx.final_goal();
+        } else {
+            let goal = SpatialPose {
+                position: q0.position + dp * s_new,
+                rotation: q0.rotation * nalgebra::UnitQuaternion::from_scaled_axis(dr * s_new),
+            };
+            ctx.set_goal(goal, SUBSTEP_TOL);
+        }
+        let budget = if last_step {
+            START_BUDGET
+        } else {
+            SUBSTEP_BUDGET
+        };
+        match damped_newton(ctx, a, ev.clone(), budget, last_step) {
+            Ok((a2, ev2, it)) => {
+                its += it;
+                if last_step {
+                    return Ok((a2, ev2, its));
+                }
+                a = a2;
+                ev = ev2;
+                s = s_new;
+                ds = (ds * 2.0).min(0.5);
+            }
+            Err(e @ IgError3d::Evaluation(_)) => return Err(e),
+            Err(e) => {
+                last = e;
+                ds *= 0.5;
+                if ds < MIN_DS {
+                    break;
+                }
+            }
+        }
+    }
+    ctx.final_goal();
+    Err(last)
+}
+
+/// Number of seeds tried by plain damped Newton before the first continuation attempt.
+const PLAIN_FIRST: usize = 4;
+
 fn robust(ctx: &mut Ctx) -> Result<Solution3d, Failure3d> {
     let mut list: Vec<SpatialParams> = Vec::with_capacity(16);
     if let Some(g) = ctx.opts.initial_guess {
         list.push(g);
     }
     list.extend(seeds(ctx.target));
-    let mut last = IgError3d::NoStableSolution {
-        starts: 0,
-        last: Box::new(IgError3d::LeftStableSet),
-    };
-    let mut tried = 0;
-    for a0 in list.into_iter().take(ctx.opts.max_starts.max(1) as usize) {
-        tried += 1;
-        let rtol0 = LOOSE_RTOL.max(ctx.opts.rtol);
+    list.truncate(ctx.opts.max_starts.max(1) as usize);
+    let mut last = IgError3d::LeftStableSet;
+    let mut tried: u32 = 0;
+    let rtol0 = LOOSE_RTOL.max(ctx.opts.rtol);
+    // Stable seeds (evaluated lazily), reused by the continuation.
+    let mut stable_seeds: Vec<(SpatialParams, Box<Evaluation3d>)> = Vec::new();
+    let attempt_plain = |ctx: &mut Ctx,
+                         a0: SpatialParams,
+                         stable_seeds: &mut Vec<(SpatialParams, Box<Evaluation3d>)>,
+                         last: &mut IgError3d|
+     -> Option<(SpatialParams, Box<Evaluation3d>, u32)> {
         let ev0 = match ctx.eval(&a0, rtol0, false) {
             Ok(EvalOutcome::Stable(ev)) => ev,
             Ok(EvalOutcome::Unstable) => {
-                last = IgError3d::LeftStableSet;
-                continue;
+                *last = IgError3d::LeftStableSet;
+                return None;
             }
             Err(e) => {
-                last = e;
-                continue;
+                *last = e;
+                return None;
             }
         };
-        match damped_newton(ctx, a0, ev0, tried - 1) {
-            Ok(sol) => return Ok(sol),
+        stable_seeds.push((a0, ev0.clone()));
+        ctx.final_goal();
+        match damped_newton(ctx, a0, ev0, START_BUDGET, true) {
+            Ok(r) => Some(r),
+            Err(e) => {
+                *last = e;
+                None
+            }
+        }
+    };
+    let n_first = PLAIN_FIRST.min(list.len());
+    for (i, a0) in list.iter().take(n_first).enumerate() {
+        tried += 1;
+        if let Some((a, ev, it)) = attempt_plain(ctx, *a0, &mut stable_seeds, &mut last) {
+            return Ok(ctx.solution(a, &ev, it, i as u32));
+        }
+    }
+    // Continuation from the closest stable rod seen so far.
+    if let Some(ab) = ctx.best.1 {
+        tried += 1;
+        if let Ok(EvalOutcome::Stable(evb)) = ctx.eval(&ab, rtol0, false) {
+            match continuation(ctx, ab, evb) {
+                Ok((a, ev, it)) => return Ok(ctx.solution(a, &ev, it, tried - 1)),
+                Err(e) => last = e,
+            }
+        }
+    }
+    for a0 in list.iter().skip(n_first) {
+        tried += 1;
+        if let Some((a, ev, it)) = attempt_plain(ctx, *a0, &mut stable_seeds, &mut last) {
+            return Ok(ctx.solution(a, &ev, it, tried - 1));
+        }
+    }
+    // Continuation from the first stable seeds.
+    for (a0, ev0) in stable_seeds.into_iter().take(2) {
+        tried += 1;
+        match continuation(ctx, a0, ev0) {
+            Ok((a, ev, it)) => return Ok(ctx.solution(a, &ev, it, tried - 1)),
             Err(e) => last = e,
         }
     }

@@ -7,7 +7,10 @@
 //! `coarse_stride`-th point, plus every step end); where it is ≤ 0 the rule's grid points since
 //! the last positive sample are checked one by one, and the first failing one is refined to
 //! the crossing by bisection on the dense output. With `coarse_stride = 1` this is exactly the
-//! full-grid rule.
+//! full-grid rule. With `coarse_stride = 0` (used on the solver's intermediate iterates) only
+//! the step ends are tested, without dense output or refinement: a non-positive det at a step
+//! end ≥ 0.02 counts as unstable (conservative: it may reject a rod whose det dips below zero
+//! only between grid points).
 
 use super::reduced::{self, jac as jac_of, pose as pose_of, ENERGY, NR as NV};
 use super::{check_params, options_for, Evaluation3d, SpatialParams, Stiffness};
@@ -29,7 +32,8 @@ pub struct StabilityOptions {
     pub rtol: f64,
     /// Absolute tolerance (FINDINGS3D trap 1: 1e-16, not 1e-30).
     pub atol: f64,
-    /// Coarse sampling stride in grid points (1 = every i/2000; 40 = every 0.02).
+    /// Coarse sampling stride in grid points (1 = every i/2000; 20 = every 0.01); 0 = step ends
+    /// only, no dense output (fast, conservative; module docs).
     pub coarse_stride: u32,
 }
 
@@ -200,6 +204,25 @@ impl Scan {
         }
     }
 
+    /// Step-end-only variant (no dense output): a non-positive sample is a failure.
+    fn step_end_only(&mut self, t1: f64, y1: &[f64; NV]) {
+        if self.failed.is_some() || self.nonfinite || t1 < STABILITY_T_MIN {
+            return;
+        }
+        let (g, det) = sample(self.planar, y1);
+        if !g.is_finite() {
+            self.nonfinite = true;
+        } else if g > 0.0 {
+            self.note_margin(t1, det);
+            self.last_pos = t1;
+        } else {
+            self.failed = Some(t1);
+            let lead = det_leading_term(&self.a, t1);
+            let m = if lead > 0.0 { -(det / lead).abs() } else { 0.0 };
+            self.margin = self.margin.min(m).min(0.0);
+        }
+    }
+
     /// Returns false when the scan is over (failure or non-finite).
     fn check(&mut self, d: &DenseStep<NV>, t: f64, s: &[f64; NV]) -> bool {
         let (g, det) = sample(self.planar, s);
@@ -264,7 +287,7 @@ fn run(
         reduced::initial::<NV>(),
         1.0,
         &options_for(a, opts.rtol, opts.atol),
-        !straight,
+        !straight && opts.coarse_stride != 0,
     )?;
     let mut scan = Scan {
         a: *a,
@@ -281,8 +304,9 @@ fn run(
         if !straight {
             let t1 = st.t();
             let y1 = *st.y();
-            if let Some(d) = st.dense() {
-                scan.step(d, t1, &y1);
+            match st.dense() {
+                Some(d) => scan.step(d, t1, &y1),
+                None => scan.step_end_only(t1, &y1),
             }
             if scan.nonfinite {
                 return Err(RodError::Overflow("non-finite Jacobian".into()));
