@@ -1,4 +1,53 @@
-fn main() {
-    eprintln!("rod_ig_node: being written");
-    std::process::exit(2);
+//! `rod_ig_node`: start-up (arguments, logging, runtime) of the ROS 2 node; see [`rod_ig_node::node`].
+
+use std::process::ExitCode;
+
+use rod_ig_node::node::{self, MiddlewareConfig};
+use rod_ig_node::params::{self, Command};
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(
+        env_logger::Env::default().default_filter_or("info,rustdds=error,ros2_client=warn"),
+    )
+    .init();
+
+    let params = match params::parse_args(std::env::args().skip(1)) {
+        Ok(Command::Run(p)) => p,
+        Ok(Command::Help) => {
+            print!("{}", params::usage());
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("rod_ig_node: {e}\n\n{}", params::usage());
+            return ExitCode::from(2);
+        }
+    };
+    let mw = match MiddlewareConfig::from_env() {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("rod_ig_node: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let runtime = match tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+    {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("rod_ig_node: cannot start the async runtime: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    match runtime.block_on(node::run(params, mw)) {
+        Ok(()) => {
+            runtime.shutdown_timeout(std::time::Duration::from_secs(1));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            log::error!("rod_ig_node: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }

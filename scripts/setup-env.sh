@@ -1,0 +1,93 @@
+#!/usr/bin/env bash
+# Sets up what rod_ig_node's tests and Python clients need, without a system ROS install:
+#   1. a Python venv with ROS 2 Kilted from PyPI wheels (rclpy on Fast DDS, message packages,
+#      the cmake/rosidl tool chain);
+#   2. the interface package rod_ig_msgs (msg/), built with cmake alone and installed to
+#      build/rod_ig_msgs/install.
+# Idempotent: each step is skipped when its inputs did not change (stamp files).
+#
+# Environment (all optional):
+#   ROD_IG_VENV    venv directory            (default: <repo>/.venv)
+#   ROD_IG_BUILD   build directory            (default: <repo>/build)
+#   PYTHON         interpreter for the venv   (default: python3; CPython 3.11 needed by the wheels)
+# Afterwards: `source scripts/env.sh` puts rclpy and rod_ig_msgs on the paths.
+set -euo pipefail
+
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+VENV="${ROD_IG_VENV:-$REPO/.venv}"
+BUILD="${ROD_IG_BUILD:-$REPO/build}"
+PYTHON="${PYTHON:-python3}"
+
+log() { printf '[setup-env] %s\n' "$*" >&2; }
+
+# --- 0. Python headers (rosidl's Python type support compiles against Python.h) -------------
+py_include="$("$PYTHON" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')"
+if [ ! -f "$py_include/Python.h" ]; then
+    if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
+        log "Python.h missing in $py_include: installing python3-dev and python3-venv"
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq python3-dev python3-venv >/dev/null
+    else
+        log "ERROR: Python.h not found in $py_include; install your Python's development headers"
+        exit 1
+    fi
+fi
+
+# --- 1. venv with the ROS 2 wheels ---------------------------------------------------------
+PACKAGES=(
+    ros-kilted-rclpy ros-kilted-rmw-fastrtps-cpp
+    ros-kilted-std-msgs ros-kilted-geometry-msgs ros-kilted-nav-msgs ros-kilted-std-srvs
+    ros-kilted-rcl-interfaces ros-kilted-visualization-msgs
+    ros-kilted-ament-cmake ros-kilted-rosidl-default-generators ros-kilted-ament-package
+    ros-kilted-ament-cmake-include-directories ros-kilted-rosidl-core-generators
+    ros-kilted-ament-cmake-ros-core catkin_pkg cmake pytest
+)
+want_stamp="$(printf '%s\n' "${PACKAGES[@]}" "$("$PYTHON" --version 2>&1)")"
+stamp="$VENV/.rod-ig-packages"
+if [ ! -x "$VENV/bin/python3" ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want_stamp" ]; then
+    log "creating venv $VENV and installing ROS 2 wheels (about a minute)"
+    [ -x "$VENV/bin/python3" ] || "$PYTHON" -m venv "$VENV"
+    "$VENV/bin/python3" -m pip install --quiet --disable-pip-version-check "${PACKAGES[@]}"
+    printf '%s' "$want_stamp" > "$stamp"
+else
+    log "venv $VENV up to date"
+fi
+
+# The wheels' exported CMake files hard-code the wheel builder's Python and numpy include
+# paths: point them at this venv's own.
+venv_py_include="$("$VENV/bin/python3" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')"
+venv_np_include="$("$VENV/bin/python3" -c 'import numpy; print(numpy.get_include())')"
+{ grep -rlZ --include='*.cmake' '/opt/python/cp311-cp311' "$VENV/share" 2>/dev/null || true; } \
+    | xargs -0 -r sed -i \
+        -e "s#/opt/python/cp311-cp311/lib/python3.11/site-packages/numpy/_core/include#$venv_np_include#g" \
+        -e "s#/opt/python/cp311-cp311/include/python3.11#$venv_py_include#g"
+
+# --- 2. the interface package rod_ig_msgs --------------------------------------------------
+MSG_SRC="$REPO/msg"
+MSG_BUILD="$BUILD/rod_ig_msgs/build"
+MSG_PREFIX="$BUILD/rod_ig_msgs/install"
+msg_hash="$(cat "$MSG_SRC/package.xml" "$MSG_SRC/CMakeLists.txt" "$MSG_SRC"/msg/*.msg "$MSG_SRC"/srv/*.srv \
+    "$stamp" | sha256sum | cut -d' ' -f1)"
+msg_stamp="$MSG_PREFIX/.rod-ig-msgs-hash"
+if [ "$(cat "$msg_stamp" 2>/dev/null)" != "$msg_hash" ] \
+    || [ ! -d "$MSG_PREFIX/lib/python3.11/site-packages/rod_ig_msgs" ]; then
+    log "building rod_ig_msgs into $MSG_PREFIX"
+    rm -rf "$MSG_BUILD" "$MSG_PREFIX"
+    mkdir -p "$MSG_BUILD"
+    (
+        export AMENT_PREFIX_PATH="$VENV"
+        export PATH="$VENV/bin:$PATH"
+        export LD_LIBRARY_PATH="$VENV/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+        "$VENV/bin/cmake" -S "$MSG_SRC" -B "$MSG_BUILD" \
+            -DCMAKE_PREFIX_PATH="$VENV" -DCMAKE_INSTALL_PREFIX="$MSG_PREFIX" \
+            -DPython3_EXECUTABLE="$VENV/bin/python3" -DBUILD_TESTING=OFF \
+            -DCMAKE_BUILD_TYPE=Release >"$BUILD/rod_ig_msgs/cmake.log" 2>&1 \
+        && "$VENV/bin/cmake" --build "$MSG_BUILD" -j 2 >>"$BUILD/rod_ig_msgs/cmake.log" 2>&1 \
+        && "$VENV/bin/cmake" --install "$MSG_BUILD" >>"$BUILD/rod_ig_msgs/cmake.log" 2>&1
+    ) || { log "ERROR: building rod_ig_msgs failed; last lines of $BUILD/rod_ig_msgs/cmake.log:";
+           tail -n 30 "$BUILD/rod_ig_msgs/cmake.log" >&2; exit 1; }
+    printf '%s' "$msg_hash" > "$msg_stamp"
+else
+    log "rod_ig_msgs up to date in $MSG_PREFIX"
+fi
+log "done; use: source $REPO/scripts/env.sh"

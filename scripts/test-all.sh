@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Everything from scratch on a fresh Debian 12 machine with Rust and CPython 3.11, idempotent:
+#   1. Python headers if missing (apt: python3-dev), the venv with ROS 2 Kilted wheels, and the
+#      interface package rod_ig_msgs (scripts/setup-env.sh);
+#   2. the Cargo workspace (release: the integration tests run the release node);
+#   3. `cargo test --workspace` and the pytest suite in tests/ (real rclpy client, node as a
+#      subprocess on random ROS domains, loopback only).
+# Prints cargo's and pytest's summary lines; exits non-zero if anything fails.
+#
+# Environment: ROD_IG_VENV, ROD_IG_BUILD, PYTHON (see setup-env.sh); CARGO_TARGET_DIR;
+# PYTEST_ARGS (extra pytest arguments, e.g. "-k service").
+set -uo pipefail
+
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$REPO"
+LOGS="${ROD_IG_BUILD:-$REPO/build}/test-logs"
+mkdir -p "$LOGS"
+status=0
+
+echo "== setting up the Python/ROS environment"
+bash "$REPO/scripts/setup-env.sh" || { echo "setup-env.sh failed"; exit 1; }
+# shellcheck source=scripts/env.sh
+source "$REPO/scripts/env.sh"
+export ROS_DISTRO="${ROS_DISTRO:-kilted}"
+
+echo "== cargo build --release --workspace"
+cargo build --release --workspace 2>&1 | tail -n 3
+[ "${PIPESTATUS[0]}" = 0 ] || { echo "cargo build failed"; exit 1; }
+
+echo "== cargo test --workspace (release profile: shares the build with the node under test)"
+cargo test --release --workspace 2>&1 | tee "$LOGS/cargo-test.log" \
+    | grep -E '^(test result:|error(\[|:)|failures:|    [a-zA-Z_:]+$|test .* FAILED)' 
+cargo_rc=${PIPESTATUS[0]}
+[ "$cargo_rc" = 0 ] || { echo "cargo test FAILED (full log: $LOGS/cargo-test.log)"; status=1; }
+
+echo "== pytest tests/"
+# shellcheck disable=SC2086
+python -m pytest "$REPO/tests" -q -p no:cacheprovider -W ignore::DeprecationWarning ${PYTEST_ARGS:-} \
+    2>&1 | tee "$LOGS/pytest.log" | tail -n 15
+pytest_rc=${PIPESTATUS[0]}
+[ "$pytest_rc" = 0 ] || { echo "pytest FAILED (full log: $LOGS/pytest.log; node logs in $LOGS)"; status=1; }
+
+echo "== summary"
+grep -E '^test result:' "$LOGS/cargo-test.log" | awk '{p+=$4; f+=$6} END {printf "cargo: %d passed, %d failed\n", p, f}'
+tail -n 1 "$LOGS/pytest.log"
+exit $status

@@ -1,0 +1,512 @@
+//! Conversions between ROS messages (metres, quaternions) and the solver's planar,
+//! normalised world (unit rod length, angle about z). No rod mechanics here: only unit
+//! scaling by the rod length L and the bending stiffness EI, and quaternion ↔ yaw.
+
+use thiserror::Error;
+
+use crate::messages::{
+    ColorRgba, Header, Marker, Path, Point, Pose, PoseStamped, Quaternion, RodSolution, Vector3,
+    Wrench,
+};
+use crate::params::Params;
+use crate::solver::{Failed, PlanarPose, Solved};
+
+/// Why a target pose cannot be solved for (answered with success = false).
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum TargetError {
+    /// NaN or infinite coordinate.
+    #[error("target pose has a non-finite {0}")]
+    NonFinite(&'static str),
+    /// Quaternion of (near) zero norm.
+    #[error("target orientation is not a rotation (quaternion norm {0:.3e})")]
+    ZeroQuaternion(f64),
+    /// z beyond `planar_tolerance`.
+    #[error("target is not planar: z = {z} m (the rod lies in the base's x-y plane, accepted |z| <= {tol} m)")]
+    OffPlane {
+        /// z (m).
+        z: f64,
+        /// Accepted |z| (m).
+        tol: f64,
+    },
+    /// Rotation not about z.
+    #[error("target rotation is not about z: tilt out of the x-y plane {tilt:.3e} rad (accepted <= {tol} rad)")]
+    Tilted {
+        /// Angle between the rotated z axis and z (rad).
+        tilt: f64,
+        /// Accepted tilt (rad).
+        tol: f64,
+    },
+    /// Farther from the base than the rod is long.
+    #[error("target out of reach: {distance} m from the base, must be less than the rod length {length} m")]
+    OutOfReach {
+        /// Base–target distance (m).
+        distance: f64,
+        /// Rod length (m).
+        length: f64,
+    },
+}
+
+/// The quaternion of a rotation by `theta` about z.
+pub fn yaw_to_quaternion(theta: f64) -> Quaternion {
+    let h = 0.5 * theta;
+    Quaternion {
+        x: 0.0,
+        y: 0.0,
+        z: h.sin(),
+        w: h.cos(),
+    }
+}
+
+/// Decomposes a quaternion (any non-zero norm) into (yaw about z, tilt): tilt is the angle
+/// between the rotated z axis and z, 0 for a pure rotation about z; yaw is then the angle of
+/// the rotated x axis in the x-y plane, in (−π, π].
+pub fn quaternion_to_yaw(q: &Quaternion) -> Result<(f64, f64), TargetError> {
+    let n = (q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w).sqrt();
+    if !(n > 1e-9) {
+        return Err(TargetError::ZeroQuaternion(n));
+    }
+    let (x, y, z, w) = (q.x / n, q.y / n, q.z / n, q.w / n);
+    // R[2][2] = 1 − 2(x² + y²) = cos(tilt).
+    let s = (x * x + y * y).sqrt().min(1.0);
+    let tilt = 2.0 * s.asin();
+    // Rotated x axis: (1 − 2(y² + z²), 2(xy + wz)).
+    let yaw = (2.0 * (x * y + w * z)).atan2(1.0 - 2.0 * (y * y + z * z));
+    Ok((yaw, tilt))
+}
+
+/// Checks a target pose (tip gripper in the base gripper's frame, metres) and returns it in
+/// the solver's normalised units: (x / L, y / L, yaw).
+pub fn target_to_planar(pose: &Pose, params: &Params) -> Result<PlanarPose, TargetError> {
+    let p = &pose.position;
+    let q = &pose.orientation;
+    for (name, v) in [
+        ("position.x", p.x),
+        ("position.y", p.y),
+        ("position.z", p.z),
+    ] {
+        if !v.is_finite() {
+            return Err(TargetError::NonFinite(name));
+        }
+    }
+    for (name, v) in [
+        ("orientation.x", q.x),
+        ("orientation.y", q.y),
+        ("orientation.z", q.z),
+        ("orientation.w", q.w),
+    ] {
+        if !v.is_finite() {
+            return Err(TargetError::NonFinite(name));
+        }
+    }
+    let tol = params.planar_tolerance;
+    if p.z.abs() > tol {
+        return Err(TargetError::OffPlane { z: p.z, tol });
+    }
+    let (yaw, tilt) = quaternion_to_yaw(q)?;
+    if tilt > tol {
+        return Err(TargetError::Tilted { tilt, tol });
+    }
+    let l = params.rod_length;
+    let distance = p.x.hypot(p.y);
+    // At exactly L only the straight rod fits, and it is not a stable equilibrium.
+    if distance >= l {
+        return Err(TargetError::OutOfReach {
+            distance,
+            length: l,
+        });
+    }
+    Ok(PlanarPose::new(p.x / l, p.y / l, yaw))
+}
+
+/// The frame of published messages: the target's frame_id, or `base_frame` when empty.
+pub fn output_header(target: &Header, params: &Params) -> Header {
+    Header {
+        stamp: target.stamp,
+        frame_id: if target.frame_id.is_empty() {
+            params.base_frame.clone()
+        } else {
+            target.frame_id.clone()
+        },
+    }
+}
+
+/// A normalised planar pose as a ROS pose in metres.
+pub fn planar_to_pose(q: &PlanarPose, rod_length: f64) -> Pose {
+    Pose {
+        position: Point {
+            x: q.x * rod_length,
+            y: q.y * rod_length,
+            z: 0.0,
+        },
+        orientation: yaw_to_quaternion(q.theta),
+    }
+}
+
+/// The rod's shape as a `nav_msgs/Path`: one pose per sample, orientation = tangent.
+pub fn shape_to_path(shape: &[PlanarPose], header: &Header, rod_length: f64) -> Path {
+    Path {
+        header: header.clone(),
+        poses: shape
+            .iter()
+            .map(|q| PoseStamped {
+                header: header.clone(),
+                pose: planar_to_pose(q, rod_length),
+            })
+            .collect(),
+    }
+}
+
+/// The rod's shape as an RViz line strip (green when stable, orange when not).
+pub fn shape_to_marker(
+    shape: &[PlanarPose],
+    header: &Header,
+    params: &Params,
+    stable: bool,
+) -> Marker {
+    let l = params.rod_length;
+    Marker {
+        header: header.clone(),
+        ns: "rod".into(),
+        id: 0,
+        marker_type: Marker::LINE_STRIP,
+        action: Marker::ADD,
+        pose: Pose::default(),
+        scale: Vector3 {
+            x: params.marker_width,
+            y: 0.0,
+            z: 0.0,
+        },
+        color: if stable {
+            ColorRgba {
+                r: 0.1,
+                g: 0.8,
+                b: 0.2,
+                a: 1.0,
+            }
+        } else {
+            ColorRgba {
+                r: 1.0,
+                g: 0.5,
+                b: 0.0,
+                a: 1.0,
+            }
+        },
+        points: shape
+            .iter()
+            .map(|q| Point {
+                x: q.x * l,
+                y: q.y * l,
+                z: 0.0,
+            })
+            .collect(),
+        ..Marker::default()
+    }
+}
+
+/// Base wrench in physical units: force = (a4, a5)·EI/L², torque z = a3·EI/L.
+pub fn base_wrench(a: &[f64; 3], rod_length: f64, bending_stiffness: f64) -> Wrench {
+    let ei = bending_stiffness;
+    let l = rod_length;
+    Wrench {
+        force: Vector3 {
+            x: a[1] * ei / (l * l),
+            y: a[2] * ei / (l * l),
+            z: 0.0,
+        },
+        torque: Vector3 {
+            x: 0.0,
+            y: 0.0,
+            z: a[0] * ei / l,
+        },
+    }
+}
+
+/// The RodSolution of a converged solve.
+pub fn solution_message(
+    s: &Solved,
+    header: &Header,
+    params: &Params,
+    solve_time: f64,
+) -> RodSolution {
+    let l = params.rod_length;
+    let ei = params.bending_stiffness;
+    let a = [s.a[0], s.a[1], s.a[2]];
+    let wrench_valid = ei > 0.0;
+    RodSolution {
+        header: header.clone(),
+        success: true,
+        message: format!(
+            "converged in {} iterations, {}",
+            s.iterations,
+            if s.stable { "stable" } else { "UNSTABLE" }
+        ),
+        a,
+        stable: s.stable,
+        stability_margin: s.stability_margin,
+        iterations: s.iterations,
+        position_error: s.position_error * l,
+        orientation_error: s.orientation_error,
+        residual: s.residual,
+        elastic_energy: s.energy,
+        elastic_energy_joules: if wrench_valid {
+            s.energy * ei / l
+        } else {
+            f64::NAN
+        },
+        wrench_valid,
+        base_wrench: if wrench_valid {
+            base_wrench(&a, l, ei)
+        } else {
+            Wrench::default()
+        },
+        tip: planar_to_pose(&s.tip, l),
+        rod_length: l,
+        solve_time,
+    }
+}
+
+/// The RodSolution of a rejected target or a failed solve (success = false).
+pub fn failure_message(
+    message: String,
+    failed: Option<&Failed>,
+    header: &Header,
+    params: &Params,
+    solve_time: f64,
+) -> RodSolution {
+    let nan = f64::NAN;
+    let a = failed
+        .and_then(|f| f.last_a)
+        .map(|a| [a[0], a[1], a[2]])
+        .unwrap_or([nan; 3]);
+    RodSolution {
+        header: header.clone(),
+        success: false,
+        message,
+        a,
+        stable: false,
+        stability_margin: nan,
+        iterations: failed.map_or(0, |f| f.iterations),
+        position_error: nan,
+        orientation_error: nan,
+        residual: failed.map_or(nan, |f| f.residual),
+        elastic_energy: nan,
+        elastic_energy_joules: nan,
+        wrench_valid: false,
+        base_wrench: Wrench::default(),
+        tip: Pose {
+            position: Point {
+                x: nan,
+                y: nan,
+                z: nan,
+            },
+            orientation: Quaternion {
+                x: nan,
+                y: nan,
+                z: nan,
+                w: nan,
+            },
+        },
+        rod_length: params.rod_length,
+        solve_time,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    fn pose(x: f64, y: f64, z: f64, q: Quaternion) -> Pose {
+        Pose {
+            position: Point { x, y, z },
+            orientation: q,
+        }
+    }
+
+    #[test]
+    fn yaw_round_trip() {
+        for &t in &[0.0, 0.3, -1.2, FRAC_PI_2, 3.0, -3.0, PI] {
+            let (yaw, tilt) = quaternion_to_yaw(&yaw_to_quaternion(t)).unwrap();
+            assert!(
+                (yaw - t).abs() < 1e-12 || (yaw - t).abs() > 2.0 * PI - 1e-12,
+                "{t} {yaw}"
+            );
+            assert!(tilt < 1e-12);
+        }
+        // Non-unit quaternion with the same rotation, and q vs −q.
+        let q = Quaternion {
+            x: 0.0,
+            y: 0.0,
+            z: -2.0 * (0.4f64).sin(),
+            w: -2.0 * (0.4f64).cos(),
+        };
+        let (yaw, _) = quaternion_to_yaw(&q).unwrap();
+        assert!((yaw - 0.8).abs() < 1e-12);
+    }
+
+    #[test]
+    fn tilt_detected() {
+        // 0.1 rad about x.
+        let q = Quaternion {
+            x: (0.05f64).sin(),
+            y: 0.0,
+            z: 0.0,
+            w: (0.05f64).cos(),
+        };
+        let (_, tilt) = quaternion_to_yaw(&q).unwrap();
+        assert!((tilt - 0.1).abs() < 1e-12);
+        let p = Params::default();
+        assert!(matches!(
+            target_to_planar(&pose(0.5, 0.0, 0.0, q), &p),
+            Err(TargetError::Tilted { .. })
+        ));
+    }
+
+    #[test]
+    fn scaling_by_rod_length() {
+        let p = Params {
+            rod_length: 2.0,
+            ..Params::default()
+        };
+        let t = target_to_planar(&pose(1.0, -0.5, 0.0, yaw_to_quaternion(0.7)), &p).unwrap();
+        assert!((t.x - 0.5).abs() < 1e-15 && (t.y + 0.25).abs() < 1e-15);
+        assert!((t.theta - 0.7).abs() < 1e-12);
+        let back = planar_to_pose(&t, p.rod_length);
+        assert!((back.position.x - 1.0).abs() < 1e-15 && (back.position.y + 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn bad_targets_rejected() {
+        let p = Params {
+            rod_length: 0.5,
+            ..Params::default()
+        };
+        let id = Quaternion::default();
+        let cases = [
+            (pose(f64::NAN, 0.0, 0.0, id), "non-finite"),
+            (pose(0.1, f64::INFINITY, 0.0, id), "non-finite"),
+            (
+                pose(0.1, 0.0, 0.0, Quaternion { w: f64::NAN, ..id }),
+                "non-finite",
+            ),
+            (
+                pose(
+                    0.1,
+                    0.0,
+                    0.0,
+                    Quaternion {
+                        x: 0.0,
+                        y: 0.0,
+                        z: 0.0,
+                        w: 0.0,
+                    },
+                ),
+                "not a rotation",
+            ),
+            (pose(0.1, 0.0, 0.01, id), "not planar"),
+            (pose(0.4, 0.4, 0.0, id), "out of reach"),
+        ];
+        for (pose, what) in cases {
+            let e = target_to_planar(&pose, &p).unwrap_err();
+            assert!(e.to_string().contains(what), "{e} vs {what}");
+        }
+        // Exactly at full length: only the straight rod, unstable: rejected too.
+        assert!(target_to_planar(&pose(0.5, 0.0, 0.0, id), &p).is_err());
+        assert!(target_to_planar(&pose(0.499, 0.0, 0.0, id), &p).is_ok());
+        // Tiny z within tolerance: accepted.
+        assert!(target_to_planar(&pose(0.3, 0.0, 1e-9, id), &p).is_ok());
+    }
+
+    #[test]
+    fn header_frame_fallback() {
+        let p = Params {
+            base_frame: "base".into(),
+            ..Params::default()
+        };
+        let h = Header {
+            frame_id: String::new(),
+            ..Header::default()
+        };
+        assert_eq!(output_header(&h, &p).frame_id, "base");
+        let h = Header {
+            frame_id: "left".into(),
+            ..Header::default()
+        };
+        assert_eq!(output_header(&h, &p).frame_id, "left");
+    }
+
+    #[test]
+    fn path_and_marker_are_scaled() {
+        let shape = vec![
+            PlanarPose::new(0.0, 0.0, 0.0),
+            PlanarPose::new(0.5, 0.5, FRAC_PI_2),
+        ];
+        let h = Header {
+            frame_id: "f".into(),
+            ..Header::default()
+        };
+        let path = shape_to_path(&shape, &h, 2.0);
+        assert_eq!(path.poses.len(), 2);
+        assert_eq!(path.poses[1].pose.position.x, 1.0);
+        assert!((path.poses[1].pose.orientation.z - (0.25 * PI).sin()).abs() < 1e-15);
+        assert_eq!(path.poses[1].header.frame_id, "f");
+        let p = Params {
+            rod_length: 2.0,
+            ..Params::default()
+        };
+        let m = shape_to_marker(&shape, &h, &p, true);
+        assert_eq!(m.points[1].y, 1.0);
+        assert_eq!(m.marker_type, Marker::LINE_STRIP);
+    }
+
+    #[test]
+    fn physical_units() {
+        // EI = 2 N m², L = 0.5 m: force × EI/L² = 8, torque × EI/L = 4, energy × 4.
+        let w = base_wrench(&[1.0, 2.0, -3.0], 0.5, 2.0);
+        assert_eq!((w.force.x, w.force.y, w.torque.z), (16.0, -24.0, 4.0));
+        let s = Solved {
+            a: crate::solver::PlanarParams::new(1.0, 2.0, -3.0),
+            tip: PlanarPose::new(0.5, 0.1, 0.2),
+            stable: true,
+            stability_margin: 0.3,
+            iterations: 4,
+            position_error: 1e-7,
+            orientation_error: 1e-8,
+            residual: 1e-9,
+            energy: 1.5,
+            shape: vec![],
+        };
+        let p = Params {
+            rod_length: 0.5,
+            bending_stiffness: 2.0,
+            ..Params::default()
+        };
+        let m = solution_message(&s, &Header::default(), &p, 1e-4);
+        assert!(m.success && m.wrench_valid);
+        assert_eq!(m.elastic_energy_joules, 6.0);
+        assert_eq!(m.position_error, 5e-8);
+        assert_eq!(m.tip.position.x, 0.25);
+        assert_eq!(m.a, [1.0, 2.0, -3.0]);
+        let p0 = Params {
+            rod_length: 0.5,
+            ..Params::default()
+        };
+        let m0 = solution_message(&s, &Header::default(), &p0, 1e-4);
+        assert!(!m0.wrench_valid && m0.elastic_energy_joules.is_nan());
+        assert_eq!(m0.base_wrench, Wrench::default());
+    }
+
+    #[test]
+    fn failure_has_reason() {
+        let m = failure_message(
+            "why".into(),
+            None,
+            &Header::default(),
+            &Params::default(),
+            0.0,
+        );
+        assert!(!m.success);
+        assert_eq!(m.message, "why");
+        assert!(m.a[0].is_nan());
+    }
+}

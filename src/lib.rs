@@ -1,0 +1,19 @@
+//! # rod-ig-node
+//!
+//! A ROS 2 node (`rod_ig_node`) serving the inverse geometry of a planar elastic rod held by
+//! two grippers: a thin adapter between ROS messages and the solver crate `rod_ig_core`.
+//!
+//! - [`params`]: parameters, start-up arguments (`-p`, `--params-file`), validation.
+//! - [`messages`]: serde mirrors of the ROS message types (byte-checked against rclpy).
+//! - [`convert`]: pose ↔ planar target, scaling by rod length and stiffness, path building.
+//! - [`solver`]: the only module that calls `rod_ig_core`.
+//! - [`pipeline`]: one target in, the messages to publish out (no DDS).
+//! - [`node`]: DDS context, topics, service, parameters and tasks.
+#![warn(missing_docs)]
+
+pub mod convert;
+pub mod messages;
+pub mod node;
+pub mod params;
+pub mod pipeline;
+pub mod solver;

@@ -1,0 +1,545 @@
+//! Serde mirrors of the ROS 2 message types the node exchanges.
+//!
+//! ros2-client ships no message packages, so the standard types are written by hand here.
+//! CDR has no field names or tags: the field order (and types) of each struct must match its
+//! `.msg` definition exactly. `tests/fixtures/cdr/*.hex` hold the bytes rclpy's serializer
+//! produces for the same values; the unit tests at the bottom compare them byte for byte.
+
+use ros2_client::{Message, MessageTypeName, ServiceTypeName};
+use serde::{Deserialize, Serialize};
+
+/// `builtin_interfaces/msg/Time`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Time {
+    /// Seconds.
+    pub sec: i32,
+    /// Nanoseconds, in [0, 1e9).
+    pub nanosec: u32,
+}
+
+/// `builtin_interfaces/msg/Duration`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Duration {
+    /// Seconds.
+    pub sec: i32,
+    /// Nanoseconds, in [0, 1e9).
+    pub nanosec: u32,
+}
+
+/// `std_msgs/msg/Header`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Header {
+    /// Time stamp.
+    pub stamp: Time,
+    /// Coordinate frame.
+    pub frame_id: String,
+}
+
+/// `std_msgs/msg/ColorRGBA`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ColorRgba {
+    /// Red, [0, 1].
+    pub r: f32,
+    /// Green, [0, 1].
+    pub g: f32,
+    /// Blue, [0, 1].
+    pub b: f32,
+    /// Opacity, [0, 1].
+    pub a: f32,
+}
+
+/// `geometry_msgs/msg/Point`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Point {
+    /// x (m).
+    pub x: f64,
+    /// y (m).
+    pub y: f64,
+    /// z (m).
+    pub z: f64,
+}
+
+/// `geometry_msgs/msg/Vector3`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Vector3 {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+}
+
+/// `geometry_msgs/msg/Quaternion` (x, y, z, w order on the wire).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Quaternion {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+    /// w.
+    pub w: f64,
+}
+
+impl Default for Quaternion {
+    /// The identity rotation, as in ROS.
+    fn default() -> Self {
+        Self {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            w: 1.0,
+        }
+    }
+}
+
+/// `geometry_msgs/msg/Pose`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Pose {
+    /// Position (m).
+    pub position: Point,
+    /// Orientation.
+    pub orientation: Quaternion,
+}
+
+/// `geometry_msgs/msg/PoseStamped`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PoseStamped {
+    /// Stamp and frame.
+    pub header: Header,
+    /// The pose.
+    pub pose: Pose,
+}
+impl Message for PoseStamped {}
+
+/// `geometry_msgs/msg/Wrench`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Wrench {
+    /// Force (N).
+    pub force: Vector3,
+    /// Torque (N·m).
+    pub torque: Vector3,
+}
+
+/// `nav_msgs/msg/Path`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Path {
+    /// Stamp and frame of the whole path.
+    pub header: Header,
+    /// The poses, in order.
+    pub poses: Vec<PoseStamped>,
+}
+impl Message for Path {}
+
+/// `sensor_msgs/msg/CompressedImage` (only nested, empty, in [`Marker`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CompressedImage {
+    /// Stamp and frame.
+    pub header: Header,
+    /// Image format.
+    pub format: String,
+    /// Image bytes.
+    pub data: Vec<u8>,
+}
+
+/// `visualization_msgs/msg/UVCoordinate`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct UvCoordinate {
+    /// u.
+    pub u: f32,
+    /// v.
+    pub v: f32,
+}
+
+/// `visualization_msgs/msg/MeshFile`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MeshFile {
+    /// File name.
+    pub filename: String,
+    /// File contents.
+    pub data: Vec<u8>,
+}
+
+/// `visualization_msgs/msg/Marker` (Kilted definition).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Marker {
+    /// Stamp and frame.
+    pub header: Header,
+    /// Namespace.
+    pub ns: String,
+    /// Id within the namespace.
+    pub id: i32,
+    /// Shape type (see the constants).
+    #[serde(rename = "type")]
+    pub marker_type: i32,
+    /// Action (add / delete).
+    pub action: i32,
+    /// Pose of the marker frame.
+    pub pose: Pose,
+    /// Scale; for a line strip, `scale.x` is the line width (m).
+    pub scale: Vector3,
+    /// Colour of the whole marker.
+    pub color: ColorRgba,
+    /// How long the marker lives (0 = forever).
+    pub lifetime: Duration,
+    /// Re-transform the marker every frame.
+    pub frame_locked: bool,
+    /// Points of a line strip.
+    pub points: Vec<Point>,
+    /// Per-point colours (empty = `color`).
+    pub colors: Vec<ColorRgba>,
+    /// Texture resource (unused).
+    pub texture_resource: String,
+    /// Texture (unused).
+    pub texture: CompressedImage,
+    /// Texture coordinates (unused).
+    pub uv_coordinates: Vec<UvCoordinate>,
+    /// Text (unused).
+    pub text: String,
+    /// Mesh resource (unused).
+    pub mesh_resource: String,
+    /// Mesh file (unused).
+    pub mesh_file: MeshFile,
+    /// Mesh materials (unused).
+    pub mesh_use_embedded_materials: bool,
+}
+impl Message for Marker {}
+
+impl Marker {
+    /// `Marker.LINE_STRIP`.
+    pub const LINE_STRIP: i32 = 4;
+    /// `Marker.ADD`.
+    pub const ADD: i32 = 0;
+}
+
+/// `rod_ig_msgs/msg/RodSolution` (see `msg/msg/RodSolution.msg` for the meaning of each field).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RodSolution {
+    /// Stamp copied from the target, frame = target frame or `base_frame`.
+    pub header: Header,
+    /// The rod reaches the target.
+    pub success: bool,
+    /// Why not, or a short summary.
+    pub message: String,
+    /// Normalised base wrench (a3, a4, a5).
+    pub a: [f64; 3],
+    /// Stable equilibrium.
+    pub stable: bool,
+    /// Normalised stability margin.
+    pub stability_margin: f64,
+    /// Solver iterations.
+    pub iterations: u32,
+    /// Tip position error (m).
+    pub position_error: f64,
+    /// Tip orientation error (rad).
+    pub orientation_error: f64,
+    /// Solver residual (normalised).
+    pub residual: f64,
+    /// Normalised elastic energy.
+    pub elastic_energy: f64,
+    /// Elastic energy in joules (NaN without `bending_stiffness`).
+    pub elastic_energy_joules: f64,
+    /// `base_wrench` is meaningful.
+    pub wrench_valid: bool,
+    /// Base wrench in N and N·m.
+    pub base_wrench: Wrench,
+    /// Reached tip pose.
+    pub tip: Pose,
+    /// Rod length used (m).
+    pub rod_length: f64,
+    /// Solve wall time (s).
+    pub solve_time: f64,
+}
+impl Message for RodSolution {}
+
+/// Request of `rod_ig_msgs/srv/SolveRod`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SolveRodRequest {
+    /// Tip gripper pose in the base frame.
+    pub target: PoseStamped,
+    /// Start from `initial_guess` rather than the previous solution.
+    pub use_initial_guess: bool,
+    /// Normalised (a3, a4, a5) start point.
+    pub initial_guess: [f64; 3],
+    /// Tolerance override (0 = parameter).
+    pub tolerance: f64,
+    /// Iteration limit override (0 = parameter).
+    pub max_iterations: u32,
+    /// Method override ("" = parameter).
+    pub method: String,
+    /// Path poses override (0 = parameter).
+    pub path_samples: u32,
+}
+impl Message for SolveRodRequest {}
+
+/// Response of `rod_ig_msgs/srv/SolveRod`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SolveRodResponse {
+    /// The solution (success = false with a reason on bad input).
+    pub solution: RodSolution,
+    /// The shape; no poses unless `solution.success`.
+    pub path: Path,
+}
+impl Message for SolveRodResponse {}
+
+/// DDS type names of the topics and the service.
+pub mod type_names {
+    use super::*;
+
+    /// `geometry_msgs/msg/PoseStamped`.
+    pub fn pose_stamped() -> MessageTypeName {
+        MessageTypeName::new("geometry_msgs", "PoseStamped")
+    }
+    /// `nav_msgs/msg/Path`.
+    pub fn path() -> MessageTypeName {
+        MessageTypeName::new("nav_msgs", "Path")
+    }
+    /// `visualization_msgs/msg/Marker`.
+    pub fn marker() -> MessageTypeName {
+        MessageTypeName::new("visualization_msgs", "Marker")
+    }
+    /// `rod_ig_msgs/msg/RodSolution`.
+    pub fn rod_solution() -> MessageTypeName {
+        MessageTypeName::new("rod_ig_msgs", "RodSolution")
+    }
+    /// `rod_ig_msgs/srv/SolveRod`.
+    pub fn solve_rod() -> ServiceTypeName {
+        ServiceTypeName::new("rod_ig_msgs", "SolveRod")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! Byte-exact CDR checks against rclpy (fixtures from `tests/gen_cdr_fixtures.py`).
+    use super::*;
+    use byteorder::LittleEndian;
+    use std::path::PathBuf;
+
+    /// Reads `tests/fixtures/cdr/<name>.hex` and strips the 4-byte encapsulation header
+    /// (00 01 00 00 = CDR little endian) that rclpy's `serialize_message` prepends.
+    fn fixture(name: &str) -> Vec<u8> {
+        let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "tests", "fixtures", "cdr", name]
+            .iter()
+            .collect();
+        let text = std::fs::read_to_string(&path)
+            .unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+        let hex: String = text.split_whitespace().collect();
+        let bytes: Vec<u8> = (0..hex.len())
+            .step_by(2)
+            .map(|i| u8::from_str_radix(&hex[i..i + 2], 16).expect("hex fixture"))
+            .collect();
+        assert_eq!(&bytes[..4], &[0, 1, 0, 0], "{name}: not CDR little endian");
+        bytes[4..].to_vec()
+    }
+
+    /// CDR payload as ros2-client writes it.
+    fn cdr<T: Serialize>(value: &T) -> Vec<u8> {
+        ros2_client::dds::rustdds::cdr_encoding::to_vec::<T, LittleEndian>(value)
+            .expect("serialize")
+    }
+
+    /// Compares, allowing trailing alignment padding (zeros, < 8 bytes) on one side only.
+    fn assert_same(ours: &[u8], theirs: &[u8], name: &str) {
+        let n = ours.len().min(theirs.len());
+        let tail = if ours.len() > n {
+            &ours[n..]
+        } else {
+            &theirs[n..]
+        };
+        assert!(
+            tail.len() < 8 && tail.iter().all(|&b| b == 0),
+            "{name}: lengths differ: ours {} rclpy {}",
+            ours.len(),
+            theirs.len()
+        );
+        assert_eq!(&ours[..n], &theirs[..n], "{name}: CDR differs from rclpy");
+    }
+
+    fn check<T>(value: &T, name: &str)
+    where
+        T: Serialize + for<'de> Deserialize<'de> + PartialEq + std::fmt::Debug,
+    {
+        let theirs = fixture(name);
+        let ours = cdr(value);
+        assert_same(&ours, &theirs, name);
+        let (back, _) =
+            ros2_client::dds::rustdds::cdr_encoding::from_bytes::<T, LittleEndian>(&theirs)
+                .unwrap_or_else(|e| panic!("{name}: deserializing rclpy bytes: {e}"));
+        assert_eq!(&back, value, "{name}: round trip from rclpy bytes");
+    }
+
+    fn header() -> Header {
+        Header {
+            stamp: Time {
+                sec: 1_700_000_000,
+                nanosec: 123_456_789,
+            },
+            frame_id: "base_gripper".into(),
+        }
+    }
+
+    /// Pose number `i` of the fixtures (exactly representable values, see the generator).
+    fn pose(i: usize) -> Pose {
+        let (z, w) = [(0.0, 1.0), (0.6, 0.8), (0.28, 0.96)][i % 3];
+        Pose {
+            position: Point {
+                x: 0.25 + i as f64,
+                y: -0.5 * i as f64,
+                z: 0.0,
+            },
+            orientation: Quaternion {
+                x: 0.0,
+                y: 0.0,
+                z,
+                w,
+            },
+        }
+    }
+
+    pub(crate) fn sample_pose_stamped() -> PoseStamped {
+        PoseStamped {
+            header: header(),
+            pose: pose(1),
+        }
+    }
+
+    pub(crate) fn sample_path() -> Path {
+        Path {
+            header: header(),
+            poses: (0..3)
+                .map(|i| PoseStamped {
+                    header: header(),
+                    pose: pose(i),
+                })
+                .collect(),
+        }
+    }
+
+    pub(crate) fn sample_marker() -> Marker {
+        Marker {
+            header: header(),
+            ns: "rod".into(),
+            id: 7,
+            marker_type: Marker::LINE_STRIP,
+            action: Marker::ADD,
+            pose: Pose::default(),
+            scale: Vector3 {
+                x: 0.01,
+                y: 0.0,
+                z: 0.0,
+            },
+            color: ColorRgba {
+                r: 0.1,
+                g: 0.8,
+                b: 0.2,
+                a: 1.0,
+            },
+            lifetime: Duration { sec: 0, nanosec: 5 },
+            frame_locked: true,
+            points: vec![
+                Point {
+                    x: 0.0,
+                    y: 0.0,
+                    z: 0.0,
+                },
+                Point {
+                    x: 0.5,
+                    y: 0.25,
+                    z: 0.0,
+                },
+            ],
+            colors: vec![],
+            texture_resource: String::new(),
+            texture: CompressedImage::default(),
+            uv_coordinates: vec![],
+            text: String::new(),
+            mesh_resource: String::new(),
+            mesh_file: MeshFile::default(),
+            mesh_use_embedded_materials: false,
+        }
+    }
+
+    pub(crate) fn sample_rod_solution() -> RodSolution {
+        RodSolution {
+            header: header(),
+            success: true,
+            message: "ok".into(),
+            a: [1.5, -2.25, 3.125],
+            stable: true,
+            stability_margin: 0.5,
+            iterations: 7,
+            position_error: 1e-9,
+            orientation_error: 2e-9,
+            residual: 3e-10,
+            elastic_energy: 4.5,
+            elastic_energy_joules: 0.045,
+            wrench_valid: true,
+            base_wrench: Wrench {
+                force: Vector3 {
+                    x: 1.0,
+                    y: 2.0,
+                    z: 0.0,
+                },
+                torque: Vector3 {
+                    x: 0.0,
+                    y: 0.0,
+                    z: -3.0,
+                },
+            },
+            tip: pose(1),
+            rod_length: 0.8,
+            solve_time: 0.00025,
+        }
+    }
+
+    pub(crate) fn sample_request() -> SolveRodRequest {
+        SolveRodRequest {
+            target: sample_pose_stamped(),
+            use_initial_guess: true,
+            initial_guess: [0.1, 0.2, 0.3],
+            tolerance: 1e-8,
+            max_iterations: 50,
+            method: "newton".into(),
+            path_samples: 9,
+        }
+    }
+
+    pub(crate) fn sample_response() -> SolveRodResponse {
+        SolveRodResponse {
+            solution: sample_rod_solution(),
+            path: sample_path(),
+        }
+    }
+
+    #[test]
+    fn pose_stamped_matches_rclpy() {
+        check(&sample_pose_stamped(), "pose_stamped.hex");
+    }
+
+    #[test]
+    fn path_matches_rclpy() {
+        check(&sample_path(), "path.hex");
+    }
+
+    #[test]
+    fn marker_matches_rclpy() {
+        check(&sample_marker(), "marker.hex");
+    }
+
+    #[test]
+    fn rod_solution_matches_rclpy() {
+        check(&sample_rod_solution(), "rod_solution.hex");
+    }
+
+    #[test]
+    fn solve_rod_request_matches_rclpy() {
+        check(&sample_request(), "solve_rod_request.hex");
+    }
+
+    #[test]
+    fn solve_rod_response_matches_rclpy() {
+        check(&sample_response(), "solve_rod_response.hex");
+    }
+}

@@ -1,0 +1,475 @@
+//! The ROS 2 side: DDS context, topics, the service, parameters, and the tasks between them.
+//!
+//! ```text
+//!  /rod/target ──► subscriber task ──watch (latest wins)──► solver task ──► /rod/path
+//!  /rod/solve  ──► service task ──mpsc + oneshot──────────►  (Processor)  ──► /rod/solution
+//!  parameter services ──validator / set action──watch<Params>──►            ──► /rod/marker
+//! ```
+//!
+//! A flood of targets cannot pile up: the subscriber task only overwrites the one slot of a
+//! `tokio::sync::watch` channel, and the solver task always takes the newest target.
+
+use std::pin::pin;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+
+use futures::StreamExt;
+use ros2_client::dds::rustdds::DomainParticipantBuilder;
+use ros2_client::log::LogLevel;
+use ros2_client::qos::{Durability, History, WhenFull};
+use ros2_client::{
+    rosout, Context, Name, NodeLoggingHandle, NodeName, NodeOptions, ParameterValue, Publisher,
+    QosProfile, ServiceMapping,
+};
+use thiserror::Error;
+use tokio::sync::{mpsc, oneshot, watch};
+
+use crate::messages::{
+    type_names, Marker, Path, PoseStamped, RodSolution, SolveRodRequest, SolveRodResponse,
+};
+use crate::params::Params;
+use crate::pipeline::{Outcome, Overrides, Processor};
+
+/// The node's name.
+pub const NODE_NAME: &str = "rod_ig_node";
+
+/// Errors that stop the node from starting.
+#[derive(Debug, Error)]
+pub enum NodeError {
+    /// Bad environment variable.
+    #[error("environment: {0}")]
+    Environment(String),
+    /// DDS / ROS entity creation failed.
+    #[error("cannot create {what}: {reason}")]
+    Create {
+        /// Which entity.
+        what: &'static str,
+        /// Why.
+        reason: String,
+    },
+}
+
+fn create_err<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> NodeError {
+    move |e| NodeError::Create {
+        what,
+        reason: format!("{e:?}"),
+    }
+}
+
+/// Middleware settings read from the environment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MiddlewareConfig {
+    /// `ROS_DOMAIN_ID` (default 0).
+    pub domain_id: u16,
+    /// Loopback only: `ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST` or `ROS_LOCALHOST_ONLY=1`.
+    pub localhost_only: bool,
+}
+
+impl MiddlewareConfig {
+    /// Reads the configuration from environment variables (given as a lookup function so
+    /// it can be tested).
+    pub fn from_lookup(get: impl Fn(&str) -> Option<String>) -> Result<Self, NodeError> {
+        let domain_id = match get("ROS_DOMAIN_ID").map(|s| s.trim().to_string()) {
+            None => 0,
+            Some(s) if s.is_empty() => 0,
+            Some(s) => match s.parse::<u16>() {
+                Ok(d) if d <= 232 => d,
+                _ => {
+                    return Err(NodeError::Environment(format!(
+                        "ROS_DOMAIN_ID must be an integer in 0..=232, got {s:?}"
+                    )))
+                }
+            },
+        };
+        let range = get("ROS_AUTOMATIC_DISCOVERY_RANGE").unwrap_or_default();
+        let localhost_only = range.trim().eq_ignore_ascii_case("LOCALHOST")
+            || get("ROS_LOCALHOST_ONLY").is_some_and(|v| v.trim() == "1");
+        Ok(Self {
+            domain_id,
+            localhost_only,
+        })
+    }
+
+    /// From the process environment.
+    pub fn from_env() -> Result<Self, NodeError> {
+        Self::from_lookup(|k| std::env::var(k).ok())
+    }
+}
+
+/// QoS of the topics: reliable, volatile, keep last 10 (rclpy's `create_publisher(T, t, 10)`).
+pub fn topic_qos() -> QosProfile {
+    QosProfile::publisher_default()
+        .reliability_reliable(WhenFull::DEFAULT)
+        .durability(Durability::Volatile)
+        .history(History::KeepLast { depth: 10 })
+}
+
+/// Console (env_logger) plus /rosout logging.
+pub struct Logger {
+    handle: NodeLoggingHandle,
+}
+
+impl Logger {
+    /// Logs at info level.
+    pub fn info(&self, msg: &str) {
+        log::info!("{msg}");
+        rosout!(self.handle, LogLevel::Info, "{}", msg);
+    }
+    /// Logs at warn level.
+    pub fn warn(&self, msg: &str) {
+        log::warn!("{msg}");
+        rosout!(self.handle, LogLevel::Warn, "{}", msg);
+    }
+    /// Logs at error level.
+    pub fn error(&self, msg: &str) {
+        log::error!("{msg}");
+        rosout!(self.handle, LogLevel::Error, "{}", msg);
+    }
+}
+
+/// Counters reported at shutdown.
+#[derive(Default)]
+struct Stats {
+    received: AtomicU64,
+    solved: AtomicU64,
+    failed: AtomicU64,
+    service_calls: AtomicU64,
+}
+
+/// A service request on its way to the solver task, with the slot for the answer.
+type ServiceJob = (SolveRodRequest, oneshot::Sender<SolveRodResponse>);
+
+/// The node's publishers.
+struct Outputs {
+    path: Publisher<Path>,
+    solution: Publisher<RodSolution>,
+    marker: Publisher<Marker>,
+}
+
+/// Creates the DDS context for `mw` (domain, loopback restriction).
+fn create_context(mw: &MiddlewareConfig) -> Result<Context, NodeError> {
+    let mut builder = DomainParticipantBuilder::new(mw.domain_id);
+    if mw.localhost_only {
+        builder = builder.with_only_networks([std::net::Ipv4Addr::LOCALHOST]);
+    }
+    let participant = builder.build().map_err(create_err("DDS participant"))?;
+    Context::from_domain_participant(participant).map_err(create_err("ROS context"))
+}
+
+/// Runs the node until SIGINT or SIGTERM.
+pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> {
+    let context = create_context(&mw)?;
+
+    // Parameters: the node's parameter store validates through `Params::validate` and
+    // applies through `Params::apply`, then the solver task sees the new `Params`.
+    let (params_tx, params_rx) = watch::channel(params.clone());
+    let params_tx = Arc::new(params_tx);
+    let validator_rx = params_rx.clone();
+    let setter_tx = Arc::clone(&params_tx);
+    let mut options = NodeOptions::new()
+        .enable_rosout(true)
+        .start_parameter_services(true)
+        .parameter_validator(Box::new(move |name: &str, value: &ParameterValue| {
+            validator_rx
+                .borrow()
+                .validate(name, value)
+                .map_err(|e| e.to_string())
+        }))
+        .parameter_set_action(Box::new(move |name: &str, value: &ParameterValue| {
+            let mut result = Ok(());
+            setter_tx.send_if_modified(|p| {
+                let before = p.clone();
+                result = p.apply(name, value).map_err(|e| e.to_string());
+                *p != before
+            });
+            result
+        }));
+    for (name, value) in params.to_declarations() {
+        options = options.declare_parameter(name, value);
+    }
+
+    let node_name = NodeName::new("/", NODE_NAME).map_err(create_err("node name"))?;
+    let mut node = context
+        .new_node(node_name, options)
+        .map_err(create_err("node"))?;
+    let logger = Logger {
+        handle: node.logging_handle(),
+    };
+
+    let qos = topic_qos();
+    let topic = |node: &mut ros2_client::Node, name: &str, ty| {
+        let n = Name::new("/rod", name).map_err(create_err("topic name"))?;
+        node.create_topic(&n, ty, &qos).map_err(create_err("topic"))
+    };
+    let target_topic = topic(&mut node, "target", type_names::pose_stamped())?;
+    let path_topic = topic(&mut node, "path", type_names::path())?;
+    let solution_topic = topic(&mut node, "solution", type_names::rod_solution())?;
+    let marker_topic = topic(&mut node, "marker", type_names::marker())?;
+
+    let subscription = node
+        .create_subscription::<PoseStamped>(&target_topic, Some(qos.clone()))
+        .map_err(create_err("/rod/target subscription"))?;
+    let outputs = Outputs {
+        path: node
+            .create_publisher(&path_topic, Some(qos.clone()))
+            .map_err(create_err("/rod/path publisher"))?,
+        solution: node
+            .create_publisher(&solution_topic, Some(qos.clone()))
+            .map_err(create_err("/rod/solution publisher"))?,
+        marker: node
+            .create_publisher(&marker_topic, Some(qos.clone()))
+            .map_err(create_err("/rod/marker publisher"))?,
+    };
+    let server = node
+        .create_server::<SolveRodRequest, SolveRodResponse>(
+            ServiceMapping::Enhanced,
+            &Name::new("/rod", "solve").map_err(create_err("service name"))?,
+            &type_names::solve_rod(),
+            qos.clone(),
+            qos.clone(),
+        )
+        .map_err(create_err("/rod/solve service"))?;
+
+    let spinner = node.spinner().map_err(create_err("spinner"))?;
+    let spin_task = tokio::spawn(async move {
+        if let Err(e) = spinner.spin().await {
+            log::error!("spinner stopped: {e:?}");
+        }
+    });
+
+    let stats = Arc::new(Stats::default());
+    let (target_tx, target_rx) = watch::channel::<Option<PoseStamped>>(None);
+    let (job_tx, job_rx) = mpsc::channel::<ServiceJob>(16);
+
+    // Subscriber task: overwrite the single slot with the newest target.
+    let sub_stats = Arc::clone(&stats);
+    let sub_log = Logger {
+        handle: node.logging_handle(),
+    };
+    let subscriber_task = tokio::spawn(async move {
+        let mut stream = pin!(subscription.async_stream());
+        while let Some(item) = stream.next().await {
+            match item {
+                Ok((msg, _info)) => {
+                    sub_stats.received.fetch_add(1, Ordering::Relaxed);
+                    target_tx.send_replace(Some(msg));
+                }
+                Err(e) => sub_log.warn(&format!("/rod/target: dropped a bad message: {e:?}")),
+            }
+        }
+    });
+
+    // Service task: forward each request to the solver task, send back its answer.
+    let srv_stats = Arc::clone(&stats);
+    let srv_log = Logger {
+        handle: node.logging_handle(),
+    };
+    let service_task = tokio::spawn(async move {
+        let mut stream = pin!(server.receive_request_stream());
+        while let Some(item) = stream.next().await {
+            let (id, request) = match item {
+                Ok(r) => r,
+                Err(e) => {
+                    srv_log.warn(&format!("/rod/solve: dropped a bad request: {e:?}"));
+                    continue;
+                }
+            };
+            srv_stats.service_calls.fetch_add(1, Ordering::Relaxed);
+            let (reply_tx, reply_rx) = oneshot::channel();
+            if job_tx.send((request, reply_tx)).await.is_err() {
+                break; // solver task gone: shutting down
+            }
+            let Ok(response) = reply_rx.await else { break };
+            if let Err(e) = server.async_send_response(id, response).await {
+                srv_log.warn(&format!("/rod/solve: cannot send the response: {e:?}"));
+            }
+        }
+    });
+
+    // Solver task: owns the Processor (and so the warm start).
+    let solver_log = Logger {
+        handle: node.logging_handle(),
+    };
+    let solver_task = tokio::spawn(solver_loop(
+        Processor::new(&params),
+        params_rx,
+        target_rx,
+        job_rx,
+        outputs,
+        Arc::clone(&stats),
+        solver_log,
+    ));
+
+    logger.info(&format!(
+        "{NODE_NAME} ready: domain {}{}, rod_length {} m, path_samples {}, method {}; \
+         subscribed /rod/target, publishing /rod/path /rod/solution /rod/marker, service /rod/solve",
+        mw.domain_id,
+        if mw.localhost_only { " (loopback only)" } else { "" },
+        params.rod_length,
+        params.path_samples,
+        params.method.as_str()
+    ));
+
+    let signal = wait_for_signal().await;
+    logger.info(&format!(
+        "{signal}: shutting down after {} targets received, {} solved, {} failed, {} service calls",
+        stats.received.load(Ordering::Relaxed),
+        stats.solved.load(Ordering::Relaxed),
+        stats.failed.load(Ordering::Relaxed),
+        stats.service_calls.load(Ordering::Relaxed),
+    ));
+    subscriber_task.abort();
+    service_task.abort();
+    solver_task.abort();
+    // Dropping the node tells the spinner to stop (stop_spinner() too, but then the drop
+    // would log an error).
+    drop(node);
+    let _ = tokio::time::timeout(std::time::Duration::from_secs(2), spin_task).await;
+    drop(params_tx);
+    Ok(())
+}
+
+/// Waits for SIGINT or SIGTERM; returns its name.
+async fn wait_for_signal() -> &'static str {
+    use tokio::signal::unix::{signal, SignalKind};
+    match signal(SignalKind::terminate()) {
+        Ok(mut term) => tokio::select! {
+            _ = tokio::signal::ctrl_c() => "SIGINT",
+            _ = term.recv() => "SIGTERM",
+        },
+        Err(e) => {
+            log::warn!("cannot install a SIGTERM handler ({e}); SIGINT only");
+            let _ = tokio::signal::ctrl_c().await;
+            "SIGINT"
+        }
+    }
+}
+
+/// Solves service requests (first) and the newest target, and publishes the results.
+async fn solver_loop(
+    mut processor: Processor,
+    mut params_rx: watch::Receiver<Params>,
+    mut target_rx: watch::Receiver<Option<PoseStamped>>,
+    mut job_rx: mpsc::Receiver<ServiceJob>,
+    outputs: Outputs,
+    stats: Arc<Stats>,
+    log: Logger,
+) {
+    loop {
+        tokio::select! {
+            biased;
+            job = job_rx.recv() => {
+                let Some((request, reply)) = job else { break };
+                let params = params_rx.borrow_and_update().clone();
+                let response = match Overrides::from_request(&request) {
+                    Ok(overrides) => {
+                        let outcome = processor.process(&request.target, &params, &overrides);
+                        report(&log, &stats, "/rod/solve", &outcome);
+                        SolveRodResponse {
+                            path: outcome.path.unwrap_or_else(|| Path {
+                                header: outcome.solution.header.clone(),
+                                poses: Vec::new(),
+                            }),
+                            solution: outcome.solution,
+                        }
+                    }
+                    Err(reason) => {
+                        log.warn(&format!("/rod/solve: bad request: {reason}"));
+                        let header = crate::convert::output_header(&request.target.header, &params);
+                        SolveRodResponse {
+                            solution: crate::convert::failure_message(
+                                format!("bad request: {reason}"), None, &header, &params, 0.0),
+                            path: Path { header, poses: Vec::new() },
+                        }
+                    }
+                };
+                let _ = reply.send(response); // the caller may have gone
+            }
+            changed = target_rx.changed() => {
+                if changed.is_err() {
+                    break; // subscriber gone
+                }
+                let Some(target) = target_rx.borrow_and_update().clone() else { continue };
+                if params_rx.has_changed().unwrap_or(false) {
+                    log.info(&format!("parameters now: {:?}", *params_rx.borrow_and_update()));
+                }
+                let params = params_rx.borrow().clone();
+                let outcome = processor.process(&target, &params, &Overrides::default());
+                report(&log, &stats, "/rod/target", &outcome);
+                publish(&log, &outputs, outcome);
+            }
+        }
+    }
+}
+
+fn report(log: &Logger, stats: &Stats, source: &str, outcome: &Outcome) {
+    if outcome.solution.success {
+        stats.solved.fetch_add(1, Ordering::Relaxed);
+        log::debug!("{source}: {}", outcome.solution.message);
+    } else {
+        stats.failed.fetch_add(1, Ordering::Relaxed);
+        log.warn(&format!(
+            "{source}: no solution: {}",
+            outcome.solution.message
+        ));
+    }
+}
+
+fn publish(log: &Logger, outputs: &Outputs, outcome: Outcome) {
+    // Path first: it is what latency-sensitive clients wait for.
+    if let Some(path) = outcome.path {
+        if let Err(e) = outputs.path.publish(path) {
+            log.error(&format!("cannot publish /rod/path: {e:?}"));
+        }
+    }
+    if let Err(e) = outputs.solution.publish(outcome.solution) {
+        log.error(&format!("cannot publish /rod/solution: {e:?}"));
+    }
+    if let Some(marker) = outcome.marker {
+        if let Err(e) = outputs.marker.publish(marker) {
+            log.error(&format!("cannot publish /rod/marker: {e:?}"));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn env<'a>(pairs: &'a [(&'a str, &'a str)]) -> impl Fn(&str) -> Option<String> + 'a {
+        move |k| {
+            pairs
+                .iter()
+                .find(|(n, _)| *n == k)
+                .map(|(_, v)| v.to_string())
+        }
+    }
+
+    #[test]
+    fn middleware_from_environment() {
+        let c = MiddlewareConfig::from_lookup(env(&[])).unwrap();
+        assert_eq!(
+            c,
+            MiddlewareConfig {
+                domain_id: 0,
+                localhost_only: false
+            }
+        );
+        let c = MiddlewareConfig::from_lookup(env(&[
+            ("ROS_DOMAIN_ID", "42"),
+            ("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST"),
+        ]))
+        .unwrap();
+        assert_eq!(
+            c,
+            MiddlewareConfig {
+                domain_id: 42,
+                localhost_only: true
+            }
+        );
+        let c = MiddlewareConfig::from_lookup(env(&[("ROS_LOCALHOST_ONLY", "1")])).unwrap();
+        assert!(c.localhost_only);
+        assert!(MiddlewareConfig::from_lookup(env(&[("ROS_DOMAIN_ID", "300")])).is_err());
+        assert!(MiddlewareConfig::from_lookup(env(&[("ROS_DOMAIN_ID", "x")])).is_err());
+    }
+}

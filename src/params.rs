@@ -1,0 +1,646 @@
+//! The node's parameters: defaults, validation, start-up parsing (command line and ROS 2
+//! parameter YAML files) and conversion to and from ROS `ParameterValue`s.
+//!
+//! ros2-client does not parse `--ros-args`; [`parse_args`] handles the subset a user needs:
+//! `--ros-args`, `-p name:=value` / `--param name:=value`, `--params-file FILE`, `-h`/`--help`.
+//! At run time the same validation ([`Params::apply`]) guards the ROS parameter services.
+
+use std::path::{Path, PathBuf};
+
+use ros2_client::ParameterValue;
+use thiserror::Error;
+
+/// Solver method, as named in the `method` parameter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Damped, guarded Newton that keeps the rod stable (default).
+    Robust,
+    /// The paper's plain Newton iteration.
+    Newton,
+}
+
+impl Method {
+    /// Parses "robust" / "newton" (case-insensitive).
+    pub fn parse(s: &str) -> Result<Self, ParamError> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "robust" => Ok(Self::Robust),
+            "newton" => Ok(Self::Newton),
+            _ => Err(ParamError::Invalid {
+                name: "method".into(),
+                reason: format!("unknown method {s:?}, expected \"robust\" or \"newton\""),
+            }),
+        }
+    }
+
+    /// The parameter spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Robust => "robust",
+            Self::Newton => "newton",
+        }
+    }
+}
+
+/// All parameters of `rod_ig_node`, always valid (construct with [`Params::default`] and
+/// change with [`Params::apply`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Params {
+    /// `rod_length` (m) > 0: physical length L of the rod.
+    pub rod_length: f64,
+    /// `base_frame`: frame_id used when a target's frame_id is empty.
+    pub base_frame: String,
+    /// `path_samples` in [2, 100000]: poses per published path.
+    pub path_samples: usize,
+    /// `tolerance` > 0: solver convergence tolerance (normalised units).
+    pub tolerance: f64,
+    /// `max_iterations` in [1, 100000].
+    pub max_iterations: u32,
+    /// `method`: "robust" or "newton".
+    pub method: Method,
+    /// `bending_stiffness` EI (N·m²) ≥ 0; 0 = unknown (no wrench or joules reported).
+    pub bending_stiffness: f64,
+    /// `planar_tolerance` ≥ 0: largest |z| (m) and tilt out of the plane (rad) accepted.
+    pub planar_tolerance: f64,
+    /// `publish_marker`: publish the RViz line strip on /rod/marker.
+    pub publish_marker: bool,
+    /// `marker_width` (m) > 0: line width of the marker.
+    pub marker_width: f64,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Self {
+            rod_length: 1.0,
+            base_frame: "rod_base".into(),
+            path_samples: 100,
+            tolerance: 1e-6,
+            max_iterations: 100,
+            method: Method::Robust,
+            bending_stiffness: 0.0,
+            planar_tolerance: 1e-4,
+            publish_marker: true,
+            marker_width: 0.01,
+        }
+    }
+}
+
+/// Why a parameter or a start-up argument was rejected.
+#[derive(Debug, Error, PartialEq)]
+pub enum ParamError {
+    /// No such parameter.
+    #[error("unknown parameter '{0}' (known: {known})", known = NAMES.join(", "))]
+    Unknown(String),
+    /// Wrong ROS type.
+    #[error("parameter '{name}' must be {expected}, got {got}")]
+    WrongType {
+        /// Parameter name.
+        name: String,
+        /// Expected type.
+        expected: &'static str,
+        /// What was given.
+        got: String,
+    },
+    /// Out of range or otherwise invalid.
+    #[error("parameter '{name}': {reason}")]
+    Invalid {
+        /// Parameter name.
+        name: String,
+        /// Why.
+        reason: String,
+    },
+    /// Bad command line.
+    #[error("command line: {0}")]
+    Args(String),
+    /// Unreadable or malformed parameters file.
+    #[error("parameters file {path}: {reason}")]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// The names of all parameters, in declaration order.
+pub const NAMES: [&str; 10] = [
+    "rod_length",
+    "base_frame",
+    "path_samples",
+    "tolerance",
+    "max_iterations",
+    "method",
+    "bending_stiffness",
+    "planar_tolerance",
+    "publish_marker",
+    "marker_width",
+];
+
+fn type_name(v: &ParameterValue) -> String {
+    match v {
+        ParameterValue::NotSet => "not set".into(),
+        ParameterValue::Boolean(b) => format!("bool {b}"),
+        ParameterValue::Integer(i) => format!("integer {i}"),
+        ParameterValue::Double(d) => format!("double {d}"),
+        ParameterValue::String(s) => format!("string {s:?}"),
+        other => format!("{:?}", other.to_parameter_type()),
+    }
+}
+
+fn double(name: &str, v: &ParameterValue) -> Result<f64, ParamError> {
+    match v {
+        ParameterValue::Double(d) => Ok(*d),
+        // Integers are accepted where a double is expected (`-p rod_length:=1`, YAML `1`).
+        ParameterValue::Integer(i) => Ok(*i as f64),
+        other => Err(ParamError::WrongType {
+            name: name.into(),
+            expected: "a double",
+            got: type_name(other),
+        }),
+    }
+}
+
+fn integer(name: &str, v: &ParameterValue, lo: i64, hi: i64) -> Result<i64, ParamError> {
+    match v {
+        ParameterValue::Integer(i) if (lo..=hi).contains(i) => Ok(*i),
+        ParameterValue::Integer(i) => Err(ParamError::Invalid {
+            name: name.into(),
+            reason: format!("{i} is outside [{lo}, {hi}]"),
+        }),
+        other => Err(ParamError::WrongType {
+            name: name.into(),
+            expected: "an integer",
+            got: type_name(other),
+        }),
+    }
+}
+
+fn check(name: &str, ok: bool, reason: impl FnOnce() -> String) -> Result<(), ParamError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(ParamError::Invalid {
+            name: name.into(),
+            reason: reason(),
+        })
+    }
+}
+
+impl Params {
+    /// Sets parameter `name` to `value` after validating it; on error `self` is unchanged.
+    pub fn apply(&mut self, name: &str, value: &ParameterValue) -> Result<(), ParamError> {
+        match name {
+            "rod_length" => {
+                let v = double(name, value)?;
+                check(name, v.is_finite() && v > 0.0, || {
+                    format!("must be a finite length > 0 m, got {v}")
+                })?;
+                self.rod_length = v;
+            }
+            "base_frame" => match value {
+                ParameterValue::String(s) => self.base_frame = s.clone(),
+                other => {
+                    return Err(ParamError::WrongType {
+                        name: name.into(),
+                        expected: "a string",
+                        got: type_name(other),
+                    })
+                }
+            },
+            "path_samples" => self.path_samples = integer(name, value, 2, 100_000)? as usize,
+            "tolerance" => {
+                let v = double(name, value)?;
+                check(name, v.is_finite() && v > 0.0 && v < 1.0, || {
+                    format!("must be in (0, 1), got {v}")
+                })?;
+                self.tolerance = v;
+            }
+            "max_iterations" => self.max_iterations = integer(name, value, 1, 100_000)? as u32,
+            "method" => match value {
+                ParameterValue::String(s) => self.method = Method::parse(s)?,
+                other => {
+                    return Err(ParamError::WrongType {
+                        name: name.into(),
+                        expected: "a string",
+                        got: type_name(other),
+                    })
+                }
+            },
+            "bending_stiffness" => {
+                let v = double(name, value)?;
+                check(name, v.is_finite() && v >= 0.0, || {
+                    format!("must be a finite EI >= 0 N m^2 (0 = unknown), got {v}")
+                })?;
+                self.bending_stiffness = v;
+            }
+            "planar_tolerance" => {
+                let v = double(name, value)?;
+                check(name, v.is_finite() && (0.0..=0.5).contains(&v), || {
+                    format!("must be in [0, 0.5], got {v}")
+                })?;
+                self.planar_tolerance = v;
+            }
+            "publish_marker" => match value {
+                ParameterValue::Boolean(b) => self.publish_marker = *b,
+                other => {
+                    return Err(ParamError::WrongType {
+                        name: name.into(),
+                        expected: "a bool",
+                        got: type_name(other),
+                    })
+                }
+            },
+            "marker_width" => {
+                let v = double(name, value)?;
+                check(name, v.is_finite() && v > 0.0, || {
+                    format!("must be a finite width > 0 m, got {v}")
+                })?;
+                self.marker_width = v;
+            }
+            _ => return Err(ParamError::Unknown(name.into())),
+        }
+        Ok(())
+    }
+
+    /// Checks `value` for `name` without changing anything.
+    pub fn validate(&self, name: &str, value: &ParameterValue) -> Result<(), ParamError> {
+        self.clone().apply(name, value)
+    }
+
+    /// The value of `name` as a ROS parameter value (the type it is declared with).
+    pub fn get(&self, name: &str) -> Option<ParameterValue> {
+        Some(match name {
+            "rod_length" => ParameterValue::Double(self.rod_length),
+            "base_frame" => ParameterValue::String(self.base_frame.clone()),
+            "path_samples" => ParameterValue::Integer(self.path_samples as i64),
+            "tolerance" => ParameterValue::Double(self.tolerance),
+            "max_iterations" => ParameterValue::Integer(i64::from(self.max_iterations)),
+            "method" => ParameterValue::String(self.method.as_str().into()),
+            "bending_stiffness" => ParameterValue::Double(self.bending_stiffness),
+            "planar_tolerance" => ParameterValue::Double(self.planar_tolerance),
+            "publish_marker" => ParameterValue::Boolean(self.publish_marker),
+            "marker_width" => ParameterValue::Double(self.marker_width),
+            _ => return None,
+        })
+    }
+
+    /// All parameters as (name, value), to declare them on the node.
+    pub fn to_declarations(&self) -> Vec<(&'static str, ParameterValue)> {
+        NAMES
+            .iter()
+            .filter_map(|n| self.get(n).map(|v| (*n, v)))
+            .collect()
+    }
+}
+
+/// What the command line asks for.
+#[derive(Debug, PartialEq)]
+pub enum Command {
+    /// Run the node with these parameters.
+    Run(Params),
+    /// Print the usage text and exit.
+    Help,
+}
+
+/// Usage text for `--help`.
+pub fn usage() -> String {
+    let d = Params::default();
+    format!(
+        "rod_ig_node: ROS 2 node serving elastic-rod inverse geometry.\n\n\
+         Usage: rod_ig_node [--ros-args] [-p NAME:=VALUE]... [--params-file FILE]...\n\n\
+         Later settings override earlier ones. Parameters (default):\n\
+         \x20 rod_length        m, > 0 ({})\n\
+         \x20 base_frame        frame_id when a target has none ({:?})\n\
+         \x20 path_samples      poses per path, 2..100000 ({})\n\
+         \x20 tolerance         solver tolerance, normalised ({:e})\n\
+         \x20 max_iterations    solver iteration limit ({})\n\
+         \x20 method            robust | newton ({})\n\
+         \x20 bending_stiffness EI in N m^2, 0 = unknown ({})\n\
+         \x20 planar_tolerance  accepted |z| (m) and tilt (rad) of targets ({:e})\n\
+         \x20 publish_marker    publish /rod/marker ({})\n\
+         \x20 marker_width      m ({})\n\n\
+         Environment: ROS_DOMAIN_ID (0..232), ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST or\n\
+         ROS_LOCALHOST_ONLY=1 (loopback only), RUST_LOG (console log level).\n",
+        d.rod_length,
+        d.base_frame,
+        d.path_samples,
+        d.tolerance,
+        d.max_iterations,
+        d.method.as_str(),
+        d.bending_stiffness,
+        d.planar_tolerance,
+        d.publish_marker,
+        d.marker_width
+    )
+}
+
+/// Parses a command-line value the way `ros2 run ... -p` does (YAML scalar rules, subset):
+/// true/false, integers, floats, otherwise a string (quotes stripped).
+pub fn parse_value(text: &str) -> ParameterValue {
+    let t = text.trim();
+    match serde_yaml::from_str::<serde_yaml::Value>(t) {
+        Ok(v) => yaml_to_value(&v).unwrap_or_else(|| ParameterValue::String(t.to_string())),
+        Err(_) => ParameterValue::String(t.to_string()),
+    }
+}
+
+fn yaml_to_value(v: &serde_yaml::Value) -> Option<ParameterValue> {
+    use serde_yaml::Value as Y;
+    Some(match v {
+        Y::Bool(b) => ParameterValue::Boolean(*b),
+        Y::Number(n) => {
+            if let Some(i) = n.as_i64() {
+                ParameterValue::Integer(i)
+            } else {
+                ParameterValue::Double(n.as_f64()?)
+            }
+        }
+        Y::String(s) => ParameterValue::String(s.clone()),
+        Y::Null => ParameterValue::NotSet,
+        _ => return None,
+    })
+}
+
+/// Parses the command line (without the program name) into a [`Command`].
+pub fn parse_args<I, S>(args: I) -> Result<Command, ParamError>
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<str>,
+{
+    let mut params = Params::default();
+    let mut it = args.into_iter().map(|s| s.as_ref().to_string());
+    while let Some(arg) = it.next() {
+        match arg.as_str() {
+            "-h" | "--help" => return Ok(Command::Help),
+            "--ros-args" | "--" => {}
+            "-p" | "--param" => {
+                let kv = it
+                    .next()
+                    .ok_or_else(|| ParamError::Args(format!("{arg} needs NAME:=VALUE")))?;
+                let (name, value) = kv
+                    .split_once(":=")
+                    .ok_or_else(|| ParamError::Args(format!("{arg} {kv}: expected NAME:=VALUE")))?;
+                params.apply(name.trim(), &parse_value(value))?;
+            }
+            "--params-file" => {
+                let file = it
+                    .next()
+                    .ok_or_else(|| ParamError::Args("--params-file needs a FILE".into()))?;
+                load_params_file(&mut params, Path::new(&file))?;
+            }
+            other => {
+                return Err(ParamError::Args(format!(
+                    "unsupported argument {other:?} (see --help)"
+                )))
+            }
+        }
+    }
+    Ok(Command::Run(params))
+}
+
+/// Node-name keys a ROS 2 parameters file may use for this node.
+const NODE_KEYS: [&str; 4] = ["rod_ig_node", "/rod_ig_node", "/**", "**"];
+
+/// Applies a ROS 2 parameters file (`rod_ig_node: {ros__parameters: {...}}`; also
+/// `/rod_ig_node` and the wildcard `/**`) to `params`. Unknown parameters are errors.
+pub fn load_params_file(params: &mut Params, path: &Path) -> Result<(), ParamError> {
+    let file_err = |reason: String| ParamError::File {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| file_err(e.to_string()))?;
+    apply_params_yaml(params, &text).map_err(|e| match e {
+        ParamError::File { reason, .. } => file_err(reason),
+        other => file_err(other.to_string()),
+    })
+}
+
+/// Applies the text of a ROS 2 parameters file (see [`load_params_file`]).
+pub fn apply_params_yaml(params: &mut Params, text: &str) -> Result<(), ParamError> {
+    let err = |reason: String| ParamError::File {
+        path: PathBuf::new(),
+        reason,
+    };
+    let doc: serde_yaml::Value = serde_yaml::from_str(text).map_err(|e| err(e.to_string()))?;
+    let top = doc
+        .as_mapping()
+        .ok_or_else(|| err("top level must be a mapping of node names".into()))?;
+    let mut found = false;
+    for (key, section) in top {
+        let Some(key) = key.as_str() else { continue };
+        if !NODE_KEYS.contains(&key) {
+            continue;
+        }
+        let Some(ros_params) = section.get("ros__parameters") else {
+            return Err(err(format!("section '{key}' has no 'ros__parameters'")));
+        };
+        let map = ros_params
+            .as_mapping()
+            .ok_or_else(|| err(format!("'{key}.ros__parameters' must be a mapping")))?;
+        for (name, value) in map {
+            let name = name
+                .as_str()
+                .ok_or_else(|| err("parameter names must be strings".into()))?;
+            let value = yaml_to_value(value)
+                .ok_or_else(|| err(format!("parameter '{name}': unsupported value {value:?}")))?;
+            params.apply(name, &value)?;
+        }
+        found = true;
+    }
+    if found {
+        Ok(())
+    } else {
+        Err(err(format!(
+            "no section for this node (expected one of {})",
+            NODE_KEYS.join(", ")
+        )))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(args: &[&str]) -> Result<Params, ParamError> {
+        match parse_args(args)? {
+            Command::Run(p) => Ok(p),
+            Command::Help => panic!("unexpected help"),
+        }
+    }
+
+    #[test]
+    fn defaults() {
+        let p = run(&[]).unwrap();
+        assert_eq!(p, Params::default());
+        assert_eq!(p.rod_length, 1.0);
+        assert_eq!(p.path_samples, 100);
+        assert_eq!(p.method, Method::Robust);
+    }
+
+    #[test]
+    fn command_line_parameters() {
+        let p = run(&[
+            "--ros-args",
+            "-p",
+            "rod_length:=0.5",
+            "-p",
+            "path_samples:=20",
+            "--param",
+            "method:=newton",
+            "-p",
+            "base_frame:=left_gripper",
+            "-p",
+            "bending_stiffness:=2",
+            "-p",
+            "publish_marker:=false",
+        ])
+        .unwrap();
+        assert_eq!(p.rod_length, 0.5);
+        assert_eq!(p.path_samples, 20);
+        assert_eq!(p.method, Method::Newton);
+        assert_eq!(p.base_frame, "left_gripper");
+        assert_eq!(p.bending_stiffness, 2.0);
+        assert!(!p.publish_marker);
+    }
+
+    #[test]
+    fn bad_command_lines_are_rejected_with_a_reason() {
+        let e = run(&["-p", "rod_length:=-1"]).unwrap_err();
+        assert!(e.to_string().contains("rod_length"), "{e}");
+        assert!(matches!(
+            run(&["-p", "nope:=1"]),
+            Err(ParamError::Unknown(_))
+        ));
+        assert!(matches!(
+            run(&["-p", "rod_length"]),
+            Err(ParamError::Args(_))
+        ));
+        assert!(matches!(run(&["-p"]), Err(ParamError::Args(_))));
+        assert!(matches!(run(&["--frobnicate"]), Err(ParamError::Args(_))));
+        assert!(matches!(
+            run(&["-p", "path_samples:=1"]),
+            Err(ParamError::Invalid { .. })
+        ));
+        assert!(matches!(
+            run(&["-p", "path_samples:=2.5"]),
+            Err(ParamError::WrongType { .. })
+        ));
+        assert!(matches!(
+            run(&["-p", "method:=magic"]),
+            Err(ParamError::Invalid { .. })
+        ));
+        assert!(matches!(
+            run(&["-p", "rod_length:=.nan"]),
+            Err(ParamError::Invalid { .. })
+        ));
+        assert_eq!(parse_args(["--help"]).unwrap(), Command::Help);
+    }
+
+    #[test]
+    fn yaml_file() {
+        let mut p = Params::default();
+        apply_params_yaml(
+            &mut p,
+            "rod_ig_node:\n  ros__parameters:\n    rod_length: 2\n    tolerance: 1.0e-9\n    \
+             max_iterations: 30\n    base_frame: world\n",
+        )
+        .unwrap();
+        assert_eq!(p.rod_length, 2.0);
+        assert_eq!(p.tolerance, 1e-9);
+        assert_eq!(p.max_iterations, 30);
+        assert_eq!(p.base_frame, "world");
+
+        let mut q = Params::default();
+        apply_params_yaml(&mut q, "/**:\n  ros__parameters:\n    path_samples: 7\n").unwrap();
+        assert_eq!(q.path_samples, 7);
+
+        let mut r = Params::default();
+        assert!(apply_params_yaml(&mut r, "other_node:\n  ros__parameters: {}\n").is_err());
+        assert!(apply_params_yaml(&mut r, "rod_ig_node:\n  ros__parameters:\n    x: 1\n").is_err());
+        assert!(apply_params_yaml(&mut r, "[1, 2]").is_err());
+        assert_eq!(r, Params::default());
+    }
+
+    #[test]
+    fn shipped_params_file_loads() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("launch_notes/rod_ig_params.yaml");
+        let mut p = Params::default();
+        load_params_file(&mut p, &path).unwrap();
+    }
+
+    #[test]
+    fn file_then_flag_order() {
+        let dir = std::env::temp_dir().join(format!("rod_ig_params_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("p.yaml");
+        std::fs::write(
+            &f,
+            "rod_ig_node:\n  ros__parameters:\n    rod_length: 3.0\n",
+        )
+        .unwrap();
+        let fs = f.to_str().unwrap();
+        assert_eq!(run(&["--params-file", fs]).unwrap().rod_length, 3.0);
+        assert_eq!(
+            run(&["--params-file", fs, "-p", "rod_length:=4.0"])
+                .unwrap()
+                .rod_length,
+            4.0
+        );
+        assert_eq!(
+            run(&["-p", "rod_length:=4.0", "--params-file", fs])
+                .unwrap()
+                .rod_length,
+            3.0
+        );
+        assert!(matches!(
+            run(&["--params-file", "/nonexistent/x.yaml"]),
+            Err(ParamError::File { .. })
+        ));
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn run_time_validation_keeps_old_value() {
+        let mut p = Params::default();
+        assert!(p.apply("rod_length", &ParameterValue::Double(0.0)).is_err());
+        assert!(p
+            .apply("rod_length", &ParameterValue::Double(f64::INFINITY))
+            .is_err());
+        assert!(p
+            .apply("rod_length", &ParameterValue::String("1".into()))
+            .is_err());
+        assert!(p
+            .apply("tolerance", &ParameterValue::Double(-1e-3))
+            .is_err());
+        assert!(p
+            .apply("max_iterations", &ParameterValue::Integer(0))
+            .is_err());
+        assert!(p
+            .apply("bending_stiffness", &ParameterValue::Double(-2.0))
+            .is_err());
+        assert!(p
+            .apply("publish_marker", &ParameterValue::Integer(1))
+            .is_err());
+        assert_eq!(p, Params::default());
+        p.apply("rod_length", &ParameterValue::Double(0.7)).unwrap();
+        assert_eq!(p.rod_length, 0.7);
+        assert!(p
+            .validate("path_samples", &ParameterValue::Integer(5))
+            .is_ok());
+        assert_eq!(p.path_samples, 100);
+    }
+
+    #[test]
+    fn declarations_round_trip() {
+        let p = Params::default();
+        let decl = p.to_declarations();
+        assert_eq!(decl.len(), NAMES.len());
+        let mut q = Params {
+            rod_length: 9.0,
+            ..Params::default()
+        };
+        for (n, v) in &decl {
+            q.apply(n, v).unwrap();
+        }
+        assert_eq!(p, q);
+    }
+}

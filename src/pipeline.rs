@@ -1,0 +1,335 @@
+//! One target in, messages out: the node's per-request logic, free of DDS so it can be
+//! tested directly. [`Processor`] owns the solver (and so the warm start); the node's
+//! solver task owns the [`Processor`].
+
+use std::time::Instant;
+
+use crate::convert::{
+    failure_message, output_header, shape_to_marker, shape_to_path, solution_message,
+    target_to_planar,
+};
+use crate::messages::{Marker, Path, PoseStamped, RodSolution, SolveRodRequest};
+use crate::params::{Method, Params};
+use crate::solver::{PlanarParams, RodSolver, SolverSettings};
+
+/// What one target produces. `path` and `marker` are `None` when `solution.success` is false:
+/// a failed solve has no shape worth drawing, and subscribers of /rod/path keep the last
+/// valid shape (the choice documented in `launch_notes/README.md`).
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// Always present.
+    pub solution: RodSolution,
+    /// The shape, on success.
+    pub path: Option<Path>,
+    /// The RViz line strip, on success when `publish_marker` is set.
+    pub marker: Option<Marker>,
+}
+
+/// Per-request options of the `/rod/solve` service.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Overrides {
+    /// Start here instead of the warm start (and leave the warm start alone).
+    pub initial_guess: Option<PlanarParams>,
+    /// Tolerance instead of the parameter.
+    pub tolerance: Option<f64>,
+    /// Iteration limit instead of the parameter.
+    pub max_iterations: Option<u32>,
+    /// Method instead of the parameter.
+    pub method: Option<Method>,
+    /// Path poses instead of the parameter.
+    pub path_samples: Option<usize>,
+}
+
+impl Overrides {
+    /// Reads the optional fields of a service request (0 / "" = not given).
+    pub fn from_request(req: &SolveRodRequest) -> Result<Self, String> {
+        let mut o = Overrides::default();
+        if req.use_initial_guess {
+            let g = req.initial_guess;
+            if !g.iter().all(|v| v.is_finite()) {
+                return Err(format!("initial_guess must be finite, got {g:?}"));
+            }
+            o.initial_guess = Some(PlanarParams::new(g[0], g[1], g[2]));
+        }
+        if req.tolerance != 0.0 {
+            if !(req.tolerance.is_finite() && req.tolerance > 0.0 && req.tolerance < 1.0) {
+                return Err(format!(
+                    "tolerance must be in (0, 1), got {}",
+                    req.tolerance
+                ));
+            }
+            o.tolerance = Some(req.tolerance);
+        }
+        if req.max_iterations != 0 {
+            o.max_iterations = Some(req.max_iterations.min(100_000));
+        }
+        if req.path_samples != 0 {
+            if !(2..=100_000).contains(&req.path_samples) {
+                return Err(format!(
+                    "path_samples must be in [2, 100000], got {}",
+                    req.path_samples
+                ));
+            }
+            o.path_samples = Some(req.path_samples as usize);
+        }
+        if !req.method.trim().is_empty() {
+            o.method = Some(Method::parse(&req.method).map_err(|e| e.to_string())?);
+        }
+        Ok(o)
+    }
+
+    fn is_empty(&self) -> bool {
+        *self == Overrides::default()
+    }
+}
+
+/// Solver settings from the parameters.
+pub fn settings_of(params: &Params) -> SolverSettings {
+    SolverSettings {
+        method: params.method,
+        tolerance: params.tolerance,
+        max_iterations: params.max_iterations,
+    }
+}
+
+/// Turns targets into solutions, warm-starting each solve from the previous solution.
+pub struct Processor {
+    solver: RodSolver,
+}
+
+impl Processor {
+    /// A processor for the given parameters (no warm start yet).
+    pub fn new(params: &Params) -> Self {
+        Self {
+            solver: RodSolver::new(settings_of(params)),
+        }
+    }
+
+    /// Solves for one target with the current `params` (and optional per-request overrides).
+    pub fn process(
+        &mut self,
+        target: &PoseStamped,
+        params: &Params,
+        overrides: &Overrides,
+    ) -> Outcome {
+        let started = Instant::now();
+        let header = output_header(&target.header, params);
+        let settings = settings_of(params);
+        if self.solver.settings() != settings {
+            self.solver.set_settings(settings);
+        }
+        let planar = match target_to_planar(&target.pose, params) {
+            Ok(p) => p,
+            Err(e) => {
+                return Outcome {
+                    solution: failure_message(
+                        e.to_string(),
+                        None,
+                        &header,
+                        params,
+                        started.elapsed().as_secs_f64(),
+                    ),
+                    path: None,
+                    marker: None,
+                }
+            }
+        };
+        let samples = overrides.path_samples.unwrap_or(params.path_samples);
+        let solver_overrides = Overrides {
+            path_samples: None,
+            ..overrides.clone()
+        };
+        let one_off = (!solver_overrides.is_empty()).then(|| SolverSettings {
+            method: overrides.method.unwrap_or(settings.method),
+            tolerance: overrides.tolerance.unwrap_or(settings.tolerance),
+            max_iterations: overrides.max_iterations.unwrap_or(settings.max_iterations),
+        });
+        let result = self
+            .solver
+            .solve(&planar, overrides.initial_guess, one_off, samples);
+        let elapsed = started.elapsed().as_secs_f64();
+        match result {
+            Ok(solved) => {
+                let path = shape_to_path(&solved.shape, &header, params.rod_length);
+                let marker = params
+                    .publish_marker
+                    .then(|| shape_to_marker(&solved.shape, &header, params, solved.stable));
+                Outcome {
+                    solution: solution_message(&solved, &header, params, elapsed),
+                    path: Some(path),
+                    marker,
+                }
+            }
+            Err(failed) => Outcome {
+                solution: failure_message(
+                    format!("solver failed: {}", failed.reason),
+                    Some(&failed),
+                    &header,
+                    params,
+                    elapsed,
+                ),
+                path: None,
+                marker: None,
+            },
+        }
+    }
+
+    /// Forgets the warm start.
+    pub fn reset(&mut self) {
+        self.solver.reset();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::convert::yaw_to_quaternion;
+    use crate::messages::{Header, Point, Pose, Quaternion, Time};
+
+    fn target(x: f64, y: f64, yaw: f64, frame: &str) -> PoseStamped {
+        PoseStamped {
+            header: Header {
+                stamp: Time { sec: 5, nanosec: 6 },
+                frame_id: frame.into(),
+            },
+            pose: Pose {
+                position: Point { x, y, z: 0.0 },
+                orientation: yaw_to_quaternion(yaw),
+            },
+        }
+    }
+
+    fn check_path_reaches(o: &Outcome, t: &PoseStamped, samples: usize, tol: f64) {
+        let path = o.path.as_ref().expect("path");
+        assert_eq!(path.poses.len(), samples);
+        let first = &path.poses[0].pose;
+        assert!(first.position.x.abs() < 1e-12 && first.position.y.abs() < 1e-12);
+        assert!((first.orientation.w.abs() - 1.0).abs() < 1e-12);
+        let last = &path.poses[samples - 1].pose;
+        assert!(
+            (last.position.x - t.pose.position.x).abs() < tol,
+            "{last:?}"
+        );
+        assert!(
+            (last.position.y - t.pose.position.y).abs() < tol,
+            "{last:?}"
+        );
+        // Same rotation about z: |dot of quaternions| ≈ 1.
+        let q = &t.pose.orientation;
+        let dot = last.orientation.z * q.z + last.orientation.w * q.w;
+        assert!((dot.abs() - 1.0).abs() < tol, "{last:?} vs {q:?}");
+    }
+
+    #[test]
+    fn solves_and_scales() {
+        let params = Params {
+            rod_length: 2.0,
+            path_samples: 33,
+            ..Params::default()
+        };
+        let mut p = Processor::new(&params);
+        let t = target(1.2, 0.6, 0.5, "left");
+        let o = p.process(&t, &params, &Overrides::default());
+        assert!(o.solution.success, "{}", o.solution.message);
+        assert_eq!(o.solution.header.frame_id, "left");
+        assert_eq!(o.solution.header.stamp, Time { sec: 5, nanosec: 6 });
+        assert_eq!(o.solution.rod_length, 2.0);
+        check_path_reaches(&o, &t, 33, 1e-5);
+        let m = o.marker.expect("marker");
+        assert_eq!(m.points.len(), 33);
+        assert_eq!(m.header.frame_id, "left");
+    }
+
+    #[test]
+    fn warm_started_sequence() {
+        let params = Params::default();
+        let mut p = Processor::new(&params);
+        for i in 0..20 {
+            let s = i as f64 / 20.0;
+            let t = target(0.8 - 0.2 * s, 0.1 + 0.3 * s, 0.8 * s, "");
+            let o = p.process(&t, &params, &Overrides::default());
+            assert!(o.solution.success, "step {i}: {}", o.solution.message);
+            assert_eq!(o.solution.header.frame_id, params.base_frame);
+            check_path_reaches(&o, &t, params.path_samples, 1e-5);
+        }
+    }
+
+    #[test]
+    fn bad_targets_answered_without_path() {
+        let params = Params::default();
+        let mut p = Processor::new(&params);
+        let mut nonfinite = target(0.5, 0.0, 0.0, "");
+        nonfinite.pose.position.y = f64::NAN;
+        let mut offplane = target(0.5, 0.0, 0.0, "");
+        offplane.pose.position.z = 0.1;
+        let mut tilted = target(0.5, 0.0, 0.0, "");
+        tilted.pose.orientation = Quaternion {
+            x: 0.2,
+            y: 0.0,
+            z: 0.0,
+            w: 0.98,
+        };
+        let far = target(1.5, 0.0, 0.0, "");
+        for (t, what) in [
+            (nonfinite, "non-finite"),
+            (offplane, "not planar"),
+            (tilted, "not about z"),
+            (far, "out of reach"),
+        ] {
+            let o = p.process(&t, &params, &Overrides::default());
+            assert!(!o.solution.success);
+            assert!(
+                o.solution.message.contains(what),
+                "{} vs {what}",
+                o.solution.message
+            );
+            assert!(o.path.is_none() && o.marker.is_none());
+        }
+        // Still works afterwards.
+        let t = target(0.5, 0.2, 0.3, "");
+        assert!(
+            p.process(&t, &params, &Overrides::default())
+                .solution
+                .success
+        );
+    }
+
+    #[test]
+    fn no_marker_when_disabled() {
+        let params = Params {
+            publish_marker: false,
+            ..Params::default()
+        };
+        let mut p = Processor::new(&params);
+        let o = p.process(&target(0.6, 0.2, 0.1, ""), &params, &Overrides::default());
+        assert!(o.path.is_some() && o.marker.is_none());
+    }
+
+    #[test]
+    fn service_overrides() {
+        let mut req = SolveRodRequest::default();
+        assert_eq!(Overrides::from_request(&req).unwrap(), Overrides::default());
+        req.method = "newton".into();
+        req.tolerance = 1e-9;
+        req.max_iterations = 20;
+        req.use_initial_guess = true;
+        req.initial_guess = [0.1, 0.2, 0.3];
+        let o = Overrides::from_request(&req).unwrap();
+        assert_eq!(o.method, Some(Method::Newton));
+        assert_eq!(o.tolerance, Some(1e-9));
+        assert_eq!(o.max_iterations, Some(20));
+        assert_eq!(o.initial_guess, Some(PlanarParams::new(0.1, 0.2, 0.3)));
+        req.path_samples = 1;
+        assert!(Overrides::from_request(&req).is_err());
+        req.path_samples = 8;
+        assert_eq!(Overrides::from_request(&req).unwrap().path_samples, Some(8));
+        req.method = "bogus".into();
+        assert!(Overrides::from_request(&req).is_err());
+        req.method.clear();
+        req.initial_guess = [f64::NAN, 0.0, 0.0];
+        assert!(Overrides::from_request(&req).is_err());
+        req.use_initial_guess = false;
+        req.tolerance = -1.0;
+        assert!(Overrides::from_request(&req).is_err());
+    }
+}

@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""Latency benchmark of rod_ig_node, measured from an rclpy client.
+
+For each of N targets (a smooth sweep, so the node warm-starts as when tracking a moving
+gripper) the client publishes a PoseStamped on /rod/target and waits for the /rod/path with
+the same stamp; latency = time of the Path callback − time just before publish. Targets are
+sent one at a time (ping-pong), so the figure is the per-target round trip, not throughput.
+
+Baseline: the same client against `rod_ig_echo` (a tiny Rust binary of this package: same
+middleware set-up, topics and QoS, answers each target at once with a Path of the same size,
+no solving). The difference of the two is what rod_ig_node adds (solve + shape + the extra
+RodSolution / Marker messages).
+
+Usage (after scripts/setup-env.sh and `source scripts/env.sh`):
+    python tests/latency_bench.py [--n 1000] [--samples 100] [--warmup 100]
+"""
+import argparse
+import statistics
+import sys
+import threading
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import rodig_harness as h  # noqa: E402
+
+
+def percentile(xs, q):
+    xs = sorted(xs)
+    k = (len(xs) - 1) * q
+    lo, hi = int(k), min(int(k) + 1, len(xs) - 1)
+    return xs[lo] + (xs[hi] - xs[lo]) * (k - lo)
+
+
+def run(binary_name, args, n, warmup):
+    domain = h.free_domain()
+    node = h.NodeProcess(domain, args, binary_name=binary_name)
+    client = h.Client(domain, name="rod_ig_latency_bench", keep=10, path_only=True)
+    arrivals = {}
+    got = threading.Event()
+    waiting = [None]
+
+    def on_path(msg):
+        key = (msg.header.stamp.sec, msg.header.stamp.nanosec)
+        arrivals[key] = time.perf_counter()
+        if key == waiting[0]:
+            got.set()
+
+    client.on_path = on_path
+    try:
+        if not client.wait_connected_topics():
+            raise SystemExit(f"{binary_name}: no connection; log {node.log_path}")
+        lat = []
+        lost = 0
+        for i in range(warmup + n):
+            u = (i % 500) / 499
+            u = 2 * u if u < 0.5 else 2 - 2 * u  # back and forth
+            seq = h.next_seq()
+            t = client.make_target(0.75 - 0.3 * u, 0.1 + 0.35 * u, 0.2 + 1.2 * u, seq)
+            key = (t.header.stamp.sec, t.header.stamp.nanosec)
+            got.clear()
+            waiting[0] = key
+            t0 = time.perf_counter()
+            client.pub.publish(t)
+            if not got.wait(2.0):
+                lost += 1
+                continue
+            if i >= warmup:
+                lat.append((arrivals.pop(key) - t0) * 1e3)
+        return lat, lost
+    finally:
+        client.close()
+        node.stop()
+
+
+def summary(name, lat, lost):
+    return (f"{name:<28} n={len(lat):5d} lost={lost:3d}  p50={percentile(lat, 0.5):7.3f} ms  "
+            f"p90={percentile(lat, 0.9):7.3f} ms  p99={percentile(lat, 0.99):7.3f} ms  "
+            f"mean={statistics.fmean(lat):7.3f} ms")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--n", type=int, default=1000, help="measured targets per run (default 1000)")
+    ap.add_argument("--warmup", type=int, default=100, help="unmeasured targets first (default 100)")
+    ap.add_argument("--samples", type=int, default=100, help="path_samples (default 100)")
+    a = ap.parse_args()
+
+    echo, echo_lost = run("rod_ig_echo", [str(a.samples)], a.n, a.warmup)
+    node, node_lost = run("rod_ig_node", ["-p", f"path_samples:={a.samples}"], a.n, a.warmup)
+    print(f"target -> /rod/path round trip seen by rclpy, {a.samples} path poses, {a.n} targets each:")
+    print(summary("rod_ig_echo (Rust, no solve)", echo, echo_lost))
+    print(summary("rod_ig_node", node, node_lost))
+    d50 = percentile(node, 0.5) - percentile(echo, 0.5)
+    d99 = percentile(node, 0.99) - percentile(echo, 0.99)
+    print(f"node adds: p50 {d50 * 1e3:+.0f} us, p99 {d99 * 1e3:+.0f} us "
+          f"(goal: <= +300 us at p50: {'met' if d50 <= 0.3 else 'NOT met'})")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,151 @@
+"""Parameters: run-time changes through /rod_ig_node/set_parameters (rcl_interfaces), start-up
+flags and YAML files, bad command lines, clean shutdown on SIGINT."""
+import math
+import signal
+import subprocess
+
+import rodig_harness as h
+
+POS_TOL = 1e-5
+
+
+def solve_topic(c, x, y, yaw, frame="base_gripper"):
+    s = h.next_seq()
+    t = c.make_target(x, y, yaw, s, frame=frame)
+    c.pub.publish(t)
+    return t, c.solution_for(s), (c.path_for(s, timeout=2.0))
+
+
+def test_get_defaults(node_and_client):
+    _, c = node_and_client
+    got = c.get_params("rod_length", "path_samples", "base_frame", "method", "tolerance",
+                       "max_iterations", "bending_stiffness")
+    assert got == {"rod_length": 1.0, "path_samples": 100, "base_frame": "rod_base", "method": "robust",
+                   "tolerance": 1e-6, "max_iterations": 100, "bending_stiffness": 0.0}
+
+
+def test_rod_length_and_samples_take_effect(node_and_client):
+    _, c = node_and_client
+    res = c.set_params(rod_length=2.0, path_samples=37)
+    assert all(r.successful for r in res), [r.reason for r in res]
+    assert c.get_params("rod_length", "path_samples") == {"rod_length": 2.0, "path_samples": 37}
+    # (1.2, 0.6) is out of reach of a 1 m rod, fine for 2 m; same shape as (0.6, 0.3) on 1 m.
+    t, sol, path = solve_topic(c, 1.2, 0.6, 0.5)
+    assert sol.success, sol.message
+    assert sol.rod_length == 2.0
+    assert len(path.poses) == 37
+    last = path.poses[-1].pose.position
+    assert math.hypot(last.x - 1.2, last.y - 0.6) < 2 * POS_TOL
+    res = c.set_params(rod_length=1.0, path_samples=100)
+    assert all(r.successful for r in res)
+    _, sol, path = solve_topic(c, 1.2, 0.6, 0.5)
+    assert not sol.success and "out of reach" in sol.message
+
+
+def test_bad_values_rejected_with_reason(node_and_client):
+    _, c = node_and_client
+    cases = [
+        (dict(rod_length=-1.0), "rod_length"),
+        (dict(rod_length=float("nan")), "rod_length"),
+        (dict(path_samples=1), "path_samples"),
+        (dict(tolerance=0.0), "tolerance"),
+        (dict(max_iterations=0), "max_iterations"),
+        (dict(method="magic"), "method"),
+        (dict(bending_stiffness=-3.0), "bending_stiffness"),
+        (dict(rod_length="long"), "rod_length"),   # wrong type
+        (dict(no_such_parameter=1.0), "no_such_parameter"),
+    ]
+    for values, name in cases:
+        (res,) = c.set_params(**values)
+        assert not res.successful, values
+        assert name in res.reason and res.reason, res.reason
+    assert c.get_params("rod_length", "path_samples", "method") == {
+        "rod_length": 1.0, "path_samples": 100, "method": "robust"}
+    _, sol, path = solve_topic(c, 0.6, 0.3, 0.5)
+    assert sol.success and len(path.poses) == 100
+
+
+def test_base_frame_and_marker_switch(node_and_client):
+    _, c = node_and_client
+    assert all(r.successful for r in c.set_params(base_frame="world", publish_marker=False))
+    s = h.next_seq()
+    c.pub.publish(c.make_target(0.6, 0.3, 0.5, s, frame=""))
+    assert c.solution_for(s).header.frame_id == "world"
+    assert c.marker_for(s, timeout=0.5) is None
+    assert all(r.successful for r in c.set_params(base_frame="rod_base", publish_marker=True))
+
+
+def test_bending_stiffness_gives_physical_wrench(node_and_client):
+    _, c = node_and_client
+    assert all(r.successful for r in c.set_params(bending_stiffness=2.0, rod_length=0.5))
+    _, sol, _ = solve_topic(c, 0.3, 0.15, 0.5)
+    assert sol.success and sol.wrench_valid
+    ei, length = 2.0, 0.5
+    a3, a4, a5 = sol.a
+    assert math.isclose(sol.base_wrench.force.x, a4 * ei / length**2, rel_tol=1e-12)
+    assert math.isclose(sol.base_wrench.force.y, a5 * ei / length**2, rel_tol=1e-12)
+    assert math.isclose(sol.base_wrench.torque.z, a3 * ei / length, rel_tol=1e-12)
+    assert math.isclose(sol.elastic_energy_joules, sol.elastic_energy * ei / length, rel_tol=1e-12)
+    # Same normalised shape as (0.6, 0.3, 0.5) on the unit rod: same a.
+    assert all(r.successful for r in c.set_params(bending_stiffness=0.0, rod_length=1.0))
+    _, sol1, _ = solve_topic(c, 0.6, 0.3, 0.5)
+    assert max(abs(p - q) for p, q in zip(sol.a, sol1.a)) < 1e-4
+    assert not sol1.wrench_valid and math.isnan(sol1.elastic_energy_joules)
+
+
+def test_solver_method_switch(node_and_client):
+    _, c = node_and_client
+    assert all(r.successful for r in c.set_params(method="newton", tolerance=1e-9, max_iterations=50))
+    for x, y, yaw in [(0.6, 0.3, 0.5), (0.62, 0.31, 0.55)]:
+        _, sol, path = solve_topic(c, x, y, yaw)
+        assert sol.success, sol.message
+        assert sol.position_error < 1e-8
+    assert all(r.successful for r in c.set_params(method="robust", tolerance=1e-6, max_iterations=100))
+
+
+def test_startup_flags_and_params_file(tmp_path):
+    yaml = tmp_path / "p.yaml"
+    yaml.write_text("rod_ig_node:\n  ros__parameters:\n    rod_length: 3.0\n    path_samples: 12\n"
+                    "    base_frame: from_file\n")
+    domain = h.free_domain()
+    node = h.NodeProcess(domain, ["--ros-args", "--params-file", str(yaml), "-p", "rod_length:=2.0"])
+    c = h.Client(domain)
+    try:
+        assert c.wait_connected(), node.log_text()
+        assert c.get_params("rod_length", "path_samples", "base_frame") == {
+            "rod_length": 2.0, "path_samples": 12, "base_frame": "from_file"}
+        _, sol, path = solve_topic(c, 1.2, 0.6, 0.5, frame="")
+        assert sol.success and sol.header.frame_id == "from_file"
+        assert len(path.poses) == 12
+    finally:
+        c.close()
+        code = node.stop(signal.SIGINT)
+    assert code == 0, node.log_path.read_text()
+    assert "SIGINT: shutting down" in node.log_path.read_text()
+
+
+def test_shipped_params_file_starts(tmp_path):
+    domain = h.free_domain()
+    node = h.NodeProcess(domain, ["--params-file", str(h.REPO / "launch_notes" / "rod_ig_params.yaml")])
+    try:
+        assert node.wait_log("rod_ig_node ready", timeout=20), node.log_text()
+    finally:
+        assert node.stop() == 0
+
+
+def test_bad_command_line_exits_with_reason():
+    for args, expected in [(["-p", "rod_length:=-2"], "rod_length"),
+                           (["--params-file", "/nonexistent.yaml"], "nonexistent"),
+                           (["--bogus"], "unsupported argument")]:
+        r = subprocess.run([str(h.binary("rod_ig_node")), *args], capture_output=True, text=True, timeout=20)
+        assert r.returncode == 2, (args, r.returncode)
+        assert expected in r.stderr, r.stderr
+    r = subprocess.run([str(h.binary("rod_ig_node")), "--help"], capture_output=True, text=True, timeout=20)
+    assert r.returncode == 0 and "rod_length" in r.stdout
+
+
+def test_bad_domain_id_exits_with_reason():
+    import os
+    env = dict(os.environ, ROS_DOMAIN_ID="999")
+    r = subprocess.run([str(h.binary("rod_ig_node"))], capture_output=True, text=True, timeout=20, env=env)
+    assert r.returncode == 2 and "ROS_DOMAIN_ID" in r.stderr
