@@ -90,15 +90,55 @@ fn det3(j: &super::SpatialJacobian, rows: [usize; 3], cols: [usize; 3]) -> f64 {
     m.determinant()
 }
 
+/// Determinant of a 6×6 matrix (columns given as arrays) by Gaussian elimination with partial
+/// pivoting, on the stack.
+fn det6(mut m: [[f64; 6]; 6]) -> f64 {
+    // m[c][r]: column-major, as stored in the state.
+    let mut det = 1.0;
+    for k in 0..6 {
+        let mut p = k;
+        let mut best = m[k][k].abs();
+        for r in k + 1..6 {
+            let v = m[k][r].abs();
+            if v > best {
+                best = v;
+                p = r;
+            }
+        }
+        if best == 0.0 || !best.is_finite() {
+            return if best == 0.0 { 0.0 } else { f64::NAN };
+        }
+        if p != k {
+            for col in m.iter_mut() {
+                col.swap(k, p);
+            }
+            det = -det;
+        }
+        let piv = m[k][k];
+        det *= piv;
+        for c in k + 1..6 {
+            let f = m[c][k] / piv;
+            if f != 0.0 {
+                for r in k + 1..6 {
+                    m[c][r] -= f * m[k][r];
+                }
+            }
+        }
+    }
+    det
+}
+
 /// (sign function g, full det): g > 0 ⇔ the sample passes the rule.
 fn sample(planar: bool, s: &[f64]) -> (f64, f64) {
-    let j = jac_of(s);
     if planar {
+        let j = jac_of(s);
         let din = det3(&j, [2, 3, 4], [2, 3, 4]);
         let dout = det3(&j, [0, 1, 5], [0, 1, 5]);
         (din.min(dout), din * dout)
     } else {
-        let d = j.determinant();
+        let o = reduced::NRB;
+        let m: [[f64; 6]; 6] = std::array::from_fn(|c| std::array::from_fn(|r| s[o + 6 * c + r]));
+        let d = det6(m);
         (d, d)
     }
 }
@@ -367,6 +407,26 @@ pub(crate) fn evaluate_if_stable(
         }),
         stability,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn det6_matches_nalgebra() {
+        let mut x = 0.3f64;
+        for _ in 0..200 {
+            let m: [[f64; 6]; 6] = std::array::from_fn(|_| {
+                std::array::from_fn(|_| {
+                    x = (x * 3.7 + 0.13).fract();
+                    x - 0.5
+                })
+            });
+            let n = nalgebra::Matrix6::from_fn(|r, c| m[c][r]);
+            let (a, b) = (super::det6(m), n.determinant());
+            assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()), "{a} {b}");
+        }
+        assert_eq!(super::det6([[0.0; 6]; 6]), 0.0);
+    }
 }
 
 pub(super) fn evaluate_impl(
