@@ -333,16 +333,17 @@ impl<T: Real> Landen<T> {
         let mut converged = false;
         for n in 1..=MAX_LEVELS {
             let a_new = (a + b) * 0.5;
+            let inv_a = a_new.recip();
             d = if n == 1 {
-                (b0 + 1.0).recip() * 0.5
+                inv_a * 0.25 // 1/(2(1 + b0)) with a1 = (1 + b0)/2
             } else {
-                m * d * d / (a_new * 4.0)
+                m * d * d * inv_a * 0.25
             };
-            omca[n - 1] = b / a_new;
+            omca[n - 1] = b * inv_a;
             b = (a * b).sqrt();
             a = a_new;
             let c = m * d;
-            ca[n - 1] = c / a;
+            ca[n - 1] = c * inv_a;
             dm[n - 1] = d;
             pow2 *= 2.0;
             q += m * d * d * pow2;

@@ -311,6 +311,17 @@ impl Atlas {
         out[start..].sort_by(|p, q| p.0.total_cmp(&q.0));
     }
 
+    /// ‖Υ(a_s) − b‖ for seed `k` (angle wrapped; from the stored tip).
+    pub(crate) fn seed_residual(&self, k: u32, target: &PlanarPose) -> f64 {
+        let s = &self.seeds[k as usize];
+        Vector3::new(
+            s.tip[0] - target.x,
+            s.tip[1] - target.y,
+            wrap_angle(s.tip[2] - target.theta),
+        )
+        .norm()
+    }
+
     /// The start for seed `k` toward `target`: the seed, and its predicted Newton step
     /// a1 = a_s − J(1, a_s)⁻¹ (Υ(a_s) − b), clipped to the local solver's trust box.
     pub(crate) fn start(&self, k: u32, target: &PlanarPose) -> Start {
