@@ -19,10 +19,21 @@ fn per_start_budget(options: &SolveOptions) -> u32 {
 }
 
 /// Counters accumulated over the starts of one solve.
-#[derive(Default)]
 struct Counts {
     iterations: u32,
     evaluations: u32,
+    /// Best residual reached by any start, and where.
+    best: (f64, Option<PlanarParams>),
+}
+
+impl Default for Counts {
+    fn default() -> Self {
+        Self {
+            iterations: 0,
+            evaluations: 0,
+            best: (f64::INFINITY, None),
+        }
+    }
 }
 
 /// Runs one start (with its optional predicted first step); returns the verified stable
@@ -44,6 +55,9 @@ fn try_start(
     );
     counts.iterations += r.iterations;
     counts.evaluations += r.evaluations;
+    if r.residual < counts.best.0 {
+        counts.best = (r.residual, Some(r.last_a));
+    }
     let (a, e) = r.found?;
     let st = model::stability(&a).ok()?;
     if !st.stable {
@@ -193,8 +207,8 @@ pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solut
     Err(Failure {
         reason: IgError::NoStableSolution { starts: n as u32 },
         iterations: counts.iterations,
-        residual: f64::INFINITY,
-        last_a: None,
+        residual: counts.best.0,
+        last_a: counts.best.1,
         elapsed_us: 0.0,
     })
 }
