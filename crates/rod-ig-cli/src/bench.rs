@@ -254,3 +254,59 @@ pub fn inverse_geometry(quick: bool, cases_path: &Path) {
     println!("(goals: robust ≥ 99.9 % success, every success stable, median ≤ 10 µs; tracking ≤ 3 iterations per step)");
     println!();
 }
+
+/// 3-D rod: forward + J by integration at 1e-8, stability, and the robust 3-D solver on
+/// random reachable targets of stable rods.
+pub fn spatial(quick: bool) {
+    use rod_ig_core::spatial::{self, ig as ig3d, StabilityOptions, Stiffness, PRODUCTION_RTOL};
+    let k = Stiffness::default();
+    let (n, rounds) = if quick { (16, 3) } else { (64, 9) };
+    let (a_box, f_box) = ig3d::TARGET_BOX;
+    let inputs: Vec<spatial::SpatialParams> = ig3d::random_targets(n, 3, &k)
+        .into_iter()
+        .map(|(a, _)| a)
+        .collect();
+    println!(
+        "## 3-D rod (numerical integration, rtol {PRODUCTION_RTOL:e}; {} stable rods from |a1..3| ≤ {a_box}, |a4..6| ≤ {f_box}, {rounds} rounds)",
+        inputs.len()
+    );
+    println!(
+        "{:<28} {:>10} {:>10}   goal",
+        "µs per call", "median", "mean"
+    );
+    let tj = measure(&inputs, rounds, |a| {
+        spatial::tip_and_jacobian(a, &k, PRODUCTION_RTOL).map(|(p, _)| p.position.x)
+    });
+    println!(
+        "{:<28} {:>10.2} {:>10.2}   ≤ 50 µs",
+        "forward + J(1)",
+        tj.median_ns / 1e3,
+        tj.mean_ns / 1e3
+    );
+    let opts = StabilityOptions::production();
+    let ev = measure(&inputs, rounds, |a| {
+        spatial::evaluate(a, &k, &opts).map(|e| e.stability.stable)
+    });
+    println!(
+        "{:<28} {:>10.2} {:>10.2}",
+        "forward + J + stability",
+        ev.median_ns / 1e3,
+        ev.mean_ns / 1e3
+    );
+    let targets = if quick { 50 } else { 500 };
+    let r = ig3d::benchmark_random_targets(targets, 5);
+    println!(
+        "robust 3-D solve, {} random stable targets: success {:.1} %, median {:.0} µs, p90 {:.0} µs, max {:.0} µs, {:.1} iterations, {:.1} integrations per solve (goals ≥ 99 %, median ≤ 1 ms)",
+        r.targets,
+        100.0 * r.success_rate,
+        r.median_us,
+        r.p90_us,
+        r.max_us,
+        r.mean_iterations,
+        r.mean_evaluations
+    );
+    for (why, count) in &r.failures {
+        println!("    failed ×{count}: {why}");
+    }
+    println!();
+}

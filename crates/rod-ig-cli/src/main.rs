@@ -4,6 +4,7 @@
 mod bench;
 mod jsonl;
 mod planar_cmds;
+mod spatial_cmds;
 mod svg;
 mod timing;
 
@@ -34,6 +35,15 @@ enum Command {
     /// {"success", "a", "tip", "stable", "iterations", "residual", "energy", "position_error",
     /// "orientation_error", "stability_margin", "reason" (on failure), "solutions" (with all)}.
     Solve,
+    /// 3-D forward map by numerical integration. Reads JSON lines {"a": [a1, .., a6],
+    /// "stiffness"?: [c1, c2, c3], "rtol"?}; writes {"tip": {"position": [x, y, z],
+    /// "quaternion": [qx, qy, qz, qw]}, "jacobian" (6×6, body twists, rows ω1 ω2 ω3 v1 v2 v3),
+    /// "stable", "energy", "stability_margin"}.
+    Forward3d,
+    /// 3-D inverse geometry. Reads JSON lines {"target": {"position": [..], "quaternion":
+    /// [qx, qy, qz, qw]}, "a0"?: [6 numbers], "method"?, "alpha"?, "max_iterations"?,
+    /// "tolerance"?, "stiffness"?}; writes the fields of `solve` with 3-D a and tip.
+    Solve3d,
     /// Samples or draws rods: given parameters (--a, repeatable) or a target pose (--target:
     /// every distinct stable solution found). JSON lines of poses, or an SVG picture.
     Shape {
@@ -55,7 +65,7 @@ enum Command {
     },
     /// Measures every speed figure in one run: forward map, J, stability, shape against the
     /// paper's RK4 baseline (dt = 1e-4); the paper's Table 1 protocol for Newton; the robust
-    /// solver and tracking.
+    /// solver and tracking; the 3-D rod's forward map and solver.
     Bench {
         /// Fewer rounds and samples (a smoke run, not for quoting).
         #[arg(long)]
@@ -74,6 +84,7 @@ enum BenchPart {
     All,
     Forward,
     Ig,
+    Spatial,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq)]
@@ -160,6 +171,12 @@ fn main() -> ExitCode {
         Command::Solve => {
             jsonl::run(stdin, stdout, planar_cmds::solve_line).map_err(|e| e.to_string())
         }
+        Command::Forward3d => {
+            jsonl::run(stdin, stdout, spatial_cmds::forward3d_line).map_err(|e| e.to_string())
+        }
+        Command::Solve3d => {
+            jsonl::run(stdin, stdout, spatial_cmds::solve3d_line).map_err(|e| e.to_string())
+        }
         Command::Shape {
             params,
             target,
@@ -177,6 +194,9 @@ fn main() -> ExitCode {
             }
             if matches!(only, BenchPart::All | BenchPart::Ig) {
                 bench::inverse_geometry(quick, &ig_cases);
+            }
+            if matches!(only, BenchPart::All | BenchPart::Spatial) {
+                bench::spatial(quick);
             }
             Ok(())
         }

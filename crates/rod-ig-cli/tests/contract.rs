@@ -111,3 +111,49 @@ fn shape_svg_and_json() {
     assert!(String::from_utf8_lossy(&bad.stderr).contains("not"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn forward3d_planar_subset_matches_forward() {
+    // (a1, a2, a6) = 0 is the planar rod (FINDINGS3D): same tip, rotation about z by θ.
+    let planar = run(&["forward"], "{\"a\": [2.5, -12.0, 7.0]}\n");
+    let spatial = run(
+        &["forward3d"],
+        "{\"a\": [0, 0, 2.5, -12.0, 7.0, 0], \"rtol\": 1e-12}\n{\"a\": [1, 2, 3]}\n{\"a\": [0, 0, 1, 1, 1, 0], \"stiffness\": [1, -1, 1]}\n",
+    );
+    assert_eq!(spatial.len(), 3);
+    let tip = &spatial[0]["tip"];
+    let p = tip["position"].as_array().unwrap();
+    let q = tip["quaternion"].as_array().unwrap();
+    let theta = planar[0]["tip"]["theta"].as_f64().unwrap();
+    assert!((p[0].as_f64().unwrap() - planar[0]["tip"]["x"].as_f64().unwrap()).abs() < 1e-9);
+    assert!((p[1].as_f64().unwrap() - planar[0]["tip"]["y"].as_f64().unwrap()).abs() < 1e-9);
+    assert!(p[2].as_f64().unwrap().abs() < 1e-12);
+    // q = (0, 0, sin θ/2, cos θ/2) up to the sign that makes w ≥ 0.
+    let (qz, qw) = (q[2].as_f64().unwrap(), q[3].as_f64().unwrap());
+    assert!(qw >= 0.0);
+    assert!((qz.atan2(qw) * 2.0 - rod_ig_core::wrap_angle(theta)).abs() < 1e-8);
+    assert_eq!(spatial[0]["stable"], planar[0]["stable"]);
+    assert_eq!(spatial[0]["jacobian"].as_array().unwrap().len(), 6);
+    assert!(spatial[1]["error"].as_str().unwrap().contains("length 6"));
+    assert!(spatial[2]["error"].as_str().unwrap().contains("stiffness"));
+}
+
+#[test]
+fn solve3d_contract() {
+    let out = run(
+        &["solve3d"],
+        "{\"target\": {\"position\": [0.5, 0.3, 0.2], \"quaternion\": [0, 0, 0.3826834, 0.9238795]}}\n\
+         {\"target\": {\"position\": [2, 0, 0], \"quaternion\": [0, 0, 0, 1]}}\n\
+         {\"target\": {\"position\": [0.5, 0, 0], \"quaternion\": [0, 0, 0, 0]}}\n",
+    );
+    assert_eq!(out.len(), 3);
+    assert_eq!(out[0]["success"], true, "{}", out[0]);
+    assert_eq!(out[0]["stable"], true);
+    let p = out[0]["tip"]["position"].as_array().unwrap();
+    for (got, want) in p.iter().zip([0.5, 0.3, 0.2]) {
+        assert!((got.as_f64().unwrap() - want).abs() < 1e-6);
+    }
+    assert_eq!(out[1]["success"], false);
+    assert!(out[1]["reason"].as_str().unwrap().contains("reach"));
+    assert!(out[2]["error"].as_str().unwrap().contains("quaternion"));
+}

@@ -225,15 +225,15 @@ pub fn ellip_fed<T: Real>(phi: T, m: T, m1: T) -> (T, T, T) {
 /// `kk` must be K(m). Near |ψ| = π/2 it uses the complementary-amplitude identity
 /// F(ψ) = K − F(χ), tan χ = cot ψ/√m1, i.e. F = sgn(s)(K − c R_F(m1 s², m1, c² + m1 s²)),
 /// which is smooth in c through c = 0 (so derivatives stay finite there) and also covers
-/// π/2 < |ψ| < π (c < 0). (s, c) must satisfy s² + c² = 1.
+/// π/2 < |ψ| < π (c < 0). (s, c) must satisfy s² + c² = 1. Only m1 enters the formulas;
+/// `m` is accepted for symmetry with the other functions.
 #[inline]
-pub fn inverse_phase<T: Real>(s: T, c: T, m: T, m1: T, kk: T) -> T {
+pub fn inverse_phase<T: Real>(s: T, c: T, _m: T, m1: T, kk: T) -> T {
     if c.re() >= s.re().abs() {
         s * carlson_rf(c * c, c * c + m1 * s * s, T::from_f64(1.0))
     } else {
         let ms2 = m1 * s * s;
         let g = c * carlson_rf(ms2, m1, c * c + ms2);
-        let _ = m;
         if s.re() < 0.0 {
             g - kk
         } else {
@@ -310,7 +310,7 @@ pub struct Landen<T> {
     dm: [T; MAX_LEVELS],
     /// K(m) = π/(2a_N).
     k: T,
-    /// q = Σₙ≥₁ 2ⁿ m (cₙ/m)², so that 2D(m)/K(m) = 1 + q and E/K = m1 − (m/2)(… ) (A&S 17.6.4).
+    /// q = Σₙ≥₁ 2ⁿ m (cₙ/m)², so that 2D(m)/K(m) = 1 + q (A&S 17.6.4).
     q: T,
     converged: bool,
 }
@@ -333,16 +333,17 @@ impl<T: Real> Landen<T> {
         let mut converged = false;
         for n in 1..=MAX_LEVELS {
             let a_new = (a + b) * 0.5;
+            let inv_a = a_new.recip();
             d = if n == 1 {
-                (b0 + 1.0).recip() * 0.5
+                inv_a * 0.25 // 1/(2(1 + b0)) with a1 = (1 + b0)/2
             } else {
-                m * d * d / (a_new * 4.0)
+                m * d * d * inv_a * 0.25
             };
-            omca[n - 1] = b / a_new;
+            omca[n - 1] = b * inv_a;
             b = (a * b).sqrt();
             a = a_new;
             let c = m * d;
-            ca[n - 1] = c / a;
+            ca[n - 1] = c * inv_a;
             dm[n - 1] = d;
             pow2 *= 2.0;
             q += m * d * d * pow2;
@@ -389,13 +390,13 @@ impl<T: Real> Landen<T> {
         (self.q + 1.0) * 0.5
     }
 
-    /// E(m)/K(m) = 1 − m D/K = m1 − m q/2... computed as 1 − m(1 + q)/2.
+    /// E(m)/K(m) = 1 − m D(m)/K(m) = 1 − m(1 + q)/2 (A&S §17.6).
     pub fn e_over_k(&self) -> T {
         T::from_f64(1.0) - self.m * (self.q + 1.0) * 0.5
     }
 
     /// Jacobi functions at u by the descending recursion sin(2φₙ₋₁ − φₙ) = (cₙ/aₙ) sin φₙ,
-    /// φ_N = 2^N a_N u (A&S 16.4.3), accumulating Z/m = Σ (cₙ/m) sin φₙ (A&S 17.6.?).
+    /// φ_N = 2^N a_N u (A&S 16.4.3), accumulating Z/m = Σ (cₙ/m) sin φₙ (A&S §17.6, Jacobi zeta by the AGM).
     #[inline]
     pub fn eval(&self, u: T) -> JacobiValues<T> {
         let mut phi = self.scale * u;

@@ -32,3 +32,8 @@ mod types;
 
 pub use error::RodError;
 pub use types::{wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, StabilityReport};
+
+// The README's Rust example is compiled and run as a doc-test.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+struct ReadmeDoctests;

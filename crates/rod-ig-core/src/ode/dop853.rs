@@ -539,7 +539,7 @@ impl<const N: usize> Dop853<N> {
                 if i >= ne {
                     continue;
                 }
-                let sk = self.weight(y[i], y_new[i]);
+                let inv = 1.0 / self.weight(y[i], y_new[i]);
                 let e3 = bk - BHH1 * k1[i] - BHH2 * k9[i] - BHH3 * k12[i];
                 let e5 = ER1 * k1[i]
                     + ER6 * k6[i]
@@ -549,8 +549,8 @@ impl<const N: usize> Dop853<N> {
                     + ER10 * k10[i]
                     + ER11 * k11[i]
                     + ER12 * k12[i];
-                err3 += (e3 / sk).powi(2);
-                err5 += (e5 / sk).powi(2);
+                err3 += (e3 * inv).powi(2);
+                err5 += (e5 * inv).powi(2);
             }
             let mut deno = err5 + 0.01 * err3;
             if deno <= 0.0 {

@@ -396,6 +396,10 @@ impl<T: Real> Closed<T> {
             s.phi, s.r, s.sqa3, s.chat, s.shat, s.lin, s.sqm, s.th0, s.e0, s.j0.sn, s.j0.cn,
             s.j0.dn, s.j0.zm,
         ];
+        // Beyond |Γ| ~ 1e9 the phase of the Jacobi functions is lost in f64 rounding.
+        if s.r.re() + s.phi.re().abs() > 1e9 {
+            return None;
+        }
         if !fields.iter().all(|v| v.re().is_finite())
             || s.r.re().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
         {

@@ -73,6 +73,7 @@ fn pose_and_jac_of(
 pub struct PlanarRod {
     a: PlanarParams,
     closed: Closed<f64>,
+    tip: PlanarPose,
 }
 
 impl PlanarRod {
@@ -81,7 +82,12 @@ impl PlanarRod {
     pub fn new(a: &PlanarParams) -> Result<Self, RodError> {
         check_params(a)?;
         let closed = Closed::new(a[0], a[1], a[2]).ok_or_else(overflow)?;
-        Ok(Self { a: *a, closed })
+        let [x, y, th] = closed.pose(1.0);
+        let tip = PlanarPose::new(x, y, th);
+        if !tip.is_finite() {
+            return Err(overflow());
+        }
+        Ok(Self { a: *a, closed, tip })
     }
 
     /// The parameters a = μ(0) this rod was built from.
@@ -102,9 +108,9 @@ impl PlanarRod {
         PlanarPose::new(x, y, th)
     }
 
-    /// Tip pose q(1).
+    /// Tip pose q(1) (computed once by [`PlanarRod::new`]).
     pub fn tip(&self) -> PlanarPose {
-        self.pose(1.0)
+        self.tip
     }
 
     /// Curvature κ(t) = μ3(t) (FINDINGS §2 table: ε√α3 cn Γ, ε√α3 dn Γ or ε√α3 sech Γ).
@@ -122,7 +128,13 @@ impl PlanarRod {
             n => {
                 let d = (n - 1) as f64;
                 (0..n)
-                    .map(|i| self.pose(if i == n - 1 { 1.0 } else { i as f64 / d }))
+                    .map(|i| {
+                        if i == n - 1 {
+                            self.tip
+                        } else {
+                            self.pose(i as f64 / d)
+                        }
+                    })
                     .collect()
             }
         }
@@ -143,12 +155,7 @@ fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
 
 /// Tip pose q(1, a) by the closed form (FINDINGS §1–§3).
 pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
-    let q = PlanarRod::new(a)?.tip();
-    if q.is_finite() {
-        Ok(q)
-    } else {
-        Err(overflow())
-    }
+    Ok(PlanarRod::new(a)?.tip())
 }
 
 /// Pose q(t, a) and J(t, a) = ∂q(t)/∂a (rows x, y, θ; columns a3, a4, a5), exact up to

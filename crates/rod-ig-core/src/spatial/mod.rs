@@ -532,7 +532,7 @@ pub fn shape(
             "shape needs at least 2 samples (got {samples})"
         )));
     }
-    if samples > 10_000_000 {
+    if samples > 1_000_000 {
         return Err(RodError::OutOfDomain(format!(
             "too many samples ({samples})"
         )));

@@ -90,36 +90,34 @@ pub(crate) fn rhs<const N: usize, const VAR: bool>(
     if !VAR {
         return;
     }
-    for j in 0..6 {
-        let o = NRB + 6 * j;
-        let eo = [s[o], s[o + 1], s[o + 2]];
-        let ev = [s[o + 3], s[o + 4], s[o + 5]];
-        // g = Rᵀ δa_m − Rᵀ (p × δa_f) for δa = e_j.
-        let g = if j < 3 {
-            [r[j][0], r[j][1], r[j][2]]
-        } else {
-            let mut e = [0.0; 3];
-            e[j - 3] = 1.0;
-            let pe = cross(p, e);
-            let v = rt_mul(&r, pe);
-            [-v[0], -v[1], -v[2]]
-        };
+    // g_j = Rᵀ δa_m − Rᵀ (p × δa_f) for δa = e_j: rows of R for j < 3, −Rᵀ(p × e_k) after.
+    let pe = [[0.0, p[2], -p[1]], [-p[2], 0.0, p[0]], [p[1], -p[0], 0.0]]; // p × e_k
+    let mut g = [[0.0; 3]; 6];
+    for k in 0..3 {
+        g[k] = r[k];
+        let v = rt_mul(&r, pe[k]);
+        g[k + 3] = [-v[0], -v[1], -v[2]];
+    }
+    let (_, var) = s.split_at(NRB);
+    let (_, dvar) = ds.split_at_mut(NRB);
+    for ((col, dcol), gj) in var
+        .chunks_exact(6)
+        .zip(dvar.chunks_exact_mut(6))
+        .zip(g.iter())
+    {
+        let eo = [col[0], col[1], col[2]];
+        let ev = [col[3], col[4], col[5]];
         let c1 = cross(eo, m);
         let c2 = cross(ev, f);
-        let dw = [
-            (g[0] - c1[0] - c2[0]) * ci[0],
-            (g[1] - c1[1] - c2[1]) * ci[1],
-            (g[2] - c1[2] - c2[2]) * ci[2],
-        ];
         let we = cross(om, eo);
         let wv = cross(om, ev);
-        ds[o] = dw[0] - we[0];
-        ds[o + 1] = dw[1] - we[1];
-        ds[o + 2] = dw[2] - we[2];
+        dcol[0] = (gj[0] - c1[0] - c2[0]) * ci[0] - we[0];
+        dcol[1] = (gj[1] - c1[1] - c2[1]) * ci[1] - we[1];
+        dcol[2] = (gj[2] - c1[2] - c2[2]) * ci[2] - we[2];
         // η_v' = −ω × η_v + η_ω × e1, with η_ω × e1 = (0, η_ω3, −η_ω2).
-        ds[o + 3] = -wv[0];
-        ds[o + 4] = -wv[1] + eo[2];
-        ds[o + 5] = -wv[2] - eo[1];
+        dcol[3] = -wv[0];
+        dcol[4] = -wv[1] + eo[2];
+        dcol[5] = -wv[2] - eo[1];
     }
 }
 

@@ -1,7 +1,10 @@
 //! Stability of the 3-D rod (Bretl & McCarthy 2014; rule of `FINDINGS3D.md`): the equilibrium
 //! is stable iff det J(t, a) > 0 at every t = i/2000 in [0.02, 1]. Straight rods
-//! (a2 = a3 = a5 = a6 = 0) have det ≡ 0 and are classified unstable. For exact planar-subset
-//! inputs (a1 = a2 = a6 = 0) J is block-diagonal and both 3×3 blocks must have det > 0.
+//! (a2 = a3 = a5 = a6 = 0) have det ≡ 0 and are classified unstable. For planar rods — the
+//! planar subset a1 = a2 = a6 = 0, or any rotation of it about the base tangent (a1 = 0 and
+//! (a2, a3) ⊥ (a5, a6), to 1e-12 relative) — J is block-diagonal in the rotated frame and both
+//! 3×3 blocks (in-plane and out-of-plane) must have det > 0 (FINDINGS3D trap 3: simultaneous
+//! crossings of the two blocks cancel in det).
 //!
 //! Fast scan: det is evaluated (dense output) on a coarse sub-grid of the rule's grid (every
 //! `coarse_stride`-th point, plus every step end); where it is ≤ 0 the rule's grid points since
@@ -81,8 +84,30 @@ fn is_straight(a: &SpatialParams) -> bool {
     a[1] == 0.0 && a[2] == 0.0 && a[4] == 0.0 && a[5] == 0.0
 }
 
-fn is_planar_subset(a: &SpatialParams) -> bool {
-    a[0] == 0.0 && a[1] == 0.0 && a[5] == 0.0
+/// For a planar rod (module docs), the matrix B = diag(Rx(−φ), Rx(−φ)) that maps J(t) to the
+/// block-diagonal J of the planar subset, B J Bᵀ; None for a non-planar rod.
+fn planar_frame(a: &SpatialParams) -> Option<nalgebra::Matrix6<f64>> {
+    let scale = a.amax();
+    if !(scale > 0.0) || a[0].abs() > 1e-12 * scale {
+        return None;
+    }
+    let dot = a[1] * a[4] + a[2] * a[5];
+    if dot.abs() > 1e-12 * scale * scale {
+        return None;
+    }
+    // The moment lies along Rx(φ) e3 = (0, −sin φ, cos φ); the force in span(e1, Rx(φ) e2).
+    let phi = if a[1] != 0.0 || a[2] != 0.0 {
+        (-a[1]).atan2(a[2])
+    } else {
+        a[5].atan2(a[4])
+    };
+    let (sn, cs) = phi.sin_cos();
+    // Rx(−φ) = [[1, 0, 0], [0, cos φ, sin φ], [0, −sin φ, cos φ]]
+    let r = nalgebra::Matrix3::new(1.0, 0.0, 0.0, 0.0, cs, sn, 0.0, -sn, cs);
+    let mut b = nalgebra::Matrix6::zeros();
+    b.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
+    b.fixed_view_mut::<3, 3>(3, 3).copy_from(&r);
+    Some(b)
 }
 
 fn det3(j: &super::SpatialJacobian, rows: [usize; 3], cols: [usize; 3]) -> f64 {
@@ -90,22 +115,62 @@ fn det3(j: &super::SpatialJacobian, rows: [usize; 3], cols: [usize; 3]) -> f64 {
     m.determinant()
 }
 
+/// Determinant of a 6×6 matrix (columns given as arrays) by Gaussian elimination with partial
+/// pivoting, on the stack.
+fn det6(mut m: [[f64; 6]; 6]) -> f64 {
+    // m[c][r]: column-major, as stored in the state.
+    let mut det = 1.0;
+    for k in 0..6 {
+        let mut p = k;
+        let mut best = m[k][k].abs();
+        for r in k + 1..6 {
+            let v = m[k][r].abs();
+            if v > best {
+                best = v;
+                p = r;
+            }
+        }
+        if best == 0.0 || !best.is_finite() {
+            return if best == 0.0 { 0.0 } else { f64::NAN };
+        }
+        if p != k {
+            for col in m.iter_mut() {
+                col.swap(k, p);
+            }
+            det = -det;
+        }
+        let piv = m[k][k];
+        det *= piv;
+        for c in k + 1..6 {
+            let f = m[c][k] / piv;
+            if f != 0.0 {
+                for r in k + 1..6 {
+                    m[c][r] -= f * m[k][r];
+                }
+            }
+        }
+    }
+    det
+}
+
 /// (sign function g, full det): g > 0 ⇔ the sample passes the rule.
-fn sample(planar: bool, s: &[f64]) -> (f64, f64) {
-    let j = jac_of(s);
-    if planar {
+fn sample(planar: Option<&nalgebra::Matrix6<f64>>, s: &[f64]) -> (f64, f64) {
+    if let Some(b) = planar {
+        let j = b * jac_of(s) * b.transpose();
         let din = det3(&j, [2, 3, 4], [2, 3, 4]);
         let dout = det3(&j, [0, 1, 5], [0, 1, 5]);
         (din.min(dout), din * dout)
     } else {
-        let d = j.determinant();
+        let o = reduced::NRB;
+        let m: [[f64; 6]; 6] = std::array::from_fn(|c| std::array::from_fn(|r| s[o + 6 * c + r]));
+        let d = det6(m);
         (d, d)
     }
 }
 
 struct Scan {
     a: SpatialParams,
-    planar: bool,
+    planar: Option<nalgebra::Matrix6<f64>>,
     stride: u32,
     next_coarse: u32,
     last_pos: f64,
@@ -139,7 +204,7 @@ impl Scan {
                 break;
             }
             let s = d.eval(t);
-            let (g, det) = sample(self.planar, &s);
+            let (g, det) = sample(self.planar.as_ref(), &s);
             if !g.is_finite() {
                 self.nonfinite = true;
                 return;
@@ -150,7 +215,7 @@ impl Scan {
                 if lo < hi {
                     for _ in 0..40 {
                         let mid = 0.5 * (lo + hi);
-                        let (gm, _) = sample(self.planar, &d.eval(mid));
+                        let (gm, _) = sample(self.planar.as_ref(), &d.eval(mid));
                         if gm > 0.0 {
                             lo = mid;
                         } else {
@@ -209,7 +274,7 @@ impl Scan {
         if self.failed.is_some() || self.nonfinite || t1 < STABILITY_T_MIN {
             return;
         }
-        let (g, det) = sample(self.planar, y1);
+        let (g, det) = sample(self.planar.as_ref(), y1);
         if !g.is_finite() {
             self.nonfinite = true;
         } else if g > 0.0 {
@@ -225,7 +290,7 @@ impl Scan {
 
     /// Returns false when the scan is over (failure or non-finite).
     fn check(&mut self, d: &DenseStep<NV>, t: f64, s: &[f64; NV]) -> bool {
-        let (g, det) = sample(self.planar, s);
+        let (g, det) = sample(self.planar.as_ref(), s);
         if !g.is_finite() {
             self.nonfinite = true;
             return false;
@@ -291,7 +356,7 @@ fn run(
     )?;
     let mut scan = Scan {
         a: *a,
-        planar: is_planar_subset(a),
+        planar: planar_frame(a),
         stride: opts.coarse_stride.clamp(1, GRID_N),
         next_coarse: GRID_START,
         last_pos: STABILITY_T_MIN - 0.5 / GRID_N as f64,
@@ -367,6 +432,26 @@ pub(crate) fn evaluate_if_stable(
         }),
         stability,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn det6_matches_nalgebra() {
+        let mut x = 0.3f64;
+        for _ in 0..200 {
+            let m: [[f64; 6]; 6] = std::array::from_fn(|_| {
+                std::array::from_fn(|_| {
+                    x = (x * 3.7 + 0.13).fract();
+                    x - 0.5
+                })
+            });
+            let n = nalgebra::Matrix6::from_fn(|r, c| m[c][r]);
+            let (a, b) = (super::det6(m), n.determinant());
+            assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()), "{a} {b}");
+        }
+        assert_eq!(super::det6([[0.0; 6]; 6]), 0.0);
+    }
 }
 
 pub(super) fn evaluate_impl(

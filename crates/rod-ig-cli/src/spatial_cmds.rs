@@ -1,0 +1,187 @@
+//! `rod-ig forward3d` and `rod-ig solve3d`: the 3-D twins of `forward` and `solve`.
+//! Poses are {"position": [x, y, z], "quaternion": [qx, qy, qz, qw]} (scalar last, qw ≥ 0).
+
+use crate::jsonl;
+use nalgebra::Vector3;
+use rod_ig_core::spatial::ig::{self as ig3d, Method3d, SolveOptions3d};
+use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// A pose as it travels in JSON.
+#[derive(Serialize, Deserialize, Clone, Copy)]
+#[serde(deny_unknown_fields)]
+struct PoseJson {
+    position: [f64; 3],
+    /// (x, y, z, w), any nonzero norm on input; unit with w ≥ 0 on output.
+    quaternion: [f64; 4],
+}
+
+impl PoseJson {
+    fn from_pose(p: &SpatialPose) -> Self {
+        PoseJson {
+            position: [p.position.x, p.position.y, p.position.z],
+            quaternion: p.quaternion_xyzw(),
+        }
+    }
+
+    fn to_pose(self) -> Result<SpatialPose, String> {
+        SpatialPose::from_xyzw(Vector3::from(self.position), self.quaternion)
+            .map_err(|e| format!("target: {e}"))
+    }
+}
+
+fn stiffness(c: Option<[f64; 3]>) -> Result<Stiffness, String> {
+    let k = match c {
+        Some([c1, c2, c3]) => Stiffness { c1, c2, c3 },
+        None => Stiffness::default(),
+    };
+    k.validate().map_err(|e| format!("stiffness: {e}"))?;
+    Ok(k)
+}
+
+/// One `forward3d` request.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Forward3dRequest {
+    a: [f64; 6],
+    /// (c1, c2, c3): torsion and the two bending stiffnesses; default (1, 1, 1).
+    stiffness: Option<[f64; 3]>,
+    /// Relative tolerance of the integration (default 1e-8).
+    rtol: Option<f64>,
+}
+
+#[derive(Serialize)]
+struct Forward3dAnswer {
+    tip: PoseJson,
+    /// J(1, a): column j = q⁻¹ ∂q/∂a_j as a body twist, rows (ω1, ω2, ω3, v1, v2, v3).
+    jacobian: [[f64; 6]; 6],
+    stable: bool,
+    energy: f64,
+    stability_margin: f64,
+}
+
+/// Answers one `forward3d` line.
+pub fn forward3d_line(line: &str) -> Result<Value, String> {
+    let request: Forward3dRequest = jsonl::parse(line)?;
+    let k = stiffness(request.stiffness)?;
+    let mut opts = StabilityOptions::production();
+    if let Some(rtol) = request.rtol {
+        if !(rtol.is_finite() && (1e-14..=1e-3).contains(&rtol)) {
+            return Err(format!("rtol must be in [1e-14, 1e-3], got {rtol}"));
+        }
+        opts.rtol = rtol;
+    }
+    let a = SpatialParams::from(request.a);
+    let e = spatial::evaluate(&a, &k, &opts).map_err(|e| e.to_string())?;
+    jsonl::to_value(&Forward3dAnswer {
+        tip: PoseJson::from_pose(&e.tip),
+        jacobian: std::array::from_fn(|r| std::array::from_fn(|c| e.jacobian[(r, c)])),
+        stable: e.stability.stable,
+        energy: e.energy,
+        stability_margin: e.stability.margin,
+    })
+}
+
+#[derive(Deserialize, Clone, Copy, Default)]
+#[serde(rename_all = "snake_case")]
+enum MethodName {
+    #[default]
+    Robust,
+    Newton,
+}
+
+/// One `solve3d` request.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Solve3dRequest {
+    target: PoseJson,
+    a0: Option<[f64; 6]>,
+    #[serde(default)]
+    method: MethodName,
+    alpha: Option<f64>,
+    max_iterations: Option<u32>,
+    tolerance: Option<f64>,
+    stiffness: Option<[f64; 3]>,
+}
+
+#[derive(Serialize)]
+struct Solve3dAnswer {
+    success: bool,
+    a: Option<[f64; 6]>,
+    tip: Option<PoseJson>,
+    stable: bool,
+    iterations: u32,
+    residual: f64,
+    energy: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    position_error: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    orientation_error: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    stability_margin: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<String>,
+}
+
+/// Answers one `solve3d` line.
+pub fn solve3d_line(line: &str) -> Result<Value, String> {
+    let request: Solve3dRequest = jsonl::parse(line)?;
+    let target = request.target.to_pose()?;
+    let mut options = SolveOptions3d {
+        stiffness: stiffness(request.stiffness)?,
+        initial_guess: request.a0.map(SpatialParams::from),
+        method: match request.method {
+            MethodName::Robust => Method3d::Robust,
+            MethodName::Newton => Method3d::Newton,
+        },
+        ..SolveOptions3d::default()
+    };
+    if let Some(alpha) = request.alpha {
+        if !(alpha.is_finite() && alpha > 0.0 && alpha <= 1.0) {
+            return Err(format!("alpha must be in (0, 1], got {alpha}"));
+        }
+        options.alpha = alpha;
+    }
+    if let Some(n) = request.max_iterations {
+        options.max_iterations = n;
+    }
+    if let Some(tol) = request.tolerance {
+        if !(tol.is_finite() && tol > 0.0) {
+            return Err(format!("tolerance must be positive and finite, got {tol}"));
+        }
+        options.tolerance = tol;
+    }
+    if options.method == Method3d::Newton && options.initial_guess.is_none() {
+        return Err("method \"newton\" needs an initial guess \"a0\"".to_string());
+    }
+    let answer = match ig3d::solve(&target, &options) {
+        Ok(s) => Solve3dAnswer {
+            success: true,
+            a: Some(std::array::from_fn(|i| s.a[i])),
+            tip: Some(PoseJson::from_pose(&s.tip)),
+            stable: s.stable,
+            iterations: s.iterations,
+            residual: s.residual,
+            energy: Some(s.energy),
+            position_error: Some(s.position_error),
+            orientation_error: Some(s.orientation_error),
+            stability_margin: Some(s.stability_margin),
+            reason: None,
+        },
+        Err(f) => Solve3dAnswer {
+            success: false,
+            a: None,
+            tip: None,
+            stable: false,
+            iterations: f.iterations,
+            residual: f.residual,
+            energy: None,
+            position_error: None,
+            orientation_error: None,
+            stability_margin: None,
+            reason: Some(f.reason.to_string()),
+        },
+    };
+    jsonl::to_value(&answer)
+}
