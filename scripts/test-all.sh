@@ -28,7 +28,7 @@ cargo build --release --workspace 2>&1 | tail -n 3
 [ "${PIPESTATUS[0]}" = 0 ] || { echo "cargo build failed"; exit 1; }
 
 echo "== cargo test --workspace (release profile: shares the build with the node under test)"
-cargo test --release --workspace 2>&1 | tee "$LOGS/cargo-test.log" \
+cargo test --release --workspace --no-fail-fast 2>&1 | tee "$LOGS/cargo-test.log" \
     | grep -E '^(test result:|error(\[|:)|failures:|    [a-zA-Z_:]+$|test .* FAILED)' 
 cargo_rc=${PIPESTATUS[0]}
 [ "$cargo_rc" = 0 ] || { echo "cargo test FAILED (full log: $LOGS/cargo-test.log)"; status=1; }

@@ -62,7 +62,7 @@ pub fn yaw_to_quaternion(theta: f64) -> Quaternion {
 /// the rotated x axis in the x-y plane, in (−π, π].
 pub fn quaternion_to_yaw(q: &Quaternion) -> Result<(f64, f64), TargetError> {
     let n = (q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w).sqrt();
-    if !(n > 1e-9) {
+    if n.is_nan() || n <= 1e-9 {
         return Err(TargetError::ZeroQuaternion(n));
     }
     let (x, y, z, w) = (q.x / n, q.y / n, q.z / n, q.w / n);

@@ -12,7 +12,7 @@ no solving). The difference of the two is what rod_ig_node adds (solve + shape +
 RodSolution / Marker messages).
 
 Usage (after scripts/setup-env.sh and `source scripts/env.sh`):
-    python tests/latency_bench.py [--n 1000] [--samples 100] [--warmup 100]
+    python tests/latency_bench.py [--n 1200] [--rounds 3] [--samples 100] [--warmup 100]
 """
 import argparse
 import statistics
@@ -81,14 +81,25 @@ def summary(name, lat, lost):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--n", type=int, default=1000, help="measured targets per run (default 1000)")
+    ap.add_argument("--n", type=int, default=1200, help="measured targets per binary, in total (default 1200)")
     ap.add_argument("--warmup", type=int, default=100, help="unmeasured targets first (default 100)")
     ap.add_argument("--samples", type=int, default=100, help="path_samples (default 100)")
+    ap.add_argument("--rounds", type=int, default=3,
+                    help="alternate echo and node runs this many times, pooling the samples, so "
+                         "drifting machine load affects both alike (default 3)")
     a = ap.parse_args()
 
-    echo, echo_lost = run("rod_ig_echo", [str(a.samples)], a.n, a.warmup)
-    node, node_lost = run("rod_ig_node", ["-p", f"path_samples:={a.samples}"], a.n, a.warmup)
-    print(f"target -> /rod/path round trip seen by rclpy, {a.samples} path poses, {a.n} targets each:")
+    echo, node, echo_lost, node_lost = [], [], 0, 0
+    per_round = max(1, a.n // a.rounds)
+    for _ in range(a.rounds):
+        lat, lost = run("rod_ig_echo", [str(a.samples)], per_round, a.warmup)
+        echo += lat
+        echo_lost += lost
+        lat, lost = run("rod_ig_node", ["-p", f"path_samples:={a.samples}"], per_round, a.warmup)
+        node += lat
+        node_lost += lost
+    print(f"target -> /rod/path round trip seen by rclpy, {a.samples} path poses, "
+          f"{a.rounds} alternating rounds of {per_round} targets each:")
     print(summary("rod_ig_echo (Rust, no solve)", echo, echo_lost))
     print(summary("rod_ig_node", node, node_lost))
     d50 = percentile(node, 0.5) - percentile(echo, 0.5)

@@ -239,6 +239,15 @@ fn classical_conjugate_points() {
         println!("Euler F = {f}: t* = {t}, expected {expect}");
         assert!(!r.stable && (t - expect).abs() < 1e-3);
     }
+    // The same Euler rod rotated about the base tangent: blocks still tested separately.
+    let phi = 0.7f64;
+    let a = Vector6::new(0.0, 0.0, 0.0, -40.0, 0.1 * phi.cos(), 0.1 * phi.sin());
+    let r = spatial::stability(&a, &k).unwrap();
+    let t = r.first_conjugate_t.expect("rotated Euler buckling");
+    assert!(
+        !r.stable && (t - 2.0 * std::f64::consts::PI / 40f64.sqrt()).abs() < 1e-3,
+        "{t}"
+    );
     // Straight rods: unstable, margin 0.
     let r = spatial::stability(&Vector6::new(3.0, 0.0, 0.0, 5.0, 0.0, 0.0), &k).unwrap();
     assert!(!r.stable && r.margin == 0.0);
@@ -246,33 +255,73 @@ fn classical_conjugate_points() {
 
 #[test]
 fn fast_stability_scan_matches_full_grid() {
-    let mut rng = Rng(3);
+    // Boxes ±5/±30 and ±8/±50, every fifth sample an exact planar-subset rod.
+    let mut rng = Rng(77);
     let k = Stiffness::default();
     let mut stable = 0;
-    let n = 300;
+    let mut step_end_only_mismatches = 0;
+    let n = 600;
     for i in 0..n {
-        let a = if i % 3 == 2 {
-            let mut a = rng.params(5.0, 30.0);
+        let (m, f) = if i % 2 == 0 { (5.0, 30.0) } else { (8.0, 50.0) };
+        let mut a = rng.params(m, f);
+        if i % 5 == 4 {
             a[0] = 0.0;
             a[1] = 0.0;
             a[5] = 0.0;
-            a
-        } else {
-            rng.params(5.0, 30.0)
-        };
-        let fast = spatial::stability(&a, &k).unwrap();
+        }
         let full = spatial::stability_full_grid(&a, &k).unwrap();
+        let fast = spatial::stability(&a, &k).unwrap();
         let prod = spatial::stability_with(&a, &k, &StabilityOptions::production()).unwrap();
         assert_eq!(fast.stable, full.stable, "a = {a:?}");
         assert_eq!(prod.stable, full.stable, "production, a = {a:?}");
         if let (Some(t1), Some(t2)) = (fast.first_conjugate_t, full.first_conjugate_t) {
             assert!((t1 - t2).abs() < 1e-6, "{t1} vs {t2}");
         }
+        let ends = StabilityOptions {
+            coarse_stride: 0,
+            ..StabilityOptions::production()
+        };
+        if spatial::stability_with(&a, &k, &ends).unwrap().stable != full.stable {
+            step_end_only_mismatches += 1;
+        }
         if full.stable {
             stable += 1;
         }
     }
-    println!("fast scan = full grid on {n} samples ({stable} stable)");
+    println!("fast scan = full grid on {n} samples ({stable} stable); step-end-only scan differs on {step_end_only_mismatches}");
+    assert!(step_end_only_mismatches <= n / 100);
+}
+
+#[test]
+fn rotated_planar_rods_match_planar_subset() {
+    // Rotating a planar-subset rod about the base tangent conjugates its shape: same verdict,
+    // same first conjugate point, tip = g q g⁻¹.
+    let mut rng = Rng(21);
+    let k = Stiffness::default();
+    for _ in 0..60 {
+        let (a3, a4, a5) = (
+            rng.uniform(-5.0, 5.0),
+            rng.uniform(-30.0, 30.0),
+            rng.uniform(-30.0, 30.0),
+        );
+        let phi = rng.uniform(-3.0, 3.0);
+        let a = Vector6::new(0.0, 0.0, a3, a4, a5, 0.0);
+        let g = Rotation3::from_axis_angle(&Vector3::x_axis(), phi);
+        let m = g * Vector3::new(0.0, 0.0, a3);
+        let f = g * Vector3::new(a4, a5, 0.0);
+        let ar = Vector6::new(0.0, m.y, m.z, f.x, f.y, f.z);
+        let s0 = spatial::stability(&a, &k).unwrap();
+        let s1 = spatial::stability(&ar, &k).unwrap();
+        assert_eq!(s0.stable, s1.stable, "a = {a:?}, phi = {phi}");
+        if let (Some(t0), Some(t1)) = (s0.first_conjugate_t, s1.first_conjugate_t) {
+            assert!((t0 - t1).abs() < 1e-6);
+        }
+        let q0 = spatial::tip(&a, &k, RTOL).unwrap();
+        let q1 = spatial::tip(&ar, &k, RTOL).unwrap();
+        assert!((g * q0.position - q1.position).amax() < 1e-10);
+        let gq = UnitQuaternion::from_rotation_matrix(&g);
+        assert!((gq * q0.rotation * gq.inverse()).angle_to(&q1.rotation) < 1e-9);
+    }
 }
 
 #[test]

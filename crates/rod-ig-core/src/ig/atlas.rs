@@ -31,7 +31,7 @@ const RAYS: usize = 8000;
 /// Ray end-points near the separatrix λ4 = 0.
 const SEPARATRIX_RAYS: usize = 8000;
 /// RK4 steps per ray.
-const STEPS: usize = 200;
+const STEPS: usize = 128;
 /// Half-widths of the end-point box.
 const A3_MAX: f64 = 14.0;
 const A45_MAX: f64 = 150.0;
@@ -114,15 +114,17 @@ fn same_branch(a: &[f64; 3], b: &[f64; 3]) -> bool {
 /// uniform sampling leaves its neighbourhood without seeds). λ4 scales as s⁴ along a ray, so the
 /// whole ray stays at the same relative offset from the separatrix. Offsets are log-uniform.
 fn separatrix_endpoint(i: u64) -> Option<PlanarParams> {
-    let a3 = (2.0 * halton(i, 2) - 1.0) * A3_MAX;
+    // a3 denser near 0 (nearly straight, tensioned rods are the most sensitive there).
+    let w = 2.0 * halton(i, 2) - 1.0;
+    let a3 = w * w.abs() * A3_MAX;
     let a4 = (2.0 * halton(i, 3) - 1.0) * A45_MAX;
     let base = a3 * a3 * (a3 * a3 / 4.0 + a4);
     let u = halton(i, 5);
     let v = halton(i, 7);
-    // Relative offset ±10^(−7..0) of the scale a3⁴/4 + |a4| a3² (+1 to stay away from 0).
+    // Relative offset ±10^(−6..0) of the scale a3⁴/4 + |a4| a3² (+1 to stay away from 0).
     let scale = a3 * a3 * (a3 * a3 / 4.0 + a4.abs()) + 1.0;
     let sign = if v < 0.5 { -1.0 } else { 1.0 };
-    let l4 = sign * scale * 10f64.powf(-7.0 * u);
+    let l4 = sign * scale * 10f64.powf(-6.0 * u);
     let a5sq = base + l4;
     if !(a5sq > 0.0) {
         return None;
@@ -309,6 +311,17 @@ impl Atlas {
             out.push((tip_distance2(&self.seeds[k as usize].tip, &tgt), k));
         }
         out[start..].sort_by(|p, q| p.0.total_cmp(&q.0));
+    }
+
+    /// ‖Υ(a_s) − b‖ for seed `k` (angle wrapped; from the stored tip).
+    pub(crate) fn seed_residual(&self, k: u32, target: &PlanarPose) -> f64 {
+        let s = &self.seeds[k as usize];
+        Vector3::new(
+            s.tip[0] - target.x,
+            s.tip[1] - target.y,
+            wrap_angle(s.tip[2] - target.theta),
+        )
+        .norm()
     }
 
     /// The start for seed `k` toward `target`: the seed, and its predicted Newton step

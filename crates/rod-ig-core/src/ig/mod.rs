@@ -186,9 +186,11 @@ pub struct Failure {
     pub reason: IgError,
     /// Iterations spent.
     pub iterations: u32,
-    /// ‖f‖ at the last evaluated iterate (∞ when none was evaluated).
+    /// ‖f‖ at the last evaluated iterate (robust solver: the smallest reached by any start;
+    /// ∞ when none was evaluated).
     pub residual: f64,
-    /// The last iterate, when there was one.
+    /// The last iterate (robust solver: where that smallest residual was reached, possibly a
+    /// converged but unstable point), when there was one.
     pub last_a: Option<PlanarParams>,
     /// Wall time, µs.
     pub elapsed_us: f64,

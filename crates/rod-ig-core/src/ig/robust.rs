@@ -8,6 +8,10 @@ use crate::{PlanarParams, PlanarPose};
 
 /// Total start budget of one robust solve.
 const MAX_STARTS: usize = 48;
+/// The polishing stage runs when the best residual is below this.
+const POLISH_BELOW: f64 = 0.05;
+/// Iteration budget of the polishing stage.
+const POLISH_BUDGET: u32 = 300;
 /// Iteration budget for the caller's initial guess, which may be far from the target: beyond
 /// it, the atlas starts (a few iterations each) are the better bet.
 const GUESS_BUDGET: u32 = 12;
@@ -19,10 +23,21 @@ fn per_start_budget(options: &SolveOptions) -> u32 {
 }
 
 /// Counters accumulated over the starts of one solve.
-#[derive(Default)]
 struct Counts {
     iterations: u32,
     evaluations: u32,
+    /// Best residual reached by any start, and where.
+    best: (f64, Option<PlanarParams>),
+}
+
+impl Default for Counts {
+    fn default() -> Self {
+        Self {
+            iterations: 0,
+            evaluations: 0,
+            best: (f64::INFINITY, None),
+        }
+    }
 }
 
 /// Runs one start (with its optional predicted first step); returns the verified stable
@@ -44,6 +59,9 @@ fn try_start(
     );
     counts.iterations += r.iterations;
     counts.evaluations += r.evaluations;
+    if r.residual < counts.best.0 {
+        counts.best = (r.residual, Some(r.last_a));
+    }
     let (a, e) = r.found?;
     let st = model::stability(&a).ok()?;
     if !st.stable {
@@ -54,11 +72,15 @@ fn try_start(
     Some(s)
 }
 
-/// Starts in order: the initial guess (brought into the stable set), then the target cell's
-/// short list of atlas seeds, then seeds in widening neighbourhoods, nearest first.
+/// Starts in order: the initial guess (brought into the stable set by weighted scaling if it
+/// is not stable), then the target cell's short list of atlas seeds, then seeds in widening
+/// neighbourhoods, nearest first. The guess goes first when its residual ‖Υ(a0) − b‖ is no
+/// larger than the nearest seed's (a good hint, e.g. a previous solution, also selects the
+/// solution branch); a far guess (larger residual) is tried after the short list.
 struct Starts<'t> {
     target: &'t PlanarPose,
     guess: Option<PlanarParams>,
+    guess_first: bool,
     buf: Vec<(f64, u32)>,
     pos: usize,
     /// 0: short list not yet loaded; r ≥ 1: neighbourhood radius loaded.
@@ -68,29 +90,72 @@ struct Starts<'t> {
 
 impl<'t> Starts<'t> {
     fn new(target: &'t PlanarPose, options: &SolveOptions) -> Self {
-        let guess = options
-            .initial_guess
-            .and_then(|g| local::pull_into_stable(&g));
-        Self {
+        // The guess: used as is when det J(1, a0) > 0 (the local solver's requirement; an
+        // unstable guess of even index is caught by the final stability test), else brought into
+        // the stable set by weighted scaling.
+        let guess_eval = |g: &PlanarParams| {
+            model::tip_and_jacobian(g)
+                .ok()
+                .map(|(tip, j)| (model::residual(&tip, target).norm(), j.determinant()))
+        };
+        let mut guess = None;
+        let mut guess_residual = f64::INFINITY;
+        if let Some(g) = options.initial_guess {
+            match guess_eval(&g) {
+                Some((r, det)) if det > 0.0 && r.is_finite() => {
+                    guess = Some(g);
+                    guess_residual = r;
+                }
+                _ => {
+                    if let Some(p) = local::pull_into_stable(&g) {
+                        if let Some((r, det)) = guess_eval(&p) {
+                            if det > 0.0 && r.is_finite() {
+                                guess = Some(p);
+                                guess_residual = r;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let mut s = Self {
             target,
             guess,
+            guess_first: true,
             buf: Vec::new(),
             pos: 0,
             stage: 0,
             served: Vec::new(),
+        };
+        if guess.is_some() {
+            let atlas = atlas::get();
+            atlas.near_list(target, &mut s.buf);
+            s.stage = 1;
+            let seed_residual = s
+                .buf
+                .first()
+                .map(|&(_, k)| atlas.seed_residual(k, target))
+                .unwrap_or(f64::INFINITY);
+            s.guess_first = guess_residual <= seed_residual;
         }
+        s
     }
 
     /// Next start, and whether it is the caller's guess.
     fn next(&mut self) -> Option<(atlas::Start, bool)> {
-        if let Some(g) = self.guess.take() {
-            return Some((
+        let as_start = |g: PlanarParams| {
+            (
                 atlas::Start {
                     a: g,
                     predicted: None,
                 },
                 true,
-            ));
+            )
+        };
+        if self.guess_first {
+            if let Some(g) = self.guess.take() {
+                return Some(as_start(g));
+            }
         }
         let atlas = atlas::get();
         loop {
@@ -101,6 +166,10 @@ impl<'t> Starts<'t> {
                     self.served.push(k);
                     return Some((atlas.start(k, self.target), false));
                 }
+            }
+            // The current list is exhausted: a far guess comes after the short list.
+            if let Some(g) = self.guess.take() {
+                return Some(as_start(g));
             }
             if self.stage >= 3 {
                 return None;
@@ -139,11 +208,25 @@ pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solut
             return Ok(s);
         }
     }
+    // Last resort: the most promising iterate (smallest residual over every start) is polished
+    // with a long run of the globalised Newton / LM steps. Near the separatrix λ4 = 0 and near
+    // folds, convergence there is linear and slow but steady.
+    if let (r, Some(a)) = counts.best {
+        if r < POLISH_BELOW {
+            let start = atlas::Start { a, predicted: None };
+            if let Some(mut s) = try_start(target, &start, options, POLISH_BUDGET, &mut counts) {
+                s.iterations = counts.iterations;
+                s.evaluations = counts.evaluations;
+                s.starts = n as u32 + 1;
+                return Ok(s);
+            }
+        }
+    }
     Err(Failure {
         reason: IgError::NoStableSolution { starts: n as u32 },
         iterations: counts.iterations,
-        residual: f64::INFINITY,
-        last_a: None,
+        residual: counts.best.0,
+        last_a: counts.best.1,
         elapsed_us: 0.0,
     })
 }

@@ -124,7 +124,7 @@ where
         for q in 0..DIM {
             y[q] += h / 6.0 * (k1[q] + 2.0 * (k2[q] + k3[q]) + k4[q]);
         }
-        let r = y[0].hypot(y[1]);
+        let r = (y[0] * y[0] + y[1] * y[1]).sqrt();
         if !(r.is_finite() && r > 0.0) {
             return None;
         }

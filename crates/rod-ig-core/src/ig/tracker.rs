@@ -83,7 +83,10 @@ impl Tracker {
         (size <= MAX_PREDICT && da.iter().all(|v| v.is_finite())).then(|| (a + da, db.norm()))
     }
 
-    /// Solves for `target`, warm-starting from the previous solution.
+    /// Solves for `target`, warm-starting from the previous solution. The first solve (or the
+    /// first after [`Tracker::reset`], without initial guess) is a cold start that picks, among
+    /// the distinct stable solutions found near the target, the one with the best-conditioned
+    /// J(1, a) (slower, ~1 ms, but the branch then tracks well).
     pub fn solve(&mut self, target: &PlanarPose) -> Result<Solution, Failure> {
         let t0 = std::time::Instant::now();
         if let Err(e) = super::check_target(target) {
@@ -117,6 +120,36 @@ impl Tracker {
         let mut opts = self.options;
         opts.initial_guess = warm;
         opts.alpha = 1.0;
+        if warm.is_none() {
+            // Cold start: among the stable solutions near the target, take the best conditioned
+            // J(1, a) (largest σ_min/σ_max): far from the fold det J(1, a) = 0 and from the
+            // separatrix λ4 = 0, where branches end or Newton's basin shrinks, so the branch
+            // followed afterwards is the easiest to track.
+            let all = robust::solve_all(target, &opts);
+            let conditioning = |a: &PlanarParams| {
+                model::tip_and_jacobian(a)
+                    .ok()
+                    .map(|(_, j)| {
+                        let sv = j.singular_values();
+                        sv.min() / sv.max()
+                    })
+                    .filter(|c| c.is_finite())
+                    .unwrap_or(0.0)
+            };
+            if let Some(mut s) = all
+                .solutions
+                .into_iter()
+                .max_by(|p, q| conditioning(&p.a).total_cmp(&conditioning(&q.a)))
+            {
+                s.iterations = all.iterations;
+                s.evaluations = all.evaluations;
+                s.starts = all.starts;
+                s.elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
+                self.prev = None;
+                self.last = Some((s.a, *target, None));
+                return Ok(s);
+            }
+        }
         match robust::solve(target, &opts) {
             Ok(mut s) => {
                 s.iterations += iterations;
