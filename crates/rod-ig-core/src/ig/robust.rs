@@ -8,6 +8,10 @@ use crate::{PlanarParams, PlanarPose};
 
 /// Total start budget of one robust solve.
 const MAX_STARTS: usize = 48;
+/// The polishing stage runs when the best residual is below this.
+const POLISH_BELOW: f64 = 0.05;
+/// Iteration budget of the polishing stage.
+const POLISH_BUDGET: u32 = 300;
 /// Iteration budget for the caller's initial guess, which may be far from the target: beyond
 /// it, the atlas starts (a few iterations each) are the better bet.
 const GUESS_BUDGET: u32 = 12;
@@ -202,6 +206,20 @@ pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solut
             s.evaluations = counts.evaluations;
             s.starts = n as u32;
             return Ok(s);
+        }
+    }
+    // Last resort: the most promising iterate (smallest residual over every start) is polished
+    // with a long run of the globalised Newton / LM steps. Near the separatrix λ4 = 0 and near
+    // folds, convergence there is linear and slow but steady.
+    if let (r, Some(a)) = counts.best {
+        if r < POLISH_BELOW {
+            let start = atlas::Start { a, predicted: None };
+            if let Some(mut s) = try_start(target, &start, options, POLISH_BUDGET, &mut counts) {
+                s.iterations = counts.iterations;
+                s.evaluations = counts.evaluations;
+                s.starts = n as u32 + 1;
+                return Ok(s);
+            }
         }
     }
     Err(Failure {

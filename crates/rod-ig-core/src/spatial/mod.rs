@@ -7,7 +7,7 @@
 //! * m' = m × ω + f × e1, f' = f × ω, i.e.
 //!   μ1' = μ2μ3(1/c3 − 1/c2), μ2' = μ6 + μ1μ3(1/c1 − 1/c3), μ3' = −μ5 + μ1μ2(1/c2 − 1/c1),
 //!   μ4' = μ3μ5/c3 − μ2μ6/c2, μ5' = μ1μ6/c1 − μ3μ4/c3, μ6' = μ2μ4/c2 − μ1μ5/c1;
-//! * R' = R [ω]×, p' = R e1 (body x is the tangent; R's columns are the body axes in the world
+//! * R' = R (ω)×, p' = R e1 (body x is the tangent; R's columns are the body axes in the world
 //!   frame), with R integrated as a unit quaternion q' = ½ q ⊗ (0, ω), renormalised on output;
 //! * μ(0) = a, q(0) = identity.
 //!
