@@ -16,5 +16,5 @@ fi
 cargo build --release -p rod-ig-node --bin rod_ig_node >&2
 BIN="${CARGO_TARGET_DIR:-$REPO/target}/release/rod_ig_node"
 export ROS_DISTRO="${ROS_DISTRO:-kilted}"
-export RUST_LOG="${RUST_LOG:-info,rustdds=error,ros2_client=warn}"
+export RUST_LOG="${RUST_LOG:-info,rustdds=error,rustdds::network::udp_listener=off,ros2_client=warn}"
 exec "$BIN" "$@"

@@ -6,9 +6,9 @@ use rod_ig_node::node::{self, MiddlewareConfig};
 use rod_ig_node::params::{self, Command};
 
 fn main() -> ExitCode {
-    env_logger::Builder::from_env(
-        env_logger::Env::default().default_filter_or("info,rustdds=error,ros2_client=warn"),
-    )
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(
+        "info,rustdds=error,rustdds::network::udp_listener=off,ros2_client=warn",
+    ))
     .init();
 
     let params = match params::parse_args(std::env::args().skip(1)) {

@@ -103,7 +103,7 @@ class NodeProcess:
         self._log = open(self.log_path, "wb")
         env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
                    ROS_DISTRO=os.environ.get("ROS_DISTRO", "kilted"),
-                   RUST_LOG=os.environ.get("RUST_LOG", "info,rustdds=error,ros2_client=warn"))
+                   RUST_LOG=os.environ.get("RUST_LOG", "info,rustdds=error,rustdds::network::udp_listener=off,ros2_client=warn"))
         self.proc = subprocess.Popen([str(binary(binary_name)), *(args or [])], env=env,
                                      stdout=self._log, stderr=subprocess.STDOUT)
 

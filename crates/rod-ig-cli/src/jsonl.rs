@@ -44,6 +44,29 @@ pub fn to_value<T: Serialize>(answer: &T) -> Result<Value, String> {
     serde_json::to_value(answer).map_err(|e| format!("cannot encode answer: {e}"))
 }
 
+/// Checks a Newton step length α ∈ (0, 1] (paper §3.1).
+pub fn check_alpha(alpha: f64) -> Result<f64, String> {
+    if alpha.is_finite() && alpha > 0.0 && alpha <= 1.0 {
+        Ok(alpha)
+    } else {
+        Err(format!("alpha must be in (0, 1], got {alpha}"))
+    }
+}
+
+/// Checks a solver tolerance (positive, finite).
+pub fn check_tolerance(tolerance: f64) -> Result<f64, String> {
+    if tolerance.is_finite() && tolerance > 0.0 {
+        Ok(tolerance)
+    } else {
+        Err(format!(
+            "tolerance must be positive and finite, got {tolerance}"
+        ))
+    }
+}
+
+/// The message for a Newton request without a start.
+pub const NEWTON_NEEDS_A0: &str = "method \"newton\" needs an initial guess \"a0\"";
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -70,6 +93,18 @@ mod tests {
         assert!(out[1]["error"].as_str().unwrap().contains("malformed"));
         assert_eq!(out[2]["error"], "empty line");
         assert_eq!(out[3]["echo"]["b"], 2);
+    }
+
+    #[test]
+    fn option_checks() {
+        assert_eq!(check_alpha(0.5), Ok(0.5));
+        assert!(
+            check_alpha(0.0).is_err()
+                && check_alpha(1.5).is_err()
+                && check_alpha(f64::NAN).is_err()
+        );
+        assert_eq!(check_tolerance(1e-9), Ok(1e-9));
+        assert!(check_tolerance(-1.0).is_err() && check_tolerance(f64::INFINITY).is_err());
     }
 
     #[test]

@@ -147,25 +147,19 @@ fn options(request: &SolveRequest) -> Result<SolveOptions, String> {
         ObjectiveName::LeastEnergy => Objective::LeastEnergy,
     };
     if let Some(alpha) = request.alpha {
-        if !(alpha.is_finite() && alpha > 0.0 && alpha <= 1.0) {
-            return Err(format!("alpha must be in (0, 1], got {alpha}"));
-        }
-        options.alpha = alpha;
+        options.alpha = jsonl::check_alpha(alpha)?;
     }
     if let Some(n) = request.max_iterations {
         options.max_iterations = n;
     }
     if let Some(tol) = request.tolerance {
-        if !(tol.is_finite() && tol > 0.0) {
-            return Err(format!("tolerance must be positive and finite, got {tol}"));
-        }
-        options.tolerance = tol;
+        options.tolerance = jsonl::check_tolerance(tol)?;
     }
     if let Some(a0) = request.a0 {
         options.initial_guess = Some(PlanarParams::from(a0));
     }
     if matches!(options.method, Method::Newton) && options.initial_guess.is_none() {
-        return Err("method \"newton\" needs an initial guess \"a0\"".to_string());
+        return Err(jsonl::NEWTON_NEEDS_A0.to_string());
     }
     Ok(options)
 }

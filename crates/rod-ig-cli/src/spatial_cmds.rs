@@ -138,22 +138,16 @@ pub fn solve3d_line(line: &str) -> Result<Value, String> {
         ..SolveOptions3d::default()
     };
     if let Some(alpha) = request.alpha {
-        if !(alpha.is_finite() && alpha > 0.0 && alpha <= 1.0) {
-            return Err(format!("alpha must be in (0, 1], got {alpha}"));
-        }
-        options.alpha = alpha;
+        options.alpha = jsonl::check_alpha(alpha)?;
     }
     if let Some(n) = request.max_iterations {
         options.max_iterations = n;
     }
     if let Some(tol) = request.tolerance {
-        if !(tol.is_finite() && tol > 0.0) {
-            return Err(format!("tolerance must be positive and finite, got {tol}"));
-        }
-        options.tolerance = tol;
+        options.tolerance = jsonl::check_tolerance(tol)?;
     }
     if options.method == Method3d::Newton && options.initial_guess.is_none() {
-        return Err("method \"newton\" needs an initial guess \"a0\"".to_string());
+        return Err(jsonl::NEWTON_NEEDS_A0.to_string());
     }
     let answer = match ig3d::solve(&target, &options) {
         Ok(s) => Solve3dAnswer {

@@ -52,12 +52,13 @@ impl Default for StabilityOptions {
 }
 
 impl StabilityOptions {
-    /// Solver accuracy: rtol 1e-8, atol 1e-12, coarse stride 20.
+    /// Solver accuracy: rtol 1e-8, atol 1e-12, coarse stride 40 (every 0.02; identical verdicts
+    /// to the full grid on 3000 random rods of the ±5/±30 and ±8/±50 boxes, tests/spatial.rs).
     pub fn production() -> Self {
         Self {
             rtol: 1e-8,
             atol: 1e-12,
-            coarse_stride: 20,
+            coarse_stride: 40,
         }
     }
     /// The full-grid rule at reference accuracy (stride 1).
