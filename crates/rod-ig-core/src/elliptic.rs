@@ -770,7 +770,7 @@ impl<T: Real> Duplication<T> {
                 T::from_f64(0.0)
             };
             let zm = v * self.d_over_k() - dv;
-            if j.rem_euclid(2.0) == 1.0 {
+            if (j as i64) & 1 != 0 {
                 sn = -sn;
                 cn = -cn;
             }
@@ -806,7 +806,7 @@ impl<T: Real> Duplication<T> {
         };
         // Z(u)/m = v D(m)/K − D(v)
         let zm = v * self.d_over_k() - dv;
-        if j.rem_euclid(2.0) == 1.0 {
+        if (j as i64) & 1 != 0 {
             sn = -sn;
             cn = -cn;
         }

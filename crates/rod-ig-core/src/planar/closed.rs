@@ -56,7 +56,7 @@ pub(crate) struct Closed<T: Real> {
     landen: Duplication<T>,
     /// Jacobi values at Γ0 = φ (cases I, II).
     j0: JacobiValues<T>,
-    /// θ/(2ε) at t = 0: atan2(√m sn φ, dn φ) (I), am φ (II), gd φ (III).
+    /// θ/(2ε) at t = 0: am φ (II), gd φ (III); unused in case I (see `pose`).
     th0: T,
     /// Case III: E(am φ) and cn φ (first order in δ).
     e0: T,
@@ -330,7 +330,7 @@ impl<T: Real> Closed<T> {
                 am: sn.atan2(cn),
                 zm: zm0,
             };
-            s.th0 = (s.sqm * sn).atan2(dn);
+            // θ0/(2ε) = atan2(√m sn φ, dn φ) is folded into the single atan2 of `pose`.
             s.landen = landen;
         } else if l4 < 0.0 {
             s.case = Case::II;
@@ -496,7 +496,11 @@ impl<T: Real> Closed<T> {
                 let j = self.landen.eval(self.r * t + self.phi, false);
                 let ib1 = self.lin * t + self.m * (j.zm - self.j0.zm) * 2.0 / self.r;
                 let ib2 = -self.sqm * (j.cn - self.j0.cn) / self.r;
-                let ht = (self.sqm * j.sn).atan2(j.dn) - self.th0;
+                // atan2(y1, x1) − atan2(y0, x0) with x0, x1 = dn > 0: both angles lie in
+                // (−π/2, π/2), so one atan2 of the rotated pair gives the difference exactly.
+                let (y1, x1) = (self.sqm * j.sn, j.dn);
+                let (y0, x0) = (self.sqm * self.j0.sn, self.j0.dn);
+                let ht = (y1 * x0 - x1 * y0).atan2(x1 * x0 + y1 * y0);
                 (ib1, ib2, ht)
             }
             Case::II => {
