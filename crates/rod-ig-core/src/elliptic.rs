@@ -439,6 +439,381 @@ impl<T: Real> Landen<T> {
     }
 }
 
+/// Largest argument at which the Maclaurin series of [`Duplication`] are used: with terms
+/// through z⁹ (sn) and z⁸ (cn, dn) the first neglected term is ≤ 0.014·z¹⁰ ≤ 1.3e-17.
+const SERIES_MAX: f64 = 1.0 / 32.0;
+
+/// Below this m, [`Duplication::eval`] carries dual numbers through the duplications instead of
+/// attaching the analytic derivatives (whose ∂D/∂m cancels like 1e-16/m).
+const ANALYTIC_MIN_M: f64 = 0.01;
+
+/// Jacobi functions by argument reduction, Maclaurin series and duplication (no sines, no
+/// arcsines). Per m: K(m) and D(m)/K(m) by the AGM (same recurrences as [`Landen`], nothing
+/// stored per level) and the series coefficients. Per u:
+/// * u = v + 2jK with |v| ≤ K (sn, cn change sign with j, dn does not, D(u) = D(v) + 2jD(m));
+/// * |v| > K/2 is reflected, w = K − |v| (sn(K − w) = cn/dn, cn(K − w) = √m1 sn/dn,
+///   dn(K − w) = √m1/dn, D(K − w) = D(m) − D(w) − sn cn/dn, A&S 16.8, 17.4.13);
+/// * z = w/2ⁿ ≤ 1/32: Maclaurin series of sn, cn, dn (A&S 16.22) and D = ∫sn²;
+/// * n duplications (A&S 16.18) with the cancellation-free forms Δ = 1 − m sn⁴ = cn² + sn²dn²,
+///   cn² − sn²dn² = cn²dn² − m1 sn², dn² − m sn²cn² = m1 + m cn⁴, and
+///   D(2z) = 2D(z) + sn²(z) sn(2z) (from the addition theorem of E(am u), A&S 17.4.14).
+///
+/// Z(u)/m = v D(m)/K − D(v) is periodic in u, so it never forms u − E(am u) at large u.
+///
+/// The values are always computed in f64. With a dual scalar, the derivatives are attached
+/// analytically at the end: ∂/∂v of (sn, cn, dn, am, D) = (cn dn, −sn dn, −m sn cn, dn, sn²)
+/// and, at fixed v, with A = ∂am/∂m = [sn cn − dn (v − D(v))]/(2 m1) (from ∂F(φ|m)/∂m,
+/// DLMF 19.4.2, and E(am v) = v − m D(v)): ∂sn/∂m = cn A, ∂cn/∂m = −sn A,
+/// ∂dn/∂m = −(sn² + 2m sn cn A)/(2 dn), ∂D/∂m = −(dn A + D/2)/m (∂E(φ|m)/∂m = −D(φ|m)/2);
+/// v = u − 2jK carries the derivative of K, and m1 = 1 − m.
+#[derive(Clone, Copy, Debug)]
+pub struct Duplication<T> {
+    m: T,
+    m1: T,
+    sqm1: T,
+    k: T,
+    q: T,
+    mr: f64,
+    m1r: f64,
+    sqm1r: f64,
+    kr: f64,
+    /// D(m) = (K − E)/m (value).
+    dcompr: f64,
+    /// sn: z³, z⁵, z⁷, z⁹ coefficients; cn, dn: z², z⁴, z⁶, z⁸; D: z⁵, z⁷, z⁹, z¹¹ (z³/3 fixed).
+    sc: [f64; 4],
+    cc: [f64; 4],
+    dc: [f64; 4],
+    pc: [f64; 4],
+    converged: bool,
+}
+
+impl<T: Real> Duplication<T> {
+    /// A placeholder (m = 0) that is never evaluated.
+    #[inline]
+    pub fn placeholder() -> Self {
+        let zero = T::from_f64(0.0);
+        Self {
+            m: zero,
+            m1: T::from_f64(1.0),
+            sqm1: T::from_f64(1.0),
+            k: T::from_f64(FRAC_PI_2),
+            q: zero,
+            mr: 0.0,
+            m1r: 1.0,
+            sqm1r: 1.0,
+            kr: FRAC_PI_2,
+            dcompr: FRAC_PI_2 * 0.5,
+            sc: [0.0; 4],
+            cc: [0.0; 4],
+            dc: [0.0; 4],
+            pc: [0.0; 4],
+            converged: false,
+        }
+    }
+
+    /// Per-m data for parameter m, complementary parameter m1 = 1 − m > 0 (both in [0, 1]).
+    #[inline]
+    pub fn new(m: T, m1: T) -> Self {
+        let zero = T::from_f64(0.0);
+        let one = T::from_f64(1.0);
+        let b0 = m1.sqrt();
+        let mut a = one;
+        let mut b = b0;
+        let mut d = zero;
+        let mut q = zero;
+        let mut pow2 = 1.0;
+        let mut converged = false;
+        for n in 1..=MAX_LEVELS {
+            let a_new = (a + b) * 0.5;
+            let inv_a = a_new.recip();
+            d = if n == 1 {
+                inv_a * 0.25
+            } else {
+                m * d * d * inv_a * 0.25
+            };
+            b = (a * b).sqrt();
+            a = a_new;
+            let c = m * d;
+            pow2 *= 2.0;
+            q += m * d * d * pow2;
+            let (cr, ar, mr) = (c.re(), a.re(), m.re());
+            let ratio = cr.abs() / ar.abs();
+            if ratio <= AGM_TOL && ratio * cr.abs() <= 4.0 * ZETA_TOL * ar.abs() * mr.abs() {
+                converged = ar.is_finite() && ar > 0.0;
+                break;
+            }
+        }
+        let k = a.recip() * FRAC_PI_2;
+        let m_dual = m;
+        let m = m.re();
+        let m2 = m * m;
+        let m3 = m2 * m;
+        let m4 = m2 * m2;
+        let s3 = -(m + 1.0) * (1.0 / 6.0);
+        let s5 = (m * 14.0 + m2 + 1.0) * (1.0 / 120.0);
+        let s7 = -((m + m2) * 135.0 + m3 + 1.0) * (1.0 / 5040.0);
+        let s9 = ((m + m3) * 1228.0 + m2 * 5478.0 + m4 + 1.0) * (1.0 / 362_880.0);
+        let cc = [
+            -0.5,
+            (m * 4.0 + 1.0) * (1.0 / 24.0),
+            -(m * 44.0 + m2 * 16.0 + 1.0) * (1.0 / 720.0),
+            (m * 408.0 + m2 * 912.0 + m3 * 64.0 + 1.0) * (1.0 / 40_320.0),
+        ];
+        let dc = [
+            m * -0.5,
+            m * (m + 4.0) * (1.0 / 24.0),
+            -m * (m * 44.0 + m2 + 16.0) * (1.0 / 720.0),
+            m * (m * 912.0 + m2 * 408.0 + m3 + 64.0) * (1.0 / 40_320.0),
+        ];
+        // sn² = z² + e4 z⁴ + e6 z⁶ + e8 z⁸ + e10 z¹⁰ + …, D = ∫ sn²
+        let e4 = s3 * 2.0;
+        let e6 = s5 * 2.0 + s3 * s3;
+        let e8 = (s7 + s3 * s5) * 2.0;
+        let e10 = (s9 + s3 * s7) * 2.0 + s5 * s5;
+        let pc = [
+            e4 * 0.2,
+            e6 * (1.0 / 7.0),
+            e8 * (1.0 / 9.0),
+            e10 * (1.0 / 11.0),
+        ];
+        let kr = k.re();
+        Self {
+            m: m_dual,
+            m1,
+            sqm1: b0,
+            k,
+            q,
+            mr: m,
+            m1r: m1.re(),
+            sqm1r: b0.re(),
+            kr,
+            dcompr: kr * (q.re() + 1.0) * 0.5,
+            sc: [s3, s5, s7, s9],
+            cc,
+            dc,
+            pc,
+            converged,
+        }
+    }
+
+    /// True if the AGM converged (m1 > 0 and finite inputs).
+    #[inline]
+    pub fn converged(&self) -> bool {
+        self.converged
+    }
+
+    /// K(m).
+    #[inline]
+    pub fn k(&self) -> T {
+        self.k
+    }
+
+    /// 2D(m)/K(m) − 1 ≥ 0 (see [`Landen::q`]).
+    #[inline]
+    pub fn q(&self) -> T {
+        self.q
+    }
+
+    /// D(m)/K(m) = (1 + q)/2.
+    #[inline]
+    pub fn d_over_k(&self) -> T {
+        (self.q + 1.0) * 0.5
+    }
+
+    /// E(m)/K(m) = 1 − m(1 + q)/2.
+    #[inline]
+    pub fn e_over_k(&self) -> T {
+        T::from_f64(1.0) - self.m * (self.q + 1.0) * 0.5
+    }
+
+    /// (sn, cn, dn, D) at v ∈ [−K, K] (f64 values).
+    #[inline]
+    fn core(&self, v: f64) -> (f64, f64, f64, f64) {
+        let kr = self.kr;
+        let neg = v < 0.0;
+        let w = v.abs();
+        let refl = w > 0.5 * kr;
+        let w = if refl { kr - w } else { w };
+        let mut zr = w;
+        let mut scale = 1.0;
+        let mut n = 0u32;
+        while zr > SERIES_MAX && n < 1100 {
+            zr *= 0.5;
+            scale *= 0.5;
+            n += 1;
+        }
+        let z = w * scale;
+        let z2 = z * z;
+        let (sc, cc, dc, pc) = (&self.sc, &self.cc, &self.dc, &self.pc);
+        let mut s = z + z * z2 * (sc[0] + z2 * (sc[1] + z2 * (sc[2] + z2 * sc[3])));
+        let mut c = z2 * (cc[0] + z2 * (cc[1] + z2 * (cc[2] + z2 * cc[3]))) + 1.0;
+        let mut d = z2 * (dc[0] + z2 * (dc[1] + z2 * (dc[2] + z2 * dc[3]))) + 1.0;
+        let mut dd = z * z2 * (z2 * (pc[0] + z2 * (pc[1] + z2 * (pc[2] + z2 * pc[3]))) + 1.0 / 3.0);
+        let (m, m1) = (self.mr, self.m1r);
+        for _ in 0..n {
+            let s2 = s * s;
+            let c2 = c * c;
+            let d2 = d * d;
+            let inv = 1.0 / (c2 + s2 * d2);
+            let sn = s * c * d * inv * 2.0;
+            // cn² − sn²dn² = cn²dn² − m1 sn²: no cancellation as m → 1 (dn → cn)
+            c = (c2 * d2 - m1 * s2) * inv;
+            d = (m * c2 * c2 + m1) * inv;
+            dd = dd * 2.0 + s2 * sn;
+            s = sn;
+        }
+        if refl {
+            let inv = 1.0 / d;
+            let (s0, c0) = (s, c);
+            s = c0 * inv;
+            c = self.sqm1r * s0 * inv;
+            d = self.sqm1r * inv;
+            dd = self.dcompr - dd - s0 * s;
+        }
+        if neg {
+            s = -s;
+            dd = -dd;
+        }
+        (s, c, d, dd)
+    }
+
+    /// (sn, cn, dn, D) at v ∈ [−K, K] with the derivatives carried through every operation
+    /// (series coefficients included). Used for dual numbers when m < [`ANALYTIC_MIN_M`],
+    /// where the analytic ∂D/∂m = −(dn A + D/2)/m would cancel like 1e-16/m.
+    fn core_generic(&self, v: T) -> (T, T, T, T) {
+        let (m, m1) = (self.m, self.m1);
+        let kr = self.kr;
+        let neg = v.re() < 0.0;
+        let w = if neg { -v } else { v };
+        let refl = w.re() > 0.5 * kr;
+        let w = if refl { self.k - w } else { w };
+        let mut zr = w.re();
+        let mut scale = 1.0;
+        let mut n = 0u32;
+        while zr > SERIES_MAX && n < 1100 {
+            zr *= 0.5;
+            scale *= 0.5;
+            n += 1;
+        }
+        let m2 = m * m;
+        let m3 = m2 * m;
+        let s3 = -(m + 1.0) * (1.0 / 6.0);
+        let s5 = (m * 14.0 + m2 + 1.0) * (1.0 / 120.0);
+        let s7 = -((m + m2) * 135.0 + m3 + 1.0) * (1.0 / 5040.0);
+        let s9 = ((m + m3) * 1228.0 + m2 * 5478.0 + m2 * m2 + 1.0) * (1.0 / 362_880.0);
+        let cc = [
+            T::from_f64(-0.5),
+            (m * 4.0 + 1.0) * (1.0 / 24.0),
+            -(m * 44.0 + m2 * 16.0 + 1.0) * (1.0 / 720.0),
+            (m * 408.0 + m2 * 912.0 + m3 * 64.0 + 1.0) * (1.0 / 40_320.0),
+        ];
+        let dc = [
+            m * -0.5,
+            m * (m + 4.0) * (1.0 / 24.0),
+            -m * (m * 44.0 + m2 + 16.0) * (1.0 / 720.0),
+            m * (m * 912.0 + m2 * 408.0 + m3 + 64.0) * (1.0 / 40_320.0),
+        ];
+        let e4 = s3 * 2.0;
+        let e6 = s5 * 2.0 + s3 * s3;
+        let e8 = (s7 + s3 * s5) * 2.0;
+        let e10 = (s9 + s3 * s7) * 2.0 + s5 * s5;
+        let pc = [
+            e4 * 0.2,
+            e6 * (1.0 / 7.0),
+            e8 * (1.0 / 9.0),
+            e10 * (1.0 / 11.0),
+        ];
+        let z = w * scale;
+        let z2 = z * z;
+        let mut s = z + z * z2 * (s3 + z2 * (s5 + z2 * (s7 + z2 * s9)));
+        let mut c = z2 * (cc[0] + z2 * (cc[1] + z2 * (cc[2] + z2 * cc[3]))) + 1.0;
+        let mut d = z2 * (dc[0] + z2 * (dc[1] + z2 * (dc[2] + z2 * dc[3]))) + 1.0;
+        let mut dd = z * z2 * (z2 * (pc[0] + z2 * (pc[1] + z2 * (pc[2] + z2 * pc[3]))) + 1.0 / 3.0);
+        for _ in 0..n {
+            let s2 = s * s;
+            let c2 = c * c;
+            let d2 = d * d;
+            let inv = (c2 + s2 * d2).recip();
+            let sn = s * c * d * inv * 2.0;
+            c = (c2 * d2 - m1 * s2) * inv;
+            d = (m * c2 * c2 + m1) * inv;
+            dd = dd * 2.0 + s2 * sn;
+            s = sn;
+        }
+        if refl {
+            let inv = d.recip();
+            let (s0, c0) = (s, c);
+            s = c0 * inv;
+            c = self.sqm1 * s0 * inv;
+            d = self.sqm1 * inv;
+            dd = self.k * self.d_over_k() - dd - s0 * s;
+        }
+        if neg {
+            s = -s;
+            dd = -dd;
+        }
+        (s, c, d, dd)
+    }
+
+    /// sn, cn, dn, Z/m at u, and the continuous amplitude am(u) if `with_am` (else am = 0).
+    #[inline]
+    pub fn eval(&self, u: T, with_am: bool) -> JacobiValues<T> {
+        let kr = self.kr;
+        let j = (u.re() / (2.0 * kr)).round();
+        let v = if j != 0.0 { u - self.k * (2.0 * j) } else { u };
+        let vr = v.re();
+        if T::HAS_DERIVATIVES && self.mr < ANALYTIC_MIN_M {
+            let (mut sn, mut cn, dn, dv) = self.core_generic(v);
+            let am = if with_am {
+                sn.atan2(cn) + j * PI
+            } else {
+                T::from_f64(0.0)
+            };
+            let zm = v * self.d_over_k() - dv;
+            if j.rem_euclid(2.0) == 1.0 {
+                sn = -sn;
+                cn = -cn;
+            }
+            return JacobiValues { sn, cn, dn, am, zm };
+        }
+        let (s, c, d, dd) = self.core(vr);
+        let am_v = if with_am { s.atan2(c) } else { 0.0 };
+        let (mut sn, mut cn, dn, dv, am) = if T::HAS_DERIVATIVES {
+            let (m, m1) = (self.mr, self.m1r);
+            let a = (s * c - d * (vr - dd)) / (2.0 * m1);
+            let gv = v - T::from_f64(vr);
+            let gm = self.m - T::from_f64(m);
+            let lin = |y: f64, yv: f64, ym: f64| T::from_f64(y) + gv * yv + gm * ym;
+            (
+                lin(s, c * d, c * a),
+                lin(c, -s * d, -s * a),
+                lin(d, -m * s * c, -(s * s + 2.0 * m * s * c * a) / (2.0 * d)),
+                lin(dd, s * s, -(d * a + 0.5 * dd) / m),
+                if with_am {
+                    lin(am_v + j * PI, d, a)
+                } else {
+                    T::from_f64(0.0)
+                },
+            )
+        } else {
+            (
+                T::from_f64(s),
+                T::from_f64(c),
+                T::from_f64(d),
+                T::from_f64(dd),
+                T::from_f64(am_v + j * PI),
+            )
+        };
+        // Z(u)/m = v D(m)/K − D(v)
+        let zm = v * self.d_over_k() - dv;
+        if j.rem_euclid(2.0) == 1.0 {
+            sn = -sn;
+            cn = -cn;
+        }
+        JacobiValues { sn, cn, dn, am, zm }
+    }
+}
+
 /// Jacobi sn, cn, dn, am (and Z/m) at u for parameter m, m1 = 1 − m (m ∈ [0, 1]).
 /// At m1 = 0 the limits tanh, sech, sech and gd are used (Z/m = tanh u there).
 pub fn jacobi<T: Real>(u: T, m: T, m1: T) -> JacobiValues<T> {
@@ -478,6 +853,77 @@ mod tests {
         assert!((rd - 1.797_210_352_103_388_4).abs() < 1e-15, "{rd}");
         let rd: f64 = carlson_rd(2.0, 3.0, 4.0);
         assert!((rd - 0.165_105_272_942_610_5).abs() < 1e-15, "{rd}");
+    }
+
+    #[test]
+    fn duplication_matches_landen() {
+        let mut worst = [0.0f64; 5];
+        for &m1 in &[
+            1.0, 0.999, 0.7, 0.5, 0.2, 0.01, 1e-4, 1e-8, 1e-12, 1e-16, 1e-25,
+        ] {
+            let m = 1.0 - m1;
+            let l = Landen::new(m, m1);
+            let d = Duplication::new(m, m1);
+            for i in -400..=400 {
+                let u = i as f64 * 0.0731;
+                let a = l.eval(u);
+                let b = d.eval(u, true);
+                let e = [
+                    (a.sn - b.sn).abs(),
+                    (a.cn - b.cn).abs(),
+                    (a.dn - b.dn).abs(),
+                    (a.am - b.am).abs() / a.am.abs().max(1.0),
+                    (a.zm - b.zm).abs() * m.max(1e-300).min(1.0),
+                ];
+                for k in 0..5 {
+                    worst[k] = worst[k].max(e[k]);
+                }
+                assert!(
+                    e.iter().all(|&x| x < 1e-13),
+                    "m1={m1} u={u} {e:?} {a:?} {b:?}"
+                );
+            }
+        }
+        eprintln!("duplication vs landen worst {worst:?}");
+    }
+
+    #[test]
+    fn duplication_dual_matches_landen_dual() {
+        use crate::scalar::Dual3;
+        let mut worst = 0.0f64;
+        for &m1v in &[0.9, 0.5, 0.2, 0.01, 1e-4, 1e-7] {
+            for &mscale in &[1.0, 1e-3] {
+                let mv = (1.0 - m1v) * mscale;
+                let m1v = 1.0 - mv;
+                let dm = Dual3::new(mv, [1.0, 0.0, 0.3]);
+                let dm1 = Dual3::constant(1.0) - dm;
+                let l = Landen::new(dm, dm1);
+                let d = Duplication::new(dm, dm1);
+                for i in -60..=60 {
+                    let du = Dual3::new(i as f64 * 0.173, [0.0, 1.0, 0.7]);
+                    let a = l.eval(du);
+                    let b = d.eval(du, true);
+                    for (x, y, name) in [
+                        (a.sn, b.sn, "sn"),
+                        (a.cn, b.cn, "cn"),
+                        (a.dn, b.dn, "dn"),
+                        (a.am, b.am, "am"),
+                        (a.zm, b.zm, "zm"),
+                    ] {
+                        for k in 0..3 {
+                            let e = (x.g[k] - y.g[k]).abs() / x.g[k].abs().max(1.0);
+                            worst = worst.max(e);
+                            assert!(
+                                e < 1e-16 / m1v.min(mv) * 1e3,
+                                "{name} m={mv} u={} k={k}: {x:?} vs {y:?}",
+                                du.v
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        eprintln!("dual duplication vs landen worst {worst:e}");
     }
 
     #[test]

@@ -188,9 +188,9 @@ fn a_good_initial_guess_selects_its_branch() {
 
 #[test]
 fn robust_random_stable_targets_paper_box() {
-    // 1000 random reachable targets of stable rods in |a3| ≤ 2π, |a4|, |a5| ≤ 100.
-    let targets = bench::random_stable_targets(1000, 2024, ParamBox::PAPER);
-    assert_eq!(targets.len(), 1000);
+    // 2000 random reachable targets of stable rods in |a3| ≤ 2π, |a4|, |a5| ≤ 100.
+    let targets = bench::random_stable_targets(2000, 2024, ParamBox::PAPER);
+    assert_eq!(targets.len(), 2000);
     let mut failures = Vec::new();
     for (i, (a, b)) in targets.iter().enumerate() {
         match ig::solve(b, &SolveOptions::default()) {
@@ -206,8 +206,8 @@ fn robust_random_stable_targets_paper_box() {
     for f in &failures {
         eprintln!("failed: a = {:?}, target {:?}: {}", f.0, f.1, f.2);
     }
-    // ≥ 99.9 % success: at most 1 failure in 1000.
-    assert!(failures.len() <= 1, "{} failures in 1000", failures.len());
+    // ≥ 99.9 % success: at most 2 failures in 2000.
+    assert!(failures.len() <= 2, "{} failures in 2000", failures.len());
 }
 
 mod property {

@@ -6,14 +6,21 @@
 //! - [`Method::Newton`], the paper's method (§3.1, eq. 3.1): a_{k+1} = a_k − α J(1, a_k)⁻¹ f(a_k)
 //!   with f(a) = Υ(a) − b (angle wrapped), fixed step length α, from a given a0, at most N
 //!   iterations, and the FINDINGS §8 protocol: an iterate fails as soon as it is unstable.
-//! - [`Method::Robust`] (default): a globalised Newton (backtracking on ‖f‖, steps that make
-//!   det J(1, a) non-positive are rejected, since the stable set can only be left through
-//!   det J(1, a) = 0), multi-started from a precomputed atlas of stable rods indexed by their tip,
-//!   with the stability test (FINDINGS §5) applied to every solution before it is returned.
+//! - [`Method::Robust`] (default): a globalised Newton (backtracking on ‖f‖, Levenberg–Marquardt
+//!   steps when the Newton direction fails; steps that make det J(1, a) non-positive are
+//!   rejected, since the stable set can only be left through det J(1, a) = 0), multi-started
+//!   from a precomputed atlas of stable rods indexed by their tip (each seed carrying J⁻¹, so the
+//!   first step is free), with small-angle starts for targets near full extension and a final
+//!   polishing of the best iterate; the stability test (FINDINGS §5) is applied to every
+//!   solution before it is returned. The caller's initial guess goes first when its residual is
+//!   no larger than the nearest seed's (it then selects the solution branch).
+//!
+//! The atlas (~80 k seeds, ~10 MB) is built once per process on first use, in about half a
+//! second; call [`warm_up`] at start-up to take that cost out of the first solve.
 //!
 //! [`solve_all`] lists the distinct stable solutions found; [`Objective::LeastEnergy`] returns the
 //! least elastic energy among them. [`Tracker`] follows a stream of nearby targets.
-//! [`bench`] computes the benchmark figures (no I/O; the CLI prints them).
+//! [`mod@bench`] computes the benchmark figures (no I/O; the CLI prints them).
 
 mod atlas;
 pub mod bench;
@@ -22,6 +29,7 @@ mod model;
 mod newton;
 mod robust;
 mod scan;
+mod straight;
 mod tracker;
 
 use crate::{PlanarParams, PlanarPose, RodError};

@@ -3,7 +3,9 @@
 //! the target; every converged point is checked with the stability test (FINDINGS §5) before it
 //! is returned.
 
-use super::{atlas, local, model, newton::make_solution, Failure, IgError, Solution, SolveOptions};
+use super::{
+    atlas, local, model, newton::make_solution, straight, Failure, IgError, Solution, SolveOptions,
+};
 use crate::{PlanarParams, PlanarPose};
 
 /// Total start budget of one robust solve.
@@ -86,6 +88,8 @@ struct Starts<'t> {
     /// 0: short list not yet loaded; r ≥ 1: neighbourhood radius loaded.
     stage: usize,
     served: Vec<u32>,
+    /// Small-angle starts for targets near full extension, served after the short list.
+    straight: Option<Vec<PlanarParams>>,
 }
 
 impl<'t> Starts<'t> {
@@ -126,6 +130,7 @@ impl<'t> Starts<'t> {
             pos: 0,
             stage: 0,
             served: Vec::new(),
+            straight: None,
         };
         if guess.is_some() {
             let atlas = atlas::get();
@@ -167,9 +172,19 @@ impl<'t> Starts<'t> {
                     return Some((atlas.start(k, self.target), false));
                 }
             }
-            // The current list is exhausted: a far guess comes after the short list.
+            // The current list is exhausted: a far guess comes after the short list, then the
+            // small-angle starts of a target near full extension.
             if let Some(g) = self.guess.take() {
                 return Some(as_start(g));
+            }
+            if self.stage >= 1 {
+                let target = self.target;
+                let list = self
+                    .straight
+                    .get_or_insert_with(|| straight::starts(target, 4));
+                if let Some(a) = list.pop() {
+                    return Some((atlas::Start { a, predicted: None }, false));
+                }
             }
             if self.stage >= 3 {
                 return None;

@@ -4,7 +4,7 @@
 //! Landen sequence, values at Γ0 = φ); [`Closed::pose`] then costs one descending-Landen
 //! evaluation. With `T = Dual3` seeded with the identity on a, the same code yields J(t, a).
 
-use crate::elliptic::{inverse_phase_zeta, JacobiValues, Landen};
+use crate::elliptic::{inverse_phase_zeta, Duplication, JacobiValues};
 use crate::scalar::Real;
 
 /// Which closed form applies (decided on f64 values).
@@ -53,7 +53,7 @@ pub(crate) struct Closed<T: Real> {
     lin: T,
     /// m1 = 1 − m (cases I, II), as computed from λ4.
     pub m1: f64,
-    landen: Landen<T>,
+    landen: Duplication<T>,
     /// Jacobi values at Γ0 = φ (cases I, II).
     j0: JacobiValues<T>,
     /// θ/(2ε) at t = 0: atan2(√m sn φ, dn φ) (I), am φ (II), gd φ (III).
@@ -236,7 +236,7 @@ impl<T: Real> Closed<T> {
         let one = T::from_f64(1.0);
         let (a3r, a4r, a5r) = (a3.re(), a4.re(), a5.re());
         let eps = if a3r < 0.0 { -1.0 } else { 1.0 };
-        let dummy_landen = Landen::new(zero, one);
+        let dummy_landen = Duplication::placeholder();
         let dummy_j = JacobiValues {
             sn: zero,
             cn: one,
@@ -310,7 +310,7 @@ impl<T: Real> Closed<T> {
             s.case = Case::I;
             let m = alpha3 / (f * 4.0);
             let m1 = lambda4 / (f * alpha3);
-            let landen = Landen::new(m, m1);
+            let landen = Duplication::new(m, m1);
             if !landen.converged() {
                 return None;
             }
@@ -340,7 +340,7 @@ impl<T: Real> Closed<T> {
                 return Some(s);
             }
             let m1 = -lambda4 * 4.0 / (alpha3 * alpha3);
-            let landen = Landen::new(m, m1);
+            let landen = Duplication::new(m, m1);
             if !landen.converged() {
                 return None;
             }
@@ -437,11 +437,11 @@ impl<T: Real> Closed<T> {
                 c + (self.a4 * (-cs + 1.0) - self.a5 * sn) / c
             }
             Case::I => {
-                let j = self.landen.eval(self.r * t + self.phi);
+                let j = self.landen.eval(self.r * t + self.phi, false);
                 self.sqa3 * j.cn * self.eps
             }
             Case::II => {
-                let j = self.landen.eval(self.r * t + self.phi);
+                let j = self.landen.eval(self.r * t + self.phi, false);
                 self.sqa3 * j.dn * self.eps
             }
             Case::III => {
@@ -493,16 +493,23 @@ impl<T: Real> Closed<T> {
                 return [x, y, th];
             }
             Case::I => {
-                let j = self.landen.eval(self.r * t + self.phi);
+                let j = self.landen.eval(self.r * t + self.phi, false);
                 let ib1 = self.lin * t + self.m * (j.zm - self.j0.zm) * 2.0 / self.r;
                 let ib2 = -self.sqm * (j.cn - self.j0.cn) / self.r;
                 let ht = (self.sqm * j.sn).atan2(j.dn) - self.th0;
                 (ib1, ib2, ht)
             }
             Case::II => {
-                let j = self.landen.eval(self.r * t + self.phi);
+                let j = self.landen.eval(self.r * t + self.phi, true);
                 let ib1 = self.lin * t + (j.zm - self.j0.zm) * 2.0 / self.r;
-                let ib2 = (j.sn * j.sn - self.j0.sn * self.j0.sn) / (self.r * (j.dn + self.j0.dn));
+                // −(dn − dn0)/(m r) (FINDINGS §3), in the form that does not cancel: through
+                // sn² − sn0² = (dn0² − dn²)/m for small m, directly for m ≥ ½ (dn, computed
+                // with relative accuracy, is tiny near the separatrix while sn ≈ 1).
+                let ib2 = if self.m.re() >= 0.5 {
+                    (self.j0.dn - j.dn) / (self.m * self.r)
+                } else {
+                    (j.sn * j.sn - self.j0.sn * self.j0.sn) / (self.r * (j.dn + self.j0.dn))
+                };
                 (ib1, ib2, j.am - self.th0)
             }
             Case::III => {
