@@ -34,6 +34,10 @@ cargo_rc=${PIPESTATUS[0]}
 [ "$cargo_rc" = 0 ] || { echo "cargo test FAILED (full log: $LOGS/cargo-test.log)"; status=1; }
 
 echo "== pytest tests/"
+# The binaries built above (rodig_harness.py would otherwise run its own `cargo build -p
+# rod-ig-node`, whose feature set differs from the workspace build's and relinks everything).
+TARGET="${CARGO_TARGET_DIR:-$REPO/target}"
+export ROD_IG_NODE_BIN="$TARGET/release/rod_ig_node" ROD_IG_ECHO_BIN="$TARGET/release/rod_ig_echo"
 # shellcheck disable=SC2086
 python -m pytest "$REPO/tests" -q -p no:cacheprovider -W ignore::DeprecationWarning ${PYTEST_ARGS:-} \
     2>&1 | tee "$LOGS/pytest.log" | tail -n 15

@@ -126,7 +126,7 @@ fn separatrix_endpoint(i: u64) -> Option<PlanarParams> {
     let sign = if v < 0.5 { -1.0 } else { 1.0 };
     let l4 = sign * scale * 10f64.powf(-6.0 * u);
     let a5sq = base + l4;
-    if !(a5sq > 0.0) {
+    if a5sq.is_nan() || a5sq <= 0.0 {
         return None;
     }
     let a5 = a5sq.sqrt() * if (2.0 * v).fract() < 0.5 { -1.0 } else { 1.0 };

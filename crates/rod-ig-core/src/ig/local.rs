@@ -181,7 +181,7 @@ fn run(
             let g = e.jac.transpose() * e.f;
             let dmax = jtj.diagonal().max();
             let diag = jtj.diagonal().map(|v| v.max(1e-12 * dmax));
-            if !(mu > 0.0) {
+            if mu.is_nan() || mu <= 0.0 {
                 mu = 1e-3;
             }
             for _ in 0..LM_TRIALS {
