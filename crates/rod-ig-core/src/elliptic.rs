@@ -15,7 +15,7 @@
 //! When the scalar is [`crate::scalar::Dual3`] the derivatives flow through every iteration;
 //! iteration counts and branches are decided on the f64 values ([`Real::re`]).
 
-use crate::scalar::Real;
+use crate::scalar::{fast_atan2, Real};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Maximum number of Landen (AGM) levels. The AGM started at b0 = √m1 converges in ≤ 12 levels
@@ -807,7 +807,7 @@ impl<T: Real> Duplication<T> {
         if T::HAS_DERIVATIVES && self.mr < ANALYTIC_MIN_M {
             let (mut sn, mut cn, dn, dv) = self.core_generic(v);
             let am = if with_am {
-                sn.atan2(cn) + j * PI
+                sn.atan2_fast(cn) + j * PI
             } else {
                 T::from_f64(0.0)
             };
@@ -819,7 +819,7 @@ impl<T: Real> Duplication<T> {
             return JacobiValues { sn, cn, dn, am, zm };
         }
         let (s, c, d, dd) = self.core(vr);
-        let am_v = if with_am { s.atan2(c) } else { 0.0 };
+        let am_v = if with_am { fast_atan2(s, c) } else { 0.0 };
         let (mut sn, mut cn, dn, dv, am) = if T::HAS_DERIVATIVES {
             let (m, m1) = (self.mr, self.m1r);
             let a = (s * c - d * (vr - dd)) / (2.0 * m1);
