@@ -327,7 +327,7 @@ impl<T: Real> Closed<T> {
                 sn,
                 cn,
                 dn,
-                am: sn.atan2(cn),
+                am: zero, // unused in case I
                 zm: zm0,
             };
             // θ0/(2ε) = atan2(√m sn φ, dn φ) is folded into the single atan2 of `pose`.
@@ -358,7 +358,7 @@ impl<T: Real> Closed<T> {
             s.lin = -landen.q();
             let dn = (m1 + m * cn * cn).sqrt();
             // φ ∈ (−2K, 2K) ⇒ am φ = atan2(sn, cn) ∈ (−π, π)
-            let am = sn.atan2(cn);
+            let am = sn.atan2_fast(cn);
             s.j0 = JacobiValues {
                 sn,
                 cn,
@@ -500,7 +500,7 @@ impl<T: Real> Closed<T> {
                 // (−π/2, π/2), so one atan2 of the rotated pair gives the difference exactly.
                 let (y1, x1) = (self.sqm * j.sn, j.dn);
                 let (y0, x0) = (self.sqm * self.j0.sn, self.j0.dn);
-                let ht = (y1 * x0 - x1 * y0).atan2(x1 * x0 + y1 * y0);
+                let ht = (y1 * x0 - x1 * y0).atan2_fast(x1 * x0 + y1 * y0);
                 (ib1, ib2, ht)
             }
             Case::II => {
