@@ -15,7 +15,7 @@
 //! When the scalar is [`crate::scalar::Dual3`] the derivatives flow through every iteration;
 //! iteration counts and branches are decided on the f64 values ([`Real::re`]).
 
-use crate::scalar::Real;
+use crate::scalar::{fast_atan2, Real};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Maximum number of Landen (AGM) levels. The AGM started at b0 = √m1 converges in ≤ 12 levels
@@ -253,8 +253,29 @@ pub fn inverse_phase<T: Real>(s: T, c: T, _m: T, m1: T, kk: T) -> T {
 ///   D(χ) = c³/3 R_D(m1s², m1, Δ²).
 ///
 /// This replaces a Jacobi evaluation at u = φ (one Carlson pair instead of a Landen descent).
+///
+/// With dual numbers and m ≥ 0.01 the values are computed in f64 and the derivatives attached
+/// analytically: ∂φ/∂ψ = 1/Δ, ∂D(ψ)/∂ψ = sin²ψ/Δ, ∂φ/∂m = [F − D(ψ) − sc/Δ]/(2m1)
+/// (DLMF 19.4.2 with E = F − mD), ∂D(ψ)/∂m = (∂φ/∂m − D(ψ)/2)/m, dψ = c ds − s dc
+/// ((s, c) on the unit circle) and dm = −dm1. Below m = 0.01 the last form would cancel and
+/// the derivatives are carried through the Carlson duplications instead.
 #[inline]
 pub fn inverse_phase_zeta<T: Real>(s: T, c: T, m1: T, kk: T, dk: T) -> (T, T) {
+    if T::HAS_DERIVATIVES && m1.re() <= 0.99 {
+        let (sr, cr, m1r) = (s.re(), c.re(), m1.re());
+        let (phi, zm0) = inverse_phase_zeta::<f64>(sr, cr, m1r, kk.re(), dk.re());
+        let m = 1.0 - m1r;
+        let delta = (cr * cr + m1r * sr * sr).sqrt();
+        let dpsi = (s - T::from_f64(sr)) * cr - (c - T::from_f64(cr)) * sr;
+        let gm = T::from_f64(m1r) - m1;
+        let dpsi_val = phi * dk.re() - zm0;
+        let f_m = (phi - dpsi_val - sr * cr / delta) / (2.0 * m1r);
+        let d_m = (f_m - 0.5 * dpsi_val) / m;
+        let inv_delta = 1.0 / delta;
+        let phi_d = T::from_f64(phi) + dpsi * inv_delta + gm * f_m;
+        let d_d = T::from_f64(dpsi_val) + dpsi * (sr * sr * inv_delta) + gm * d_m;
+        return (phi_d, phi_d * dk - d_d);
+    }
     let c2 = c * c;
     let ms2 = m1 * s * s;
     let delta2 = c2 + ms2;
@@ -447,6 +468,40 @@ const SERIES_MAX: f64 = 1.0 / 32.0;
 /// attaching the analytic derivatives (whose ∂D/∂m cancels like 1e-16/m).
 const ANALYTIC_MIN_M: f64 = 0.01;
 
+/// K(m) and q = 2D(m)/K(m) − 1 by the AGM started at b0 = √m1 (the recurrences of
+/// [`Landen::new`], nothing stored per level); the flag is false if it did not converge.
+#[inline]
+fn agm_kq<T: Real>(m: T, m1: T) -> (T, T, bool) {
+    let zero = T::from_f64(0.0);
+    let mut a = T::from_f64(1.0);
+    let mut b = m1.sqrt();
+    let mut d = zero;
+    let mut q = zero;
+    let mut pow2 = 1.0;
+    let mut converged = false;
+    for n in 1..=MAX_LEVELS {
+        let a_new = (a + b) * 0.5;
+        let inv_a = a_new.recip();
+        d = if n == 1 {
+            inv_a * 0.25
+        } else {
+            m * d * d * inv_a * 0.25
+        };
+        b = (a * b).sqrt();
+        a = a_new;
+        let c = m * d;
+        pow2 *= 2.0;
+        q += m * d * d * pow2;
+        let (cr, ar, mr) = (c.re(), a.re(), m.re());
+        let ratio = cr.abs() / ar.abs();
+        if ratio <= AGM_TOL && ratio * cr.abs() <= 4.0 * ZETA_TOL * ar.abs() * mr.abs() {
+            converged = ar.is_finite() && ar > 0.0;
+            break;
+        }
+    }
+    (a.recip() * FRAC_PI_2, q, converged)
+}
+
 /// Jacobi functions by argument reduction, Maclaurin series and duplication (no sines, no
 /// arcsines). Per m: K(m) and D(m)/K(m) by the AGM (same recurrences as [`Landen`], nothing
 /// stored per level) and the series coefficients. Per u:
@@ -512,38 +567,25 @@ impl<T: Real> Duplication<T> {
     }
 
     /// Per-m data for parameter m, complementary parameter m1 = 1 − m > 0 (both in [0, 1]).
+    ///
+    /// With dual numbers and m ≥ 0.01 the AGM runs in f64 and the derivatives are attached
+    /// analytically: dK/dm = (K − D)/(2m1) (A&S 17.3.10 with E = K − mD),
+    /// dD/dm = (dK/dm − D/2)/m (dE/dm = −D/2), q = 2D/K − 1.
     #[inline]
     pub fn new(m: T, m1: T) -> Self {
-        let zero = T::from_f64(0.0);
-        let one = T::from_f64(1.0);
         let b0 = m1.sqrt();
-        let mut a = one;
-        let mut b = b0;
-        let mut d = zero;
-        let mut q = zero;
-        let mut pow2 = 1.0;
-        let mut converged = false;
-        for n in 1..=MAX_LEVELS {
-            let a_new = (a + b) * 0.5;
-            let inv_a = a_new.recip();
-            d = if n == 1 {
-                inv_a * 0.25
-            } else {
-                m * d * d * inv_a * 0.25
-            };
-            b = (a * b).sqrt();
-            a = a_new;
-            let c = m * d;
-            pow2 *= 2.0;
-            q += m * d * d * pow2;
-            let (cr, ar, mr) = (c.re(), a.re(), m.re());
-            let ratio = cr.abs() / ar.abs();
-            if ratio <= AGM_TOL && ratio * cr.abs() <= 4.0 * ZETA_TOL * ar.abs() * mr.abs() {
-                converged = ar.is_finite() && ar > 0.0;
-                break;
-            }
-        }
-        let k = a.recip() * FRAC_PI_2;
+        let (k, q, converged) = if T::HAS_DERIVATIVES && m.re() >= ANALYTIC_MIN_M {
+            let (mr, m1r) = (m.re(), m1.re());
+            let (k, q, conv) = agm_kq(mr, m1r);
+            let d = k * (q + 1.0) * 0.5;
+            let k_m = (k - d) / (2.0 * m1r);
+            let d_m = (k_m - 0.5 * d) / mr;
+            let q_m = 2.0 * (d_m * k - d * k_m) / (k * k);
+            let gm = m - T::from_f64(mr);
+            (T::from_f64(k) + gm * k_m, T::from_f64(q) + gm * q_m, conv)
+        } else {
+            agm_kq(m, m1)
+        };
         let m_dual = m;
         let m = m.re();
         let m2 = m * m;
@@ -765,7 +807,7 @@ impl<T: Real> Duplication<T> {
         if T::HAS_DERIVATIVES && self.mr < ANALYTIC_MIN_M {
             let (mut sn, mut cn, dn, dv) = self.core_generic(v);
             let am = if with_am {
-                sn.atan2(cn) + j * PI
+                sn.atan2_fast(cn) + j * PI
             } else {
                 T::from_f64(0.0)
             };
@@ -777,7 +819,7 @@ impl<T: Real> Duplication<T> {
             return JacobiValues { sn, cn, dn, am, zm };
         }
         let (s, c, d, dd) = self.core(vr);
-        let am_v = if with_am { s.atan2(c) } else { 0.0 };
+        let am_v = if with_am { fast_atan2(s, c) } else { 0.0 };
         let (mut sn, mut cn, dn, dv, am) = if T::HAS_DERIVATIVES {
             let (m, m1) = (self.mr, self.m1r);
             let a = (s * c - d * (vr - dd)) / (2.0 * m1);
@@ -924,6 +966,53 @@ mod tests {
             }
         }
         eprintln!("dual duplication vs landen worst {worst:e}");
+    }
+
+    #[test]
+    fn inverse_phase_zeta_analytic_derivatives() {
+        use crate::scalar::Dual3;
+        let mut worst = 0.0f64;
+        for &m1v in &[0.985, 0.9, 0.5, 0.2, 0.01, 1e-4] {
+            // m, m1 as duals of (p0, p1, p2); ψ as a dual too
+            let dm1 = Dual3::new(m1v, [0.3, -1.0, 0.2]);
+            let dm = Dual3::constant(1.0) - dm1;
+            let l = Duplication::new(dm, dm1);
+            for i in -30..=30 {
+                let psi = Dual3::new(i as f64 * 0.1045, [1.0, 0.5, -0.25]);
+                let (sn, cn) = psi.sin_cos();
+                let a = inverse_phase_zeta(sn, cn, dm1, l.k(), l.d_over_k());
+                // reference: derivatives carried through the Carlson duplications
+                let b = {
+                    let c2 = cn * cn;
+                    let ms2 = dm1 * sn * sn;
+                    let delta2 = c2 + ms2;
+                    let (kk, dk) = (l.k(), l.d_over_k());
+                    if cn.v >= sn.v.abs() {
+                        let (rf, rd) = carlson_rf_rd(c2, delta2, Dual3::constant(1.0));
+                        let phi = sn * rf;
+                        (phi, phi * dk - sn * sn * sn * rd / 3.0)
+                    } else {
+                        let (rf, rd) = carlson_rf_rd(ms2, dm1, delta2);
+                        let f_chi = cn * rf;
+                        let g = sn.abs() * cn / delta2.sqrt() + cn * c2 * rd / 3.0 - f_chi * dk;
+                        if sn.v < 0.0 {
+                            (f_chi - kk, -g)
+                        } else {
+                            (kk - f_chi, g)
+                        }
+                    }
+                };
+                for (x, y) in [(a.0, b.0), (a.1, b.1)] {
+                    assert!((x.v - y.v).abs() < 1e-14);
+                    for k in 0..3 {
+                        let e = (x.g[k] - y.g[k]).abs() / y.g[k].abs().max(1.0);
+                        worst = worst.max(e);
+                        assert!(e < 1e-10, "m1={m1v} psi={} k={k}: {x:?} vs {y:?}", psi.v);
+                    }
+                }
+            }
+        }
+        eprintln!("inverse_phase_zeta analytic vs dual worst {worst:e}");
     }
 
     #[test]

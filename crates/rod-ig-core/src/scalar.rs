@@ -51,6 +51,11 @@ pub trait Real:
     fn atan(self) -> Self;
     /// Two-argument arctangent atan2(self, x), in (−π, π].
     fn atan2(self, x: Self) -> Self;
+    /// atan2 with an absolute error ≤ 5e-16 instead of libm's correct rounding (see
+    /// [`fast_atan2`]); several times cheaper.
+    fn atan2_fast(self, x: Self) -> Self {
+        self.atan2(x)
+    }
     /// Exponential.
     fn exp(self) -> Self;
     /// Natural logarithm.
@@ -112,6 +117,10 @@ impl Real for f64 {
         f64::atan2(self, x)
     }
     #[inline]
+    fn atan2_fast(self, x: Self) -> Self {
+        fast_atan2(self, x)
+    }
+    #[inline]
     fn exp(self) -> Self {
         f64::exp(self)
     }
@@ -146,6 +155,65 @@ impl Real for f64 {
     #[inline]
     fn is_finite(self) -> bool {
         f64::is_finite(self)
+    }
+}
+
+/// (−1)ᵏ/(2k + 1), k = 0..14: Maclaurin coefficients of atan z / z.
+const ATAN_COEFFS: [f64; 15] = [
+    1.0,
+    -1.0 / 3.0,
+    1.0 / 5.0,
+    -1.0 / 7.0,
+    1.0 / 9.0,
+    -1.0 / 11.0,
+    1.0 / 13.0,
+    -1.0 / 15.0,
+    1.0 / 17.0,
+    -1.0 / 19.0,
+    1.0 / 21.0,
+    -1.0 / 23.0,
+    1.0 / 25.0,
+    -1.0 / 27.0,
+    1.0 / 29.0,
+];
+
+/// atan2(y, x) in (−π, π] by octant reduction to t = min/max ∈ [0, 1], the shift
+/// atan t = π/6 + atan((√3 t − 1)/(t + √3)) for t > tan(π/12), and the Maclaurin series of
+/// atan on |z| ≤ tan(π/12) (15 terms: truncation ≤ 4e-18). Absolute error ≤ 5e-16. Zeros,
+/// infinities and NaN are passed to libm.
+#[inline]
+pub fn fast_atan2(y: f64, x: f64) -> f64 {
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_6, PI};
+    const TAN_PI_12: f64 = 0.267_949_192_431_122_7;
+    const SQRT3: f64 = 1.732_050_807_568_877_2;
+    let (ax, ay) = (x.abs(), y.abs());
+    let swap = ay > ax;
+    let (num, den) = if swap { (ax, ay) } else { (ay, ax) };
+    if den == 0.0 || !den.is_finite() {
+        return y.atan2(x);
+    }
+    let t = num / den;
+    let (z, off) = if t > TAN_PI_12 {
+        ((t * SQRT3 - 1.0) / (t + SQRT3), FRAC_PI_6)
+    } else {
+        (t, 0.0)
+    };
+    let z2 = z * z;
+    let mut p = ATAN_COEFFS[14];
+    for k in (0..14).rev() {
+        p = p * z2 + ATAN_COEFFS[k];
+    }
+    let mut r = off + z * p;
+    if swap {
+        r = FRAC_PI_2 - r;
+    }
+    if x < 0.0 {
+        r = PI - r;
+    }
+    if y.is_sign_negative() {
+        -r
+    } else {
+        r
     }
 }
 
@@ -365,6 +433,20 @@ impl Real for Dual3 {
         }
     }
     #[inline]
+    fn atan2_fast(self, x: Self) -> Self {
+        let y = self;
+        let r2 = x.v * x.v + y.v * y.v;
+        let inv = if r2 > 0.0 { 1.0 / r2 } else { 0.0 };
+        Self {
+            v: fast_atan2(y.v, x.v),
+            g: [
+                (x.v * y.g[0] - y.v * x.g[0]) * inv,
+                (x.v * y.g[1] - y.v * x.g[1]) * inv,
+                (x.v * y.g[2] - y.v * x.g[2]) * inv,
+            ],
+        }
+    }
+    #[inline]
     fn exp(self) -> Self {
         let e = self.v.exp();
         self.chain(e, e)
@@ -489,6 +571,43 @@ mod tests {
                 assert_eq!(d.g[2], 0.0);
             }
         }
+    }
+
+    #[test]
+    fn fast_atan2_matches_libm() {
+        let mut state: u64 = 12345;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut worst = 0.0f64;
+        for i in 0..400_000 {
+            let sc = 10f64.powf(-20.0 + 40.0 * next());
+            let (y, x) = if i % 4 == 0 {
+                // near the octant and reduction boundaries
+                let a = std::f64::consts::PI * ((next() * 24.0).round() / 12.0 - 1.0);
+                let a = a + (next() - 0.5) * 1e-6;
+                (a.sin() * sc, a.cos() * sc)
+            } else {
+                ((next() - 0.5) * sc, (next() - 0.5) * sc)
+            };
+            let e = (fast_atan2(y, x) - y.atan2(x)).abs();
+            worst = worst.max(e);
+            assert!(e <= 5e-16, "atan2({y}, {x}): {e:e}");
+        }
+        for (y, x) in [
+            (0.0, 0.0),
+            (-0.0, 1.0),
+            (0.0, -1.0),
+            (1.0, 0.0),
+            (-1.0, 0.0),
+        ] {
+            assert_eq!(fast_atan2(y, x).to_bits(), y.atan2(x).to_bits(), "{y} {x}");
+        }
+        assert!(fast_atan2(f64::NAN, 1.0).is_nan());
+        eprintln!("fast_atan2 worst {worst:e}");
     }
 
     #[test]

@@ -473,24 +473,3 @@ fn least_energy_is_minimum_of_solve_all() {
     }
     assert!(multi > 0, "no target with several stable solutions found");
 }
-
-#[test]
-#[ignore]
-fn report() {
-    let cases = ig_cases();
-    let t = std::time::Instant::now();
-    let n = ig::warm_up();
-    eprintln!("atlas: {n} seeds in {:?}", t.elapsed());
-    for r in bench::table1(&cases, &[1.0, 0.9, 0.7, 0.5, 0.3, 0.2], 100, 1e-6) {
-        eprintln!("{r:?}");
-    }
-    let o = SolveOptions::default();
-    eprintln!("{:?}", bench::robust_from_starts(&cases, &o));
-    eprintln!("{:?}", bench::robust_no_start(&cases, &o));
-    eprintln!("{:?}", bench::robust_random(2000, 7, ParamBox::PAPER, &o));
-    eprintln!("{:?}", bench::robust_random(2000, 8, ParamBox::PUBLIC, &o));
-    let path = bench::ellipse_path(0.5, 0.2, 0.2, 0.3, 0.5, 400);
-    eprintln!("{:?}", bench::tracking("ellipse", &path, &o));
-    let path = bench::random_stable_path(3, ParamBox::PAPER, 400, 0.01);
-    eprintln!("{:?}", bench::tracking("random stable path", &path, &o));
-}

@@ -42,6 +42,14 @@ pub(crate) struct Closed<T: Real> {
     shat: T,
     /// Γ = r t + φ.
     r: T,
+    /// 1/r (cases I, II).
+    inv_r: T,
+    /// 2m/r (case I), 2/r (case II): coefficient of Z/m in ∫β1.
+    zcoef: T,
+    /// −√m/r (case I), 1/(m r) (case II): coefficient of the cn / dn difference in ∫β2.
+    b2coef: T,
+    /// √m sn φ (case I).
+    y0: T,
     phi: T,
     /// √α3 (κ = ε √α3 cn/dn/sech Γ).
     sqa3: T,
@@ -253,6 +261,10 @@ impl<T: Real> Closed<T> {
             chat: one,
             shat: zero,
             r: zero,
+            inv_r: zero,
+            zcoef: zero,
+            b2coef: zero,
+            y0: zero,
             phi: zero,
             sqa3: zero,
             sqm: one,
@@ -327,10 +339,14 @@ impl<T: Real> Closed<T> {
                 sn,
                 cn,
                 dn,
-                am: sn.atan2(cn),
+                am: zero, // unused in case I
                 zm: zm0,
             };
             // θ0/(2ε) = atan2(√m sn φ, dn φ) is folded into the single atan2 of `pose`.
+            s.inv_r = s.r.recip();
+            s.zcoef = m * s.inv_r * 2.0;
+            s.b2coef = -s.sqm * s.inv_r;
+            s.y0 = s.sqm * sn;
             s.landen = landen;
         } else if l4 < 0.0 {
             s.case = Case::II;
@@ -358,7 +374,7 @@ impl<T: Real> Closed<T> {
             s.lin = -landen.q();
             let dn = (m1 + m * cn * cn).sqrt();
             // φ ∈ (−2K, 2K) ⇒ am φ = atan2(sn, cn) ∈ (−π, π)
-            let am = sn.atan2(cn);
+            let am = sn.atan2_fast(cn);
             s.j0 = JacobiValues {
                 sn,
                 cn,
@@ -367,6 +383,9 @@ impl<T: Real> Closed<T> {
                 zm: zm0,
             };
             s.th0 = am;
+            s.inv_r = s.r.recip();
+            s.zcoef = s.inv_r * 2.0;
+            s.b2coef = (m * s.r).recip();
             s.landen = landen;
         } else {
             s.case = Case::III;
@@ -494,25 +513,25 @@ impl<T: Real> Closed<T> {
             }
             Case::I => {
                 let j = self.landen.eval(self.r * t + self.phi, false);
-                let ib1 = self.lin * t + self.m * (j.zm - self.j0.zm) * 2.0 / self.r;
-                let ib2 = -self.sqm * (j.cn - self.j0.cn) / self.r;
+                let ib1 = self.lin * t + (j.zm - self.j0.zm) * self.zcoef;
+                let ib2 = (j.cn - self.j0.cn) * self.b2coef;
                 // atan2(y1, x1) − atan2(y0, x0) with x0, x1 = dn > 0: both angles lie in
                 // (−π/2, π/2), so one atan2 of the rotated pair gives the difference exactly.
                 let (y1, x1) = (self.sqm * j.sn, j.dn);
-                let (y0, x0) = (self.sqm * self.j0.sn, self.j0.dn);
-                let ht = (y1 * x0 - x1 * y0).atan2(x1 * x0 + y1 * y0);
+                let (y0, x0) = (self.y0, self.j0.dn);
+                let ht = (y1 * x0 - x1 * y0).atan2_fast(x1 * x0 + y1 * y0);
                 (ib1, ib2, ht)
             }
             Case::II => {
                 let j = self.landen.eval(self.r * t + self.phi, true);
-                let ib1 = self.lin * t + (j.zm - self.j0.zm) * 2.0 / self.r;
+                let ib1 = self.lin * t + (j.zm - self.j0.zm) * self.zcoef;
                 // −(dn − dn0)/(m r) (FINDINGS §3), in the form that does not cancel: through
                 // sn² − sn0² = (dn0² − dn²)/m for small m, directly for m ≥ ½ (dn, computed
                 // with relative accuracy, is tiny near the separatrix while sn ≈ 1).
                 let ib2 = if self.m.re() >= 0.5 {
-                    (self.j0.dn - j.dn) / (self.m * self.r)
+                    (self.j0.dn - j.dn) * self.b2coef
                 } else {
-                    (j.sn * j.sn - self.j0.sn * self.j0.sn) / (self.r * (j.dn + self.j0.dn))
+                    (j.sn * j.sn - self.j0.sn * self.j0.sn) * self.inv_r / (j.dn + self.j0.dn)
                 };
                 (ib1, ib2, j.am - self.th0)
             }

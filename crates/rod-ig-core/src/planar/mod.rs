@@ -155,7 +155,15 @@ fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
 
 /// Tip pose q(1, a) by the closed form (FINDINGS §1–§3).
 pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
-    Ok(PlanarRod::new(a)?.tip())
+    // Same checks as `PlanarRod::new`, without building (and copying) the rod.
+    check_params(a)?;
+    let closed = Closed::<f64>::new(a[0], a[1], a[2]).ok_or_else(overflow)?;
+    let [x, y, th] = closed.pose(1.0);
+    let tip = PlanarPose::new(x, y, th);
+    if !tip.is_finite() {
+        return Err(overflow());
+    }
+    Ok(tip)
 }
 
 /// Pose q(t, a) and J(t, a) = ∂q(t)/∂a (rows x, y, θ; columns a3, a4, a5), exact up to
