@@ -1,6 +1,7 @@
-//! Conversions between ROS messages (metres, quaternions) and the solver's planar,
-//! normalised world (unit rod length, angle about z). No rod mechanics here: only unit
-//! scaling by the rod length L and the bending stiffness EI, and quaternion ↔ yaw.
+//! Conversions between ROS messages (metres, quaternions) and the solver's normalised world
+//! (unit rod length): planar (x, y, angle about z) or, for non-planar targets with the
+//! parameter `solve_3d`, 3-D poses. No rod mechanics here: only unit scaling by the rod length
+//! L ([`to_normalised`] / [`to_metres`]) and the bending stiffness EI, and quaternion ↔ yaw.
 
 use thiserror::Error;
 
@@ -9,7 +10,7 @@ use crate::messages::{
     Wrench,
 };
 use crate::params::Params;
-use crate::solver::{Failed, PlanarPose, Solved};
+use crate::solver::{Failed, PlanarPose, Solved, Solved3d, SpatialParams, SpatialPose};
 
 /// Why a target pose cannot be solved for (answered with success = false).
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -46,6 +47,28 @@ pub enum TargetError {
     },
 }
 
+impl TargetError {
+    /// The target is valid except that it is not planar (z or tilt beyond
+    /// `planar_tolerance`): the 3-D solver can take it when `solve_3d` is set.
+    pub fn is_non_planar(&self) -> bool {
+        matches!(self, Self::OffPlane { .. } | Self::Tilted { .. })
+    }
+}
+
+/// A position in metres as normalised coordinates (divided by the rod length).
+pub fn to_normalised(p: &Point, rod_length: f64) -> [f64; 3] {
+    [p.x / rod_length, p.y / rod_length, p.z / rod_length]
+}
+
+/// Normalised coordinates as a position in metres (multiplied by the rod length).
+pub fn to_metres(v: [f64; 3], rod_length: f64) -> Point {
+    Point {
+        x: v[0] * rod_length,
+        y: v[1] * rod_length,
+        z: v[2] * rod_length,
+    }
+}
+
 /// The quaternion of a rotation by `theta` about z.
 pub fn yaw_to_quaternion(theta: f64) -> Quaternion {
     let h = 0.5 * theta;
@@ -77,6 +100,54 @@ pub fn quaternion_to_yaw(q: &Quaternion) -> Result<(f64, f64), TargetError> {
 /// Checks a target pose (tip gripper in the base gripper's frame, metres) and returns it in
 /// the solver's normalised units: (x / L, y / L, yaw).
 pub fn target_to_planar(pose: &Pose, params: &Params) -> Result<PlanarPose, TargetError> {
+    check_finite(pose)?;
+    let p = &pose.position;
+    let q = &pose.orientation;
+    let tol = params.planar_tolerance;
+    if p.z.abs() > tol {
+        return Err(TargetError::OffPlane { z: p.z, tol });
+    }
+    let (yaw, tilt) = quaternion_to_yaw(q)?;
+    if tilt > tol {
+        return Err(TargetError::Tilted { tilt, tol });
+    }
+    let l = params.rod_length;
+    let distance = p.x.hypot(p.y);
+    // At exactly L only the straight rod fits, and it is not a stable equilibrium.
+    if distance >= l {
+        return Err(TargetError::OutOfReach {
+            distance,
+            length: l,
+        });
+    }
+    let [x, y, _] = to_normalised(p, l);
+    Ok(PlanarPose::new(x, y, yaw))
+}
+
+/// Checks a target pose for the 3-D solver and returns it normalised: position / L and the
+/// orientation (any non-zero quaternion norm; normalised). Rejects non-finite values, a zero
+/// quaternion and targets at least L from the base.
+pub fn target_to_spatial(pose: &Pose, params: &Params) -> Result<SpatialPose, TargetError> {
+    check_finite(pose)?;
+    let p = &pose.position;
+    let q = &pose.orientation;
+    let n = (q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w).sqrt();
+    if n.is_nan() || n <= 1e-9 {
+        return Err(TargetError::ZeroQuaternion(n));
+    }
+    let l = params.rod_length;
+    let distance = (p.x * p.x + p.y * p.y + p.z * p.z).sqrt();
+    if distance >= l {
+        return Err(TargetError::OutOfReach {
+            distance,
+            length: l,
+        });
+    }
+    SpatialPose::from_xyzw(to_normalised(p, l).into(), [q.x, q.y, q.z, q.w])
+        .map_err(|_| TargetError::ZeroQuaternion(n))
+}
+
+fn check_finite(pose: &Pose) -> Result<(), TargetError> {
     let p = &pose.position;
     let q = &pose.orientation;
     for (name, v) in [
@@ -98,24 +169,7 @@ pub fn target_to_planar(pose: &Pose, params: &Params) -> Result<PlanarPose, Targ
             return Err(TargetError::NonFinite(name));
         }
     }
-    let tol = params.planar_tolerance;
-    if p.z.abs() > tol {
-        return Err(TargetError::OffPlane { z: p.z, tol });
-    }
-    let (yaw, tilt) = quaternion_to_yaw(q)?;
-    if tilt > tol {
-        return Err(TargetError::Tilted { tilt, tol });
-    }
-    let l = params.rod_length;
-    let distance = p.x.hypot(p.y);
-    // At exactly L only the straight rod fits, and it is not a stable equilibrium.
-    if distance >= l {
-        return Err(TargetError::OutOfReach {
-            distance,
-            length: l,
-        });
-    }
-    Ok(PlanarPose::new(p.x / l, p.y / l, yaw))
+    Ok(())
 }
 
 /// The frame of published messages: the target's frame_id, or `base_frame` when empty.
@@ -133,32 +187,55 @@ pub fn output_header(target: &Header, params: &Params) -> Header {
 /// A normalised planar pose as a ROS pose in metres.
 pub fn planar_to_pose(q: &PlanarPose, rod_length: f64) -> Pose {
     Pose {
-        position: Point {
-            x: q.x * rod_length,
-            y: q.y * rod_length,
-            z: 0.0,
-        },
+        position: to_metres([q.x, q.y, 0.0], rod_length),
         orientation: yaw_to_quaternion(q.theta),
     }
 }
 
+/// A normalised 3-D pose as a ROS pose in metres (quaternion with w ≥ 0).
+pub fn spatial_to_pose(q: &SpatialPose, rod_length: f64) -> Pose {
+    let [x, y, z, w] = q.quaternion_xyzw();
+    Pose {
+        position: to_metres([q.position.x, q.position.y, q.position.z], rod_length),
+        orientation: Quaternion { x, y, z, w },
+    }
+}
+
+/// A sample of the rod's shape (planar or 3-D, normalised) that can be drawn in metres.
+pub trait ShapeSample {
+    /// The sample as a ROS pose in metres (orientation: body x = tangent).
+    fn to_pose(&self, rod_length: f64) -> Pose;
+}
+
+impl ShapeSample for PlanarPose {
+    fn to_pose(&self, rod_length: f64) -> Pose {
+        planar_to_pose(self, rod_length)
+    }
+}
+
+impl ShapeSample for SpatialPose {
+    fn to_pose(&self, rod_length: f64) -> Pose {
+        spatial_to_pose(self, rod_length)
+    }
+}
+
 /// The rod's shape as a `nav_msgs/Path`: one pose per sample, orientation = tangent.
-pub fn shape_to_path(shape: &[PlanarPose], header: &Header, rod_length: f64) -> Path {
+pub fn shape_to_path<S: ShapeSample>(shape: &[S], header: &Header, rod_length: f64) -> Path {
     Path {
         header: header.clone(),
         poses: shape
             .iter()
             .map(|q| PoseStamped {
                 header: header.clone(),
-                pose: planar_to_pose(q, rod_length),
+                pose: q.to_pose(rod_length),
             })
             .collect(),
     }
 }
 
 /// The rod's shape as an RViz line strip (green when stable, orange when not).
-pub fn shape_to_marker(
-    shape: &[PlanarPose],
+pub fn shape_to_marker<S: ShapeSample>(
+    shape: &[S],
     header: &Header,
     params: &Params,
     stable: bool,
@@ -191,14 +268,7 @@ pub fn shape_to_marker(
                 a: 1.0,
             }
         },
-        points: shape
-            .iter()
-            .map(|q| Point {
-                x: q.x * l,
-                y: q.y * l,
-                z: 0.0,
-            })
-            .collect(),
+        points: shape.iter().map(|q| q.to_pose(l).position).collect(),
         ..Marker::default()
     }
 }
@@ -221,7 +291,73 @@ pub fn base_wrench(a: &[f64; 3], rod_length: f64, bending_stiffness: f64) -> Wre
     }
 }
 
-/// The RodSolution of a converged solve.
+/// Base wrench of a 3-D solution in physical units, base frame:
+/// force = (a4, a5, a6)·EI/L², torque = (a1, a2, a3)·EI/L.
+pub fn base_wrench_3d(a: &SpatialParams, rod_length: f64, bending_stiffness: f64) -> Wrench {
+    let ei = bending_stiffness;
+    let l = rod_length;
+    Wrench {
+        force: Vector3 {
+            x: a[3] * ei / (l * l),
+            y: a[4] * ei / (l * l),
+            z: a[5] * ei / (l * l),
+        },
+        torque: Vector3 {
+            x: a[0] * ei / l,
+            y: a[1] * ei / l,
+            z: a[2] * ei / l,
+        },
+    }
+}
+
+/// The RodSolution of a converged 3-D solve: `spatial` = true, `a_spatial` = (a1..a6),
+/// `a` = its planar components (a3, a4, a5), `tip` the reached 3-D pose.
+pub fn solution_message_3d(
+    s: &Solved3d,
+    header: &Header,
+    params: &Params,
+    solve_time: f64,
+) -> RodSolution {
+    let l = params.rod_length;
+    let ei = params.bending_stiffness;
+    let wrench_valid = ei > 0.0;
+    let a6: [f64; 6] = std::array::from_fn(|i| s.a[i]);
+    RodSolution {
+        header: header.clone(),
+        success: true,
+        message: format!(
+            "3-D solver converged in {} iterations, {}",
+            s.iterations,
+            if s.stable { "stable" } else { "UNSTABLE" }
+        ),
+        a: [a6[2], a6[3], a6[4]],
+        stable: s.stable,
+        stability_margin: s.stability_margin,
+        iterations: s.iterations,
+        position_error: s.position_error * l,
+        orientation_error: s.orientation_error,
+        residual: s.residual,
+        elastic_energy: s.energy,
+        elastic_energy_joules: if wrench_valid {
+            s.energy * ei / l
+        } else {
+            f64::NAN
+        },
+        wrench_valid,
+        base_wrench: if wrench_valid {
+            base_wrench_3d(&s.a, l, ei)
+        } else {
+            Wrench::default()
+        },
+        tip: spatial_to_pose(&s.tip, l),
+        rod_length: l,
+        solve_time,
+        spatial: true,
+        a_spatial: a6,
+    }
+}
+
+/// The RodSolution of a converged (planar) solve.
 pub fn solution_message(
     s: &Solved,
     header: &Header,
@@ -262,10 +398,14 @@ pub fn solution_message(
         tip: planar_to_pose(&s.tip, l),
         rod_length: l,
         solve_time,
+        spatial: false,
+        a_spatial: [0.0; 6],
     }
 }
 
-/// The RodSolution of a rejected target or a failed solve (success = false).
+/// The RodSolution of a rejected target or a failed solve (success = false). `spatial` is
+/// true when the 3-D solver failed; `a_spatial` is then its last iterate (NaN without one),
+/// zeros otherwise.
 pub fn failure_message(
     message: String,
     failed: Option<&Failed>,
@@ -278,6 +418,12 @@ pub fn failure_message(
         .and_then(|f| f.last_a)
         .map(|a| [a[0], a[1], a[2]])
         .unwrap_or([nan; 3]);
+    let spatial = failed.is_some_and(|f| f.spatial);
+    let a_spatial = match failed.and_then(|f| f.last_a_spatial) {
+        Some(a) => std::array::from_fn(|i| a[i]),
+        None if spatial => [nan; 6],
+        None => [0.0; 6],
+    };
     RodSolution {
         header: header.clone(),
         success: false,
@@ -308,6 +454,8 @@ pub fn failure_message(
         },
         rod_length: params.rod_length,
         solve_time,
+        spatial,
+        a_spatial,
     }
 }
 
@@ -497,6 +645,48 @@ mod tests {
     }
 
     #[test]
+    fn spatial_target_scaling_and_reach() {
+        let p = Params {
+            rod_length: 2.0,
+            ..Params::default()
+        };
+        let q = Quaternion {
+            x: 0.1,
+            y: 0.2,
+            z: 0.3,
+            w: 0.9,
+        };
+        let t = target_to_spatial(&pose(1.0, 0.4, 0.6, q), &p).unwrap();
+        assert!((t.position.x - 0.5).abs() < 1e-15 && (t.position.z - 0.3).abs() < 1e-15);
+        let back = spatial_to_pose(&t, p.rod_length);
+        assert!((back.position.z - 0.6).abs() < 1e-15);
+        let n = (0.01f64 + 0.04 + 0.09 + 0.81).sqrt();
+        assert!((back.orientation.y - 0.2 / n).abs() < 1e-12);
+        assert!(matches!(
+            target_to_spatial(&pose(1.2, 1.2, 1.2, q), &p),
+            Err(TargetError::OutOfReach { .. })
+        ));
+        let zero = Quaternion {
+            x: 0.0,
+            y: 0.0,
+            z: 0.0,
+            w: 0.0,
+        };
+        assert!(matches!(
+            target_to_spatial(&pose(0.1, 0.0, 0.0, zero), &p),
+            Err(TargetError::ZeroQuaternion(_))
+        ));
+        assert!(target_to_planar(&pose(1.0, 0.4, 0.6, q), &p)
+            .unwrap_err()
+            .is_non_planar());
+        // 3-D wrench: force (a4, a5, a6)·EI/L², torque (a1, a2, a3)·EI/L.
+        let a = SpatialParams::new(1.0, 2.0, 3.0, 4.0, 5.0, 6.0);
+        let w = base_wrench_3d(&a, 0.5, 2.0);
+        assert_eq!((w.force.x, w.force.y, w.force.z), (32.0, 40.0, 48.0));
+        assert_eq!((w.torque.x, w.torque.y, w.torque.z), (4.0, 8.0, 12.0));
+    }
+
+    #[test]
     fn failure_has_reason() {
         let m = failure_message(
             "why".into(),
@@ -508,5 +698,6 @@ mod tests {
         assert!(!m.success);
         assert_eq!(m.message, "why");
         assert!(m.a[0].is_nan());
+        assert!(!m.spatial && m.a_spatial == [0.0; 6]);
     }
 }

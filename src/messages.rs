@@ -251,6 +251,10 @@ pub struct RodSolution {
     pub rod_length: f64,
     /// Solve wall time (s).
     pub solve_time: f64,
+    /// The 3-D solver answered (appended field; `solve_3d` parameter).
+    pub spatial: bool,
+    /// Normalised 3-D base wrench (a1..a6); zeros for planar answers (appended field).
+    pub a_spatial: [f64; 6],
 }
 impl Message for RodSolution {}
 
@@ -491,6 +495,8 @@ mod tests {
             tip: pose(1),
             rod_length: 0.8,
             solve_time: 0.00025,
+            spatial: true,
+            a_spatial: [0.5, -0.25, 1.5, -2.25, 3.125, 0.75],
         }
     }
 

@@ -65,6 +65,9 @@ pub struct Params {
     pub publish_marker: bool,
     /// `marker_width` (m) > 0: line width of the marker.
     pub marker_width: f64,
+    /// `solve_3d`: answer non-planar targets (beyond `planar_tolerance`) with the 3-D solver
+    /// instead of rejecting them (default false).
+    pub solve_3d: bool,
 }
 
 impl Default for Params {
@@ -80,6 +83,7 @@ impl Default for Params {
             planar_tolerance: 1e-4,
             publish_marker: true,
             marker_width: 0.01,
+            solve_3d: false,
         }
     }
 }
@@ -122,7 +126,7 @@ pub enum ParamError {
 }
 
 /// The names of all parameters, in declaration order.
-pub const NAMES: [&str; 10] = [
+pub const NAMES: [&str; 11] = [
     "rod_length",
     "base_frame",
     "path_samples",
@@ -133,6 +137,7 @@ pub const NAMES: [&str; 10] = [
     "planar_tolerance",
     "publish_marker",
     "marker_width",
+    "solve_3d",
 ];
 
 fn type_name(v: &ParameterValue) -> String {
@@ -169,6 +174,17 @@ fn integer(name: &str, v: &ParameterValue, lo: i64, hi: i64) -> Result<i64, Para
         other => Err(ParamError::WrongType {
             name: name.into(),
             expected: "an integer",
+            got: type_name(other),
+        }),
+    }
+}
+
+fn boolean(name: &str, v: &ParameterValue) -> Result<bool, ParamError> {
+    match v {
+        ParameterValue::Boolean(b) => Ok(*b),
+        other => Err(ParamError::WrongType {
+            name: name.into(),
+            expected: "a bool",
             got: type_name(other),
         }),
     }
@@ -256,6 +272,7 @@ impl Params {
                 })?;
                 self.marker_width = v;
             }
+            "solve_3d" => self.solve_3d = boolean(name, value)?,
             _ => return Err(ParamError::Unknown(name.into())),
         }
         Ok(())
@@ -279,6 +296,7 @@ impl Params {
             "planar_tolerance" => ParameterValue::Double(self.planar_tolerance),
             "publish_marker" => ParameterValue::Boolean(self.publish_marker),
             "marker_width" => ParameterValue::Double(self.marker_width),
+            "solve_3d" => ParameterValue::Boolean(self.solve_3d),
             _ => return None,
         })
     }
@@ -317,7 +335,8 @@ pub fn usage() -> String {
          \x20 bending_stiffness EI in N m^2, 0 = unknown ({})\n\
          \x20 planar_tolerance  accepted |z| (m) and tilt (rad) of targets ({:e})\n\
          \x20 publish_marker    publish /rod/marker ({})\n\
-         \x20 marker_width      m ({})\n\n\
+         \x20 marker_width      m ({})\n\
+         \x20 solve_3d          answer non-planar targets with the 3-D solver ({})\n\n\
          Environment: ROS_DOMAIN_ID (0..232), ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST or\n\
          ROS_LOCALHOST_ONLY=1 (loopback only), RUST_LOG (console log level).\n",
         d.rod_length,
@@ -329,7 +348,8 @@ pub fn usage() -> String {
         d.bending_stiffness,
         d.planar_tolerance,
         d.publish_marker,
-        d.marker_width
+        d.marker_width,
+        d.solve_3d
     )
 }
 
@@ -492,8 +512,11 @@ mod tests {
             "bending_stiffness:=2",
             "-p",
             "publish_marker:=false",
+            "-p",
+            "solve_3d:=true",
         ])
         .unwrap();
+        assert!(p.solve_3d);
         assert_eq!(p.rod_length, 0.5);
         assert_eq!(p.path_samples, 20);
         assert_eq!(p.method, Method::Newton);
@@ -619,6 +642,9 @@ mod tests {
             .is_err());
         assert!(p
             .apply("publish_marker", &ParameterValue::Integer(1))
+            .is_err());
+        assert!(p
+            .apply("solve_3d", &ParameterValue::String("yes".into()))
             .is_err());
         assert_eq!(p, Params::default());
         p.apply("rod_length", &ParameterValue::Double(0.7)).unwrap();

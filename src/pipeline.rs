@@ -6,11 +6,11 @@ use std::time::Instant;
 
 use crate::convert::{
     failure_message, output_header, shape_to_marker, shape_to_path, solution_message,
-    target_to_planar,
+    solution_message_3d, target_to_planar, target_to_spatial, ShapeSample,
 };
-use crate::messages::{Marker, Path, PoseStamped, RodSolution, SolveRodRequest};
+use crate::messages::{Header, Marker, Path, PoseStamped, RodSolution, SolveRodRequest};
 use crate::params::{Method, Params};
-use crate::solver::{PlanarParams, RodSolver, SolverSettings};
+use crate::solver::{spatial_of_planar, Failed, PlanarParams, RodSolver, SolverSettings};
 
 /// What one target produces. `path` and `marker` are `None` when `solution.success` is false:
 /// a failed solve has no shape worth drawing, and subscribers of /rod/path keep the last
@@ -83,6 +83,42 @@ impl Overrides {
     }
 }
 
+/// The outcome of a solve (planar or 3-D): `parts` gives the solution message, the shape and
+/// the stability of a converged solve.
+fn outcome<T, S: ShapeSample>(
+    result: Result<T, Failed>,
+    header: &Header,
+    params: &Params,
+    elapsed: f64,
+    parts: impl FnOnce(T) -> (RodSolution, Vec<S>, bool),
+) -> Outcome {
+    match result {
+        Ok(solved) => {
+            let (solution, shape, stable) = parts(solved);
+            let path = shape_to_path(&shape, header, params.rod_length);
+            let marker = params
+                .publish_marker
+                .then(|| shape_to_marker(&shape, header, params, stable));
+            Outcome {
+                solution,
+                path: Some(path),
+                marker,
+            }
+        }
+        Err(failed) => Outcome {
+            solution: failure_message(
+                format!("solver failed: {}", failed.reason),
+                Some(&failed),
+                header,
+                params,
+                elapsed,
+            ),
+            path: None,
+            marker: None,
+        },
+    }
+}
+
 /// Solver settings from the parameters.
 pub fn settings_of(params: &Params) -> SolverSettings {
     SolverSettings {
@@ -118,22 +154,6 @@ impl Processor {
         if self.solver.settings() != settings {
             self.solver.set_settings(settings);
         }
-        let planar = match target_to_planar(&target.pose, params) {
-            Ok(p) => p,
-            Err(e) => {
-                return Outcome {
-                    solution: failure_message(
-                        e.to_string(),
-                        None,
-                        &header,
-                        params,
-                        started.elapsed().as_secs_f64(),
-                    ),
-                    path: None,
-                    marker: None,
-                }
-            }
-        };
         let samples = overrides.path_samples.unwrap_or(params.path_samples);
         let solver_overrides = Overrides {
             path_samples: None,
@@ -144,33 +164,50 @@ impl Processor {
             tolerance: overrides.tolerance.unwrap_or(settings.tolerance),
             max_iterations: overrides.max_iterations.unwrap_or(settings.max_iterations),
         });
-        let result = self
-            .solver
-            .solve(&planar, overrides.initial_guess, one_off, samples);
-        let elapsed = started.elapsed().as_secs_f64();
-        match result {
-            Ok(solved) => {
-                let path = shape_to_path(&solved.shape, &header, params.rod_length);
-                let marker = params
-                    .publish_marker
-                    .then(|| shape_to_marker(&solved.shape, &header, params, solved.stable));
-                Outcome {
-                    solution: solution_message(&solved, &header, params, elapsed),
-                    path: Some(path),
-                    marker,
-                }
+        let rejected = |message: String| Outcome {
+            solution: failure_message(
+                message,
+                None,
+                &header,
+                params,
+                started.elapsed().as_secs_f64(),
+            ),
+            path: None,
+            marker: None,
+        };
+        match target_to_planar(&target.pose, params) {
+            Ok(planar) => {
+                let result = self
+                    .solver
+                    .solve(&planar, overrides.initial_guess, one_off, samples);
+                let elapsed = started.elapsed().as_secs_f64();
+                outcome(result, &header, params, elapsed, |s| {
+                    (
+                        solution_message(&s, &header, params, elapsed),
+                        s.shape,
+                        s.stable,
+                    )
+                })
             }
-            Err(failed) => Outcome {
-                solution: failure_message(
-                    format!("solver failed: {}", failed.reason),
-                    Some(&failed),
-                    &header,
-                    params,
-                    elapsed,
-                ),
-                path: None,
-                marker: None,
-            },
+            // Non-planar but otherwise valid: the 3-D solver when enabled (the planar
+            // initial guess of a service request is embedded as (0, 0, a3, a4, a5, 0)).
+            Err(e) if e.is_non_planar() && params.solve_3d => {
+                let spatial = match target_to_spatial(&target.pose, params) {
+                    Ok(t) => t,
+                    Err(e) => return rejected(e.to_string()),
+                };
+                let guess = overrides.initial_guess.as_ref().map(spatial_of_planar);
+                let result = self.solver.solve_3d(&spatial, guess, one_off, samples);
+                let elapsed = started.elapsed().as_secs_f64();
+                outcome(result, &header, params, elapsed, |s| {
+                    (
+                        solution_message_3d(&s, &header, params, elapsed),
+                        s.shape,
+                        s.stable,
+                    )
+                })
+            }
+            Err(e) => rejected(e.to_string()),
         }
     }
 
@@ -292,6 +329,103 @@ mod tests {
                 .solution
                 .success
         );
+    }
+
+    /// z = 0.2 m and a rotation of 0.3 rad about (1, 1, 0)/√2 composed with yaw 0.4: not
+    /// planar.
+    fn tilted_target() -> PoseStamped {
+        let mut t = target(0.6, 0.2, 0.0, "left");
+        t.pose.position.z = 0.2;
+        // q = q_yaw(0.4) ⊗ q_tilt(0.3 about (1, 1, 0)/√2).
+        let (s, c) = (0.15f64.sin() / 2f64.sqrt(), 0.15f64.cos());
+        let (sz, cz) = (0.2f64.sin(), 0.2f64.cos());
+        t.pose.orientation = Quaternion {
+            x: cz * s - sz * s,
+            y: cz * s + sz * s,
+            z: sz * c,
+            w: cz * c,
+        };
+        t
+    }
+
+    #[test]
+    fn non_planar_target_solved_in_3d_when_enabled() {
+        let off = Params::default();
+        let mut p = Processor::new(&off);
+        let t = tilted_target();
+        let o = p.process(&t, &off, &Overrides::default());
+        assert!(!o.solution.success && o.path.is_none());
+        assert!(
+            o.solution.message.contains("not planar"),
+            "{}",
+            o.solution.message
+        );
+        assert!(!o.solution.spatial);
+
+        let on = Params {
+            solve_3d: true,
+            rod_length: 1.0,
+            bending_stiffness: 2.0,
+            path_samples: 41,
+            ..Params::default()
+        };
+        let o = p.process(&t, &on, &Overrides::default());
+        let sol = &o.solution;
+        assert!(sol.success, "{}", sol.message);
+        assert!(sol.spatial && sol.stable && sol.stability_margin > 0.0);
+        assert!(sol.position_error < 1e-5 && sol.orientation_error < 1e-5);
+        let tip = &sol.tip;
+        let dp = ((tip.position.x - 0.6).powi(2)
+            + (tip.position.y - 0.2).powi(2)
+            + (tip.position.z - 0.2).powi(2))
+        .sqrt();
+        assert!(dp < 1e-5, "{tip:?}");
+        let q = &t.pose.orientation;
+        let o_ = &tip.orientation;
+        let dot = q.x * o_.x + q.y * o_.y + q.z * o_.z + q.w * o_.w;
+        assert!((dot.abs() - 1.0).abs() < 1e-9, "{tip:?} vs {q:?}");
+        assert_eq!(
+            sol.a,
+            [sol.a_spatial[2], sol.a_spatial[3], sol.a_spatial[4]]
+        );
+        assert!(sol.a_spatial.iter().any(|v| *v != 0.0));
+        // Wrench: force (a4, a5, a6)·EI/L², torque (a1, a2, a3)·EI/L (EI = 2, L = 1).
+        assert!(sol.wrench_valid);
+        assert_eq!(sol.base_wrench.force.z, 2.0 * sol.a_spatial[5]);
+        assert_eq!(sol.base_wrench.torque.x, 2.0 * sol.a_spatial[0]);
+        // The 3-D path: base at the origin, tip at the target.
+        let path = o.path.as_ref().expect("path");
+        assert_eq!(path.poses.len(), 41);
+        let first = &path.poses[0].pose;
+        assert!(first.position.x.abs() < 1e-12 && first.position.z.abs() < 1e-12);
+        assert!((first.orientation.w.abs() - 1.0).abs() < 1e-12);
+        let last = &path.poses[40].pose;
+        assert!((last.position.z - 0.2).abs() < 1e-5, "{last:?}");
+        assert!((last.position.x - 0.6).abs() < 1e-5, "{last:?}");
+        let m = o.marker.expect("marker");
+        assert!((m.points[40].z - 0.2).abs() < 1e-5);
+
+        // Warm start: a nearby target converges in few iterations.
+        let mut t2 = t.clone();
+        t2.pose.position.z = 0.21;
+        let o2 = p.process(&t2, &on, &Overrides::default());
+        assert!(
+            o2.solution.success && o2.solution.spatial,
+            "{}",
+            o2.solution.message
+        );
+        assert!(o2.solution.iterations <= 10, "{}", o2.solution.iterations);
+
+        // Planar targets still use the planar solver.
+        let o3 = p.process(&target(0.6, 0.3, 0.5, ""), &on, &Overrides::default());
+        assert!(o3.solution.success && !o3.solution.spatial);
+        assert_eq!(o3.solution.a_spatial, [0.0; 6]);
+
+        // Out of reach in 3-D: rejected.
+        let mut far = t.clone();
+        far.pose.position.z = 0.9;
+        let o4 = p.process(&far, &on, &Overrides::default());
+        assert!(!o4.solution.success && o4.solution.message.contains("out of reach"));
     }
 
     #[test]

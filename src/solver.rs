@@ -2,12 +2,17 @@
 //!
 //! Everything the node needs from the solver goes through [`RodSolver`]: warm-started
 //! tracking of consecutive targets (`ig::Tracker`), one-off solves with per-request options
-//! (`ig::solve`), and the sampled shape of the solution (`planar::PlanarRod`). Units here are
+//! (`ig::solve`), and the sampled shape of the solution (`planar::PlanarRod`); for non-planar
+//! targets (parameter `solve_3d`) the 3-D solver `spatial::ig::solve`, warm-started from the
+//! previous 3-D solution, and its shape `spatial::shape`. Units here are
 //! the solver's normalised units (unit rod length, unit bending stiffness); scaling to metres
 //! happens in [`crate::convert`].
 
 use rod_ig_core::ig::{self, Failure, Solution, SolveOptions, Tracker};
 use rod_ig_core::planar::PlanarRod;
+use rod_ig_core::spatial::ig::{self as ig3d, Failure3d, Method3d, Solution3d, SolveOptions3d};
+use rod_ig_core::spatial::{self, Stiffness};
+pub use rod_ig_core::spatial::{SpatialParams, SpatialPose};
 pub use rod_ig_core::{PlanarParams, PlanarPose};
 
 use crate::params::Method;
@@ -57,8 +62,13 @@ pub struct Failed {
     pub iterations: u32,
     /// Last residual.
     pub residual: f64,
-    /// Last iterate, when there was one.
+    /// Last iterate, when there was one (for the 3-D solver: its planar components
+    /// (a3, a4, a5)).
     pub last_a: Option<PlanarParams>,
+    /// Last iterate of the 3-D solver (a1..a6), when it answered and had one.
+    pub last_a_spatial: Option<SpatialParams>,
+    /// The 3-D solver answered (parameter `solve_3d`, non-planar target).
+    pub spatial: bool,
 }
 
 impl From<Failure> for Failed {
@@ -68,8 +78,58 @@ impl From<Failure> for Failed {
             iterations: f.iterations,
             residual: f.residual,
             last_a: f.last_a,
+            last_a_spatial: None,
+            spatial: false,
         }
     }
+}
+
+impl From<Failure3d> for Failed {
+    fn from(f: Failure3d) -> Self {
+        Self {
+            reason: f.reason.to_string(),
+            iterations: f.iterations,
+            residual: f.residual,
+            last_a: f.last_a.as_ref().map(planar_part),
+            last_a_spatial: f.last_a,
+            spatial: true,
+        }
+    }
+}
+
+/// A converged 3-D solve, normalised units.
+#[derive(Clone, Debug)]
+pub struct Solved3d {
+    /// Base wrench a = μ(0) = (a1, a2, a3 moment; a4, a5, a6 force), base frame.
+    pub a: SpatialParams,
+    /// Tip pose reached.
+    pub tip: SpatialPose,
+    /// Stable equilibrium.
+    pub stable: bool,
+    /// Normalised stability margin.
+    pub stability_margin: f64,
+    /// Iterations of the successful start.
+    pub iterations: u32,
+    /// |tip − target| (normalised length).
+    pub position_error: f64,
+    /// Rotation angle between the reached and the target orientation (rad).
+    pub orientation_error: f64,
+    /// Solver residual (position + angle error).
+    pub residual: f64,
+    /// Elastic energy (normalised).
+    pub energy: f64,
+    /// `samples` poses from t = 0 to t = 1.
+    pub shape: Vec<SpatialPose>,
+}
+
+/// The planar components (a3, a4, a5) of 3-D parameters (the in-plane moment and force).
+pub fn planar_part(a: &SpatialParams) -> PlanarParams {
+    PlanarParams::new(a[2], a[3], a[4])
+}
+
+/// 3-D parameters of a planar rod: (0, 0, a3, a4, a5, 0).
+pub fn spatial_of_planar(a: &PlanarParams) -> SpatialParams {
+    SpatialParams::new(0.0, 0.0, a[0], a[1], a[2], 0.0)
 }
 
 fn options(s: &SolverSettings, initial_guess: Option<PlanarParams>) -> SolveOptions {
@@ -85,10 +145,25 @@ fn options(s: &SolverSettings, initial_guess: Option<PlanarParams>) -> SolveOpti
     }
 }
 
-/// Inverse-geometry solver with warm start.
+fn options_3d(s: &SolverSettings, initial_guess: Option<SpatialParams>) -> SolveOptions3d {
+    SolveOptions3d {
+        method: match s.method {
+            Method::Robust => Method3d::Robust,
+            Method::Newton => Method3d::Newton,
+        },
+        tolerance: s.tolerance,
+        max_iterations: s.max_iterations,
+        initial_guess,
+        ..SolveOptions3d::default()
+    }
+}
+
+/// Inverse-geometry solver with warm start (planar and 3-D kept separately).
 pub struct RodSolver {
     settings: SolverSettings,
     tracker: Tracker,
+    /// Previous 3-D solution: the warm start of the next 3-D target.
+    last_3d: Option<SpatialParams>,
 }
 
 impl RodSolver {
@@ -97,6 +172,7 @@ impl RodSolver {
         Self {
             settings,
             tracker: Tracker::new(options(&settings, None)),
+            last_3d: None,
         }
     }
 
@@ -116,9 +192,37 @@ impl RodSolver {
         self.tracker = Tracker::new(options(&settings, self.tracker.last()));
     }
 
-    /// Forgets the warm start.
+    /// Forgets the warm starts (planar and 3-D).
     pub fn reset(&mut self) {
         self.tracker.reset();
+        self.last_3d = None;
+    }
+
+    /// Solves the 3-D inverse geometry for `target` (normalised) with the 3-D solver and
+    /// samples `samples` shape poses.
+    ///
+    /// Without `initial_guess` and `one_off` settings: warm-started from the previous 3-D
+    /// solution, which this solution replaces. With either: a one-off solve that leaves the
+    /// warm start untouched. The rod is isotropic (the core's default stiffnesses).
+    pub fn solve_3d(
+        &mut self,
+        target: &SpatialPose,
+        initial_guess: Option<SpatialParams>,
+        one_off: Option<SolverSettings>,
+        samples: usize,
+    ) -> Result<Solved3d, Failed> {
+        let one_off_solve = initial_guess.is_some() || one_off.is_some();
+        let s = one_off.unwrap_or(self.settings);
+        let guess = if one_off_solve {
+            initial_guess
+        } else {
+            self.last_3d
+        };
+        let solution = ig3d::solve(target, &options_3d(&s, guess))?;
+        if !one_off_solve {
+            self.last_3d = Some(solution.a);
+        }
+        with_shape_3d(&solution, samples)
     }
 
     /// Solves for `target` (normalised) and samples `samples` shape poses.
@@ -157,6 +261,8 @@ fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
         iterations: s.iterations,
         residual: s.residual,
         last_a: Some(s.a),
+        last_a_spatial: None,
+        spatial: false,
     })?;
     Ok(Solved {
         a: s.a,
@@ -169,5 +275,28 @@ fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
         residual: s.residual,
         energy: s.energy,
         shape: rod.shape(samples),
+    })
+}
+
+fn with_shape_3d(s: &Solution3d, samples: usize) -> Result<Solved3d, Failed> {
+    let shape = spatial::shape(&s.a, &Stiffness::default(), samples).map_err(|e| Failed {
+        reason: format!("cannot evaluate the solution's shape: {e}"),
+        iterations: s.iterations,
+        residual: s.residual,
+        last_a: Some(planar_part(&s.a)),
+        last_a_spatial: Some(s.a),
+        spatial: true,
+    })?;
+    Ok(Solved3d {
+        a: s.a,
+        tip: s.tip,
+        stable: s.stable,
+        stability_margin: s.stability_margin,
+        iterations: s.iterations,
+        position_error: s.position_error,
+        orientation_error: s.orientation_error,
+        residual: s.residual,
+        energy: s.energy,
+        shape,
     })
 }
