@@ -5,12 +5,12 @@ use criterion::{black_box, criterion_group, criterion_main, BatchSize, Criterion
 use rod_ig_core::spatial::{self, ig, SpatialParams, StabilityOptions, Stiffness};
 
 fn params(n: usize) -> Vec<SpatialParams> {
-    let mut rng = ig::SplitMix64(17);
+    let mut rng = ig::SplitMix64::new(17);
     (0..n)
         .map(|_| {
             SpatialParams::from_fn(|i, _| {
                 let h = if i < 3 { 5.0 } else { 30.0 };
-                rng.uniform(-h, h)
+                rng.range(-h, h)
             })
         })
         .collect()

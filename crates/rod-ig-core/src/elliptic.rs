@@ -915,7 +915,7 @@ mod tests {
                     (a.cn - b.cn).abs(),
                     (a.dn - b.dn).abs(),
                     (a.am - b.am).abs() / a.am.abs().max(1.0),
-                    (a.zm - b.zm).abs() * m.max(1e-300).min(1.0),
+                    (a.zm - b.zm).abs() * m.clamp(1e-300, 1.0),
                 ];
                 for k in 0..5 {
                     worst[k] = worst[k].max(e[k]);

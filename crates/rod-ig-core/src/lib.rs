@@ -18,6 +18,7 @@
 //! - [`ode`]: numerical integrators (adaptive Dormand–Prince 8(5,3) and fixed-step RK4) and the
 //!   planar ODE reference with variational equations.
 //! - [`ig`]: planar inverse geometry (paper's Newton, robust solver, tracking).
+//! - [`rng`]: a small deterministic generator for reproducible samples.
 //! - [`spatial`]: the 3-D rod by numerical integration, and its inverse geometry.
 #![warn(missing_docs)]
 
@@ -26,6 +27,7 @@ mod error;
 pub mod ig;
 pub mod ode;
 pub mod planar;
+pub mod rng;
 pub mod scalar;
 pub mod spatial;
 mod types;

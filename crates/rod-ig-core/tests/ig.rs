@@ -11,31 +11,9 @@ use rod_ig_core::ig::{
     IgError, Method, Objective, SolveOptions, Tracker,
 };
 use rod_ig_core::{wrap_angle, PlanarParams, PlanarPose};
-use std::path::PathBuf;
 
-fn shared_dir() -> PathBuf {
-    if let Ok(p) = std::env::var("ROD_IG_SHARED") {
-        let p = PathBuf::from(p);
-        assert!(
-            p.join("oracle").is_dir(),
-            "ROD_IG_SHARED={} has no oracle/ directory",
-            p.display()
-        );
-        return p;
-    }
-    let start = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    for dir in start.ancestors() {
-        let cand = dir.join("shared");
-        if cand.join("oracle").is_dir() {
-            return cand;
-        }
-    }
-    panic!(
-        "shared data directory not found: set ROD_IG_SHARED, or place `shared/oracle` in an \
-         ancestor of {} (e.g. a sibling of the repository)",
-        start.display()
-    );
-}
+mod common;
+use common::shared_dir;
 
 fn ig_cases() -> Vec<IgCase> {
     let path = shared_dir().join("oracle").join("ig_public.jsonl");

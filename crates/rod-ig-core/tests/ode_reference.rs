@@ -4,39 +4,9 @@
 use nalgebra::{Matrix3, Vector3};
 use rod_ig_core::ode::{self, planar_reference as pr, OdeError, OdeOptions};
 use std::ops::ControlFlow;
-use std::path::{Path, PathBuf};
 
-/// Finds the shared directory: `$ROD_IG_SHARED`, else walks up from the crate looking for
-/// `shared/oracle` (or a sibling `../shared` of an ancestor). Panics with a clear message if absent.
-fn shared_dir() -> PathBuf {
-    if let Ok(p) = std::env::var("ROD_IG_SHARED") {
-        let p = PathBuf::from(p);
-        assert!(
-            p.join("oracle").is_dir(),
-            "ROD_IG_SHARED={} has no oracle/ directory",
-            p.display()
-        );
-        return p;
-    }
-    let start = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for dir in start.ancestors() {
-        let cand = dir.join("shared");
-        if cand.join("oracle").is_dir() {
-            return cand;
-        }
-        if let Some(parent) = dir.parent() {
-            let sib = parent.join("shared");
-            if sib.join("oracle").is_dir() {
-                return sib;
-            }
-        }
-    }
-    panic!(
-        "shared oracle directory not found: set ROD_IG_SHARED or place `shared/oracle` next to \
-         an ancestor of {}",
-        start.display()
-    );
-}
+mod common;
+use common::shared_dir;
 
 struct Case {
     a: Vector3<f64>,

@@ -8,32 +8,9 @@
 
 use rod_ig_core::planar;
 use rod_ig_core::{PlanarJacobian, PlanarParams};
-use std::path::{Path, PathBuf};
 
-fn shared_dir() -> PathBuf {
-    if let Ok(p) = std::env::var("ROD_IG_SHARED") {
-        let p = PathBuf::from(p);
-        assert!(
-            p.join("oracle").is_dir(),
-            "ROD_IG_SHARED={} has no oracle/ directory",
-            p.display()
-        );
-        return p;
-    }
-    let start = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for dir in start.ancestors() {
-        for cand in [dir.join("shared"), dir.join("..").join("shared")] {
-            if cand.join("oracle").join("cases_public.jsonl").is_file() {
-                return cand;
-            }
-        }
-    }
-    panic!(
-        "shared oracle directory not found: set ROD_IG_SHARED or place `shared/oracle` beside \
-         the repository (searched upwards from {})",
-        start.display()
-    );
-}
+mod common;
+use common::shared_dir;
 
 fn arr(v: &serde_json::Value) -> Vec<f64> {
     v.as_array()

@@ -677,25 +677,7 @@ pub fn seeds(target: &SpatialPose) -> Vec<SpatialParams> {
     ]
 }
 
-/// splitmix64: a tiny deterministic generator for reproducible random targets.
-#[derive(Clone, Debug)]
-pub struct SplitMix64(pub u64);
-
-impl SplitMix64 {
-    /// Next uniform in [0, 1).
-    pub fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Uniform in [lo, hi).
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next_f64()
-    }
-}
+pub use crate::rng::SplitMix64;
 
 /// Half-widths of the random-target box: |a1..3| ≤ 5, |a4..6| ≤ 30 (FINDINGS3D: ≈ 70 % stable,
 /// straddles the Euler load 4π² and the twist limit 8.99).
@@ -704,7 +686,7 @@ pub const TARGET_BOX: (f64, f64) = (5.0, 30.0);
 /// `n` random stable rods from [`TARGET_BOX`] (rejection sampling with the production
 /// stability test, at most 100·n draws) and their tips.
 pub fn random_targets(n: usize, seed: u64, k: &Stiffness) -> Vec<(SpatialParams, SpatialPose)> {
-    let mut rng = SplitMix64(seed);
+    let mut rng = SplitMix64::new(seed);
     let mut out = Vec::with_capacity(n);
     let (m, f) = TARGET_BOX;
     let opts = StabilityOptions::production();
@@ -714,7 +696,7 @@ pub fn random_targets(n: usize, seed: u64, k: &Stiffness) -> Vec<(SpatialParams,
         }
         let a = SpatialParams::from_fn(|i, _| {
             let h = if i < 3 { m } else { f };
-            rng.uniform(-h, h)
+            rng.range(-h, h)
         });
         if let Ok(ev) = super::evaluate(&a, k, &opts) {
             if ev.stability.stable {
