@@ -419,7 +419,7 @@ pub fn failure_message(
         .map(|a| [a[0], a[1], a[2]])
         .unwrap_or([nan; 3]);
     let spatial = failed.is_some_and(|f| f.spatial);
-    let a_spatial = match failed.and_then(|f| f.last_a_spatial) {
+    let a_spatial = match failed.and_then(|f| f.last_a_spatial.as_deref()) {
         Some(a) => std::array::from_fn(|i| a[i]),
         None if spatial => [nan; 6],
         None => [0.0; 6],

@@ -66,7 +66,7 @@ pub struct Failed {
     /// (a3, a4, a5)).
     pub last_a: Option<PlanarParams>,
     /// Last iterate of the 3-D solver (a1..a6), when it answered and had one.
-    pub last_a_spatial: Option<SpatialParams>,
+    pub last_a_spatial: Option<Box<SpatialParams>>,
     /// The 3-D solver answered (parameter `solve_3d`, non-planar target).
     pub spatial: bool,
 }
@@ -91,7 +91,7 @@ impl From<Failure3d> for Failed {
             iterations: f.iterations,
             residual: f.residual,
             last_a: f.last_a.as_ref().map(planar_part),
-            last_a_spatial: f.last_a,
+            last_a_spatial: f.last_a.map(Box::new),
             spatial: true,
         }
     }
@@ -284,7 +284,7 @@ fn with_shape_3d(s: &Solution3d, samples: usize) -> Result<Solved3d, Failed> {
         iterations: s.iterations,
         residual: s.residual,
         last_a: Some(planar_part(&s.a)),
-        last_a_spatial: Some(s.a),
+        last_a_spatial: Some(Box::new(s.a)),
         spatial: true,
     })?;
     Ok(Solved3d {
