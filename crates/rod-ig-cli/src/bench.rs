@@ -84,7 +84,7 @@ pub fn planar_forward(quick: bool) {
         Some(rk4_tip),
         "≈ 100 elliptic evaluations",
     );
-    let energy = measure(&inputs, rounds, |a| planar::energy(a));
+    let energy = measure(&inputs, rounds, planar::energy);
     row("elastic energy", energy, None, "");
     println!();
 }

@@ -137,14 +137,16 @@ impl SolveAnswer {
 }
 
 fn options(request: &SolveRequest) -> Result<SolveOptions, String> {
-    let mut options = SolveOptions::default();
-    options.method = match request.method {
-        MethodName::Robust => Method::Robust,
-        MethodName::Newton => Method::Newton,
-    };
-    options.objective = match request.objective {
-        ObjectiveName::First => Objective::FirstFound,
-        ObjectiveName::LeastEnergy => Objective::LeastEnergy,
+    let mut options = SolveOptions {
+        method: match request.method {
+            MethodName::Robust => Method::Robust,
+            MethodName::Newton => Method::Newton,
+        },
+        objective: match request.objective {
+            ObjectiveName::First => Objective::FirstFound,
+            ObjectiveName::LeastEnergy => Objective::LeastEnergy,
+        },
+        ..SolveOptions::default()
     };
     if let Some(alpha) = request.alpha {
         options.alpha = jsonl::check_alpha(alpha)?;

@@ -435,6 +435,21 @@ pub(crate) fn evaluate_if_stable(
     ))
 }
 
+pub(super) fn evaluate_impl(
+    a: &SpatialParams,
+    k: &Stiffness,
+    opts: &StabilityOptions,
+) -> Result<Evaluation3d, RodError> {
+    let (y, stability) = run(a, k, opts, false)?;
+    let y = y.ok_or_else(|| RodError::Integration("no final state".into()))?;
+    Ok(Evaluation3d {
+        tip: pose_of(&y),
+        jacobian: jac_of(&y),
+        energy: y[ENERGY],
+        stability,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -453,19 +468,4 @@ mod tests {
         }
         assert_eq!(super::det6([[0.0; 6]; 6]), 0.0);
     }
-}
-
-pub(super) fn evaluate_impl(
-    a: &SpatialParams,
-    k: &Stiffness,
-    opts: &StabilityOptions,
-) -> Result<Evaluation3d, RodError> {
-    let (y, stability) = run(a, k, opts, false)?;
-    let y = y.ok_or_else(|| RodError::Integration("no final state".into()))?;
-    Ok(Evaluation3d {
-        tip: pose_of(&y),
-        jacobian: jac_of(&y),
-        energy: y[ENERGY],
-        stability,
-    })
 }
