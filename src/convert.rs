@@ -310,6 +310,73 @@ pub fn base_wrench_3d(a: &SpatialParams, rod_length: f64, bending_stiffness: f64
     }
 }
 
+/// What a converged RodSolution says, from either solver, before scaling to physical units.
+struct Converged {
+    what: &'static str,
+    iterations: u32,
+    stable: bool,
+    stability_margin: f64,
+    position_error: f64,
+    orientation_error: f64,
+    residual: f64,
+    energy: f64,
+    /// (a3, a4, a5).
+    a: [f64; 3],
+    /// (a1..a6) for the 3-D solver, zeros for the planar one.
+    a_spatial: [f64; 6],
+    spatial: bool,
+    /// The base wrench in SI units for EI = `bending_stiffness`.
+    wrench: Wrench,
+    /// The reached tip, metres.
+    tip: Pose,
+}
+
+/// Scales a converged answer to physical units (rod length L, bending stiffness EI).
+fn converged_message(
+    c: Converged,
+    header: &Header,
+    params: &Params,
+    solve_time: f64,
+) -> RodSolution {
+    let l = params.rod_length;
+    let ei = params.bending_stiffness;
+    let wrench_valid = ei > 0.0;
+    RodSolution {
+        header: header.clone(),
+        success: true,
+        message: format!(
+            "{} in {} iterations, {}",
+            c.what,
+            c.iterations,
+            if c.stable { "stable" } else { "UNSTABLE" }
+        ),
+        a: c.a,
+        stable: c.stable,
+        stability_margin: c.stability_margin,
+        iterations: c.iterations,
+        position_error: c.position_error * l,
+        orientation_error: c.orientation_error,
+        residual: c.residual,
+        elastic_energy: c.energy,
+        elastic_energy_joules: if wrench_valid {
+            c.energy * ei / l
+        } else {
+            f64::NAN
+        },
+        wrench_valid,
+        base_wrench: if wrench_valid {
+            c.wrench
+        } else {
+            Wrench::default()
+        },
+        tip: c.tip,
+        rod_length: l,
+        solve_time,
+        spatial: c.spatial,
+        a_spatial: c.a_spatial,
+    }
+}
+
 /// The RodSolution of a converged 3-D solve: `spatial` = true, `a_spatial` = (a1..a6),
 /// `a` = its planar components (a3, a4, a5), `tip` the reached 3-D pose.
 pub fn solution_message_3d(
@@ -318,43 +385,25 @@ pub fn solution_message_3d(
     params: &Params,
     solve_time: f64,
 ) -> RodSolution {
-    let l = params.rod_length;
-    let ei = params.bending_stiffness;
-    let wrench_valid = ei > 0.0;
-    let a6: [f64; 6] = std::array::from_fn(|i| s.a[i]);
-    RodSolution {
-        header: header.clone(),
-        success: true,
-        message: format!(
-            "3-D solver converged in {} iterations, {}",
-            s.iterations,
-            if s.stable { "stable" } else { "UNSTABLE" }
-        ),
-        a: [a6[2], a6[3], a6[4]],
+    let s = &s.solution;
+    let (l, ei) = (params.rod_length, params.bending_stiffness);
+    let a_spatial: [f64; 6] = std::array::from_fn(|i| s.a[i]);
+    let c = Converged {
+        what: "3-D solver converged",
+        iterations: s.iterations,
         stable: s.stable,
         stability_margin: s.stability_margin,
-        iterations: s.iterations,
-        position_error: s.position_error * l,
+        position_error: s.position_error,
         orientation_error: s.orientation_error,
         residual: s.residual,
-        elastic_energy: s.energy,
-        elastic_energy_joules: if wrench_valid {
-            s.energy * ei / l
-        } else {
-            f64::NAN
-        },
-        wrench_valid,
-        base_wrench: if wrench_valid {
-            base_wrench_3d(&s.a, l, ei)
-        } else {
-            Wrench::default()
-        },
-        tip: spatial_to_pose(&s.tip, l),
-        rod_length: l,
-        solve_time,
+        energy: s.energy,
+        a: [a_spatial[2], a_spatial[3], a_spatial[4]],
+        a_spatial,
         spatial: true,
-        a_spatial: a6,
-    }
+        wrench: base_wrench_3d(&s.a, l, ei),
+        tip: spatial_to_pose(&s.tip, l),
+    };
+    converged_message(c, header, params, solve_time)
 }
 
 /// The RodSolution of a converged (planar) solve.
@@ -364,43 +413,25 @@ pub fn solution_message(
     params: &Params,
     solve_time: f64,
 ) -> RodSolution {
-    let l = params.rod_length;
-    let ei = params.bending_stiffness;
+    let s = &s.solution;
+    let (l, ei) = (params.rod_length, params.bending_stiffness);
     let a = [s.a[0], s.a[1], s.a[2]];
-    let wrench_valid = ei > 0.0;
-    RodSolution {
-        header: header.clone(),
-        success: true,
-        message: format!(
-            "converged in {} iterations, {}",
-            s.iterations,
-            if s.stable { "stable" } else { "UNSTABLE" }
-        ),
-        a,
+    let c = Converged {
+        what: "converged",
+        iterations: s.iterations,
         stable: s.stable,
         stability_margin: s.stability_margin,
-        iterations: s.iterations,
-        position_error: s.position_error * l,
+        position_error: s.position_error,
         orientation_error: s.orientation_error,
         residual: s.residual,
-        elastic_energy: s.energy,
-        elastic_energy_joules: if wrench_valid {
-            s.energy * ei / l
-        } else {
-            f64::NAN
-        },
-        wrench_valid,
-        base_wrench: if wrench_valid {
-            base_wrench(&a, l, ei)
-        } else {
-            Wrench::default()
-        },
-        tip: planar_to_pose(&s.tip, l),
-        rod_length: l,
-        solve_time,
-        spatial: false,
+        energy: s.energy,
+        a,
         a_spatial: [0.0; 6],
-    }
+        spatial: false,
+        wrench: base_wrench(&a, l, ei),
+        tip: planar_to_pose(&s.tip, l),
+    };
+    converged_message(c, header, params, solve_time)
 }
 
 /// The RodSolution of a rejected target or a failed solve (success = false). `spatial` is
@@ -613,15 +644,20 @@ mod tests {
         let w = base_wrench(&[1.0, 2.0, -3.0], 0.5, 2.0);
         assert_eq!((w.force.x, w.force.y, w.torque.z), (16.0, -24.0, 4.0));
         let s = Solved {
-            a: crate::solver::PlanarParams::new(1.0, 2.0, -3.0),
-            tip: PlanarPose::new(0.5, 0.1, 0.2),
-            stable: true,
-            stability_margin: 0.3,
-            iterations: 4,
-            position_error: 1e-7,
-            orientation_error: 1e-8,
-            residual: 1e-9,
-            energy: 1.5,
+            solution: rod_ig_core::ig::Solution {
+                a: crate::solver::PlanarParams::new(1.0, 2.0, -3.0),
+                tip: PlanarPose::new(0.5, 0.1, 0.2),
+                stable: true,
+                stability_margin: 0.3,
+                iterations: 4,
+                position_error: 1e-7,
+                orientation_error: 1e-8,
+                residual: 1e-9,
+                energy: 1.5,
+                evaluations: 5,
+                starts: 1,
+                elapsed_us: 3.0,
+            },
             shape: vec![],
         };
         let p = Params {

@@ -185,7 +185,7 @@ impl Processor {
                     (
                         solution_message(&s, &header, params, elapsed),
                         s.shape,
-                        s.stable,
+                        s.solution.stable,
                     )
                 })
             }
@@ -203,7 +203,7 @@ impl Processor {
                     (
                         solution_message_3d(&s, &header, params, elapsed),
                         s.shape,
-                        s.stable,
+                        s.solution.stable,
                     )
                 })
             }

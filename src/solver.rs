@@ -28,30 +28,20 @@ pub struct SolverSettings {
     pub max_iterations: u32,
 }
 
-/// A converged solve, normalised units.
+/// A converged solve with its sampled shape, normalised units: the core crate's solution
+/// as it is, plus `samples` poses from t = 0 to t = 1.
 #[derive(Clone, Debug)]
-pub struct Solved {
-    /// Base wrench a = (a3, a4, a5).
-    pub a: PlanarParams,
-    /// Tip pose reached (θ unwrapped).
-    pub tip: PlanarPose,
-    /// Stable equilibrium.
-    pub stable: bool,
-    /// Normalised stability margin.
-    pub stability_margin: f64,
-    /// Iterations used.
-    pub iterations: u32,
-    /// |tip − target| (normalised length).
-    pub position_error: f64,
-    /// Wrapped |θ_tip − θ_target| (rad).
-    pub orientation_error: f64,
-    /// Solver residual.
-    pub residual: f64,
-    /// ½∫κ² (normalised).
-    pub energy: f64,
-    /// `samples` poses from t = 0 to t = 1.
-    pub shape: Vec<PlanarPose>,
+pub struct WithShape<S, P> {
+    /// The solver's answer.
+    pub solution: S,
+    /// The rod's shape, base to tip.
+    pub shape: Vec<P>,
 }
+
+/// A converged planar solve and its shape.
+pub type Solved = WithShape<Solution, PlanarPose>;
+/// A converged 3-D solve and its shape.
+pub type Solved3d = WithShape<Solution3d, SpatialPose>;
 
 /// A failed solve.
 #[derive(Clone, Debug)]
@@ -95,31 +85,6 @@ impl From<Failure3d> for Failed {
             spatial: true,
         }
     }
-}
-
-/// A converged 3-D solve, normalised units.
-#[derive(Clone, Debug)]
-pub struct Solved3d {
-    /// Base wrench a = μ(0) = (a1, a2, a3 moment; a4, a5, a6 force), base frame.
-    pub a: SpatialParams,
-    /// Tip pose reached.
-    pub tip: SpatialPose,
-    /// Stable equilibrium.
-    pub stable: bool,
-    /// Normalised stability margin.
-    pub stability_margin: f64,
-    /// Iterations of the successful start.
-    pub iterations: u32,
-    /// |tip − target| (normalised length).
-    pub position_error: f64,
-    /// Rotation angle between the reached and the target orientation (rad).
-    pub orientation_error: f64,
-    /// Solver residual (position + angle error).
-    pub residual: f64,
-    /// Elastic energy (normalised).
-    pub energy: f64,
-    /// `samples` poses from t = 0 to t = 1.
-    pub shape: Vec<SpatialPose>,
 }
 
 /// The planar components (a3, a4, a5) of 3-D parameters (the in-plane moment and force).
@@ -264,16 +229,8 @@ fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
         last_a_spatial: None,
         spatial: false,
     })?;
-    Ok(Solved {
-        a: s.a,
-        tip: s.tip,
-        stable: s.stable,
-        stability_margin: s.stability_margin,
-        iterations: s.iterations,
-        position_error: s.position_error,
-        orientation_error: s.orientation_error,
-        residual: s.residual,
-        energy: s.energy,
+    Ok(WithShape {
+        solution: *s,
         shape: rod.shape(samples),
     })
 }
@@ -287,16 +244,8 @@ fn with_shape_3d(s: &Solution3d, samples: usize) -> Result<Solved3d, Failed> {
         last_a_spatial: Some(Box::new(s.a)),
         spatial: true,
     })?;
-    Ok(Solved3d {
-        a: s.a,
-        tip: s.tip,
-        stable: s.stable,
-        stability_margin: s.stability_margin,
-        iterations: s.iterations,
-        position_error: s.position_error,
-        orientation_error: s.orientation_error,
-        residual: s.residual,
-        energy: s.energy,
+    Ok(WithShape {
+        solution: *s,
         shape,
     })
 }
