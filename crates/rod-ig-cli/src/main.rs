@@ -1,6 +1,7 @@
 //! `rod-ig`: the command-line face of rod-ig-core. JSON lines in, JSON lines out; benchmarks;
 //! SVG pictures. A thin adapter: every number comes from the solver crate.
 
+mod answer;
 mod bench;
 mod jsonl;
 mod planar_cmds;

@@ -1,5 +1,6 @@
 //! `rod-ig forward`, `rod-ig solve` and `rod-ig shape`: JSON in, JSON out, no math here.
 
+use crate::answer::{Converged, SolveAnswer};
 use crate::jsonl;
 use rod_ig_core::ig::{self, Method, Objective, SolveOptions};
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
@@ -78,62 +79,20 @@ struct SolveRequest {
     all: bool,
 }
 
-/// One solution as printed by `solve` (the CLI contract of issue #3, plus error split and margin).
-#[derive(Serialize)]
-struct SolveAnswer {
-    success: bool,
-    a: Option<[f64; 3]>,
-    tip: Option<PlanarPose>,
-    stable: bool,
-    iterations: u32,
-    residual: f64,
-    energy: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    position_error: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    orientation_error: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    stability_margin: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    reason: Option<String>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    solutions: Option<Vec<SolveAnswer>>,
-}
+type PlanarAnswer = SolveAnswer<[f64; 3], PlanarPose>;
 
-impl SolveAnswer {
-    fn from_solution(s: &ig::Solution) -> Self {
-        SolveAnswer {
-            success: true,
-            a: Some([s.a[0], s.a[1], s.a[2]]),
-            tip: Some(s.tip),
-            stable: s.stable,
-            iterations: s.iterations,
-            residual: s.residual,
-            energy: Some(s.energy),
-            position_error: Some(s.position_error),
-            orientation_error: Some(s.orientation_error),
-            stability_margin: Some(s.stability_margin),
-            reason: None,
-            solutions: None,
-        }
-    }
-
-    fn from_failure(f: &ig::Failure) -> Self {
-        SolveAnswer {
-            success: false,
-            a: None,
-            tip: None,
-            stable: false,
-            iterations: f.iterations,
-            residual: f.residual,
-            energy: None,
-            position_error: None,
-            orientation_error: None,
-            stability_margin: None,
-            reason: Some(f.reason.to_string()),
-            solutions: None,
-        }
-    }
+fn answer_of(s: &ig::Solution) -> PlanarAnswer {
+    SolveAnswer::success(Converged {
+        a: [s.a[0], s.a[1], s.a[2]],
+        tip: s.tip,
+        stable: s.stable,
+        iterations: s.iterations,
+        residual: s.residual,
+        energy: s.energy,
+        position_error: s.position_error,
+        orientation_error: s.orientation_error,
+        stability_margin: s.stability_margin,
+    })
 }
 
 fn options(request: &SolveRequest) -> Result<SolveOptions, String> {
@@ -171,12 +130,12 @@ pub fn solve_line(line: &str) -> Result<Value, String> {
     let request: SolveRequest = jsonl::parse(line)?;
     let options = options(&request)?;
     let mut answer = match ig::solve(&request.target, &options) {
-        Ok(s) => SolveAnswer::from_solution(&s),
-        Err(f) => SolveAnswer::from_failure(&f),
+        Ok(s) => answer_of(&s),
+        Err(f) => PlanarAnswer::failure(f.iterations, f.residual, f.reason.to_string()),
     };
     if request.all {
         let all = ig::solve_all(&request.target, &options);
-        answer.solutions = Some(all.iter().map(SolveAnswer::from_solution).collect());
+        answer.solutions = Some(all.iter().map(answer_of).collect());
     }
     jsonl::to_value(&answer)
 }

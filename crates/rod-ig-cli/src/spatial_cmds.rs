@@ -1,6 +1,7 @@
 //! `rod-ig forward3d` and `rod-ig solve3d`: the 3-D twins of `forward` and `solve`.
 //! Poses are {"position": [x, y, z], "quaternion": [qx, qy, qz, qw]} (scalar last, qw ≥ 0).
 
+use crate::answer::{Converged, SolveAnswer};
 use crate::jsonl;
 use nalgebra::Vector3;
 use rod_ig_core::spatial::ig::{self as ig3d, Method3d, SolveOptions3d};
@@ -105,25 +106,6 @@ struct Solve3dRequest {
     stiffness: Option<[f64; 3]>,
 }
 
-#[derive(Serialize)]
-struct Solve3dAnswer {
-    success: bool,
-    a: Option<[f64; 6]>,
-    tip: Option<PoseJson>,
-    stable: bool,
-    iterations: u32,
-    residual: f64,
-    energy: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    position_error: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    orientation_error: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    stability_margin: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    reason: Option<String>,
-}
-
 /// Answers one `solve3d` line.
 pub fn solve3d_line(line: &str) -> Result<Value, String> {
     let request: Solve3dRequest = jsonl::parse(line)?;
@@ -150,32 +132,18 @@ pub fn solve3d_line(line: &str) -> Result<Value, String> {
         return Err(jsonl::NEWTON_NEEDS_A0.to_string());
     }
     let answer = match ig3d::solve(&target, &options) {
-        Ok(s) => Solve3dAnswer {
-            success: true,
-            a: Some(std::array::from_fn(|i| s.a[i])),
-            tip: Some(PoseJson::from_pose(&s.tip)),
+        Ok(s) => SolveAnswer::success(Converged {
+            a: std::array::from_fn::<f64, 6, _>(|i| s.a[i]),
+            tip: PoseJson::from_pose(&s.tip),
             stable: s.stable,
             iterations: s.iterations,
             residual: s.residual,
-            energy: Some(s.energy),
-            position_error: Some(s.position_error),
-            orientation_error: Some(s.orientation_error),
-            stability_margin: Some(s.stability_margin),
-            reason: None,
-        },
-        Err(f) => Solve3dAnswer {
-            success: false,
-            a: None,
-            tip: None,
-            stable: false,
-            iterations: f.iterations,
-            residual: f.residual,
-            energy: None,
-            position_error: None,
-            orientation_error: None,
-            stability_margin: None,
-            reason: Some(f.reason.to_string()),
-        },
+            energy: s.energy,
+            position_error: s.position_error,
+            orientation_error: s.orientation_error,
+            stability_margin: s.stability_margin,
+        }),
+        Err(f) => SolveAnswer::failure(f.iterations, f.residual, f.reason.to_string()),
     };
     jsonl::to_value(&answer)
 }
