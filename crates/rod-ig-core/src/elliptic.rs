@@ -542,6 +542,43 @@ pub struct Duplication<T> {
     converged: bool,
 }
 
+/// Maclaurin coefficients in z of sn, cn, dn and D = ∫sn² at parameter m (DLMF 22.10.1–3):
+/// sn = z + Σ sc[k] z^(2k+3), cn = 1 + Σ cc[k] z^(2k+2), dn = 1 + Σ dc[k] z^(2k+2),
+/// D = z³/3 + Σ pc[k] z^(2k+5). Generic so that the dual-number path (small m) carries their
+/// derivatives.
+fn series_coefficients<U: Real>(m: U) -> [[U; 4]; 4] {
+    let m2 = m * m;
+    let m3 = m2 * m;
+    let s3 = -(m + 1.0) * (1.0 / 6.0);
+    let s5 = (m * 14.0 + m2 + 1.0) * (1.0 / 120.0);
+    let s7 = -((m + m2) * 135.0 + m3 + 1.0) * (1.0 / 5040.0);
+    let s9 = ((m + m3) * 1228.0 + m2 * 5478.0 + m2 * m2 + 1.0) * (1.0 / 362_880.0);
+    let cc = [
+        U::from_f64(-0.5),
+        (m * 4.0 + 1.0) * (1.0 / 24.0),
+        -(m * 44.0 + m2 * 16.0 + 1.0) * (1.0 / 720.0),
+        (m * 408.0 + m2 * 912.0 + m3 * 64.0 + 1.0) * (1.0 / 40_320.0),
+    ];
+    let dc = [
+        m * -0.5,
+        m * (m + 4.0) * (1.0 / 24.0),
+        -m * (m * 44.0 + m2 + 16.0) * (1.0 / 720.0),
+        m * (m * 912.0 + m2 * 408.0 + m3 + 64.0) * (1.0 / 40_320.0),
+    ];
+    // sn² = z² + e4 z⁴ + e6 z⁶ + e8 z⁸ + e10 z¹⁰ + …, D = ∫ sn²
+    let e4 = s3 * 2.0;
+    let e6 = s5 * 2.0 + s3 * s3;
+    let e8 = (s7 + s3 * s5) * 2.0;
+    let e10 = (s9 + s3 * s7) * 2.0 + s5 * s5;
+    let pc = [
+        e4 * 0.2,
+        e6 * (1.0 / 7.0),
+        e8 * (1.0 / 9.0),
+        e10 * (1.0 / 11.0),
+    ];
+    [[s3, s5, s7, s9], cc, dc, pc]
+}
+
 impl<T: Real> Duplication<T> {
     /// A placeholder (m = 0) that is never evaluated.
     #[inline]
@@ -588,36 +625,7 @@ impl<T: Real> Duplication<T> {
         };
         let m_dual = m;
         let m = m.re();
-        let m2 = m * m;
-        let m3 = m2 * m;
-        let m4 = m2 * m2;
-        let s3 = -(m + 1.0) * (1.0 / 6.0);
-        let s5 = (m * 14.0 + m2 + 1.0) * (1.0 / 120.0);
-        let s7 = -((m + m2) * 135.0 + m3 + 1.0) * (1.0 / 5040.0);
-        let s9 = ((m + m3) * 1228.0 + m2 * 5478.0 + m4 + 1.0) * (1.0 / 362_880.0);
-        let cc = [
-            -0.5,
-            (m * 4.0 + 1.0) * (1.0 / 24.0),
-            -(m * 44.0 + m2 * 16.0 + 1.0) * (1.0 / 720.0),
-            (m * 408.0 + m2 * 912.0 + m3 * 64.0 + 1.0) * (1.0 / 40_320.0),
-        ];
-        let dc = [
-            m * -0.5,
-            m * (m + 4.0) * (1.0 / 24.0),
-            -m * (m * 44.0 + m2 + 16.0) * (1.0 / 720.0),
-            m * (m * 912.0 + m2 * 408.0 + m3 + 64.0) * (1.0 / 40_320.0),
-        ];
-        // sn² = z² + e4 z⁴ + e6 z⁶ + e8 z⁸ + e10 z¹⁰ + …, D = ∫ sn²
-        let e4 = s3 * 2.0;
-        let e6 = s5 * 2.0 + s3 * s3;
-        let e8 = (s7 + s3 * s5) * 2.0;
-        let e10 = (s9 + s3 * s7) * 2.0 + s5 * s5;
-        let pc = [
-            e4 * 0.2,
-            e6 * (1.0 / 7.0),
-            e8 * (1.0 / 9.0),
-            e10 * (1.0 / 11.0),
-        ];
+        let [sc, cc, dc, pc] = series_coefficients(m);
         let kr = k.re();
         Self {
             m: m_dual,
@@ -630,7 +638,7 @@ impl<T: Real> Duplication<T> {
             sqm1r: b0.re(),
             kr,
             dcompr: kr * (q.re() + 1.0) * 0.5,
-            sc: [s3, s5, s7, s9],
+            sc,
             cc,
             dc,
             pc,
@@ -737,37 +745,10 @@ impl<T: Real> Duplication<T> {
             scale *= 0.5;
             n += 1;
         }
-        let m2 = m * m;
-        let m3 = m2 * m;
-        let s3 = -(m + 1.0) * (1.0 / 6.0);
-        let s5 = (m * 14.0 + m2 + 1.0) * (1.0 / 120.0);
-        let s7 = -((m + m2) * 135.0 + m3 + 1.0) * (1.0 / 5040.0);
-        let s9 = ((m + m3) * 1228.0 + m2 * 5478.0 + m2 * m2 + 1.0) * (1.0 / 362_880.0);
-        let cc = [
-            T::from_f64(-0.5),
-            (m * 4.0 + 1.0) * (1.0 / 24.0),
-            -(m * 44.0 + m2 * 16.0 + 1.0) * (1.0 / 720.0),
-            (m * 408.0 + m2 * 912.0 + m3 * 64.0 + 1.0) * (1.0 / 40_320.0),
-        ];
-        let dc = [
-            m * -0.5,
-            m * (m + 4.0) * (1.0 / 24.0),
-            -m * (m * 44.0 + m2 + 16.0) * (1.0 / 720.0),
-            m * (m * 912.0 + m2 * 408.0 + m3 + 64.0) * (1.0 / 40_320.0),
-        ];
-        let e4 = s3 * 2.0;
-        let e6 = s5 * 2.0 + s3 * s3;
-        let e8 = (s7 + s3 * s5) * 2.0;
-        let e10 = (s9 + s3 * s7) * 2.0 + s5 * s5;
-        let pc = [
-            e4 * 0.2,
-            e6 * (1.0 / 7.0),
-            e8 * (1.0 / 9.0),
-            e10 * (1.0 / 11.0),
-        ];
+        let [sc, cc, dc, pc] = series_coefficients(m);
         let z = w * scale;
         let z2 = z * z;
-        let mut s = z + z * z2 * (s3 + z2 * (s5 + z2 * (s7 + z2 * s9)));
+        let mut s = z + z * z2 * (sc[0] + z2 * (sc[1] + z2 * (sc[2] + z2 * sc[3])));
         let mut c = z2 * (cc[0] + z2 * (cc[1] + z2 * (cc[2] + z2 * cc[3]))) + 1.0;
         let mut d = z2 * (dc[0] + z2 * (dc[1] + z2 * (dc[2] + z2 * dc[3]))) + 1.0;
         let mut dd = z * z2 * (z2 * (pc[0] + z2 * (pc[1] + z2 * (pc[2] + z2 * pc[3]))) + 1.0 / 3.0);
