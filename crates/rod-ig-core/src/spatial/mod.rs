@@ -341,7 +341,13 @@ pub(crate) fn initial_var(a: &SpatialParams) -> [f64; NV] {
 }
 
 pub(crate) fn pose_of(s: &[f64]) -> SpatialPose {
-    let q = Quaternion::new(s[9], s[10], s[11], s[12]);
+    pose_from_parts([s[9], s[10], s[11], s[12]], [s[6], s[7], s[8]])
+}
+
+/// A pose from an integrated quaternion (w, x, y, z), renormalised (identity if degenerate),
+/// and a position.
+pub(crate) fn pose_from_parts(wxyz: [f64; 4], position: [f64; 3]) -> SpatialPose {
+    let q = Quaternion::new(wxyz[0], wxyz[1], wxyz[2], wxyz[3]);
     let n = q.norm();
     let rotation = if n.is_finite() && n > 0.0 {
         UnitQuaternion::new_unchecked(q / n)
@@ -349,7 +355,7 @@ pub(crate) fn pose_of(s: &[f64]) -> SpatialPose {
         UnitQuaternion::identity()
     };
     SpatialPose {
-        position: Vector3::new(s[6], s[7], s[8]),
+        position: Vector3::from(position),
         rotation,
     }
 }

@@ -11,7 +11,6 @@
 //! μ-form of [`super`] needs 86).
 
 use super::{SpatialJacobian, SpatialParams, SpatialPose};
-use nalgebra::{Quaternion, UnitQuaternion, Vector3};
 
 /// Base state size (q, p, energy).
 pub(crate) const NRB: usize = 8;
@@ -134,17 +133,7 @@ pub(crate) fn params(a: &SpatialParams) -> [f64; 6] {
 
 /// Pose from a reduced state (quaternion renormalised).
 pub(crate) fn pose(s: &[f64]) -> SpatialPose {
-    let q = Quaternion::new(s[0], s[1], s[2], s[3]);
-    let n = q.norm();
-    let rotation = if n.is_finite() && n > 0.0 {
-        UnitQuaternion::new_unchecked(q / n)
-    } else {
-        UnitQuaternion::identity()
-    };
-    SpatialPose {
-        position: Vector3::new(s[4], s[5], s[6]),
-        rotation,
-    }
+    super::pose_from_parts([s[0], s[1], s[2], s[3]], [s[4], s[5], s[6]])
 }
 
 /// J from a reduced state.
