@@ -120,6 +120,20 @@ pub fn read_cases(path: &Path) -> Result<Vec<IgCase>, String> {
         .collect()
 }
 
+fn robust_header() {
+    println!(
+        "{:<72} {:>6} {:>8} {:>9} {:>8} {:>6} {:>9} {:>9}",
+        "## Robust solver",
+        "runs",
+        "success%",
+        "verified%",
+        "iter",
+        "max it",
+        "median µs",
+        "mean µs"
+    );
+}
+
 fn robust_row(r: &ig_bench::RobustRow) {
     println!(
         "{:<72} {:>6} {:>8.2} {:>9.1} {:>8.2} {:>6} {:>9.2} {:>9.2}",
@@ -179,33 +193,13 @@ pub fn inverse_geometry(quick: bool, cases_path: &Path) {
             }
             println!("(ref = the independent reference of FINDINGS §8 on this file; paper = its Table 1, on its own unstated box and test)");
             println!();
-            println!(
-                "{:<72} {:>6} {:>8} {:>9} {:>8} {:>6} {:>9} {:>9}",
-                "## Robust solver",
-                "runs",
-                "success%",
-                "verified%",
-                "iter",
-                "max it",
-                "median µs",
-                "mean µs"
-            );
+            robust_header();
             robust_row(&ig_bench::robust_from_starts(&cases, &options));
             robust_row(&ig_bench::robust_no_start(&cases, &options));
         }
         Err(e) => {
             println!("## Inverse geometry: Table 1 skipped ({e}); pass --ig-cases FILE");
-            println!(
-                "{:<72} {:>6} {:>8} {:>9} {:>8} {:>6} {:>9} {:>9}",
-                "## Robust solver",
-                "runs",
-                "success%",
-                "verified%",
-                "iter",
-                "max it",
-                "median µs",
-                "mean µs"
-            );
+            robust_header();
         }
     }
     let n = if quick { 200 } else { 2000 };

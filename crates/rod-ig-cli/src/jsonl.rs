@@ -64,6 +64,24 @@ pub fn check_tolerance(tolerance: f64) -> Result<f64, String> {
     }
 }
 
+/// Applies a request's optional step length, iteration limit and tolerance (shared by `solve`
+/// and `solve3d`) to a solver's options, checking each.
+pub fn apply_newton_knobs(
+    (alpha, max_iterations, tolerance): (Option<f64>, Option<u32>, Option<f64>),
+    into: (&mut f64, &mut u32, &mut f64),
+) -> Result<(), String> {
+    if let Some(a) = alpha {
+        *into.0 = check_alpha(a)?;
+    }
+    if let Some(n) = max_iterations {
+        *into.1 = n;
+    }
+    if let Some(t) = tolerance {
+        *into.2 = check_tolerance(t)?;
+    }
+    Ok(())
+}
+
 /// The message for a Newton request without a start.
 pub const NEWTON_NEEDS_A0: &str = "method \"newton\" needs an initial guess \"a0\"";
 

@@ -107,15 +107,14 @@ fn options(request: &SolveRequest) -> Result<SolveOptions, String> {
         },
         ..SolveOptions::default()
     };
-    if let Some(alpha) = request.alpha {
-        options.alpha = jsonl::check_alpha(alpha)?;
-    }
-    if let Some(n) = request.max_iterations {
-        options.max_iterations = n;
-    }
-    if let Some(tol) = request.tolerance {
-        options.tolerance = jsonl::check_tolerance(tol)?;
-    }
+    jsonl::apply_newton_knobs(
+        (request.alpha, request.max_iterations, request.tolerance),
+        (
+            &mut options.alpha,
+            &mut options.max_iterations,
+            &mut options.tolerance,
+        ),
+    )?;
     if let Some(a0) = request.a0 {
         options.initial_guess = Some(PlanarParams::from(a0));
     }

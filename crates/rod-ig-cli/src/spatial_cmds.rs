@@ -119,15 +119,14 @@ pub fn solve3d_line(line: &str) -> Result<Value, String> {
         },
         ..SolveOptions3d::default()
     };
-    if let Some(alpha) = request.alpha {
-        options.alpha = jsonl::check_alpha(alpha)?;
-    }
-    if let Some(n) = request.max_iterations {
-        options.max_iterations = n;
-    }
-    if let Some(tol) = request.tolerance {
-        options.tolerance = jsonl::check_tolerance(tol)?;
-    }
+    jsonl::apply_newton_knobs(
+        (request.alpha, request.max_iterations, request.tolerance),
+        (
+            &mut options.alpha,
+            &mut options.max_iterations,
+            &mut options.tolerance,
+        ),
+    )?;
     if options.method == Method3d::Newton && options.initial_guess.is_none() {
         return Err(jsonl::NEWTON_NEEDS_A0.to_string());
     }
