@@ -42,15 +42,14 @@ impl Default for Counts {
     }
 }
 
-/// Runs one start (with its optional predicted first step); returns the verified stable
-/// solution, if any.
-fn try_start(
+/// Newton from one start (with its optional predicted first step), its work added to `counts`.
+fn run_counted(
     target: &PlanarPose,
     start: &atlas::Start,
     options: &SolveOptions,
     budget: u32,
     counts: &mut Counts,
-) -> Option<Solution> {
+) -> local::Local {
     let r = local::solve_predicted(
         target,
         &start.a,
@@ -61,6 +60,19 @@ fn try_start(
     );
     counts.iterations += r.iterations;
     counts.evaluations += r.evaluations;
+    r
+}
+
+/// Runs one start (with its optional predicted first step); returns the verified stable
+/// solution, if any.
+fn try_start(
+    target: &PlanarPose,
+    start: &atlas::Start,
+    options: &SolveOptions,
+    budget: u32,
+    counts: &mut Counts,
+) -> Option<Solution> {
+    let r = run_counted(target, start, options, budget, counts);
     if r.residual < counts.best.0 {
         counts.best = (r.residual, Some(r.last_a));
     }
@@ -284,16 +296,7 @@ pub(crate) fn solve_all(target: &PlanarPose, options: &SolveOptions) -> All {
     let mut starts = 0;
     for start in &list {
         starts += 1;
-        let r = local::solve_predicted(
-            target,
-            &start.a,
-            start.predicted,
-            options.alpha,
-            budget,
-            options.tolerance,
-        );
-        counts.iterations += r.iterations;
-        counts.evaluations += r.evaluations;
+        let r = run_counted(target, start, options, budget, &mut counts);
         let Some((a, e)) = r.found else { continue };
         if solutions.iter().any(|s| !distinct(&s.a, &a)) {
             continue;
