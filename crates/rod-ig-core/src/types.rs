@@ -43,15 +43,26 @@ impl PlanarPose {
 
 /// Verdict of the stability test (Bretl & McCarthy 2014; FINDINGS §5): the rod is a stable
 /// equilibrium iff det J(t, a) > 0 for every t ∈ (0, 1].
+///
+/// Three outcomes: stable (`stable`), unstable (neither flag), or `uncertain` — the margin is
+/// within its own error estimate of zero, so the sign of det J cannot be decided in f64
+/// (a rod at a fold of the equilibrium set, or the exactly straight rod a3 = a5 = 0, for which
+/// det J ≡ 0). `stable` is false when uncertain: callers that need a stable rod reject it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StabilityReport {
-    /// True iff no sign change (or zero) of det J(t, a) was found on (0, 1].
+    /// True iff det J(t, a) > 0 on (0, 1] was established (the margin exceeds its error bound).
     pub stable: bool,
-    /// Normalised margin: min over the scanned t of det J(t) divided by its small-t leading term
-    /// (FINDINGS §5 `det_min`); dimensionless, → 1 as t → 0, negative iff a sign change was seen.
+    /// Normalised margin g_min = min over t ∈ [0.05, 1] of
+    /// g(t) = det J(t) / (t⁹ (a3²/8640 + a5² t²/33600)) (FINDINGS §5 `det_min`): scale-free,
+    /// ≈ 1 for a gently bent rod, → 1 as t → 0; negative iff det J changes sign. 0 for the
+    /// straight rod.
     pub margin: f64,
     /// First t at which det J changes sign (a conjugate point), when unstable.
     pub first_conjugate_t: Option<f64>,
+    /// True when |margin| is within its rounding-error estimate: the verdict is undecided
+    /// (then `stable` is false).
+    #[serde(default)]
+    pub uncertain: bool,
 }
 
 /// Wraps an angle to (−π, π].

@@ -281,6 +281,7 @@ impl StabilityScan {
             } else {
                 0.0
             },
+            uncertain: false,
             first_conjugate_t: self.first_conjugate,
         }
     }
@@ -288,10 +289,11 @@ impl StabilityScan {
 
 fn straight_rod(a: &PlanarParams) -> Option<StabilityReport> {
     if a[0] == 0.0 && a[2] == 0.0 {
-        // FINDINGS §5: the x-row of J vanishes identically; det ≡ 0, classified unstable.
+        // FINDINGS §5: the x-row of J vanishes identically; det ≡ 0: undecidable.
         Some(StabilityReport {
             stable: false,
             margin: 0.0,
+            uncertain: true,
             first_conjugate_t: None,
         })
     } else {

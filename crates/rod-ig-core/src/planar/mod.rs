@@ -15,12 +15,92 @@
 
 mod closed;
 mod stability;
+mod taylor;
 
 pub use closed::Case;
 use closed::Closed;
 
 use crate::scalar::Dual3;
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
+use taylor::{DualF64x2, Gradient, TaylorRod};
+
+/// Rods with ρ = max(|a3|, √‖(a4, a5)‖) up to this value are evaluated by the Taylor series
+/// (one step from 0 to 1 whose truncation estimate certifies full accuracy: the terms behave
+/// like ρᵏ/k!, 2³⁰/30! ≈ 4e-24). This is the regime of nearly straight, gently bent and tiny
+/// rods, where the closed form is built from O(1) elliptic quantities whose differences are the
+/// answer (cancellation). Above it, the closed form is used unless its own a-priori error
+/// estimate (`Closed::needs_reference`) says it loses accuracy.
+const SERIES_RHO: f64 = 2.0;
+/// Step budget of the Taylor series (bounded time: ≈ 3 µs per step in dual numbers; a rod that
+/// needs more steps than this is beyond what the fallback resolves quickly).
+const SERIES_MAX_STEPS: usize = 2_000;
+
+/// ρ = max(|a3|, √‖(a4, a5)‖): the rod's curvature scale (its Taylor terms grow like ρᵏ/k!).
+fn curvature_scale(a: &PlanarParams) -> f64 {
+    a[0].abs().max(a[1].hypot(a[2]).sqrt())
+}
+
+/// True when the series is chosen without building the closed form.
+fn series_first(a: &PlanarParams) -> bool {
+    curvature_scale(a) <= SERIES_RHO
+}
+
+fn series_f64(a: &PlanarParams, dense: bool) -> Result<TaylorRod<f64>, RodError> {
+    TaylorRod::new(a[0], a[1], a[2], SERIES_MAX_STEPS, dense)
+}
+
+fn series_dual(a: &PlanarParams, dense: bool) -> Result<TaylorRod<Dual3>, RodError> {
+    TaylorRod::new(
+        Dual3::variable(a[0], 0),
+        Dual3::variable(a[1], 1),
+        Dual3::variable(a[2], 2),
+        SERIES_MAX_STEPS,
+        dense,
+    )
+}
+
+/// The dense series in double-double dual numbers, for rods where the closed form's error
+/// estimate fails. Those are the ill-conditioned ones (strong axial force: rounding made while
+/// the rod loops grows like e^{√F (1 − t)} while it then sits near the unstable straight
+/// equilibrium; an f64 integration, the oracle's included, is off by up to 1e-5 there, see
+/// tests/relaxed_oracle.rs), so they are integrated with a 106-bit significand.
+fn series_dd(a: &PlanarParams, dense: bool) -> Result<TaylorRod<DualF64x2>, RodError> {
+    TaylorRod::new(
+        DualF64x2::variable(a[0], 0),
+        DualF64x2::variable(a[1], 1),
+        DualF64x2::variable(a[2], 2),
+        SERIES_MAX_STEPS,
+        dense,
+    )
+}
+
+/// q(1), J(1) and the energy of an ill-conditioned rod (see [`series_dd`]).
+fn ill_conditioned_tip(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian, f64), RodError> {
+    let rod = series_dd(a, false)?;
+    let (p, j) = pose_jac_from(rod.tip())?;
+    Ok((p, j, rod.energy().value()))
+}
+
+fn pose_jac_from<T: Gradient>(p: [T; 3]) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    let [x, y, th] = p.map(|v| (v.value(), v.gradient()));
+    let pose = PlanarPose::new(x.0, y.0, th.0);
+    let j = PlanarJacobian::new(
+        x.1[0], x.1[1], x.1[2], y.1[0], y.1[1], y.1[2], th.1[0], th.1[1], th.1[2],
+    );
+    if !(pose.is_finite() && j.iter().all(|v| v.is_finite())) {
+        return Err(overflow());
+    }
+    Ok((pose, j))
+}
+
+/// q(t) and J(t) from the series (dense only when t < 1).
+fn series_pose_and_jac(a: &PlanarParams, t: f64) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    if t >= 1.0 {
+        return pose_jac_from(series_dual(a, false)?.tip());
+    }
+    let rod = series_dual(a, true)?;
+    pose_jac_from(rod.pose(t.max(0.0)).ok_or_else(overflow)?)
+}
 
 fn check_params(a: &PlanarParams) -> Result<(), RodError> {
     RodError::check_finite("a", a.as_slice())
@@ -49,54 +129,91 @@ fn with_seeded<R>(
     }
 }
 
-/// Relative tolerance of the ODE reference used for J near the separatrix.
-const REFERENCE_RTOL: f64 = 1e-12;
-
 fn pose_and_jac_of(
     c: &Closed<Dual3>,
     a: &PlanarParams,
     t: f64,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     if c.needs_reference() {
-        // FINDINGS §4: fall back to the ODE where the closed form's derivatives are poor;
-        // the pose itself stays the closed form's.
-        let (_, j) = crate::ode::planar_reference::pose_and_jacobian(a, t, REFERENCE_RTOL)?;
-        let [x, y, th] = c.pose(t);
-        return Ok((PlanarPose::new(x.v, y.v, th.v), j));
+        // FINDINGS §4: where the closed form's error estimate fails, the Taylor series gives
+        // the pose and J (both: near the separatrix the closed-form pose drifts too).
+        if t >= 1.0 {
+            let (p, j, _) = ill_conditioned_tip(a)?;
+            return Ok((p, j));
+        }
+        return series_pose_and_jac(a, t);
     }
-    let [x, y, th] = c.pose(t);
-    let pose = PlanarPose::new(x.v, y.v, th.v);
-    let j = PlanarJacobian::new(
-        x.g[0], x.g[1], x.g[2], y.g[0], y.g[1], y.g[2], th.g[0], th.g[1], th.g[2],
-    );
-    if !(pose.is_finite() && j.iter().all(|v| v.is_finite())) {
-        return Err(overflow());
-    }
-    Ok((pose, j))
+    pose_jac_from(c.pose(t))
 }
 
-/// A planar rod with everything that depends on a only precomputed (case, m, m1 = 1 − m, r,
-/// phase φ, the Landen sequence and the values at Γ0 = φ; FINDINGS §2). Each [`PlanarRod::pose`]
-/// then costs one Jacobi-function evaluation.
+/// A planar rod ready to be sampled: the closed form with everything that depends on a only
+/// precomputed (case, m, m1 = 1 − m, r, phase φ, the Landen sequence and the values at Γ0 = φ;
+/// FINDINGS §2), so that each [`PlanarRod::pose`] costs one Jacobi-function evaluation — or,
+/// for nearly straight, gently bent and tiny rods (and wherever the closed form's error
+/// estimate fails), the Taylor-series polynomials of the rod, each pose one Horner evaluation.
 #[derive(Clone, Debug)]
 pub struct PlanarRod {
     a: PlanarParams,
-    closed: Closed<f64>,
+    case: Case,
+    backend: Backend,
     tip: PlanarPose,
 }
 
+#[derive(Clone, Debug)]
+enum Backend {
+    Closed(Closed<f64>),
+    Series(TaylorRod<f64>),
+}
+
+/// The closed-form case of a when the series is used without building the closed form (the
+/// classification of FINDINGS §2, which `case()` reports for information).
+fn case_without_closed(a: &PlanarParams) -> Case {
+    let (a3, a4, a5) = (a[0], a[1], a[2]);
+    if a3 == 0.0 && a5 == 0.0 {
+        Case::Straight
+    } else if a4 == 0.0 && a5 == 0.0 {
+        Case::Circle
+    } else {
+        // Tiny inputs can overflow the closed form's intermediate ratios: case I then.
+        Closed::new(a3, a4, a5).map_or(Case::I, |c| c.case)
+    }
+}
+
 impl PlanarRod {
-    /// Precomputes the closed form for a. Errors: [`RodError::NonFinite`] if a component of a
-    /// is NaN or ±∞, [`RodError::Overflow`] if a is too large for f64 arithmetic.
+    /// Precomputes the rod for a. Errors: [`RodError::NonFinite`] if a component of a is NaN
+    /// or ±∞, [`RodError::Overflow`] if the shape cannot be represented in f64.
     pub fn new(a: &PlanarParams) -> Result<Self, RodError> {
         check_params(a)?;
-        let closed = Closed::new(a[0], a[1], a[2]).ok_or_else(overflow)?;
-        let [x, y, th] = closed.pose(1.0);
-        let tip = PlanarPose::new(x, y, th);
+        let closed = if series_first(a) {
+            None
+        } else {
+            Some(Closed::new(a[0], a[1], a[2]).ok_or_else(overflow)?)
+        };
+        let (case, backend) = match closed {
+            Some(c) if !c.needs_reference() => (c.case, Backend::Closed(c)),
+            Some(c) => (c.case, Backend::Series(series_f64(a, true)?)),
+            None => (
+                case_without_closed(a),
+                Backend::Series(series_f64(a, true)?),
+            ),
+        };
+        let tip = match &backend {
+            Backend::Closed(c) => c.pose(1.0),
+            Backend::Series(_) if closed.is_some() => {
+                ill_conditioned_tip(a).map(|(p, _, _)| [p.x, p.y, p.theta])?
+            }
+            Backend::Series(r) => r.tip(),
+        };
+        let tip = PlanarPose::new(tip[0], tip[1], tip[2]);
         if !tip.is_finite() {
             return Err(overflow());
         }
-        Ok(Self { a: *a, closed, tip })
+        Ok(Self {
+            a: *a,
+            case,
+            backend,
+            tip,
+        })
     }
 
     /// The parameters a = μ(0) this rod was built from.
@@ -104,17 +221,22 @@ impl PlanarRod {
         self.a
     }
 
-    /// Which closed form applies (FINDINGS §2 table and degenerate inputs).
+    /// Which closed form applies to a (FINDINGS §2 table and degenerate inputs), whichever
+    /// formulation evaluates it.
     pub fn case(&self) -> Case {
-        self.closed.case
+        self.case
     }
 
     /// Pose q(t) = (x, y, θ)(t), θ unwrapped (FINDINGS §1: x = (a4 I4 + a5 I5)/F²,
-    /// y = (a5 I4 − a4 I5)/F², with the integrals of §3). Intended for t ∈ [0, 1]; the
-    /// formulas are evaluated as they are for other t (NaN t gives a NaN pose).
+    /// y = (a5 I4 − a4 I5)/F², with the integrals of §3; or the Taylor series). Intended for
+    /// t ∈ [0, 1] (the series clamps t to it); NaN t gives a NaN pose.
     pub fn pose(&self, t: f64) -> PlanarPose {
-        let [x, y, th] = self.closed.pose(t);
-        PlanarPose::new(x, y, th)
+        let p = match &self.backend {
+            Backend::Closed(c) => c.pose(t),
+            Backend::Series(r) if t.is_nan() => [t; 3],
+            Backend::Series(r) => r.pose(t.clamp(0.0, 1.0)).unwrap_or([f64::NAN; 3]),
+        };
+        PlanarPose::new(p[0], p[1], p[2])
     }
 
     /// Tip pose q(1) (computed once by [`PlanarRod::new`]).
@@ -124,7 +246,10 @@ impl PlanarRod {
 
     /// Curvature κ(t) = μ3(t) (FINDINGS §2 table: ε√α3 cn Γ, ε√α3 dn Γ or ε√α3 sech Γ).
     pub fn curvature(&self, t: f64) -> f64 {
-        self.closed.curvature(t)
+        match &self.backend {
+            Backend::Closed(c) => c.curvature(t),
+            Backend::Series(r) => r.curvature(t.clamp(0.0, 1.0)).unwrap_or(f64::NAN),
+        }
     }
 
     /// `samples` poses at t_i = i/(samples − 1) (one Jacobi evaluation each). `samples = 1`
@@ -152,8 +277,11 @@ impl PlanarRod {
     /// Elastic energy ½∫₀¹κ² = λ2/2 − a4 x(1) − a5 y(1), λ2 = a3² + 2a4 (FINDINGS §1).
     /// May be +∞ when a3² overflows (the free function [`energy`] reports that as an error).
     pub fn energy(&self) -> f64 {
-        let tip = self.tip();
-        energy_from_tip(&self.a, &tip)
+        match &self.backend {
+            Backend::Closed(_) => energy_from_tip(&self.a, &self.tip),
+            // ½∫κ² integrated along: the identity cancels for a nearly straight rod under force.
+            Backend::Series(r) => r.energy(),
+        }
     }
 }
 
@@ -166,8 +294,16 @@ fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
 pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
     // Same checks as `PlanarRod::new`, without building (and copying) the rod.
     check_params(a)?;
-    let closed = Closed::<f64>::new(a[0], a[1], a[2]).ok_or_else(overflow)?;
-    let [x, y, th] = closed.pose(1.0);
+    let [x, y, th] = if series_first(a) {
+        series_f64(a, false)?.tip()
+    } else {
+        let closed = Closed::<f64>::new(a[0], a[1], a[2]).ok_or_else(overflow)?;
+        if closed.needs_reference() {
+            ill_conditioned_tip(a).map(|(p, _, _)| [p.x, p.y, p.theta])?
+        } else {
+            closed.pose(1.0)
+        }
+    };
     let tip = PlanarPose::new(x, y, th);
     if !tip.is_finite() {
         return Err(overflow());
@@ -186,6 +322,10 @@ pub fn pose_and_jacobian(
     t: f64,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     RodError::check_finite("t", &[t])?;
+    check_params(a)?;
+    if series_first(a) {
+        return series_pose_and_jac(a, t);
+    }
     with_seeded(a, |c| pose_and_jac_of(c, a, t))
 }
 
@@ -202,6 +342,10 @@ pub fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian)
 /// over t ≥ 0.05 of det J(t)/(t⁹(a3²/8640 + a5²t²/33600)). The straight rod (a3 = a5 = 0) has
 /// det J ≡ 0: unstable, margin 0.
 pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
+    check_params(a)?;
+    if series_first(a) {
+        return stability::stability_of_series(a, None, None, false);
+    }
     with_seeded(a, |c| stability::stability_of(c, a))
 }
 
@@ -228,9 +372,37 @@ pub struct Evaluation {
     pub stability: StabilityReport,
 }
 
+/// [`evaluate`] on the Taylor series (one dense integration serves all four quantities).
+fn evaluate_series(a: &PlanarParams) -> Result<Evaluation, RodError> {
+    let rod = series_dual(a, true)?;
+    let (tip, jacobian) = pose_jac_from(rod.tip())?;
+    let energy = rod.energy().v;
+    let stability = stability::stability_of_series(a, Some(&rod), None, false)?;
+    Ok(Evaluation {
+        tip,
+        jacobian,
+        energy,
+        stability,
+    })
+}
+
 /// Tip, J(1, a), energy and stability in one call (one precomputation shared by all).
 pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
+    check_params(a)?;
+    if series_first(a) {
+        return evaluate_series(a);
+    }
     with_seeded(a, |c| {
+        if c.needs_reference() {
+            let (tip, jacobian, energy) = ill_conditioned_tip(a)?;
+            let stability = stability::stability_of(c, a)?;
+            return Ok(Evaluation {
+                tip,
+                jacobian,
+                energy,
+                stability,
+            });
+        }
         let (tip, jacobian) = pose_and_jac_of(c, a, 1.0)?;
         let energy = energy_from_tip(a, &tip);
         if !energy.is_finite() {

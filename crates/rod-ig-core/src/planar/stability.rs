@@ -1,6 +1,7 @@
 //! Fast stability test on the closed form (FINDINGS §5).
 
 use super::closed::{Case, Closed};
+use super::taylor::{Gradient, TaylorRod};
 use crate::scalar::Dual3;
 use crate::{PlanarParams, RodError, StabilityReport};
 
@@ -9,33 +10,171 @@ use crate::{PlanarParams, RodError, StabilityReport};
 const T_MIN: f64 = 0.02;
 /// Smallest t entering the margin `det_min` (FINDINGS §5).
 const T_MARGIN: f64 = 0.05;
+/// First t of the scan on the Taylor series. Its J entries are accurate relative to
+/// themselves, so det J ≈ t⁹·(…) is resolved down to small t (the cofactor terms are O(t⁸) and
+/// cancel to O(t⁹): a 1/t loss, 100× here).
+const SERIES_T_MIN: f64 = 0.01;
+/// Scan spacing on the series for a rod with no wavelength below it (gently bent rods: g is a
+/// smooth function of t, and local minima are refined by parabolic steps).
+const SERIES_SPACING: f64 = 0.05;
+/// Relative accuracy of the Taylor series' J entries (truncation below one unit roundoff plus
+/// the rounding of ≲ 33 terms of products: measured ≤ 2e-15 against the reference, ×5).
+const SERIES_ENTRY_REL: f64 = 1e-14;
+/// Below this bending scale max(|a3|, |a5|), g(t) is evaluated on the ray (a3, a5)·λ with
+/// λ = SIGMA_RAY/σ: g depends on (a3, a5) only through their ratio up to O(σ²) (the map is odd
+/// in (a3, a5)), so the substitution is exact in f64, and it keeps det J ∝ σ² clear of
+/// underflow.
+const SIGMA_RAY: f64 = 1e-60;
 
-/// det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (FINDINGS §5), from the dual-number closed form.
-fn normalised_det(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64) -> f64 {
-    let [x, y, th] = c.pose(t);
-    let (r0, r1, r2) = (x.g, y.g, th.g);
-    let det = r0[0] * (r1[1] * r2[2] - r1[2] * r2[1]) - r0[1] * (r1[0] * r2[2] - r1[2] * r2[0])
-        + r0[2] * (r1[0] * r2[1] - r1[1] * r2[0]);
-    let t2 = t * t;
-    let t9 = t2 * t2 * t2 * t2 * t;
-    det / (t9 * (a3 * a3 / 8640.0 + a5 * a5 * t2 / 33600.0))
+/// Absolute error floor of the closed form's J entries: they are differences of O(1) internal
+/// quantities, so an entry that is itself tiny (∂x/∂a4 = O(θ²t⁵) on a nearly straight rod)
+/// carries an absolute error of a few ulps of 1 (observed 2.3e-16 at t = 0.05 on a rod with
+/// a = (1.4e-5, 10.4, −8.2e-3); ×64 allowance).
+const CLOSED_J_ABS: f64 = 64.0 * f64::EPSILON;
+
+/// det J and a first-order bound on its error: Σ e_ij |C_ij| over the entries' errors
+/// e_ij = rel·|J_ij| + abs and the cofactors C_ij, plus the rounding of the expansion.
+fn det_and_error(j: &[[f64; 3]; 3], rel: f64, abs: f64) -> (f64, f64) {
+    let m0 = j[1][1] * j[2][2] - j[1][2] * j[2][1];
+    let m1 = j[1][0] * j[2][2] - j[1][2] * j[2][0];
+    let m2 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
+    let det = j[0][0] * m0 - j[0][1] * m1 + j[0][2] * m2;
+    let mut err = 0.0;
+    let mut size = 0.0;
+    for r in 0..3 {
+        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+        for c in 0..3 {
+            let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
+            let cof = (j[r1][c1] * j[r2][c2]).abs() + (j[r1][c2] * j[r2][c1]).abs();
+            err += (rel * j[r][c].abs() + abs) * cof;
+            if r == 0 {
+                size += j[r][c].abs() * cof;
+            }
+        }
+    }
+    (det, err + 8.0 * f64::EPSILON * size)
 }
 
-/// Scan of g(t) = normalised det on [T_MIN, 1] with spacing ≈ wavelength/4, regula falsi on
-/// the first sign change and parabolic refinement of local minima for the margin.
+/// The FINDINGS §5 normalisation t⁹ (a3²/8640 + a5² t²/33600).
+fn normalisation(a3: f64, a5: f64, t: f64) -> f64 {
+    let t2 = t * t;
+    let t9 = t2 * t2 * t2 * t2 * t;
+    t9 * (a3 * a3 / 8640.0 + a5 * a5 * t2 / 33600.0)
+}
+
+fn rows(p: &[Dual3; 3]) -> [[f64; 3]; 3] {
+    [p[0].g, p[1].g, p[2].g]
+}
+
+/// g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (FINDINGS §5) and its error bound, from the
+/// dual-number closed form.
+fn normalised_det(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64) -> (f64, f64) {
+    let (det, err) = det_and_error(&rows(&c.pose(t)), c.jacobian_rel_error(), CLOSED_J_ABS);
+    let n = normalisation(a3, a5, t);
+    (det / n, err / n)
+}
+
+/// g(t) and its error bound from the Taylor series, with the x row and the a4 column divided
+/// by σ = max(|a3|, |a5|) (det scales by 1/σ², the normalisation is taken with a/σ): both are
+/// O(σ²) for a nearly straight rod, and the scaled quantities are O(1).
+fn normalised_det_series<T: Gradient>(rod: &TaylorRod<T>, a3: f64, a5: f64, t: f64) -> (f64, f64) {
+    let sigma = a3.abs().max(a5.abs());
+    let Some(p) = rod.pose(t) else {
+        return (f64::NAN, f64::INFINITY);
+    };
+    let mut j = p.map(|v| v.gradient());
+    for v in j[0].iter_mut() {
+        *v /= sigma;
+    }
+    for r in j.iter_mut() {
+        r[1] /= sigma;
+    }
+    let (det, err) = det_and_error(&j, SERIES_ENTRY_REL, 0.0);
+    let n = normalisation(a3 / sigma, a5 / sigma, t);
+    (det / n, err / n)
+}
+
+/// The straight rod a3 = a5 = 0: J's x row vanishes (∂x/∂a ≡ 0: an inextensible straight rod
+/// stays straight to first order), so det J ≡ 0 on (0, 1]. The test "det J > 0 on (0, 1]"
+/// neither passes nor fails: the rod is a singular point of the a-chart, on the boundary of
+/// the reachable set (|tip| = 1). Reported uncertain, margin 0.
+fn straight_report() -> StabilityReport {
+    StabilityReport {
+        stable: false,
+        margin: 0.0,
+        first_conjugate_t: None,
+        uncertain: true,
+    }
+}
+
+/// The verdict from a scan and the error bound of g where the margin was found.
+fn verdict(scan: Scan, g_error: f64) -> StabilityReport {
+    let clear = scan.margin.abs() > g_error;
+    let (stable, uncertain) = match scan.first {
+        None => (clear, !clear),
+        Some(_) => (false, !clear),
+    };
+    StabilityReport {
+        stable,
+        margin: scan.margin,
+        first_conjugate_t: if uncertain { None } else { scan.first },
+        uncertain,
+    }
+}
+
+/// Stability on the Taylor series of near-relaxed rods (`rod`, when given, is their dense
+/// dual-number series), or, with `precise`, on the double-double series of the rods where the
+/// closed form's error estimate fails. `wavelength` bounds the scan spacing.
+pub(crate) fn stability_of_series(
+    a: &PlanarParams,
+    rod: Option<&TaylorRod<Dual3>>,
+    wavelength: Option<f64>,
+    precise: bool,
+) -> Result<StabilityReport, RodError> {
+    let (mut a3, a4, mut a5) = (a[0], a[1], a[2]);
+    let sigma = a3.abs().max(a5.abs());
+    if sigma == 0.0 {
+        return Ok(straight_report());
+    }
+    let on_ray = sigma < SIGMA_RAY;
+    if on_ray {
+        let l = SIGMA_RAY / sigma;
+        a3 *= l;
+        a5 *= l;
+    }
+    let b = PlanarParams::new(a3, a4, a5);
+    let spacing = wavelength.map_or(SERIES_SPACING, |w| (0.25 * w).clamp(1e-3, SERIES_SPACING));
+    if precise {
+        return scan_series(&super::series_dd(&b, true)?, a3, a5, spacing);
+    }
+    match rod {
+        Some(r) if !on_ray => scan_series(r, a3, a5, spacing),
+        _ => scan_series(&super::series_dual(&b, true)?, a3, a5, spacing),
+    }
+}
+
+fn scan_series<T: Gradient>(
+    rod: &TaylorRod<T>,
+    a3: f64,
+    a5: f64,
+    spacing: f64,
+) -> Result<StabilityReport, RodError> {
+    let g = |t: f64| normalised_det_series(rod, a3, a5, t);
+    let s = scan(&|t| g(t).0, SERIES_T_MIN, spacing, a3, a5)?;
+    Ok(verdict(s, g(s.t_margin).1))
+}
+
+/// Stability on the closed form (FINDINGS §5), with the series where the closed form's own
+/// error estimate fails.
 pub(crate) fn stability_of(
     c: &Closed<Dual3>,
     a: &PlanarParams,
 ) -> Result<StabilityReport, RodError> {
     if c.case == Case::Straight {
-        return Ok(StabilityReport {
-            stable: false,
-            margin: 0.0,
-            first_conjugate_t: None,
-        });
+        return Ok(straight_report());
     }
     if c.needs_reference() {
-        return crate::ode::planar_reference::stability(a);
+        return stability_of_series(a, None, Some(c.wavelength()), true);
     }
     let (a3, a5) = (a[0], a[2]);
     let g = |t: f64| normalised_det(c, a3, a5, t);
@@ -43,11 +182,41 @@ pub(crate) fn stability_of(
     // No conjugate point comes before a fraction of the half-wavelength, and there the
     // closed-form det J (≈ t⁹) is swamped by rounding: start the scan at t0.
     let t0 = (0.1 * wl).clamp(T_MIN, T_MARGIN);
-    let h_target = (0.25 * wl).clamp(0.01, 0.1);
+    let s = scan(&|t| g(t).0, t0, (0.25 * wl).clamp(0.01, 0.1), a3, a5)?;
+    let report = verdict(s, g(s.t_margin).1);
+    if report.uncertain {
+        // The closed form cannot decide: its error bound covers the margin. The series'
+        // entries are accurate relative to themselves; ask it.
+        return stability_of_series(a, None, Some(wl), false);
+    }
+    Ok(report)
+}
+
+/// What a scan of g found.
+#[derive(Clone, Copy, Debug)]
+struct Scan {
+    /// First sign change (det ≤ 0).
+    first: Option<f64>,
+    /// min g over t ≥ T_MARGIN (or the negative value at a sign change below it).
+    margin: f64,
+    /// Where the margin was found.
+    t_margin: f64,
+}
+
+/// Scan of g on [t0, 1] with spacing ≈ `h_target`, regula falsi on the first sign change and
+/// parabolic refinement of local minima for the margin.
+fn scan(
+    g: &impl Fn(f64) -> f64,
+    t0: f64,
+    h_target: f64,
+    a3: f64,
+    a5: f64,
+) -> Result<Scan, RodError> {
     let n = ((1.0 - t0) / h_target).ceil().max(1.0) as usize;
+    let n = n.min(MAX_SAMPLES - 4);
     let h = (1.0 - t0) / n as f64;
-    let mut ts = [0.0f64; 112];
-    let mut gs = [0.0f64; 112];
+    let mut ts = [0.0f64; MAX_SAMPLES];
+    let mut gs = [0.0f64; MAX_SAMPLES];
     let mut np = n + 1;
     for (i, t) in ts.iter_mut().enumerate().take(np) {
         *t = if i == n { 1.0 } else { t0 + i as f64 * h };
@@ -82,22 +251,26 @@ pub(crate) fn stability_of(
     // First sign change (det ≤ 0).
     let mut first: Option<f64> = None;
     let mut neg_value = f64::INFINITY;
+    let mut neg_t = 1.0;
     for i in 0..np {
         if gs[i] <= 0.0 {
             neg_value = gs[i];
+            neg_t = ts[i];
             first = Some(if i == 0 {
                 ts[0]
             } else {
-                regula_falsi(&g, ts[i - 1], gs[i - 1], ts[i], gs[i])
+                regula_falsi(g, ts[i - 1], gs[i - 1], ts[i], gs[i])
             });
             break;
         }
     }
     // Margin: min over t ≥ T_MARGIN, with local minima refined by parabolic steps.
     let mut margin = f64::INFINITY;
+    let mut t_margin = 1.0;
     for i in 0..np {
-        if ts[i] >= T_MARGIN {
-            margin = margin.min(gs[i]);
+        if ts[i] >= T_MARGIN && gs[i] < margin {
+            margin = gs[i];
+            t_margin = ts[i];
         }
     }
     // Refine the coarse minima that matter: those low enough to hide a dip below zero or to
@@ -110,34 +283,43 @@ pub(crate) fn stability_of(
     };
     for i in 1..np.saturating_sub(1) {
         if gs[i] <= gs[i - 1] && gs[i] <= gs[i + 1] && ts[i + 1] >= T_MARGIN && gs[i] <= cutoff {
-            let (tm, gm) = refine_min(&g, ts[i - 1], ts[i], ts[i + 1], gs[i - 1], gs[i], gs[i + 1]);
+            let (tm, gm) = refine_min(g, ts[i - 1], ts[i], ts[i + 1], gs[i - 1], gs[i], gs[i + 1]);
             if tm >= T_MARGIN {
-                margin = margin.min(gm);
+                if gm < margin {
+                    margin = gm;
+                    t_margin = tm;
+                }
                 if first.is_none() && gm <= 0.0 {
                     // A dip below zero between two coarse samples.
                     let tc = if gs[i - 1] > 0.0 {
-                        regula_falsi(&g, ts[i - 1], gs[i - 1], tm, gm)
+                        regula_falsi(g, ts[i - 1], gs[i - 1], tm, gm)
                     } else {
                         tm
                     };
                     first = Some(tc);
                     neg_value = gm;
+                    neg_t = tm;
                 }
             }
         }
     }
     if first.is_some() && margin >= 0.0 {
+        // The sign change lies below T_MARGIN: report the negative value seen there.
         margin = neg_value.min(0.0);
+        t_margin = neg_t;
     }
     if !margin.is_finite() {
         margin = 0.0;
     }
-    Ok(StabilityReport {
-        stable: first.is_none(),
+    Ok(Scan {
+        first,
         margin,
-        first_conjugate_t: first,
+        t_margin,
     })
 }
+
+/// Sample budget of one scan (coarse grid plus three samples around t*).
+const MAX_SAMPLES: usize = 112;
 
 /// Illinois regula falsi for the root of g in (t0, t1) with g(t0) > 0 ≥ g(t1).
 fn regula_falsi(g: &impl Fn(f64) -> f64, t0: f64, g0: f64, t1: f64, g1: f64) -> f64 {

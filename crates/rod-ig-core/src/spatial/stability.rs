@@ -314,6 +314,7 @@ impl Scan {
             } else {
                 0.0
             },
+            uncertain: false,
             first_conjugate_t: self.failed,
         }
     }
@@ -323,6 +324,8 @@ fn straight_report() -> StabilityReport {
     StabilityReport {
         stable: false,
         margin: 0.0,
+        // det J ≡ 0 for the straight rod: the test can neither pass nor fail.
+        uncertain: true,
         first_conjugate_t: None,
     }
 }
