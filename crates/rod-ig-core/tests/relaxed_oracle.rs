@@ -47,20 +47,18 @@ struct Stats {
     errors: Vec<String>,
 }
 
-/// High-precision tips (mpmath, 40 digits; scripts/gen_relaxed_truth.py) for the strong-axial
-/// block, keyed by line: there the oracle's own f64 integration is off by up to 1e-5 (rounding
-/// made during the loop grows like e^{√a4 (1 − t)}), so tips are checked against these.
-fn truth() -> std::collections::HashMap<usize, [f64; 3]> {
+/// High-precision references (mpmath, 40 digits; scripts/gen_relaxed_truth.py) for the
+/// strong-axial block, keyed by line: there the oracle's own f64 integration is off by up to
+/// 1e-5 in the tip and 100 % in J (rounding made during the loop grows like e^{√a4 (1 − t)}).
+/// Every line has a tip; the lines where we disagree with the oracle's J, energy or verdict
+/// also have those fields, which then replace the oracle's.
+fn truth() -> std::collections::HashMap<usize, serde_json::Value> {
     let text = include_str!("data/relaxed_truth.jsonl");
     text.lines()
         .filter(|l| !l.trim().is_empty())
         .map(|l| {
             let v: serde_json::Value = serde_json::from_str(l).expect("truth line");
-            let t = arr(&v["tip"]);
-            (
-                v["line"].as_u64().expect("line") as usize,
-                [t[0], t[1], t[2]],
-            )
+            (v["line"].as_u64().expect("line") as usize, v)
         })
         .collect()
 }
@@ -77,10 +75,17 @@ fn relaxed_families_match_the_oracle() {
     for (name, lo, hi) in BLOCKS {
         let mut s = Stats::default();
         for (i, line) in lines.iter().enumerate().take(hi).skip(lo) {
-            let v: serde_json::Value = serde_json::from_str(line).expect("json line");
+            let mut v: serde_json::Value = serde_json::from_str(line).expect("json line");
+            if let Some(t) = truth.get(&i) {
+                for key in ["tip", "jac", "energy", "det_min", "stable"] {
+                    if !t[key].is_null() {
+                        v[key] = t[key].clone();
+                    }
+                }
+            }
             let a = arr(&v["a"]);
             let a = PlanarParams::new(a[0], a[1], a[2]);
-            let tip_o = truth.get(&i).map_or_else(|| arr(&v["tip"]), |t| t.to_vec()); // θ, x, y
+            let tip_o = arr(&v["tip"]); // θ, x, y
             let jac_o: Vec<Vec<f64>> = v["jac"].as_array().expect("jac").iter().map(arr).collect();
             let jo = PlanarJacobian::from_fn(|r, c| jac_o[(r + 1) % 3][c]);
             let ev = match planar::evaluate(&a) {
@@ -149,7 +154,7 @@ fn relaxed_families_match_the_oracle() {
             s.uncertain_clear,
             s.errors.len()
         );
-        for m in s.wrong_verdicts.iter().chain(&s.errors).take(60) {
+        for m in s.wrong_verdicts.iter().chain(&s.errors).take(12) {
             eprintln!("    {m}");
         }
         failed |= s.tip > 1e-9

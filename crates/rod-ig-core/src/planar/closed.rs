@@ -214,6 +214,17 @@ const REFERENCE_MAX_SCALE: f64 = 1e6;
 /// Case III: the first-order δ terms grow like e^|Γ|; beyond this |Γ| they cancel badly.
 const SEPARATRIX_GAMMA: f64 = 8.0;
 
+/// How the closed form must be replaced where its error estimate fails.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum SeriesNeed {
+    /// The closed form is accurate.
+    None,
+    /// Cancellation in the closed form only: the f64 series is accurate.
+    Cancellation,
+    /// Near the separatrix: exponential growth of rounding; double-double series.
+    IllConditioned,
+}
+
 /// Relative accuracy of the closed form's J entries away from its thin regimes (oracle agreement
 /// 8.2e-11 relative over 2000 box cases, rounded up).
 pub(crate) const CLOSED_J_REL: f64 = 1e-10;
@@ -242,6 +253,24 @@ impl<T: Real> Closed<T> {
     /// stability test from the ODE reference (FINDINGS §4: "fall back to an ODE"), unless
     /// max(a3², |a4|, |a5|) > 1e6.
     pub fn needs_reference(&self) -> bool {
+        self.needs_series() != SeriesNeed::None
+    }
+
+    /// Why (and how) the closed form must be replaced by the series: near the separatrix the
+    /// rod lingers by the hyperbolic straight equilibrium, where rounding grows exponentially
+    /// (ill-conditioned: double-double series); at small m the loss is plain cancellation in the
+    /// closed form (f64 series).
+    pub fn needs_series(&self) -> SeriesNeed {
+        if !self.needs_reference_by_estimate() {
+            SeriesNeed::None
+        } else if self.case == Case::III || self.m1 < SEPARATRIX_M1 {
+            SeriesNeed::IllConditioned
+        } else {
+            SeriesNeed::Cancellation
+        }
+    }
+
+    fn needs_reference_by_estimate(&self) -> bool {
         let (a3, a4, a5) = (self.a3.re(), self.a4.re(), self.a5.re());
         if (a3 * a3).max(a4.abs()).max(a5.abs()) > REFERENCE_MAX_SCALE {
             // the ODE would need too many steps; keep the closed form's J

@@ -18,7 +18,7 @@ mod stability;
 mod taylor;
 
 pub use closed::Case;
-use closed::Closed;
+use closed::{Closed, SeriesNeed};
 
 use crate::scalar::Dual3;
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
@@ -31,9 +31,13 @@ use taylor::{DualF64x2, Gradient, TaylorRod};
 /// answer (cancellation). Above it, the closed form is used unless its own a-priori error
 /// estimate (`Closed::needs_reference`) says it loses accuracy.
 const SERIES_RHO: f64 = 2.0;
-/// Step budget of the Taylor series (bounded time: ≈ 3 µs per step in dual numbers; a rod that
-/// needs more steps than this is beyond what the fallback resolves quickly).
+/// Step budget of the f64 Taylor series (bounded time: ≈ 3 µs per step in dual numbers, so
+/// ≲ 6 ms; a rod that needs more steps is beyond what the fallback resolves quickly).
 const SERIES_MAX_STEPS: usize = 2_000;
+/// Step budget of the double-double series (≈ 30–60 µs per step in dual numbers: ≲ 40 ms).
+const SERIES_DD_MAX_STEPS: usize = 800;
+/// ln(f64::MAX): under tension F the rod's J grows like e^{√F t}; beyond this √F it overflows.
+const LN_F64_MAX: f64 = 709.7;
 
 /// ρ = max(|a3|, √‖(a4, a5)‖): the rod's curvature scale (its Taylor terms grow like ρᵏ/k!).
 fn curvature_scale(a: &PlanarParams) -> f64 {
@@ -59,17 +63,27 @@ fn series_dual(a: &PlanarParams, dense: bool) -> Result<TaylorRod<Dual3>, RodErr
     )
 }
 
+fn overflow_force() -> RodError {
+    RodError::Overflow(format!(
+        "planar rod: under this force J(t, a) grows like e^(sqrt|F| t) and exceeds f64 \
+         (sqrt|F| > {LN_F64_MAX})"
+    ))
+}
+
 /// The dense series in double-double dual numbers, for rods where the closed form's error
 /// estimate fails. Those are the ill-conditioned ones (strong axial force: rounding made while
 /// the rod loops grows like e^{√F (1 − t)} while it then sits near the unstable straight
 /// equilibrium; an f64 integration, the oracle's included, is off by up to 1e-5 there, see
 /// tests/relaxed_oracle.rs), so they are integrated with a 106-bit significand.
 fn series_dd(a: &PlanarParams, dense: bool) -> Result<TaylorRod<DualF64x2>, RodError> {
+    if a[1].hypot(a[2]).sqrt() > LN_F64_MAX {
+        return Err(overflow_force());
+    }
     TaylorRod::new(
         DualF64x2::variable(a[0], 0),
         DualF64x2::variable(a[1], 1),
         DualF64x2::variable(a[2], 2),
-        SERIES_MAX_STEPS,
+        SERIES_DD_MAX_STEPS,
         dense,
     )
 }
@@ -134,14 +148,17 @@ fn pose_and_jac_of(
     a: &PlanarParams,
     t: f64,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-    if c.needs_reference() {
+    match c.needs_series() {
         // FINDINGS §4: where the closed form's error estimate fails, the Taylor series gives
         // the pose and J (both: near the separatrix the closed-form pose drifts too).
-        if t >= 1.0 {
+        SeriesNeed::IllConditioned if t >= 1.0 => {
             let (p, j, _) = ill_conditioned_tip(a)?;
             return Ok((p, j));
         }
-        return series_pose_and_jac(a, t);
+        SeriesNeed::IllConditioned | SeriesNeed::Cancellation => {
+            return series_pose_and_jac(a, t)
+        }
+        SeriesNeed::None => {}
     }
     pose_jac_from(c.pose(t))
 }
@@ -298,10 +315,12 @@ pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
         series_f64(a, false)?.tip()
     } else {
         let closed = Closed::<f64>::new(a[0], a[1], a[2]).ok_or_else(overflow)?;
-        if closed.needs_reference() {
-            ill_conditioned_tip(a).map(|(p, _, _)| [p.x, p.y, p.theta])?
-        } else {
-            closed.pose(1.0)
+        match closed.needs_series() {
+            SeriesNeed::IllConditioned => {
+                ill_conditioned_tip(a).map(|(p, _, _)| [p.x, p.y, p.theta])?
+            }
+            SeriesNeed::Cancellation => series_f64(a, false)?.tip(),
+            SeriesNeed::None => closed.pose(1.0),
         }
     };
     let tip = PlanarPose::new(x, y, th);
@@ -393,7 +412,10 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
         return evaluate_series(a);
     }
     with_seeded(a, |c| {
-        if c.needs_reference() {
+        if c.needs_series() == SeriesNeed::Cancellation {
+            return evaluate_series(a);
+        }
+        if c.needs_series() == SeriesNeed::IllConditioned {
             let (tip, jacobian, energy) = ill_conditioned_tip(a)?;
             let stability = stability::stability_of(c, a)?;
             return Ok(Evaluation {

@@ -1,6 +1,6 @@
 //! Fast stability test on the closed form (FINDINGS §5).
 
-use super::closed::{Case, Closed};
+use super::closed::{Case, Closed, SeriesNeed};
 use super::taylor::{Gradient, TaylorRod};
 use crate::scalar::Dual3;
 use crate::{PlanarParams, RodError, StabilityReport};
@@ -173,8 +173,14 @@ pub(crate) fn stability_of(
     if c.case == Case::Straight {
         return Ok(straight_report());
     }
-    if c.needs_reference() {
-        return stability_of_series(a, None, Some(c.wavelength()), true);
+    match c.needs_series() {
+        SeriesNeed::IllConditioned => {
+            return stability_of_series(a, None, Some(c.wavelength()), true)
+        }
+        SeriesNeed::Cancellation => {
+            return stability_of_series(a, None, Some(c.wavelength()), false)
+        }
+        SeriesNeed::None => {}
     }
     let (a3, a5) = (a[0], a[2]);
     let g = |t: f64| normalised_det(c, a3, a5, t);
