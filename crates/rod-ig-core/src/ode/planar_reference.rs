@@ -134,6 +134,24 @@ pub fn tip_and_jacobian(
     pose_and_jacobian(a, 1.0, rtol)
 }
 
+/// Tip pose q(1) and J(1, a) with a pure relative tolerance (atol = 1e-300), as the oracle's
+/// reference integration (shared/oracle/README.md): tiny a give tiny entries of J (O(|a|²)),
+/// which an absolute tolerance would not resolve.
+pub fn tip_and_jacobian_relative(
+    a: &PlanarParams,
+    rtol: f64,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    check_params(a)?;
+    let mut opts = options(rtol)?;
+    opts.atol = PURE_RELATIVE_ATOL;
+    let (s, _) = solve(|_, s, ds| var_rhs(s, ds), 0.0, initial_var(a), 1.0, &opts)?;
+    finite_or_overflow(&s)?;
+    Ok((pose_of(&s), jac_of(&s)))
+}
+
+/// Absolute tolerance of the pure-relative integrations (the smallest normal f64 order).
+const PURE_RELATIVE_ATOL: f64 = 1e-300;
+
 /// Pose q(t) and J(t, a) for t ∈ [0, 1], by DOP853 at relative tolerance `rtol`.
 pub fn pose_and_jacobian(
     a: &PlanarParams,

@@ -36,6 +36,9 @@ const SERIES_RHO: f64 = 2.0;
 const SERIES_MAX_STEPS: usize = 2_000;
 /// Step budget of the double-double series (≈ 30–60 µs per step in dual numbers: ≲ 40 ms).
 const SERIES_DD_MAX_STEPS: usize = 800;
+/// Largest √‖F‖ for which the double-double series runs (the steps scale like √‖F‖: ≈ 20 ms at
+/// √‖F‖ = 100, the top of issue 9's strong-force family a4 ≤ 1e4).
+const SERIES_DD_MAX_ROOT_F: f64 = 120.0;
 /// ln(f64::MAX): under tension F the rod's J grows like e^{√F t}; beyond this √F it overflows.
 const LN_F64_MAX: f64 = 709.7;
 
@@ -76,8 +79,17 @@ fn overflow_force() -> RodError {
 /// equilibrium; an f64 integration, the oracle's included, is off by up to 1e-5 there, see
 /// tests/relaxed_oracle.rs), so they are integrated with a 106-bit significand.
 fn series_dd(a: &PlanarParams, dense: bool) -> Result<TaylorRod<DualF64x2>, RodError> {
-    if a[1].hypot(a[2]).sqrt() > LN_F64_MAX {
+    let root_f = a[1].hypot(a[2]).sqrt();
+    if root_f > LN_F64_MAX {
         return Err(overflow_force());
+    }
+    if root_f > SERIES_DD_MAX_ROOT_F {
+        return Err(RodError::OutOfDomain(format!(
+            "planar rod near its straight equilibrium under a force of {:.3e}: rounding grows \
+             like e^(sqrt|F|) and the answer cannot be certified to 1e-9 in bounded time \
+             (supported: sqrt|F| <= {SERIES_DD_MAX_ROOT_F})",
+            root_f * root_f
+        )));
     }
     TaylorRod::new(
         DualF64x2::variable(a[0], 0),
@@ -130,6 +142,7 @@ fn overflow() -> RodError {
 fn with_seeded<R>(
     a: &PlanarParams,
     f: impl FnOnce(&Closed<Dual3>) -> Result<R, RodError>,
+    series: impl FnOnce() -> Result<R, RodError>,
 ) -> Result<R, RodError> {
     check_params(a)?;
     let closed = Closed::new(
@@ -139,7 +152,9 @@ fn with_seeded<R>(
     );
     match &closed {
         Some(c) => f(c),
-        None => Err(overflow()),
+        // The closed form's intermediate ratios overflowed (e.g. a tiny moment against a
+        // moderate force): the series has its own overflow detection.
+        None => series(),
     }
 }
 
@@ -155,9 +170,7 @@ fn pose_and_jac_of(
             let (p, j, _) = ill_conditioned_tip(a)?;
             return Ok((p, j));
         }
-        SeriesNeed::IllConditioned | SeriesNeed::Cancellation => {
-            return series_pose_and_jac(a, t)
-        }
+        SeriesNeed::IllConditioned | SeriesNeed::Cancellation => return series_pose_and_jac(a, t),
         SeriesNeed::None => {}
     }
     pose_jac_from(c.pose(t))
@@ -204,7 +217,7 @@ impl PlanarRod {
         let closed = if series_first(a) {
             None
         } else {
-            Some(Closed::new(a[0], a[1], a[2]).ok_or_else(overflow)?)
+            Closed::new(a[0], a[1], a[2])
         };
         let (case, backend) = match closed {
             Some(c) if !c.needs_reference() => (c.case, Backend::Closed(c)),
@@ -307,14 +320,26 @@ fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
     0.5 * a3 * a3 + a4 - a4 * tip.x - a5 * tip.y
 }
 
-/// Tip pose q(1, a) by the closed form (FINDINGS §1–§3).
+fn finite_tip([x, y, th]: [f64; 3]) -> Result<PlanarPose, RodError> {
+    let tip = PlanarPose::new(x, y, th);
+    if tip.is_finite() {
+        Ok(tip)
+    } else {
+        Err(overflow())
+    }
+}
+
+/// Tip pose q(1, a): the closed form (FINDINGS §1–§3), or the Taylor series for nearly
+/// straight, gently bent and tiny rods and wherever the closed form's error estimate fails.
 pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
     // Same checks as `PlanarRod::new`, without building (and copying) the rod.
     check_params(a)?;
     let [x, y, th] = if series_first(a) {
         series_f64(a, false)?.tip()
     } else {
-        let closed = Closed::<f64>::new(a[0], a[1], a[2]).ok_or_else(overflow)?;
+        let Some(closed) = Closed::<f64>::new(a[0], a[1], a[2]) else {
+            return finite_tip(series_f64(a, false)?.tip());
+        };
         match closed.needs_series() {
             SeriesNeed::IllConditioned => {
                 ill_conditioned_tip(a).map(|(p, _, _)| [p.x, p.y, p.theta])?
@@ -345,7 +370,11 @@ pub fn pose_and_jacobian(
     if series_first(a) {
         return series_pose_and_jac(a, t);
     }
-    with_seeded(a, |c| pose_and_jac_of(c, a, t))
+    with_seeded(
+        a,
+        |c| pose_and_jac_of(c, a, t),
+        || series_pose_and_jac(a, t),
+    )
 }
 
 /// Tip pose q(1, a) and J(1, a) (see [`pose_and_jacobian`]).
@@ -365,7 +394,11 @@ pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
     if series_first(a) {
         return stability::stability_of_series(a, None, None, false);
     }
-    with_seeded(a, |c| stability::stability_of(c, a))
+    with_seeded(
+        a,
+        |c| stability::stability_of(c, a),
+        || stability::stability_of_series(a, None, None, false),
+    )
 }
 
 /// Elastic energy ½∫₀¹κ² (FINDINGS §1 identity λ2/2 − a4 x(1) − a5 y(1)).
@@ -411,31 +444,35 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
     if series_first(a) {
         return evaluate_series(a);
     }
-    with_seeded(a, |c| {
-        if c.needs_series() == SeriesNeed::Cancellation {
-            return evaluate_series(a);
-        }
-        if c.needs_series() == SeriesNeed::IllConditioned {
-            let (tip, jacobian, energy) = ill_conditioned_tip(a)?;
+    with_seeded(
+        a,
+        |c| {
+            if c.needs_series() == SeriesNeed::Cancellation {
+                return evaluate_series(a);
+            }
+            if c.needs_series() == SeriesNeed::IllConditioned {
+                let (tip, jacobian, energy) = ill_conditioned_tip(a)?;
+                let stability = stability::stability_of(c, a)?;
+                return Ok(Evaluation {
+                    tip,
+                    jacobian,
+                    energy,
+                    stability,
+                });
+            }
+            let (tip, jacobian) = pose_and_jac_of(c, a, 1.0)?;
+            let energy = energy_from_tip(a, &tip);
+            if !energy.is_finite() {
+                return Err(overflow());
+            }
             let stability = stability::stability_of(c, a)?;
-            return Ok(Evaluation {
+            Ok(Evaluation {
                 tip,
                 jacobian,
                 energy,
                 stability,
-            });
-        }
-        let (tip, jacobian) = pose_and_jac_of(c, a, 1.0)?;
-        let energy = energy_from_tip(a, &tip);
-        if !energy.is_finite() {
-            return Err(overflow());
-        }
-        let stability = stability::stability_of(c, a)?;
-        Ok(Evaluation {
-            tip,
-            jacobian,
-            energy,
-            stability,
-        })
-    })
+            })
+        },
+        || evaluate_series(a),
+    )
 }
