@@ -44,6 +44,18 @@ pub fn to_value<T: Serialize>(answer: &T) -> Result<Value, String> {
     serde_json::to_value(answer).map_err(|e| format!("cannot encode answer: {e}"))
 }
 
+/// A request's `deadline_ms` as a duration: finite and positive (the solver checks the upper
+/// limit and says so).
+pub fn deadline_from_ms(ms: f64) -> Result<std::time::Duration, String> {
+    if ms.is_finite() && ms > 0.0 && ms <= 1e7 {
+        Ok(std::time::Duration::from_secs_f64(ms / 1000.0))
+    } else {
+        Err(format!(
+            "deadline_ms must be a positive number of milliseconds, got {ms}"
+        ))
+    }
+}
+
 /// Checks a Newton step length α ∈ (0, 1] (paper §3.1).
 pub fn check_alpha(alpha: f64) -> Result<f64, String> {
     if alpha.is_finite() && alpha > 0.0 && alpha <= 1.0 {

@@ -3,6 +3,7 @@
 
 mod answer;
 mod bench;
+mod bench_tails;
 mod jsonl;
 mod planar_cmds;
 mod spatial_cmds;
@@ -27,7 +28,7 @@ struct Cli {
 enum Command {
     /// Forward map. Reads JSON lines {"a": [a3, a4, a5]} on stdin; writes one line each:
     /// {"tip": {"x", "y", "theta"}, "jacobian": [[dx/da3, dx/da4, dx/da5], [dy/..], [dθ/..]],
-    /// "stable", "energy", "stability_margin"}. theta is unwrapped (∫κ). A line that cannot be
+    /// "stable", "energy", "stability_margin" (normalised g_min, ≈ 1 for a gently bent rod), "stability_uncertain"}. theta is unwrapped (∫κ). A line that cannot be
     /// parsed or evaluated gets {"error": "why"}; the stream goes on.
     Forward,
     /// Inverse geometry. Reads JSON lines {"target": {"x", "y", "theta"}, "a0"?: [..],
@@ -54,7 +55,7 @@ enum Command {
         /// Target tip pose "x,y,theta": draw every stable solution found for it.
         #[arg(long, allow_hyphen_values = true)]
         target: Option<String>,
-        /// Number of samples from base to tip (≥ 2).
+        /// Number of samples from base to tip (2 to 1000000).
         #[arg(long, default_value_t = 100)]
         samples: usize,
         /// Output format (default: svg when --output ends in .svg, else json).
@@ -84,6 +85,8 @@ enum Command {
 enum BenchPart {
     All,
     Forward,
+    /// Latency tails on the box and the log-scale samples of issue 9.
+    Tails,
     Ig,
     Spatial,
 }
@@ -192,6 +195,9 @@ fn main() -> ExitCode {
         } => {
             if matches!(only, BenchPart::All | BenchPart::Forward) {
                 bench::planar_forward(quick);
+            }
+            if matches!(only, BenchPart::All | BenchPart::Tails) {
+                bench_tails::run(quick);
             }
             if matches!(only, BenchPart::All | BenchPart::Ig) {
                 bench::inverse_geometry(quick, &ig_cases);

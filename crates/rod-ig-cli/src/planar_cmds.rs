@@ -22,7 +22,11 @@ struct ForwardAnswer {
     jacobian: [[f64; 3]; 3],
     stable: bool,
     energy: f64,
+    /// Normalised g_min of FINDINGS §5 (≈ 1 for a gently bent rod).
     stability_margin: f64,
+    /// The margin is within its rounding-error bound: the verdict is undecided (`stable` is
+    /// false then). Always true for the exactly straight rod.
+    stability_uncertain: bool,
 }
 
 fn rows(j: &rod_ig_core::PlanarJacobian) -> [[f64; 3]; 3] {
@@ -40,6 +44,7 @@ pub fn forward_line(line: &str) -> Result<Value, String> {
         stable: e.stability.stable,
         energy: e.energy,
         stability_margin: e.stability.margin,
+        stability_uncertain: e.stability.uncertain,
     })
 }
 
@@ -77,6 +82,8 @@ struct SolveRequest {
     /// When true, also list every distinct stable solution found (`solutions`).
     #[serde(default)]
     all: bool,
+    /// Wall-time budget of the request in ms (default 50, at most 10000).
+    deadline_ms: Option<f64>,
 }
 
 type PlanarAnswer = SolveAnswer<[f64; 3], PlanarPose>;
@@ -115,6 +122,9 @@ fn options(request: &SolveRequest) -> Result<SolveOptions, String> {
             &mut options.tolerance,
         ),
     )?;
+    if let Some(ms) = request.deadline_ms {
+        options.deadline = jsonl::deadline_from_ms(ms)?;
+    }
     if let Some(a0) = request.a0 {
         options.initial_guess = Some(PlanarParams::from(a0));
     }
@@ -128,21 +138,41 @@ fn options(request: &SolveRequest) -> Result<SolveOptions, String> {
 pub fn solve_line(line: &str) -> Result<Value, String> {
     let request: SolveRequest = jsonl::parse(line)?;
     let options = options(&request)?;
-    let mut answer = match ig::solve(&request.target, &options) {
-        Ok(s) => answer_of(&s),
+    let first = ig::solve(&request.target, &options);
+    let mut answer = match &first {
+        Ok(s) => answer_of(s),
         Err(f) => PlanarAnswer::failure(f.iterations, f.residual, f.reason.to_string()),
     };
     if request.all {
-        let all = ig::solve_all(&request.target, &options);
+        let mut all = ig::solve_all(&request.target, &options);
+        if let Ok(s) = &first {
+            // The answer itself is one of the solutions (solve_all's cell search may have
+            // missed the branch the first-found search reached).
+            if !all
+                .iter()
+                .any(|o| (o.a - s.a).norm() <= 1e-6 * (1.0 + s.a.norm()))
+            {
+                all.push(*s);
+            }
+        }
+        if all.is_empty() {
+            answer = PlanarAnswer::failure(0, f64::INFINITY, "no stable solution found".into());
+        }
         answer.solutions = Some(all.iter().map(answer_of).collect());
     }
     jsonl::to_value(&answer)
 }
 
+/// Most samples `shape` draws per rod: 1e6 poses are ≈ 24 MB of f64 and far beyond any screen
+/// or path message; larger requests are a mistake (issue 9: 1e12 aborted, 2⁶⁴ − 1 panicked).
+pub const MAX_SHAPE_SAMPLES: usize = 1_000_000;
+
 /// Samples the rod `a` at `samples` points from the base to the tip.
 pub fn sample_shape(a: [f64; 3], samples: usize) -> Result<Vec<PlanarPose>, String> {
-    if samples < 2 {
-        return Err("at least 2 samples are needed".to_string());
+    if !(2..=MAX_SHAPE_SAMPLES).contains(&samples) {
+        return Err(format!(
+            "--samples must be between 2 and {MAX_SHAPE_SAMPLES}, got {samples}"
+        ));
     }
     let rod = planar::PlanarRod::new(&PlanarParams::from(a)).map_err(|e| e.to_string())?;
     Ok(rod.shape(samples))

@@ -166,6 +166,7 @@ pub fn table1(
                 tolerance,
                 initial_guess: None,
                 objective: Objective::FirstFound,
+                deadline: super::DEFAULT_DEADLINE,
             };
             let (mut ok, mut unst, mut maxit, mut sing, mut nonf) = (0, 0, 0, 0, 0);
             let mut iters = Vec::new();

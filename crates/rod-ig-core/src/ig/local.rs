@@ -43,6 +43,8 @@ pub(crate) enum Stop {
     /// Backtracking found no acceptable step.
     Stalled,
     MaxIterations,
+    /// The solve's deadline passed.
+    Deadline,
 }
 
 const MAX_DA3: f64 = 4.0;
@@ -142,6 +144,10 @@ fn run(
         }
         if out.iterations >= max_iterations {
             out.stop = Stop::MaxIterations;
+            return out;
+        }
+        if super::deadline::expired() {
+            out.stop = Stop::Deadline;
             return out;
         }
         let mut accepted = None;

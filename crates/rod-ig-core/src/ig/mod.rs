@@ -24,6 +24,7 @@
 
 mod atlas;
 pub mod bench;
+mod deadline;
 mod local;
 mod model;
 mod newton;
@@ -74,7 +75,24 @@ pub struct SolveOptions {
     pub initial_guess: Option<PlanarParams>,
     /// Which solution to return.
     pub objective: Objective,
+    /// Wall-time budget of one call ([`DEFAULT_DEADLINE`]; at most [`MAX_DEADLINE`]). Every
+    /// loop of the solvers polls it; a solve that runs out returns [`IgError::Deadline`].
+    pub deadline: std::time::Duration,
 }
+
+/// Default wall-time budget of one solve: 250 ms. The robust solver's p99.9 on the uniform box
+/// is ≈ 2 ms (`rod-ig bench --only tails`); near full extension and under strong axial force an
+/// evaluation costs up to a few ms (the double-double series), and a robust solve there may
+/// need ~100 of them. 250 ms cuts only those and pathological requests.
+pub const DEFAULT_DEADLINE: std::time::Duration = std::time::Duration::from_millis(250);
+/// Largest accepted deadline (10 s): beyond, a request is a mistake, not a budget.
+pub const MAX_DEADLINE: std::time::Duration = std::time::Duration::from_secs(10);
+/// Largest accepted `max_iterations`: the paper's protocol uses 100, the robust solver ≤ 300
+/// per start; 1e5 is far beyond any useful run and bounds the work even without a deadline.
+pub const MAX_ITERATIONS_LIMIT: u32 = 100_000;
+/// Smallest accepted tolerance: positions of the unit rod carry rounding errors of a few 1e-16
+/// (and J-conditioned amplification), so a tolerance below 1e-14 cannot be met reliably.
+pub const MIN_TOLERANCE: f64 = 1e-14;
 
 impl Default for SolveOptions {
     fn default() -> Self {
@@ -85,6 +103,7 @@ impl Default for SolveOptions {
             tolerance: 1e-6,
             initial_guess: None,
             objective: Objective::FirstFound,
+            deadline: DEFAULT_DEADLINE,
         }
     }
 }
@@ -175,6 +194,12 @@ pub enum IgError {
         /// What was non-finite.
         detail: String,
     },
+    /// The solve's deadline ([`SolveOptions::deadline`]) passed before it converged.
+    #[error("deadline reached after {iteration} iterations without convergence")]
+    Deadline {
+        /// Iterations spent.
+        iteration: u32,
+    },
     /// The robust solver found no stable solution from any of its starts.
     #[error("no stable solution found from {starts} starts (target may be outside the stable workspace)")]
     NoStableSolution {
@@ -238,10 +263,22 @@ fn check_options(options: &SolveOptions) -> Result<(), IgError> {
             options.alpha
         )));
     }
-    if !(options.tolerance > 0.0 && options.tolerance.is_finite()) {
+    if !(options.tolerance >= MIN_TOLERANCE && options.tolerance.is_finite()) {
         return Err(IgError::InvalidOptions(format!(
-            "tolerance = {} is not a positive finite number",
+            "tolerance = {:e} is not a finite number >= {MIN_TOLERANCE:e} (rounding bound)",
             options.tolerance
+        )));
+    }
+    if options.max_iterations > MAX_ITERATIONS_LIMIT {
+        return Err(IgError::InvalidOptions(format!(
+            "max_iterations = {} exceeds the limit {MAX_ITERATIONS_LIMIT}",
+            options.max_iterations
+        )));
+    }
+    if options.deadline.is_zero() || options.deadline > MAX_DEADLINE {
+        return Err(IgError::InvalidOptions(format!(
+            "deadline = {:?} is not in (0, {MAX_DEADLINE:?}]",
+            options.deadline
         )));
     }
     if let Some(a0) = options.initial_guess {
@@ -274,6 +311,9 @@ pub fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Fa
     if let Err(e) = check_target(target).and_then(|_| check_options(options)) {
         return stamp(Err(Failure::early(e)));
     }
+    // The atlas is built once per process (≈ 0.5 s): not part of any request's budget.
+    let _ = atlas::get();
+    let _deadline = deadline::scope(options.deadline);
     let r = match (options.method, options.objective) {
         (Method::Newton, _) => {
             let a0 = match options.initial_guess {
@@ -296,7 +336,7 @@ pub fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Fa
         (Method::Robust, Objective::FirstFound) => robust::solve(target, options),
         (Method::Robust, Objective::LeastEnergy) => {
             let all = robust::solve_all(target, options);
-            let iterations = all.iterations;
+            let (iterations, evaluations, starts) = (all.iterations, all.evaluations, all.starts);
             match all
                 .solutions
                 .into_iter()
@@ -304,16 +344,18 @@ pub fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Fa
             {
                 Some(mut s) => {
                     s.iterations = iterations;
-                    s.evaluations = all.evaluations;
-                    s.starts = all.starts;
+                    s.evaluations = evaluations;
+                    s.starts = starts;
                     Ok(s)
                 }
-                None => Err(Failure {
-                    reason: IgError::NoStableSolution { starts: all.starts },
-                    iterations,
-                    residual: f64::INFINITY,
-                    last_a: None,
-                    elapsed_us: 0.0,
+                // The cell of atlas seeds around the target held no converging start: the
+                // first-found strategy (more starts, polishing) still finds one where it
+                // exists, so least energy never fails where the default objective succeeds.
+                None => robust::solve(target, options).map(|mut s| {
+                    s.iterations += iterations;
+                    s.evaluations += evaluations;
+                    s.starts += starts;
+                    s
                 }),
             }
         }
@@ -328,7 +370,16 @@ pub fn solve_all(target: &PlanarPose, options: &SolveOptions) -> Vec<Solution> {
     if check_target(target).is_err() || check_options(options).is_err() {
         return Vec::new();
     }
+    let _ = atlas::get();
+    let _deadline = deadline::scope(options.deadline);
     let mut v = robust::solve_all(target, options).solutions;
+    if v.is_empty() {
+        // As for least energy: the first-found strategy's wider search, so that "all" is
+        // never empty where `solve` succeeds.
+        if let Ok(s) = robust::solve(target, options) {
+            v.push(s);
+        }
+    }
     v.sort_by(|a, b| a.energy.total_cmp(&b.energy));
     v
 }

@@ -7,9 +7,18 @@
 use crate::{wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 use nalgebra::Vector3;
 
-/// Υ(a) and J(1, a) (rows x, y, θ; columns a3, a4, a5).
+/// Υ(a) and J(1, a) (rows x, y, θ; columns a3, a4, a5), for iterations: on ill-conditioned
+/// rods accurate to ≈ 1e-8 only (see `planar::tip_and_jacobian_for_iteration`).
 #[inline]
 pub(crate) fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    crate::planar::tip_and_jacobian_for_iteration(a)
+}
+
+/// Υ(a) and J(1, a) at full accuracy: for the verification of an answer.
+#[inline]
+pub(crate) fn tip_and_jacobian_precise(
+    a: &PlanarParams,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     backend::tip_and_jacobian(a)
 }
 

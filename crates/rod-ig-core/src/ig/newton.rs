@@ -43,7 +43,17 @@ pub(crate) struct Eval {
 }
 
 pub(crate) fn eval(a: &PlanarParams, target: &PlanarPose) -> Option<Eval> {
-    let (tip, jac) = model::tip_and_jacobian(a).ok()?;
+    eval_from(model::tip_and_jacobian(a).ok()?, target)
+}
+
+/// The converged iterate `a` re-evaluated at full accuracy: Some when it still meets the
+/// tolerance (iterations may use a cheaper evaluation on ill-conditioned rods).
+pub(crate) fn verify(a: &PlanarParams, target: &PlanarPose, tolerance: f64) -> Option<Eval> {
+    let e = eval_from(model::tip_and_jacobian_precise(a).ok()?, target)?;
+    (e.pos_err <= tolerance && e.ang_err <= tolerance).then_some(e)
+}
+
+fn eval_from((tip, jac): (PlanarPose, PlanarJacobian), target: &PlanarPose) -> Option<Eval> {
     let f = model::residual(&tip, target);
     if !(f.iter().all(|v| v.is_finite()) && jac.iter().all(|v| v.is_finite())) {
         return None;
@@ -103,6 +113,9 @@ pub(crate) fn solve(
     };
     let mut k: u32 = 0;
     loop {
+        if super::deadline::expired() {
+            return Err(fail(IgError::Deadline { iteration: k }, k, last_res, a));
+        }
         let e = match eval(&a, target) {
             Some(e) => e,
             None => {
@@ -141,7 +154,9 @@ pub(crate) fn solve(
             ));
         }
         if e.pos_err <= tolerance && e.ang_err <= tolerance {
-            return Ok(make_solution(&a, &e, true, st.margin, k));
+            if let Some(e) = verify(&a, target, tolerance) {
+                return Ok(make_solution(&a, &e, true, st.margin, k));
+            }
         }
         if k >= max_iterations {
             return Err(fail(

@@ -4,7 +4,8 @@
 //! is returned.
 
 use super::{
-    atlas, local, model, newton::make_solution, straight, Failure, IgError, Solution, SolveOptions,
+    atlas, local, model, newton, newton::make_solution, straight, Failure, IgError, Solution,
+    SolveOptions,
 };
 use crate::{PlanarParams, PlanarPose};
 
@@ -76,7 +77,8 @@ fn try_start(
     if r.residual < counts.best.0 {
         counts.best = (r.residual, Some(r.last_a));
     }
-    let (a, e) = r.found?;
+    let (a, _) = r.found?;
+    let e = newton::verify(&a, target, options.tolerance)?;
     let st = model::stability(&a).ok()?;
     if !st.stable {
         return None;
@@ -219,6 +221,17 @@ pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solut
     let budget = per_start_budget(options);
     let mut n = 0;
     while n < MAX_STARTS {
+        if super::deadline::expired() {
+            return Err(Failure {
+                reason: IgError::Deadline {
+                    iteration: counts.iterations,
+                },
+                iterations: counts.iterations,
+                residual: counts.best.0,
+                last_a: counts.best.1,
+                elapsed_us: 0.0,
+            });
+        }
         let Some((start, is_guess)) = starts.next() else {
             break;
         };
@@ -295,12 +308,18 @@ pub(crate) fn solve_all(target: &PlanarPose, options: &SolveOptions) -> All {
     let mut solutions: Vec<Solution> = Vec::new();
     let mut starts = 0;
     for start in &list {
+        if super::deadline::expired() {
+            break;
+        }
         starts += 1;
         let r = run_counted(target, start, options, budget, &mut counts);
-        let Some((a, e)) = r.found else { continue };
+        let Some((a, _)) = r.found else { continue };
         if solutions.iter().any(|s| !distinct(&s.a, &a)) {
             continue;
         }
+        let Some(e) = newton::verify(&a, target, options.tolerance) else {
+            continue;
+        };
         let Ok(st) = model::stability(&a) else {
             continue;
         };

@@ -89,6 +89,8 @@ impl Tracker {
     /// J(1, a) (slower, ~1 ms, but the branch then tracks well).
     pub fn solve(&mut self, target: &PlanarPose) -> Result<Solution, Failure> {
         let t0 = std::time::Instant::now();
+        let _ = super::warm_up();
+        let _deadline = super::deadline::scope(self.options.deadline);
         if let Err(e) = super::check_target(target) {
             let mut f = Failure::early(e);
             f.elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
@@ -104,7 +106,13 @@ impl Tracker {
                 local::solve_predicted(target, &a0, predicted, 1.0, budget, self.options.tolerance);
             iterations += r.iterations;
             evaluations += r.evaluations;
-            if let Some((a, e)) = r.found {
+            let verified = r.found.and_then(|(a, _)| {
+                Some((
+                    a,
+                    super::newton::verify(&a, target, self.options.tolerance)?,
+                ))
+            });
+            if let Some((a, e)) = verified {
                 if let Ok(st) = model::stability(&a) {
                     if st.stable {
                         let mut s = make_solution(&a, &e, true, st.margin, iterations);

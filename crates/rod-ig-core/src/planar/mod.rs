@@ -163,10 +163,21 @@ fn pose_and_jac_of(
     a: &PlanarParams,
     t: f64,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    pose_and_jac_with(c, a, t, true)
+}
+
+/// `precise`: double-double where the rod is ill-conditioned; otherwise the f64 series there
+/// (errors up to ≈ 1e-8: good enough for a Newton step, not for an answer).
+fn pose_and_jac_with(
+    c: &Closed<Dual3>,
+    a: &PlanarParams,
+    t: f64,
+    precise: bool,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     match c.needs_series() {
         // FINDINGS §4: where the closed form's error estimate fails, the Taylor series gives
         // the pose and J (both: near the separatrix the closed-form pose drifts too).
-        SeriesNeed::IllConditioned if t >= 1.0 => {
+        SeriesNeed::IllConditioned if t >= 1.0 && precise => {
             let (p, j, _) = ill_conditioned_tip(a)?;
             return Ok((p, j));
         }
@@ -374,6 +385,24 @@ pub fn pose_and_jacobian(
         a,
         |c| pose_and_jac_of(c, a, t),
         || series_pose_and_jac(a, t),
+    )
+}
+
+/// q(1) and J(1, a) for the iterations of a solver: as [`tip_and_jacobian`] except on
+/// ill-conditioned rods (near the separatrix), where the f64 series replaces the double-double
+/// one (≈ 100× cheaper, errors up to ≈ 1e-8). Solvers verify their answer with
+/// [`tip_and_jacobian`].
+pub(crate) fn tip_and_jacobian_for_iteration(
+    a: &PlanarParams,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    check_params(a)?;
+    if series_first(a) {
+        return series_pose_and_jac(a, 1.0);
+    }
+    with_seeded(
+        a,
+        |c| pose_and_jac_with(c, a, 1.0, false),
+        || series_pose_and_jac(a, 1.0),
     )
 }
 

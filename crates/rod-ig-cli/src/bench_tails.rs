@@ -1,0 +1,168 @@
+//! `rod-ig bench --only tails`: per-call latency distributions (p50, p99, p99.9, max) of the
+//! forward map and of the robust solve on the uniform box next to log-scale samples of the
+//! regime a cable lives in (issue 9), with the ratio log-scale / box.
+
+use rod_ig_core::ig::{self, bench::SplitMix64, SolveOptions};
+use rod_ig_core::{planar, PlanarParams, PlanarPose};
+use std::hint::black_box;
+use std::time::Instant;
+
+/// Latency distribution of one function over one sample (µs).
+#[derive(Clone, Copy, Debug)]
+pub struct Tails {
+    /// Mean per call.
+    pub mean: f64,
+    /// Median.
+    pub p50: f64,
+    /// 99th percentile.
+    pub p99: f64,
+    /// 99.9th percentile.
+    pub p999: f64,
+    /// Slowest call.
+    pub max: f64,
+    /// Calls that returned an error.
+    pub errors: usize,
+}
+
+fn percentile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return 0.0;
+    }
+    let i = ((sorted.len() as f64 - 1.0) * q).round() as usize;
+    sorted[i.min(sorted.len() - 1)]
+}
+
+/// Times every call of `f` individually (after one untimed warm-up pass).
+pub fn tails<T, R, E>(inputs: &[T], mut f: impl FnMut(&T) -> Result<R, E>) -> Tails {
+    for x in inputs {
+        let _ = black_box(f(black_box(x)));
+    }
+    let mut us = Vec::with_capacity(inputs.len());
+    let mut errors = 0;
+    for x in inputs {
+        let t0 = Instant::now();
+        let r = black_box(f(black_box(x)));
+        us.push(t0.elapsed().as_secs_f64() * 1e6);
+        errors += usize::from(r.is_err());
+    }
+    let mean = us.iter().sum::<f64>() / us.len().max(1) as f64;
+    us.sort_by(f64::total_cmp);
+    Tails {
+        mean,
+        p50: percentile(&us, 0.5),
+        p99: percentile(&us, 0.99),
+        p999: percentile(&us, 0.999),
+        max: us.last().copied().unwrap_or(0.0),
+        errors,
+    }
+}
+
+fn signed_pow10(rng: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
+    let v = 10f64.powf(rng.range(lo, hi));
+    if rng.range(0.0, 1.0) < 0.5 {
+        -v
+    } else {
+        v
+    }
+}
+
+/// The samples: the uniform box and issue 9's log-scale families.
+pub fn samples(n: usize) -> Vec<(&'static str, Vec<PlanarParams>)> {
+    let mut rng = SplitMix64::new(9);
+    let mut gen = |f: &mut dyn FnMut(&mut SplitMix64) -> PlanarParams| {
+        (0..n).map(|_| f(&mut rng)).collect::<Vec<_>>()
+    };
+    vec![
+        (
+            "uniform box",
+            gen(&mut |r| {
+                PlanarParams::new(
+                    r.range(-10.0, 10.0),
+                    r.range(-100.0, 100.0),
+                    r.range(-100.0, 100.0),
+                )
+            }),
+        ),
+        (
+            "log-scale",
+            gen(&mut |r| {
+                PlanarParams::new(
+                    signed_pow10(r, -8.0, 0.7),
+                    signed_pow10(r, -9.0, 1.5),
+                    signed_pow10(r, -9.0, 1.5),
+                )
+            }),
+        ),
+        (
+            "tiny (1e-60..1e-6)",
+            gen(&mut |r| {
+                PlanarParams::new(
+                    signed_pow10(r, -60.0, -6.0),
+                    signed_pow10(r, -60.0, -6.0),
+                    signed_pow10(r, -60.0, -6.0),
+                )
+            }),
+        ),
+        (
+            "strong force (|a4| 1e2..1e4)",
+            gen(&mut |r| {
+                PlanarParams::new(
+                    signed_pow10(r, -6.0, 0.0),
+                    signed_pow10(r, 2.0, 4.0),
+                    signed_pow10(r, -6.0, 0.0),
+                )
+            }),
+        ),
+    ]
+}
+
+fn print_row(what: &str, sample: &str, t: &Tails, box_mean: f64) {
+    println!(
+        "{what:<8} {sample:<30} {:>9.2} {:>9.2} {:>9.2} {:>10.2} {:>10.2} {:>7.2}× {:>7}",
+        t.mean,
+        t.p50,
+        t.p99,
+        t.p999,
+        t.max,
+        t.mean / box_mean,
+        t.errors
+    );
+}
+
+/// Prints the table.
+pub fn run(quick: bool) {
+    let n = if quick { 300 } else { 4000 };
+    let sets = samples(n);
+    println!("## Latency tails (per call, µs; {n} inputs per sample; single thread)");
+    println!(
+        "{:<8} {:<30} {:>9} {:>9} {:>9} {:>10} {:>10} {:>8} {:>7}",
+        "call", "sample", "mean", "p50", "p99", "p99.9", "max", "vs box", "errors"
+    );
+    let mut box_mean = f64::NAN;
+    for (name, inputs) in &sets {
+        let t = tails(inputs, planar::evaluate);
+        if box_mean.is_nan() {
+            box_mean = t.mean;
+        }
+        print_row("forward", name, &t, box_mean);
+    }
+    // Solve: targets that stable rods of each sample reach.
+    let opts = SolveOptions::default();
+    let mut box_mean = f64::NAN;
+    for (name, inputs) in &sets {
+        let targets: Vec<PlanarPose> = inputs
+            .iter()
+            .filter_map(|a| planar::evaluate(a).ok())
+            .filter(|e| e.stability.stable)
+            .map(|e| e.tip)
+            .filter(|p| p.x.hypot(p.y) < 1.0)
+            .take(if quick { 100 } else { 1000 })
+            .collect();
+        let t = tails(&targets, |b| ig::solve(b, &opts));
+        if box_mean.is_nan() {
+            box_mean = t.mean;
+        }
+        print_row("solve", name, &t, box_mean);
+    }
+    println!("goal (issue 9): the log-scale sample within 1.5× the box per call");
+}
