@@ -28,12 +28,14 @@ struct Cli {
 enum Command {
     /// Forward map. Reads JSON lines {"a": [a3, a4, a5]} on stdin; writes one line each:
     /// {"tip": {"x", "y", "theta"}, "jacobian": [[dx/da3, dx/da4, dx/da5], [dy/..], [dθ/..]],
-    /// "stable", "energy", "stability_margin" (normalised g_min, ≈ 1 for a gently bent rod), "stability_uncertain"}. theta is unwrapped (∫κ). A line that cannot be
-    /// parsed or evaluated gets {"error": "why"}; the stream goes on.
+    /// "stable", "energy", "stability_margin" (normalised g_min, ≈ 1 for a gently bent rod),
+    /// "stability_uncertain"}. theta is unwrapped (∫κ). A line that cannot be parsed or
+    /// evaluated gets {"error": "why"}; the stream goes on.
     Forward,
     /// Inverse geometry. Reads JSON lines {"target": {"x", "y", "theta"}, "a0"?: [..],
     /// "method"?: "robust"|"newton", "alpha"?, "max_iterations"?, "tolerance"?,
-    /// "objective"?: "first"|"least_energy", "all"?: bool}; writes one line each:
+    /// "objective"?: "first"|"least_energy", "all"?: bool, "deadline_ms"? (default 250, at
+    /// most 10000)}; writes one line each:
     /// {"success", "a", "tip", "stable", "iterations", "residual", "energy", "position_error",
     /// "orientation_error", "stability_margin", "reason" (on failure), "solutions" (with all)}.
     Solve,
@@ -44,7 +46,8 @@ enum Command {
     Forward3d,
     /// 3-D inverse geometry. Reads JSON lines {"target": {"position": [..], "quaternion":
     /// [qx, qy, qz, qw]}, "a0"?: [6 numbers], "method"?, "alpha"?, "max_iterations"?,
-    /// "tolerance"?, "stiffness"?}; writes the fields of `solve` with 3-D a and tip.
+    /// "tolerance"?, "stiffness"?, "deadline_ms"? (default 1000)}; writes the fields of `solve`
+    /// with 3-D a and tip.
     Solve3d,
     /// Samples or draws rods: given parameters (--a, repeatable) or a target pose (--target:
     /// every distinct stable solution found). JSON lines of poses, or an SVG picture.

@@ -104,6 +104,8 @@ struct Solve3dRequest {
     max_iterations: Option<u32>,
     tolerance: Option<f64>,
     stiffness: Option<[f64; 3]>,
+    /// Wall-time budget of the request in ms (default 1000, at most 10000).
+    deadline_ms: Option<f64>,
 }
 
 /// Answers one `solve3d` line.
@@ -127,6 +129,9 @@ pub fn solve3d_line(line: &str) -> Result<Value, String> {
             &mut options.tolerance,
         ),
     )?;
+    if let Some(ms) = request.deadline_ms {
+        options.deadline = jsonl::deadline_from_ms(ms)?;
+    }
     if options.method == Method3d::Newton && options.initial_guess.is_none() {
         return Err(jsonl::NEWTON_NEEDS_A0.to_string());
     }

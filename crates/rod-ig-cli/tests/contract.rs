@@ -157,3 +157,106 @@ fn solve3d_contract() {
     assert!(out[1]["reason"].as_str().unwrap().contains("reach"));
     assert!(out[2]["error"].as_str().unwrap().contains("quaternion"));
 }
+
+/// Issue 9: every request is bounded — absurd iteration counts and tolerances are refused with
+/// the reason, a deadline is honoured and reported, shapes have a size limit.
+#[test]
+fn requests_are_bounded_with_clear_reasons() {
+    let target = "{\"x\": 0.5, \"y\": 0.2, \"theta\": 1.0}";
+    let out = run(
+        &["solve"],
+        &format!(
+            "{{\"target\": {target}, \"method\": \"newton\", \"a0\": [1, -5, 3], \"max_iterations\": 1000000000, \"tolerance\": 1e-6}}\n\
+             {{\"target\": {target}, \"method\": \"newton\", \"a0\": [1, -5, 3], \"tolerance\": 1e-300}}\n\
+             {{\"target\": {target}, \"method\": \"newton\", \"a0\": [1, -5, 3], \"alpha\": 0.001, \"max_iterations\": 100000, \"tolerance\": 1e-14, \"deadline_ms\": 20}}\n\
+             {{\"target\": {target}, \"deadline_ms\": -1}}\n\
+             {{\"target\": {target}, \"deadline_ms\": 60000}}\n"
+        ),
+    );
+    assert_eq!(out.len(), 5);
+    assert!(
+        out[0]["reason"]
+            .as_str()
+            .unwrap()
+            .contains("max_iterations"),
+        "{}",
+        out[0]
+    );
+    assert!(
+        out[1]["reason"].as_str().unwrap().contains("tolerance"),
+        "{}",
+        out[1]
+    );
+    assert!(
+        out[2]["reason"].as_str().unwrap().contains("deadline"),
+        "{}",
+        out[2]
+    );
+    assert!(
+        out[3]["error"].as_str().unwrap().contains("deadline_ms"),
+        "{}",
+        out[3]
+    );
+    assert!(
+        out[4]["reason"].as_str().unwrap().contains("deadline"),
+        "{}",
+        out[4]
+    );
+    let status = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
+        .args(["shape", "--a", "1,2,3", "--samples", "18446744073709551615"])
+        .output()
+        .expect("rod-ig runs");
+    assert!(!status.status.success());
+    assert!(String::from_utf8_lossy(&status.stderr).contains("--samples must be between"));
+}
+
+/// Issue 9: `all` never reports success with no solutions; least energy succeeds where the
+/// default does; the forward answer says when the verdict is uncertain (straight rod).
+#[test]
+fn all_least_energy_and_uncertain_verdicts() {
+    let target = "{\"x\": 0.95, \"y\": 0.05, \"theta\": 0.02}";
+    let out = run(
+        &["solve"],
+        &format!(
+            "{{\"target\": {target}}}\n\
+             {{\"target\": {target}, \"objective\": \"least_energy\", \"all\": true}}\n"
+        ),
+    );
+    assert_eq!(out[0]["success"], true, "{}", out[0]);
+    assert_eq!(out[1]["success"], true, "{}", out[1]);
+    assert!(!out[1]["solutions"].as_array().unwrap().is_empty());
+    let out = run(
+        &["forward"],
+        "{\"a\": [0, 3, 0]}\n{\"a\": [0.05, 1e-8, 1e-8]}\n",
+    );
+    assert_eq!(out[0]["stability_uncertain"], true);
+    assert_eq!(out[0]["stable"], false);
+    assert_eq!(out[1]["stability_uncertain"], false);
+    assert_eq!(out[1]["stable"], true);
+    let m = out[1]["stability_margin"].as_f64().unwrap();
+    assert!((0.9..=1.01).contains(&m), "{m}");
+}
+
+/// Issue 9: a 3-D rod of stiffness [s, s, s] is solved for s ≠ 1 (seeds scale with stiffness);
+/// its a is s times the unit rod's (moments and forces scale with the stiffness).
+#[test]
+fn solve3d_with_scaled_stiffness() {
+    let req = |s: f64| {
+        format!(
+            "{{\"target\": {{\"position\": [0.5, 0.3, 0.2], \"quaternion\": [0, 0, 0.3827, 0.9239]}}, \"stiffness\": [{s}, {s}, {s}]}}\n"
+        )
+    };
+    let unit = run(&["solve3d"], &req(1.0));
+    for s in [0.3, 2.0, 5.0] {
+        let out = run(&["solve3d"], &req(s));
+        assert_eq!(out[0]["success"], true, "s = {s}: {}", out[0]);
+        let a = out[0]["a"].as_array().unwrap();
+        let u = unit[0]["a"].as_array().unwrap();
+        let dev = a
+            .iter()
+            .zip(u)
+            .map(|(x, y)| (x.as_f64().unwrap() - s * y.as_f64().unwrap()).abs())
+            .fold(0.0, f64::max);
+        assert!(dev < 1e-4 * s * 200.0, "s = {s}: a deviates by {dev}");
+    }
+}

@@ -24,7 +24,7 @@
 
 mod atlas;
 pub mod bench;
-mod deadline;
+pub(crate) mod deadline;
 mod local;
 mod model;
 mod newton;
