@@ -68,6 +68,9 @@ pub struct Params {
     /// `solve_3d`: answer non-planar targets (beyond `planar_tolerance`) with the 3-D solver
     /// instead of rejecting them (default false).
     pub solve_3d: bool,
+    /// `deadline_ms` in (0, 10000]: wall-time budget of one solve (default 250 ms, the
+    /// library's `ig::DEFAULT_DEADLINE`); a solve that runs out answers "deadline reached".
+    pub deadline_ms: f64,
 }
 
 impl Default for Params {
@@ -84,6 +87,7 @@ impl Default for Params {
             publish_marker: true,
             marker_width: 0.01,
             solve_3d: false,
+            deadline_ms: rod_ig_core::ig::DEFAULT_DEADLINE.as_secs_f64() * 1e3,
         }
     }
 }
@@ -126,7 +130,7 @@ pub enum ParamError {
 }
 
 /// The names of all parameters, in declaration order.
-pub const NAMES: [&str; 11] = [
+pub const NAMES: [&str; 12] = [
     "rod_length",
     "base_frame",
     "path_samples",
@@ -138,6 +142,7 @@ pub const NAMES: [&str; 11] = [
     "publish_marker",
     "marker_width",
     "solve_3d",
+    "deadline_ms",
 ];
 
 fn type_name(v: &ParameterValue) -> String {
@@ -225,8 +230,9 @@ impl Params {
             "path_samples" => self.path_samples = integer(name, value, 2, 100_000)? as usize,
             "tolerance" => {
                 let v = double(name, value)?;
-                check(name, v.is_finite() && v > 0.0 && v < 1.0, || {
-                    format!("must be in (0, 1), got {v}")
+                let min = rod_ig_core::ig::MIN_TOLERANCE;
+                check(name, v.is_finite() && v >= min && v < 1.0, || {
+                    format!("must be in [{min:e}, 1), got {v}")
                 })?;
                 self.tolerance = v;
             }
@@ -273,6 +279,14 @@ impl Params {
                 self.marker_width = v;
             }
             "solve_3d" => self.solve_3d = boolean(name, value)?,
+            "deadline_ms" => {
+                let v = double(name, value)?;
+                let max = rod_ig_core::ig::MAX_DEADLINE.as_secs_f64() * 1e3;
+                check(name, v.is_finite() && v > 0.0 && v <= max, || {
+                    format!("must be in (0, {max}] ms, got {v}")
+                })?;
+                self.deadline_ms = v;
+            }
             _ => return Err(ParamError::Unknown(name.into())),
         }
         Ok(())
@@ -297,6 +311,7 @@ impl Params {
             "publish_marker" => ParameterValue::Boolean(self.publish_marker),
             "marker_width" => ParameterValue::Double(self.marker_width),
             "solve_3d" => ParameterValue::Boolean(self.solve_3d),
+            "deadline_ms" => ParameterValue::Double(self.deadline_ms),
             _ => return None,
         })
     }
@@ -336,7 +351,8 @@ pub fn usage() -> String {
          \x20 planar_tolerance  accepted |z| (m) and tilt (rad) of targets ({:e})\n\
          \x20 publish_marker    publish /rod/marker ({})\n\
          \x20 marker_width      m ({})\n\
-         \x20 solve_3d          answer non-planar targets with the 3-D solver ({})\n\n\
+         \x20 solve_3d          answer non-planar targets with the 3-D solver ({})\n\
+         \x20 deadline_ms       wall-time budget of one solve, ms, <= 10000 ({})\n\n\
          Environment: ROS_DOMAIN_ID (0..232), ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST or\n\
          ROS_LOCALHOST_ONLY=1 (loopback only), RUST_LOG (console log level).\n",
         d.rod_length,
@@ -349,7 +365,8 @@ pub fn usage() -> String {
         d.planar_tolerance,
         d.publish_marker,
         d.marker_width,
-        d.solve_3d
+        d.solve_3d,
+        d.deadline_ms,
     )
 }
 
@@ -494,6 +511,21 @@ mod tests {
         assert_eq!(p.rod_length, 1.0);
         assert_eq!(p.path_samples, 100);
         assert_eq!(p.method, Method::Robust);
+    }
+
+    #[test]
+    fn deadline_and_tolerance_limits() {
+        let p = run(&["--ros-args", "-p", "deadline_ms:=20"]).unwrap();
+        assert_eq!(p.deadline_ms, 20.0);
+        assert_eq!(Params::default().deadline_ms, 250.0);
+        for bad in [
+            "deadline_ms:=0",
+            "deadline_ms:=20000",
+            "deadline_ms:=-1",
+            "tolerance:=1e-20",
+        ] {
+            assert!(run(&["--ros-args", "-p", bad]).is_err(), "{bad}");
+        }
     }
 
     #[test]

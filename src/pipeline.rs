@@ -125,6 +125,7 @@ pub fn settings_of(params: &Params) -> SolverSettings {
         method: params.method,
         tolerance: params.tolerance,
         max_iterations: params.max_iterations,
+        deadline: std::time::Duration::from_secs_f64(params.deadline_ms / 1e3),
     }
 }
 
@@ -163,6 +164,7 @@ impl Processor {
             method: overrides.method.unwrap_or(settings.method),
             tolerance: overrides.tolerance.unwrap_or(settings.tolerance),
             max_iterations: overrides.max_iterations.unwrap_or(settings.max_iterations),
+            deadline: settings.deadline,
         });
         let rejected = |message: String| Outcome {
             solution: failure_message(

@@ -26,6 +26,8 @@ pub struct SolverSettings {
     pub tolerance: f64,
     /// Iteration limit.
     pub max_iterations: u32,
+    /// Wall-time budget of one solve.
+    pub deadline: std::time::Duration,
 }
 
 /// A converged solve with its sampled shape, normalised units: the core crate's solution
@@ -106,6 +108,7 @@ fn options(s: &SolverSettings, initial_guess: Option<PlanarParams>) -> SolveOpti
         tolerance: s.tolerance,
         max_iterations: s.max_iterations,
         initial_guess,
+        deadline: s.deadline,
         ..SolveOptions::default()
     }
 }
@@ -119,6 +122,7 @@ fn options_3d(s: &SolverSettings, initial_guess: Option<SpatialParams>) -> Solve
         tolerance: s.tolerance,
         max_iterations: s.max_iterations,
         initial_guess,
+        deadline: s.deadline,
         ..SolveOptions3d::default()
     }
 }

@@ -149,3 +149,23 @@ def test_bad_domain_id_exits_with_reason():
     env = dict(os.environ, ROS_DOMAIN_ID="999")
     r = subprocess.run([str(h.binary("rod_ig_node"))], capture_output=True, text=True, timeout=20, env=env)
     assert r.returncode == 2 and "ROS_DOMAIN_ID" in r.stderr
+
+
+def test_deadline_parameter_bounds_a_solve(node_and_client):
+    """Issue 9: every solve has a deadline; the node's `deadline_ms` sets it (default 250 ms),
+    within (0, 10000]. A solve that runs out answers success = false with the reason."""
+    _, c = node_and_client
+    assert c.get_params("deadline_ms") == {"deadline_ms": 250.0}
+    for bad in (0.0, 20000.0, -5.0):
+        (res,) = c.set_params(deadline_ms=bad)
+        assert not res.successful and "deadline_ms" in res.reason
+    # 1 µs: the robust solver's start list alone takes longer.
+    res = c.set_params(deadline_ms=0.001)
+    assert all(r.successful for r in res), [r.reason for r in res]
+    _, sol, _ = solve_topic(c, 0.95, 0.05, 0.02)
+    assert not sol.success
+    assert "deadline" in sol.message, sol.message
+    res = c.set_params(deadline_ms=250.0)
+    assert all(r.successful for r in res)
+    _, sol, _ = solve_topic(c, 0.5, 0.2, 1.0)
+    assert sol.success, sol.message
