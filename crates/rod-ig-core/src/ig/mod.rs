@@ -335,28 +335,28 @@ pub fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Fa
         }
         (Method::Robust, Objective::FirstFound) => robust::solve(target, options),
         (Method::Robust, Objective::LeastEnergy) => {
+            // The first-found search first (its wider start list and polishing find a solution
+            // wherever the default objective does), then every start of the target's cell with
+            // the time left; the least energy among all of them.
+            let first = robust::solve(target, options);
             let all = robust::solve_all(target, options);
             let (iterations, evaluations, starts) = (all.iterations, all.evaluations, all.starts);
-            match all
+            let best = all
                 .solutions
                 .into_iter()
-                .min_by(|a, b| a.energy.total_cmp(&b.energy))
-            {
-                Some(mut s) => {
-                    s.iterations = iterations;
-                    s.evaluations = evaluations;
-                    s.starts = starts;
+                .chain(first.as_ref().ok().copied())
+                .min_by(|a, b| a.energy.total_cmp(&b.energy));
+            match (best, first) {
+                (Some(mut s), first) => {
+                    let (fi, fe, fs) = first
+                        .as_ref()
+                        .map_or((0, 0, 0), |f| (f.iterations, f.evaluations, f.starts));
+                    s.iterations = iterations + fi;
+                    s.evaluations = evaluations + fe;
+                    s.starts = starts + fs;
                     Ok(s)
                 }
-                // The cell of atlas seeds around the target held no converging start: the
-                // first-found strategy (more starts, polishing) still finds one where it
-                // exists, so least energy never fails where the default objective succeeds.
-                None => robust::solve(target, options).map(|mut s| {
-                    s.iterations += iterations;
-                    s.evaluations += evaluations;
-                    s.starts += starts;
-                    s
-                }),
+                (None, first) => first,
             }
         }
     };
