@@ -3,8 +3,11 @@
 #   1. Python headers if missing (apt: python3-dev), the venv with ROS 2 Kilted wheels, and the
 #      interface package rod_ig_msgs (scripts/setup-env.sh);
 #   2. the Cargo workspace (release: the integration tests run the release node);
-#   3. `cargo test --workspace` and the pytest suite in tests/ (real rclpy client, node as a
-#      subprocess on random ROS domains, loopback only).
+#   3. lint: `cargo fmt --check`, `cargo clippy --workspace --all-targets -- -D warnings`,
+#      `RUSTDOCFLAGS="-D warnings" cargo doc --no-deps`;
+#   4. `cargo test --workspace` (unit, integration and doc-tests, the seeded CLI fuzz) and the
+#      pytest suite in tests/ (real rclpy client, node as a subprocess on random ROS domains,
+#      loopback only).
 # Prints cargo's and pytest's summary lines; exits non-zero if anything fails.
 #
 # Environment: ROD_IG_VENV, ROD_IG_BUILD, PYTHON (see setup-env.sh); CARGO_TARGET_DIR;
@@ -22,6 +25,13 @@ bash "$REPO/scripts/setup-env.sh" || { echo "setup-env.sh failed"; exit 1; }
 # shellcheck source=scripts/env.sh
 source "$REPO/scripts/env.sh"
 export ROS_DISTRO="${ROS_DISTRO:-kilted}"
+
+echo "== lint: cargo fmt --check, clippy -D warnings, rustdoc -D warnings"
+cargo fmt --all -- --check >"$LOGS/fmt.log" 2>&1 || { echo "cargo fmt --check FAILED (see $LOGS/fmt.log)"; status=1; }
+cargo clippy --workspace --all-targets --release -- -D warnings >"$LOGS/clippy.log" 2>&1 \
+    || { echo "clippy FAILED (see $LOGS/clippy.log)"; grep -E '^(error|warning)' "$LOGS/clippy.log" | head; status=1; }
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --workspace >"$LOGS/doc.log" 2>&1 \
+    || { echo "cargo doc FAILED (see $LOGS/doc.log)"; status=1; }
 
 echo "== cargo build --release --workspace"
 cargo build --release --workspace 2>&1 | tail -n 3

@@ -67,7 +67,7 @@ fn line(rng: &mut SplitMix64, templates: &[&str]) -> Vec<u8> {
     let mut s = String::new();
     for c in pick(rng, templates).chars() {
         if c == '#' {
-            if rng.next_u64() % 3 == 0 {
+            if rng.next_u64().is_multiple_of(3) {
                 s.push_str(pick(rng, &NUMBERS));
             } else {
                 s.push_str(&format!("{}", rng.range(-1.2, 1.2)));

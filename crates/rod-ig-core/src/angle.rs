@@ -34,7 +34,8 @@ const INV_TWO_PI_BITS: [u64; 20] = [
     0x1580CC11BF1EDAEA,
     0xFC33EF0826BD0D87,
 ];
-const TWO_PI_HI: f64 = 6.283185307179586;
+/// f64 nearest to 2π (equal to `TAU`; spelled out as the high word of the pair).
+const TWO_PI_HI: f64 = std::f64::consts::TAU;
 const TWO_PI_LO: f64 = 2.4492935982947064e-16;
 
 /// 64 bits of 1/(2π) after skipping `offset` bits (zeros for positions before the point).

@@ -201,6 +201,7 @@ pub struct PlanarRod {
 }
 
 #[derive(Clone, Debug)]
+#[allow(clippy::large_enum_variant)] // one per rod, never in bulk; boxing costs an allocation
 enum Backend {
     Closed(Closed<f64>),
     Series(TaylorRod<f64>),

@@ -268,6 +268,7 @@ impl std::ops::Sub for DualF64x2 {
 }
 impl std::ops::Mul for DualF64x2 {
     type Output = Self;
+    #[allow(clippy::suspicious_arithmetic_impl)] // the product rule adds two products
     #[inline]
     fn mul(self, o: Self) -> Self {
         let g = |i: usize| self.g[i] * o.v + self.v * o.g[i];
