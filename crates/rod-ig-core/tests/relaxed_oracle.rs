@@ -32,6 +32,15 @@ const BLOCKS: [(&str, usize, usize); 5] = [
     ("strong axial force", 700, 800),
 ];
 
+/// Agreement of our margin with the oracle's det_min, relative to max(|det_min|, 1).
+const MARGIN_TOL: f64 = 1e-3;
+
+/// The same for the strong-force block, whose g(t) has dips of width ≈ 1/√F: the 40-digit
+/// references sample g at 10√F points only, and there our refined minima lie *below* theirs
+/// (up to 13 %, lines 710, 718, 738, 776); where the f64 oracle is the reference, its margins of
+/// a few 1e-3 carry its own errors.
+const STRONG_MARGIN_TOL: f64 = 0.15;
+
 /// A clear verdict of the oracle: |det_min| above this (oracle README).
 const CLEAR_MARGIN: f64 = 1e-3;
 
@@ -157,7 +166,15 @@ fn relaxed_families_match_the_oracle() {
         for m in s.wrong_verdicts.iter().chain(&s.errors).take(12) {
             eprintln!("    {m}");
         }
+        // The margin is g_min over [0.05, 1] (FINDINGS §5): the oracle takes it on a grid of
+        // spacing 5e-4 and we refine local minima, so they agree to ≈ the grid's resolution.
+        let margin_tol = if name.starts_with("strong") {
+            STRONG_MARGIN_TOL
+        } else {
+            MARGIN_TOL
+        };
         failed |= s.tip > 1e-9
+            || s.margin > margin_tol
             || s.jac > 1e-6
             || s.energy > 1e-8
             || !s.wrong_verdicts.is_empty()

@@ -228,21 +228,23 @@ fn scan(
         *t = if i == n { 1.0 } else { t0 + i as f64 * h };
     }
     // The normalisation t⁹(a3²/8640 + a5²t²/33600) changes regime at t* = √(33600/8640)|a3/a5|,
-    // where g often has a narrow dip: sample around it too (for the margin).
-    if a5 != 0.0 {
-        let ts_star = (33600.0f64 / 8640.0).sqrt() * (a3 / a5).abs();
-        for f in [0.7, 1.0, 1.4] {
-            let t = ts_star * f;
-            if t > t0 && t < 1.0 && np < ts.len() {
-                // insert keeping ts sorted
-                let mut k = np;
-                while k > 0 && ts[k - 1] > t {
-                    ts[k] = ts[k - 1];
-                    k -= 1;
-                }
-                ts[k] = t;
-                np += 1;
+    // where g often has a narrow dip: sample around it too (for the margin). The margin's
+    // window starts at T_MARGIN, where g is often smallest (|a3| ≪ |a5|): sample it exactly.
+    let ts_star = if a5 != 0.0 {
+        (33600.0f64 / 8640.0).sqrt() * (a3 / a5).abs()
+    } else {
+        f64::NAN
+    };
+    for t in [T_MARGIN, ts_star * 0.7, ts_star, ts_star * 1.4] {
+        if t > t0 && t < 1.0 && np < ts.len() {
+            // insert keeping ts sorted
+            let mut k = np;
+            while k > 0 && ts[k - 1] > t {
+                ts[k] = ts[k - 1];
+                k -= 1;
             }
+            ts[k] = t;
+            np += 1;
         }
     }
     for i in 0..np {
