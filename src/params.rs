@@ -438,7 +438,9 @@ where
 const NODE_KEYS: [&str; 4] = ["rod_ig_node", "/rod_ig_node", "/**", "**"];
 
 /// Applies a ROS 2 parameters file (`rod_ig_node: {ros__parameters: {...}}`; also
-/// `/rod_ig_node` and the wildcard `/**`) to `params`. Unknown parameters are errors.
+/// `/rod_ig_node` and the wildcard `/**`) to `params`. Unknown parameters are skipped with a
+/// warning (a shared file may configure other nodes' parameters, e.g. `use_sim_time`, under
+/// `/**`); invalid values of known ones are errors.
 pub fn load_params_file(params: &mut Params, path: &Path) -> Result<(), ParamError> {
     let file_err = |reason: String| ParamError::File {
         path: path.to_path_buf(),
@@ -477,6 +479,14 @@ pub fn apply_params_yaml(params: &mut Params, text: &str) -> Result<(), ParamErr
             let name = name
                 .as_str()
                 .ok_or_else(|| err("parameter names must be strings".into()))?;
+            if !NAMES.contains(&name) {
+                log::warn!(
+                    "parameters file: ignoring unknown parameter '{name}' in section '{key}' \
+                     (known: {})",
+                    NAMES.join(", ")
+                );
+                continue;
+            }
             let value = yaml_to_value(value)
                 .ok_or_else(|| err(format!("parameter '{name}': unsupported value {value:?}")))?;
             params.apply(name, &value)?;
@@ -511,6 +521,18 @@ mod tests {
         assert_eq!(p.rod_length, 1.0);
         assert_eq!(p.path_samples, 100);
         assert_eq!(p.method, Method::Robust);
+    }
+
+    #[test]
+    fn unknown_keys_in_a_params_file_are_skipped() {
+        let mut p = Params::default();
+        let yaml = "/**:\n  ros__parameters:\n    use_sim_time: false\n    rod_length: 0.7\n    \
+                    some_other_node_param: [1, 2]\n";
+        apply_params_yaml(&mut p, yaml).unwrap();
+        assert_eq!(p.rod_length, 0.7);
+        // A known parameter with a bad value is still an error.
+        let bad = "rod_ig_node:\n  ros__parameters:\n    rod_length: -1.0\n";
+        assert!(apply_params_yaml(&mut Params::default(), bad).is_err());
     }
 
     #[test]
@@ -610,7 +632,8 @@ mod tests {
 
         let mut r = Params::default();
         assert!(apply_params_yaml(&mut r, "other_node:\n  ros__parameters: {}\n").is_err());
-        assert!(apply_params_yaml(&mut r, "rod_ig_node:\n  ros__parameters:\n    x: 1\n").is_err());
+        // Unknown keys are skipped with a warning (issue 10), not fatal.
+        assert!(apply_params_yaml(&mut r, "rod_ig_node:\n  ros__parameters:\n    x: 1\n").is_ok());
         assert!(apply_params_yaml(&mut r, "[1, 2]").is_err());
         assert_eq!(r, Params::default());
     }

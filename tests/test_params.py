@@ -169,3 +169,23 @@ def test_deadline_parameter_bounds_a_solve(node_and_client):
     assert all(r.successful for r in res)
     _, sol, _ = solve_topic(c, 0.5, 0.2, 1.0)
     assert sol.success, sol.message
+
+
+def test_params_file_with_unknown_keys_warns_and_starts(tmp_path):
+    """Issue 10: a shared params file (other nodes' keys under /**, use_sim_time) must not stop
+    the node; unknown keys are skipped with a warning naming them."""
+    yaml = tmp_path / "shared.yaml"
+    yaml.write_text("/**:\n  ros__parameters:\n    use_sim_time: false\n    camera_rate: 30.0\n"
+                    "rod_ig_node:\n  ros__parameters:\n    path_samples: 9\n")
+    domain = h.free_domain()
+    node = h.NodeProcess(domain, ["--ros-args", "--params-file", str(yaml)])
+    c = h.Client(domain)
+    try:
+        assert c.wait_connected(), node.log_text()
+        assert c.get_params("path_samples") == {"path_samples": 9}
+        log = node.log_text()
+        assert "ignoring unknown parameter 'camera_rate'" in log, log
+        assert "ignoring unknown parameter 'use_sim_time'" in log, log
+    finally:
+        c.close()
+        assert node.stop() == 0
