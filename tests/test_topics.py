@@ -151,3 +151,22 @@ def test_rosout_reports_rejections(node_and_client):
                                    and "out of reach" in m.msg), None), timeout=5)
     assert log is not None, [m.msg for m in c.logs][-5:]
     assert log.level == 30  # WARN
+
+
+def test_first_target_respects_max_iterations():
+    """Issue 10: the first target (the tracker's cold start, which compares the stable solutions
+    near the target) used to report 551-771 iterations, above max_iterations (100): its search
+    now stops once max_iterations are spent and a solution is known."""
+    domain = h.free_domain()
+    node = h.NodeProcess(domain, [])
+    c = h.Client(domain)
+    try:
+        assert c.wait_connected(), node.log_text()
+        s = h.next_seq()
+        c.pub.publish(c.make_target(0.5, 0.2, 1.0, s))
+        sol = c.solution_for(s, timeout=20)
+        assert sol is not None and sol.success, sol and sol.message
+        assert sol.iterations <= 100, sol.iterations
+    finally:
+        c.close()
+        assert node.stop() == 0

@@ -339,7 +339,7 @@ pub fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Fa
             // wherever the default objective does), then every start of the target's cell with
             // the time left; the least energy among all of them.
             let first = robust::solve(target, options);
-            let all = robust::solve_all(target, options);
+            let all = robust::solve_all(target, options, None);
             let (iterations, evaluations, starts) = (all.iterations, all.evaluations, all.starts);
             let best = all
                 .solutions
@@ -372,7 +372,7 @@ pub fn solve_all(target: &PlanarPose, options: &SolveOptions) -> Vec<Solution> {
     }
     let _ = atlas::get();
     let _deadline = deadline::scope(options.deadline);
-    let mut v = robust::solve_all(target, options).solutions;
+    let mut v = robust::solve_all(target, options, None).solutions;
     if v.is_empty() {
         // As for least energy: the first-found strategy's wider search, so that "all" is
         // never empty where `solve` succeeds.

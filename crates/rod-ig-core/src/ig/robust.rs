@@ -288,7 +288,14 @@ fn distinct(a: &PlanarParams, b: &PlanarParams) -> bool {
 
 /// Every start of the initial guess and of the atlas seeds within one cell of the target (at
 /// most 200); the distinct stable solutions.
-pub(crate) fn solve_all(target: &PlanarPose, options: &SolveOptions) -> All {
+///
+/// `total_budget`: stop starting new runs once this many iterations were spent in total and at
+/// least one solution is known (the tracker's cold start: it must respect `max_iterations`).
+pub(crate) fn solve_all(
+    target: &PlanarPose,
+    options: &SolveOptions,
+    total_budget: Option<u32>,
+) -> All {
     let mut counts = Counts::default();
     let budget = per_start_budget(options);
     let atlas = atlas::get();
@@ -309,6 +316,9 @@ pub(crate) fn solve_all(target: &PlanarPose, options: &SolveOptions) -> All {
     let mut starts = 0;
     for start in &list {
         if super::deadline::expired() {
+            break;
+        }
+        if total_budget.is_some_and(|b| counts.iterations >= b) && !solutions.is_empty() {
             break;
         }
         starts += 1;

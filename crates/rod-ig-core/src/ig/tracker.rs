@@ -133,7 +133,7 @@ impl Tracker {
             // J(1, a) (largest σ_min/σ_max): far from the fold det J(1, a) = 0 and from the
             // separatrix λ4 = 0, where branches end or Newton's basin shrinks, so the branch
             // followed afterwards is the easiest to track.
-            let all = robust::solve_all(target, &opts);
+            let all = robust::solve_all(target, &opts, Some(opts.max_iterations));
             let conditioning = |a: &PlanarParams| {
                 model::tip_and_jacobian(a)
                     .ok()

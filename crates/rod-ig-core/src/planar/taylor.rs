@@ -403,7 +403,11 @@ impl<T: Measured> Segment<T> {
 /// The rod on [0, 1] as a chain of Taylor steps.
 #[derive(Clone, Debug)]
 pub(crate) struct TaylorRod<T> {
-    segments: Vec<Segment<T>>,
+    /// The first step, inline: a near-relaxed rod is one step, and the solvers evaluate
+    /// thousands of them, so no heap allocation for it.
+    first: Option<Segment<T>>,
+    /// Later steps (multi-step rods only).
+    rest: Vec<Segment<T>>,
     end: [T; SERIES],
 }
 
@@ -417,7 +421,8 @@ impl<T: Measured> TaylorRod<T> {
         state[K] = a3;
         state[C] = T::constant(1.0);
         let mut t0 = 0.0f64;
-        let mut segments = Vec::new();
+        let mut first = None;
+        let mut rest = Vec::new();
         for _ in 0..max_steps {
             let seg = step(&state, a4, a5, t0, 1.0 - t0)?;
             state = seg.state_at_end();
@@ -429,11 +434,16 @@ impl<T: Measured> TaylorRod<T> {
             }
             t0 = if seg.h >= 1.0 - t0 { 1.0 } else { t0 + seg.h };
             if dense {
-                segments.push(seg);
+                if first.is_none() {
+                    first = Some(seg);
+                } else {
+                    rest.push(seg);
+                }
             }
             if t0 >= 1.0 {
                 return Ok(Self {
-                    segments,
+                    first,
+                    rest,
                     end: state,
                 });
             }
@@ -454,11 +464,15 @@ impl<T: Measured> TaylorRod<T> {
     }
 
     fn segment(&self, t: f64) -> Option<&Segment<T>> {
+        let first = self.first.as_ref()?;
+        if t <= first.t0 + first.h || self.rest.is_empty() {
+            return Some(first);
+        }
         let i = self
-            .segments
+            .rest
             .partition_point(|s| s.t0 + s.h < t)
-            .min(self.segments.len().checked_sub(1)?);
-        self.segments.get(i)
+            .min(self.rest.len() - 1);
+        self.rest.get(i)
     }
 
     /// (x, y, θ) at t ∈ [0, 1] (needs `dense`); None without dense output.
