@@ -23,6 +23,7 @@
 #![warn(missing_docs)]
 
 mod angle;
+mod eft;
 pub mod elliptic;
 mod error;
 pub mod ig;

@@ -13,15 +13,7 @@ use rod_ig_core::planar;
 use rod_ig_core::{PlanarJacobian, PlanarParams};
 
 mod common;
-use common::shared_dir;
-
-fn arr(v: &serde_json::Value) -> Vec<f64> {
-    v.as_array()
-        .expect("array")
-        .iter()
-        .map(|x| x.as_f64().expect("number"))
-        .collect()
-}
+use common::{numbers as arr, shared_dir};
 
 /// Blocks of the file (shared/oracle/README.md).
 const BLOCKS: [(&str, usize, usize); 5] = [

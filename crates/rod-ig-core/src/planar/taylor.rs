@@ -22,6 +22,7 @@
 //! a-posteriori truncation estimate (Jorba & Zou 2005, §3.2). A gently bent rod is covered by one
 //! step from 0 to 1; otherwise h shrinks until the estimate holds at [`MAX_ORDER`].
 
+use crate::eft::{two_prod, two_sum};
 use crate::scalar::Dual3;
 use crate::RodError;
 
@@ -124,28 +125,8 @@ impl DoubleF64 {
         self.hi + self.lo
     }
     #[inline]
-    fn two_sum(a: f64, b: f64) -> (f64, f64) {
-        let s = a + b;
-        let bb = s - a;
-        (s, (a - (s - bb)) + (b - bb))
-    }
-    #[inline]
-    fn split(a: f64) -> (f64, f64) {
-        // Dekker's splitting constant 2^27 + 1.
-        let t = 134_217_729.0 * a;
-        let hi = t - (t - a);
-        (hi, a - hi)
-    }
-    #[inline]
-    fn two_prod(a: f64, b: f64) -> (f64, f64) {
-        let p = a * b;
-        let (ah, al) = Self::split(a);
-        let (bh, bl) = Self::split(b);
-        (p, ((ah * bh - p) + ah * bl + al * bh) + al * bl)
-    }
-    #[inline]
     fn renorm(hi: f64, lo: f64) -> Self {
-        let (hi, lo) = Self::two_sum(hi, lo);
+        let (hi, lo) = two_sum(hi, lo);
         Self { hi, lo }
     }
 }
@@ -154,7 +135,7 @@ impl std::ops::Add for DoubleF64 {
     type Output = Self;
     #[inline]
     fn add(self, o: Self) -> Self {
-        let (s, e) = Self::two_sum(self.hi, o.hi);
+        let (s, e) = two_sum(self.hi, o.hi);
         Self::renorm(s, e + self.lo + o.lo)
     }
 }
@@ -179,7 +160,7 @@ impl std::ops::Mul for DoubleF64 {
     type Output = Self;
     #[inline]
     fn mul(self, o: Self) -> Self {
-        let (p, e) = Self::two_prod(self.hi, o.hi);
+        let (p, e) = two_prod(self.hi, o.hi);
         Self::renorm(p, e + self.hi * o.lo + self.lo * o.hi)
     }
 }
@@ -209,13 +190,13 @@ impl Measured for DoubleF64 {
     fn div_n(self, n: f64) -> Self {
         // One Newton-corrected quotient: q = hi/n, remainder exact by two_prod.
         let q1 = self.hi / n;
-        let (p, e) = Self::two_prod(q1, n);
+        let (p, e) = two_prod(q1, n);
         let r = ((self.hi - p) - e + self.lo) / n;
         Self::renorm(q1, r)
     }
     #[inline]
     fn mul_f(self, h: f64) -> Self {
-        let (p, e) = Self::two_prod(self.hi, h);
+        let (p, e) = two_prod(self.hi, h);
         Self::renorm(p, e + self.lo * h)
     }
 }

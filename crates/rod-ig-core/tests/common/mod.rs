@@ -29,3 +29,13 @@ pub fn shared_dir() -> PathBuf {
             )
         })
 }
+
+/// The numbers of a JSON array (panics with a clear message on anything else: test data).
+#[allow(dead_code)] // not every test binary that includes this module reads JSON arrays
+pub fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .expect("array")
+        .iter()
+        .map(|x| x.as_f64().expect("number"))
+        .collect()
+}
