@@ -254,9 +254,9 @@ impl<T: Real> Closed<T> {
     /// True when J (and det J) from this closed form may be off by more than ≈ 1e-9 relative:
     /// near the separatrix (0 < m1 < 1e-7, including near-straight rods under tension), small
     /// m (1e-6 > m, near-straight rods under compression, near-circles above the small-force
-    /// switch) and case III with |Γ| > 8 somewhere on [0, 1]. Callers then take J and the
-    /// stability test from the ODE reference (FINDINGS §4: "fall back to an ODE"), unless
-    /// max(a3², |a4|, |a5|) > 1e6.
+    /// switch) and case III with |Γ| > 8 somewhere on [0, 1]. Callers then take the pose, J and
+    /// the stability test from the Taylor series (FINDINGS §4: "fall back to an ODE"), unless
+    /// max(a3², |a4|, |a5|) > 1e6; see `needs_series` for which one.
     pub fn needs_reference(&self) -> bool {
         self.needs_series() != SeriesNeed::None
     }

@@ -368,11 +368,11 @@ pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
 }
 
 /// Pose q(t, a) and J(t, a) = ∂q(t)/∂a (rows x, y, θ; columns a3, a4, a5), exact up to
-/// rounding: the closed form evaluated in forward-mode dual numbers. In the thin regimes where
-/// those derivatives lose accuracy to cancellation (1 − m < 1e-7 near the separatrix, m < 1e-6
-/// for near-straight rods under compression, see `Closed::needs_reference`), J comes from the
-/// ODE reference (variational equations, rtol 1e-12) instead (FINDINGS §4); the pose is
-/// always the closed form's.
+/// rounding: the closed form evaluated in forward-mode dual numbers, or, for nearly straight,
+/// gently bent and tiny rods (ρ ≤ 2) and in the thin regimes where the closed form's error
+/// estimate fails (1 − m < 1e-7 near the separatrix, m < 1e-6, see `Closed::needs_series`),
+/// the Taylor series in dual numbers (double-double where rounding grows like e^{√‖F‖}).
+/// FINDINGS §4 asks for such a fallback.
 pub fn pose_and_jacobian(
     a: &PlanarParams,
     t: f64,
@@ -413,12 +413,12 @@ pub fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian)
 }
 
 /// Stability of the equilibrium a (Bretl & McCarthy; FINDINGS §5): stable iff det J(t, a) > 0
-/// on (0, 1]. The closed form is trusted for t ≥ 0.02 (below, det J > 0 by its leading term
-/// a3²t⁹/8640 + a5²t¹¹/33600). det J is scanned on a grid whose spacing follows the rod's
-/// wavelength, sign changes are located by regula falsi and local minima refined, so the cost
-/// is a few tens of dual-number evaluations. The margin is FINDINGS §5 `det_min`: the minimum
-/// over t ≥ 0.05 of det J(t)/(t⁹(a3²/8640 + a5²t²/33600)). The straight rod (a3 = a5 = 0) has
-/// det J ≡ 0: unstable, margin 0.
+/// on (0, 1]. g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) is scanned on a grid whose spacing
+/// follows the rod's wavelength (from t = 0.02 on the closed form, 0.01 on the series; below,
+/// det J > 0 by its leading term), sign changes are located by regula falsi and local minima
+/// refined. The margin is FINDINGS §5 `det_min`, min over t ∈ [0.05, 1] of g; the report is
+/// `uncertain` when it lies within its error bound (the closed form first hands such rods to
+/// the series). The straight rod (a3 = a5 = 0) has det J ≡ 0: uncertain, margin 0.
 pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
     check_params(a)?;
     if series_first(a) {
