@@ -138,7 +138,7 @@ fn pct(k: usize, n: usize) -> f64 {
 /// Independent re-check of a returned solution: stable by the stability test (FINDINGS §5)
 /// and Υ(a) within `tolerance` of the target (position and wrapped angle).
 pub fn verify(target: &PlanarPose, a: &PlanarParams, tolerance: f64) -> bool {
-    let Ok((tip, _)) = model::tip_and_jacobian(a) else {
+    let Ok((tip, _)) = model::tip_and_jacobian(a, model::Precision::Fast) else {
         return false;
     };
     let f = model::residual(&tip, target);
@@ -305,7 +305,7 @@ pub fn random_stable_targets(n: usize, seed: u64, bx: ParamBox) -> Vec<(PlanarPa
         if !st.stable {
             continue;
         }
-        let Ok((tip, _)) = model::tip_and_jacobian(&a) else {
+        let Ok((tip, _)) = model::tip_and_jacobian(&a, model::Precision::Fast) else {
             continue;
         };
         out.push((a, tip));
@@ -361,7 +361,7 @@ pub fn random_stable_path(seed: u64, bx: ParamBox, steps: usize, db: f64) -> Vec
     let mut rng = SplitMix64::new(seed);
     let tip_of = |a: &PlanarParams| -> Option<PlanarPose> {
         let st = model::stability(a).ok()?;
-        let (tip, _) = model::tip_and_jacobian(a).ok()?;
+        let (tip, _) = model::tip_and_jacobian(a, model::Precision::Fast).ok()?;
         (st.stable && st.margin > 1e-3).then_some(tip)
     };
     for _ in 0..1000 {

@@ -14,6 +14,7 @@
 //! det J(t, a(s)) has the sign of det J(s t, a): scaling by s < t₁ (the first conjugate time)
 //! brings any a into the stable set ([`pull_into_stable`]).
 
+use super::model::Precision;
 use super::newton::{eval, solve3, Eval};
 use super::scan;
 use crate::{PlanarParams, PlanarPose};
@@ -80,9 +81,18 @@ pub(crate) fn solve_predicted(
 ) -> Local {
     if let Some((a1, r0)) = predicted {
         if max_iterations > 0 {
-            if let Some(e1) = eval(&a1, target) {
+            if let Some(e1) = eval(&a1, target, Precision::for_start(a0)) {
                 if e1.jac.determinant() > 0.0 && e1.norm < (1.0 - 1e-4) * r0 {
-                    let mut out = run(target, a1, e1, alpha, max_iterations - 1, tolerance);
+                    let precision = Precision::for_start(a0);
+                    let mut out = run(
+                        target,
+                        a1,
+                        e1,
+                        precision,
+                        alpha,
+                        max_iterations - 1,
+                        tolerance,
+                    );
                     out.iterations += 1;
                     out.evaluations += 1;
                     return out;
@@ -101,9 +111,10 @@ pub(crate) fn solve_predicted(
         last_a: *a0,
         stop: Stop::BadStart,
     };
-    match eval(a0, target) {
+    let precision = Precision::for_start(a0);
+    match eval(a0, target, precision) {
         Some(e) if e.jac.determinant() > 0.0 => {
-            let mut out = run(target, *a0, e, alpha, max_iterations, tolerance);
+            let mut out = run(target, *a0, e, precision, alpha, max_iterations, tolerance);
             out.evaluations += 1;
             out
         }
@@ -111,11 +122,13 @@ pub(crate) fn solve_predicted(
     }
 }
 
-/// The iteration proper, from an evaluated start (`evaluations` excludes the start's).
+/// The iteration proper, from an evaluated start (`evaluations` excludes the start's), every
+/// evaluation at the start's `precision`.
 fn run(
     target: &PlanarPose,
     a0: PlanarParams,
     e0: Eval,
+    precision: Precision,
     alpha: f64,
     max_iterations: u32,
     tolerance: f64,
@@ -160,7 +173,7 @@ fn run(
             for _ in 0..NEWTON_TRIALS {
                 let trial = a - lambda * p;
                 out.evaluations += 1;
-                if let Some(et) = eval(&trial, target) {
+                if let Some(et) = eval(&trial, target, precision) {
                     if et.jac.determinant() > 0.0 && et.norm <= (1.0 - 1e-4 * lambda) * e.norm {
                         accepted = Some((trial, et));
                         break;
@@ -205,7 +218,7 @@ fn run(
                 let p = if size > 1.0 { p / size } else { p };
                 let trial = a - p;
                 out.evaluations += 1;
-                if let Some(et) = eval(&trial, target) {
+                if let Some(et) = eval(&trial, target, precision) {
                     if et.jac.determinant() > 0.0 && et.norm <= (1.0 - 1e-4) * e.norm {
                         accepted = Some((trial, et));
                         mu *= 0.1;

@@ -25,6 +25,7 @@
 mod atlas;
 pub mod bench;
 pub(crate) mod deadline;
+mod fronts;
 mod local;
 mod model;
 mod newton;

@@ -7,11 +7,35 @@
 use crate::{wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 use nalgebra::Vector3;
 
-/// Υ(a) and J(1, a) (rows x, y, θ; columns a3, a4, a5), for iterations: on ill-conditioned
-/// rods accurate to ≈ 1e-8 only (see `planar::tip_and_jacobian_for_iteration`).
+/// How a solver's iterations evaluate rods near the separatrix, chosen once per start.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Precision {
+    /// The f64 series: errors up to ε·e^{√‖F‖} (≤ 1e-6 where starts choose it).
+    Fast,
+    /// The double-double series where the f64 one would lose more than 1e-6: for starts under
+    /// strong tension.
+    Precise,
+}
+
+impl Precision {
+    /// The precision iterations from `a0` need (`planar::needs_precise_iterations`).
+    pub(crate) fn for_start(a0: &PlanarParams) -> Self {
+        if crate::planar::needs_precise_iterations(a0) {
+            Self::Precise
+        } else {
+            Self::Fast
+        }
+    }
+}
+
+/// Υ(a) and J(1, a) (rows x, y, θ; columns a3, a4, a5), for iterations (see [`Precision`] and
+/// `planar::tip_and_jacobian_for_iteration`).
 #[inline]
-pub(crate) fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-    crate::planar::tip_and_jacobian_for_iteration(a)
+pub(crate) fn tip_and_jacobian(
+    a: &PlanarParams,
+    precision: Precision,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    crate::planar::tip_and_jacobian_for_iteration(a, precision == Precision::Precise)
 }
 
 /// Υ(a) and J(1, a) at full accuracy: for the verification of an answer.

@@ -5,6 +5,7 @@
 //! (det J(t, a) > 0 on (0, 1]); the run fails as soon as one is not. Convergence: position
 //! error and wrapped angle error both ≤ tolerance. A NaN residual never counts as converged.
 
+use super::model::Precision;
 use super::{model, Failure, IgError, Solution};
 use crate::{PlanarJacobian, PlanarParams, PlanarPose};
 use nalgebra::Vector3;
@@ -42,8 +43,8 @@ pub(crate) struct Eval {
     pub norm: f64,
 }
 
-pub(crate) fn eval(a: &PlanarParams, target: &PlanarPose) -> Option<Eval> {
-    eval_from(model::tip_and_jacobian(a).ok()?, target)
+pub(crate) fn eval(a: &PlanarParams, target: &PlanarPose, precision: Precision) -> Option<Eval> {
+    eval_from(model::tip_and_jacobian(a, precision).ok()?, target)
 }
 
 /// The converged iterate `a` re-evaluated at full accuracy: Some when it still meets the
@@ -103,6 +104,7 @@ pub(crate) fn solve(
     tolerance: f64,
 ) -> Result<Solution, Failure> {
     let mut a = *a0;
+    let precision = Precision::for_start(a0);
     let mut last_res = f64::INFINITY;
     let fail = |reason, k, res, a| Failure {
         reason,
@@ -116,7 +118,7 @@ pub(crate) fn solve(
         if super::deadline::expired() {
             return Err(fail(IgError::Deadline { iteration: k }, k, last_res, a));
         }
-        let e = match eval(&a, target) {
+        let e = match eval(&a, target, precision) {
             Some(e) => e,
             None => {
                 return Err(fail(

@@ -4,8 +4,8 @@
 //! is returned.
 
 use super::{
-    atlas, local, model, newton, newton::make_solution, straight, Failure, IgError, Solution,
-    SolveOptions,
+    atlas, fronts, local, model, newton, newton::make_solution, straight, Failure, IgError,
+    Solution, SolveOptions,
 };
 use crate::{PlanarParams, PlanarPose};
 
@@ -102,8 +102,28 @@ struct Starts<'t> {
     /// 0: short list not yet loaded; r ≥ 1: neighbourhood radius loaded.
     stage: usize,
     served: Vec<u32>,
-    /// Small-angle starts for targets near full extension, served after the short list.
-    straight: Option<Vec<PlanarParams>>,
+    /// Model-based starts ([`model_starts`]): served after the short list, and at the end.
+    model: Option<(Vec<PlanarParams>, Vec<PlanarParams>)>,
+}
+
+/// Most small-angle starts ([`straight`]) and strong-tension starts ([`fronts`]) per solve.
+const MODEL_STARTS: usize = 4;
+
+/// The model-based starts for `target`, each list in the order it is served by `pop`: first
+/// the small-angle starts with cheap f64 iterations and the strong-tension starts (double-double
+/// iterations, a few ms each, but only where the target fits the model); second, small-angle
+/// starts under strong tension, served after every atlas seed. Those come from targets so close
+/// to full extension that the small-angle model has roots up to a4 = 1e4; iterated precisely,
+/// they would spend the deadline that the atlas seeds after them need (seen: 5 % of log-scale
+/// targets near full extension lost to the deadline).
+fn model_starts(target: &PlanarPose) -> (Vec<PlanarParams>, Vec<PlanarParams>) {
+    let (mut late, mut early): (Vec<_>, Vec<_>) = straight::starts(target, MODEL_STARTS)
+        .into_iter()
+        .partition(crate::planar::needs_precise_iterations);
+    early.extend(fronts::starts(target, MODEL_STARTS));
+    early.reverse();
+    late.reverse();
+    (early, late)
 }
 
 impl<'t> Starts<'t> {
@@ -112,7 +132,7 @@ impl<'t> Starts<'t> {
         // unstable guess of even index is caught by the final stability test), else brought into
         // the stable set by weighted scaling.
         let guess_eval = |g: &PlanarParams| {
-            model::tip_and_jacobian(g)
+            model::tip_and_jacobian(g, model::Precision::for_start(g))
                 .ok()
                 .map(|(tip, j)| (model::residual(&tip, target).norm(), j.determinant()))
         };
@@ -144,7 +164,7 @@ impl<'t> Starts<'t> {
             pos: 0,
             stage: 0,
             served: Vec::new(),
-            straight: None,
+            model: None,
         };
         if guess.is_some() {
             let atlas = atlas::get();
@@ -191,17 +211,16 @@ impl<'t> Starts<'t> {
             if let Some(g) = self.guess.take() {
                 return Some(as_start(g));
             }
+            let as_model_start = |a| Some((atlas::Start { a, predicted: None }, false));
             if self.stage >= 1 {
                 let target = self.target;
-                let list = self
-                    .straight
-                    .get_or_insert_with(|| straight::starts(target, 4));
-                if let Some(a) = list.pop() {
-                    return Some((atlas::Start { a, predicted: None }, false));
+                let (early, late) = self.model.get_or_insert_with(|| model_starts(target));
+                if let Some(a) = early.pop() {
+                    return as_model_start(a);
                 }
-            }
-            if self.stage >= 3 {
-                return None;
+                if self.stage >= 3 {
+                    return late.pop().and_then(as_model_start);
+                }
             }
             self.buf.clear();
             if self.stage == 0 {
@@ -312,6 +331,14 @@ pub(crate) fn solve_all(
     let mut idx = Vec::new();
     atlas.candidates(target, 1, &mut idx);
     list.extend(idx.iter().take(200).map(|&(_, k)| atlas.start(k, target)));
+    let (early, late) = model_starts(target);
+    list.extend(
+        early
+            .into_iter()
+            .rev()
+            .chain(late.into_iter().rev())
+            .map(|a| atlas::Start { a, predicted: None }),
+    );
     let mut solutions: Vec<Solution> = Vec::new();
     let mut starts = 0;
     for start in &list {

@@ -135,7 +135,7 @@ impl Tracker {
             // followed afterwards is the easiest to track.
             let all = robust::solve_all(target, &opts, Some(opts.max_iterations));
             let conditioning = |a: &PlanarParams| {
-                model::tip_and_jacobian(a)
+                model::tip_and_jacobian(a, model::Precision::Fast)
                     .ok()
                     .map(|(_, j)| {
                         let sv = j.singular_values();

@@ -389,12 +389,27 @@ pub fn pose_and_jacobian(
     )
 }
 
+/// Largest estimated error (ε·e^{√‖F‖}) of the f64 series for which a solver's iterations
+/// use it: beyond (√‖F‖ ≳ 22), the f64 tip has fewer than six correct digits and Newton steps
+/// from it are noise (strong-tension rods, a4 ~ 1e3, were left unsolved).
+const ITERATION_F64_MAX_ERROR: f64 = 1e-6;
+
+/// Whether iterations near `a` need the double-double series near the separatrix
+/// (ε·e^{√‖F‖} > [`ITERATION_F64_MAX_ERROR`]). Solvers decide this once per start, from the
+/// start: a start in the strong-tension regime iterates precisely (a few ms per evaluation),
+/// while an iterate that wanders there from an ordinary start keeps the cheap f64 evaluation
+/// and fails fast instead of spending the deadline.
+pub(crate) fn needs_precise_iterations(a: &PlanarParams) -> bool {
+    a[1].hypot(a[2]).sqrt().exp() * f64::EPSILON > ITERATION_F64_MAX_ERROR
+}
+
 /// q(1) and J(1, a) for the iterations of a solver: as [`tip_and_jacobian`] except on
-/// ill-conditioned rods (near the separatrix), where the f64 series replaces the double-double
-/// one (≈ 100× cheaper, errors up to ≈ 1e-8). Solvers verify their answer with
-/// [`tip_and_jacobian`].
+/// ill-conditioned rods (near the separatrix) when `precise` is false, where the f64 series
+/// replaces the double-double one (≈ 100× cheaper, errors ε·e^{√‖F‖}, see
+/// [`needs_precise_iterations`]). Solvers verify their answer with [`tip_and_jacobian`].
 pub(crate) fn tip_and_jacobian_for_iteration(
     a: &PlanarParams,
+    precise: bool,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     check_params(a)?;
     if series_first(a) {
@@ -402,7 +417,7 @@ pub(crate) fn tip_and_jacobian_for_iteration(
     }
     with_seeded(
         a,
-        |c| pose_and_jac_with(c, a, 1.0, false),
+        |c| pose_and_jac_with(c, a, 1.0, precise),
         || series_pose_and_jac(a, 1.0),
     )
 }

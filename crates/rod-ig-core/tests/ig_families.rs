@@ -1,0 +1,186 @@
+//! Issue 9, point 3: the robust inverse geometry solves ≥ 99.5 % of the targets that stable
+//! rods of every family reach — log-scale, moment with tiny force, small force, tiny, strong
+//! axial force, and the paper's box — for the default and the least-energy objective, and
+//! every success is a verified stable rod.
+//!
+//! Families as in `shared/oracle/relaxed_public.jsonl`'s README, drawn with our own seeds.
+//! Targets: tips of rods our stability test calls stable with a clear verdict, ‖(x, y)‖ < 1.
+//! The deadline is raised to 5 s so that the outcome depends on the iteration budgets, not on
+//! the machine's speed (the 250 ms default cuts ≈ 0.2 % of strong-force solves, whose
+//! evaluations run in double-double; those are reported as `Deadline`, never as success).
+//!
+//! Independent check of each success: tip and stability by the DOP853 reference where it is
+//! accurate (√‖F‖ ≤ 10: its rounding grows like e^{√‖F‖}); under strong force, where no f64
+//! integrator is, by the double-double series, which `relaxed_oracle.rs` checks against
+//! 40-digit references.
+
+use rod_ig_core::ig::{self, Objective, SolveOptions};
+use rod_ig_core::rng::SplitMix64;
+use rod_ig_core::{planar, wrap_angle, PlanarParams, PlanarPose};
+use std::time::Duration;
+
+fn signed_pow10(r: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
+    let v = 10f64.powf(r.range(lo, hi));
+    if r.uniform() < 0.5 {
+        -v
+    } else {
+        v
+    }
+}
+
+fn signed(r: &mut SplitMix64, v: f64) -> f64 {
+    if r.uniform() < 0.5 {
+        -v
+    } else {
+        v
+    }
+}
+
+type Family = (&'static str, fn(&mut SplitMix64) -> PlanarParams);
+
+const FAMILIES: [Family; 6] = [
+    ("log-scale", |r| {
+        PlanarParams::new(
+            signed_pow10(r, -8.0, 0.7),
+            signed_pow10(r, -9.0, 1.5),
+            signed_pow10(r, -9.0, 1.5),
+        )
+    }),
+    ("moment, tiny force", |r| {
+        let a3 = r.range(0.01, 6.0);
+        PlanarParams::new(
+            signed(r, a3),
+            signed_pow10(r, -12.0, -3.0),
+            signed_pow10(r, -12.0, -3.0),
+        )
+    }),
+    ("small force, tiny or no moment", |r| {
+        let a3 = if r.uniform() < 0.2 {
+            0.0
+        } else {
+            signed_pow10(r, -12.0, -3.0)
+        };
+        let a4 = if r.uniform() < 0.2 {
+            0.0
+        } else {
+            signed_pow10(r, -6.0, 0.5)
+        };
+        PlanarParams::new(a3, a4, signed_pow10(r, -6.0, 0.5))
+    }),
+    ("tiny", |r| {
+        PlanarParams::new(
+            signed_pow10(r, -60.0, -6.0),
+            if r.uniform() < 0.2 {
+                0.0
+            } else {
+                signed_pow10(r, -60.0, -6.0)
+            },
+            signed_pow10(r, -60.0, -6.0),
+        )
+    }),
+    ("strong axial force", |r| {
+        PlanarParams::new(
+            signed_pow10(r, -6.0, 0.0),
+            signed_pow10(r, 2.0, 4.0),
+            signed_pow10(r, -6.0, 0.0),
+        )
+    }),
+    ("paper's box", |r| {
+        PlanarParams::new(
+            r.range(-10.0, 10.0),
+            r.range(-100.0, 100.0),
+            r.range(-100.0, 100.0),
+        )
+    }),
+];
+
+/// Up to `n` targets: tips of clearly stable rods of the family, strictly inside the disc.
+fn targets(family: fn(&mut SplitMix64) -> PlanarParams, seed: u64, n: usize) -> Vec<PlanarPose> {
+    let mut r = SplitMix64::new(seed);
+    let mut out = Vec::new();
+    for _ in 0..200 * n {
+        if out.len() == n {
+            break;
+        }
+        let a = family(&mut r);
+        let Ok(st) = planar::stability(&a) else {
+            continue;
+        };
+        if !st.stable || st.uncertain {
+            continue;
+        }
+        let Ok(tip) = planar::tip(&a) else { continue };
+        if tip.x.hypot(tip.y) < 1.0 {
+            out.push(tip);
+        }
+    }
+    out
+}
+
+/// The independent check of a success (see the module docs); `None` when it passes.
+fn check(target: &PlanarPose, a: &PlanarParams, tol: f64) -> Option<String> {
+    use rod_ig_core::ode::planar_reference as reference;
+    let force = a[1].hypot(a[2]);
+    let (tip, stable) = if force.sqrt() <= 10.0 {
+        let (tip, _) = reference::tip_and_jacobian_relative(a, 1e-12).ok()?;
+        (tip, reference::stability(a).ok()?.stable)
+    } else {
+        (planar::tip(a).ok()?, planar::stability(a).ok()?.stable)
+    };
+    let dp = (tip.x - target.x).hypot(tip.y - target.y);
+    let dth = wrap_angle(tip.theta - target.theta).abs();
+    // The reference's own error (rtol 1e-12 through a J of norm ≲ 1e3) on top of the tolerance.
+    let allowance = 1e-8;
+    (dp > tol + allowance || dth > tol + allowance || !stable)
+        .then(|| format!("a = {a:?}: tip {tip:?} vs {target:?} ({dp:e}, {dth:e}), stable {stable}"))
+}
+
+fn run(objective: Objective, per_family: usize, seed: u64) {
+    let opts = SolveOptions {
+        objective,
+        deadline: Duration::from_secs(5),
+        ..SolveOptions::default()
+    };
+    let mut report = String::new();
+    let mut all_ok = true;
+    for (name, family) in FAMILIES {
+        let ts = targets(family, seed, per_family);
+        assert!(
+            ts.len() >= per_family / 2,
+            "{name}: only {} targets",
+            ts.len()
+        );
+        let mut solved = 0;
+        let mut reasons = Vec::new();
+        for t in &ts {
+            match ig::solve(t, &opts) {
+                Ok(s) => {
+                    if let Some(bad) = check(t, &s.a, opts.tolerance) {
+                        panic!("{name}: wrong answer returned as success: {bad}");
+                    }
+                    solved += 1;
+                }
+                Err(f) => reasons.push(format!("{t:?}: {}", f.reason)),
+            }
+        }
+        let rate = solved as f64 / ts.len() as f64;
+        report += &format!(
+            "{name}: {solved}/{} ({:.2} %) {reasons:?}\n",
+            ts.len(),
+            100.0 * rate
+        );
+        all_ok &= rate >= 0.995;
+    }
+    eprintln!("{report}");
+    assert!(all_ok, "below 99.5 % in some family:\n{report}");
+}
+
+#[test]
+fn robust_solve_every_family_default_objective() {
+    run(Objective::FirstFound, 400, 91);
+}
+
+#[test]
+fn robust_solve_every_family_least_energy() {
+    run(Objective::LeastEnergy, 150, 92);
+}
