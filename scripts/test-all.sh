@@ -20,6 +20,9 @@ LOGS="${ROD_IG_BUILD:-$REPO/build}/test-logs"
 mkdir -p "$LOGS"
 status=0
 
+echo "== patching dependencies (patches/*.patch onto the crates.io releases)"
+bash "$REPO/scripts/patch-deps.sh" || { echo "patch-deps.sh failed"; exit 1; }
+
 echo "== setting up the Python/ROS environment"
 bash "$REPO/scripts/setup-env.sh" || { echo "setup-env.sh failed"; exit 1; }
 # shellcheck source=scripts/env.sh

@@ -12,8 +12,7 @@ import rodig_harness as h
 
 POS_TOL = 1e-5
 ANG_TOL = 1e-5
-# Responses must fit one UDP datagram for Fast DDS clients on default settings (see
-# launch_notes/README.md, known gaps): ask for a short path.
+# A short path keeps the many-call tests fast (full-size replies: test_service_full_path).
 SMALL = 8
 LOOPBACK_PROFILE = h.REPO / "launch_notes" / "fastdds_loopback_client.xml"
 
@@ -94,21 +93,22 @@ def test_service_bad_target(node_and_client, kw, expected):
     assert node.alive()
 
 
-@pytest.mark.xfail(reason="known gap (RustDDS 0.15.1): a response larger than the client's "
-                          "datagram budget (LAN MTU, ~1.4 kB: more than ~10 path poses) goes out "
-                          "as DATA_FRAG, and RustDDS writes DATA_FRAG inline QoS (the related "
-                          "sample identity) with a stray Option tag byte, so Fast DDS drops every "
-                          "fragment. See launch_notes/README.md, known gaps.", strict=False)
-def test_service_full_path(node_and_client):
+@pytest.mark.parametrize("samples", [None, 1000, 10000], ids=["default", "1000", "10000"])
+def test_service_full_path(node_and_client, samples):
+    """A stock rclpy client (rmw_fastrtps_cpp, default profile) gets replies of every size:
+    the default 100 poses (~9 kB), 1,000 and 10,000 poses (~0.9 MB, thousands of DATA_FRAG
+    submessages). Before patches/rustdds-0.15.1-datafrag-inline-qos.patch every fragmented
+    reply was malformed on the wire and the call hung."""
     _, c = node_and_client
     t = c.make_target(0.6, 0.3, 0.5, h.next_seq())
-    check_response(c.solve(t, timeout=3.0), t, 100)
+    kw = {} if samples is None else dict(path_samples=samples)
+    check_response(c.solve(t, timeout=30.0, **kw), t, samples or 100)
 
 
 def test_service_full_path_loopback_client():
-    """The documented client-side workaround: a Fast DDS client that advertises only its
-    loopback locator (launch_notes/fastdds_loopback_client.xml) gets the full-size response
-    (100 poses, ~9 kB) as one unfragmented DATA. Runs the client in its own process, since
+    """A Fast DDS client that advertises only its loopback locator
+    (launch_notes/fastdds_loopback_client.xml, the workaround before the DATA_FRAG patch) gets
+    the full-size response (100 poses, ~9 kB) too, as one unfragmented DATA. Runs the client in its own process, since
     Fast DDS reads the profile file once per process."""
     domain = h.free_domain()
     node = h.NodeProcess(domain)
