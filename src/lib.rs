@@ -16,4 +16,5 @@ pub mod messages;
 pub mod node;
 pub mod params;
 pub mod pipeline;
+pub mod ros_args;
 pub mod solver;

@@ -5,14 +5,25 @@ use std::process::ExitCode;
 use rod_ig_node::node::{self, MiddlewareConfig};
 use rod_ig_node::params::{self, Command};
 
-fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or(
-        "info,rustdds=error,rustdds::network::udp_listener=off,ros2_client=warn",
-    ))
-    .init();
+/// Console log filter: info, with the DDS libraries' chatter kept down.
+const DEFAULT_LOG_FILTER: &str =
+    "info,rustdds=error,rustdds::network::udp_listener=off,ros2_client=warn";
 
-    let params = match params::parse_args(std::env::args().skip(1)) {
-        Ok(Command::Run(p)) => p,
+fn main() -> ExitCode {
+    let parsed = params::parse_args(std::env::args().skip(1));
+    // `--log-level` wins over RUST_LOG, as the ROS command line does over the environment.
+    let mut logger = env_logger::Builder::from_env(
+        env_logger::Env::default().default_filter_or(DEFAULT_LOG_FILTER),
+    );
+    if let Ok(Command::Run(s)) = &parsed {
+        if let Some(f) = &s.log_filter {
+            logger.parse_filters(f);
+        }
+    }
+    logger.init();
+
+    let startup = match parsed {
+        Ok(Command::Run(s)) => *s,
         Ok(Command::Help) => {
             print!("{}", params::usage());
             return ExitCode::SUCCESS;
@@ -40,7 +51,7 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    match runtime.block_on(node::run(params, mw)) {
+    match runtime.block_on(node::run(startup, mw)) {
         Ok(()) => {
             runtime.shutdown_timeout(std::time::Duration::from_secs(1));
             ExitCode::SUCCESS

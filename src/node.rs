@@ -1,4 +1,7 @@
 //! The ROS 2 side: DDS context, topics, the service, parameters, and the tasks between them.
+//! Names are relative (`rod/target`, ...) and resolved through the command line's
+//! [`NodeIdentity`] (namespace, node name, remapping rules): started plainly they are
+//! `/rod/...`.
 //!
 //! ```text
 //!  /rod/target ──► subscriber task ──watch (latest wins)──► solver task ──► /rod/path
@@ -27,8 +30,9 @@ use tokio::sync::{mpsc, oneshot, watch};
 use crate::messages::{
     type_names, Marker, Path, PoseStamped, RodSolution, SolveRodRequest, SolveRodResponse,
 };
-use crate::params::Params;
+use crate::params::{Params, Startup};
 use crate::pipeline::{Outcome, Overrides, Processor};
+use crate::ros_args::NodeIdentity;
 
 /// The node's name.
 pub const NODE_NAME: &str = "rod_ig_node";
@@ -156,8 +160,57 @@ fn create_context(mw: &MiddlewareConfig) -> Result<Context, NodeError> {
     Context::from_domain_participant(participant).map_err(create_err("ROS context"))
 }
 
+/// The node's relative topic and service names (resolved through [`NodeIdentity`]).
+pub mod names {
+    /// Targets in (geometry_msgs/PoseStamped).
+    pub const TARGET: &str = "rod/target";
+    /// Rod shape out (nav_msgs/Path).
+    pub const PATH: &str = "rod/path";
+    /// Solution out (rod_ig_msgs/RodSolution).
+    pub const SOLUTION: &str = "rod/solution";
+    /// RViz marker out (visualization_msgs/Marker).
+    pub const MARKER: &str = "rod/marker";
+    /// The service (rod_ig_msgs/srv/SolveRod).
+    pub const SOLVE: &str = "rod/solve";
+}
+
+/// `identity.resolve_split(name)` as a ros2-client [`Name`].
+fn resolved_name(identity: &NodeIdentity, name: &str) -> Result<(Name, String), NodeError> {
+    let (ns, base) = identity.resolve_split(name).map_err(create_err("name"))?;
+    let full = if ns == "/" {
+        format!("/{base}")
+    } else {
+        format!("{ns}/{base}")
+    };
+    Ok((Name::new(&ns, &base).map_err(create_err("name"))?, full))
+}
+
+/// A target stamped zero is answered with the node's current ROS time (sim time when
+/// `use_sim_time` is on, as rclcpp's `now()`); other stamps are kept.
+fn stamp_if_zero(target: &mut PoseStamped, now: impl FnOnce() -> crate::messages::Time) {
+    let t = &mut target.header.stamp;
+    if t.sec == 0 && t.nanosec == 0 {
+        *t = now();
+    }
+}
+
+/// The node's current ROS time (sim time when `use_sim_time` is on).
+fn ros_now(node: &ros2_client::Node) -> crate::messages::Time {
+    let nanos = node.time_now().to_nanos();
+    crate::messages::Time {
+        sec: i32::try_from(nanos.div_euclid(1_000_000_000)).unwrap_or(i32::MAX),
+        nanosec: nanos.rem_euclid(1_000_000_000) as u32,
+    }
+}
+
 /// Runs the node until SIGINT or SIGTERM.
-pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> {
+pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError> {
+    let Startup {
+        params,
+        identity,
+        rosout_logs,
+        ..
+    } = startup;
     let context = create_context(&mw)?;
 
     // Parameters: the node's parameter store validates through `Params::validate` and
@@ -167,7 +220,7 @@ pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> 
     let validator_rx = params_rx.clone();
     let setter_tx = Arc::clone(&params_tx);
     let mut options = NodeOptions::new()
-        .enable_rosout(true)
+        .enable_rosout(rosout_logs)
         .start_parameter_services(true)
         .parameter_validator(Box::new(move |name: &str, value: &ParameterValue| {
             validator_rx
@@ -188,7 +241,8 @@ pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> 
         options = options.declare_parameter(name, value);
     }
 
-    let node_name = NodeName::new("/", NODE_NAME).map_err(create_err("node name"))?;
+    let node_name =
+        NodeName::new(&identity.namespace, &identity.name).map_err(create_err("node name"))?;
     let mut node = context
         .new_node(node_name, options)
         .map_err(create_err("node"))?;
@@ -197,14 +251,17 @@ pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> 
     };
 
     let qos = topic_qos();
-    let topic = |node: &mut ros2_client::Node, name: &str, ty| {
-        let n = Name::new("/rod", name).map_err(create_err("topic name"))?;
+    let mut resolved = Vec::new();
+    let mut topic = |node: &mut ros2_client::Node, name: &str, ty| {
+        let (n, full) = resolved_name(&identity, name)?;
+        resolved.push(full);
         node.create_topic(&n, ty, &qos).map_err(create_err("topic"))
     };
-    let target_topic = topic(&mut node, "target", type_names::pose_stamped())?;
-    let path_topic = topic(&mut node, "path", type_names::path())?;
-    let solution_topic = topic(&mut node, "solution", type_names::rod_solution())?;
-    let marker_topic = topic(&mut node, "marker", type_names::marker())?;
+    let target_topic = topic(&mut node, names::TARGET, type_names::pose_stamped())?;
+    let path_topic = topic(&mut node, names::PATH, type_names::path())?;
+    let solution_topic = topic(&mut node, names::SOLUTION, type_names::rod_solution())?;
+    let marker_topic = topic(&mut node, names::MARKER, type_names::marker())?;
+    let (solve_name, solve_full) = resolved_name(&identity, names::SOLVE)?;
 
     let subscription = node
         .create_subscription::<PoseStamped>(&target_topic, Some(qos.clone()))
@@ -223,7 +280,7 @@ pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> 
     let server = node
         .create_server::<SolveRodRequest, SolveRodResponse>(
             ServiceMapping::Enhanced,
-            &Name::new("/rod", "solve").map_err(create_err("service name"))?,
+            &solve_name,
             &type_names::solve_rod(),
             qos.clone(),
             qos.clone(),
@@ -231,6 +288,15 @@ pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> 
         .map_err(create_err("/rod/solve service"))?;
 
     let spinner = node.spinner().map_err(create_err("spinner"))?;
+    if params.use_sim_time {
+        // The declaration above holds the start-up value; setting it again makes the
+        // parameter store switch its clock (and announce it on /parameter_events).
+        node.set_parameter("use_sim_time", ParameterValue::Boolean(true))
+            .map_err(|e| NodeError::Create {
+                what: "use_sim_time",
+                reason: e,
+            })?;
+    }
     let spin_task = tokio::spawn(async move {
         if let Err(e) = spinner.spin().await {
             log::error!("spinner stopped: {e:?}");
@@ -246,11 +312,14 @@ pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> 
     let sub_log = Logger {
         handle: node.logging_handle(),
     };
+    let node = Arc::new(node);
+    let clock_node = Arc::clone(&node);
     let subscriber_task = tokio::spawn(async move {
         let mut stream = pin!(subscription.async_stream());
         while let Some(item) = stream.next().await {
             match item {
-                Ok((msg, _info)) => {
+                Ok((mut msg, _info)) => {
+                    stamp_if_zero(&mut msg, || ros_now(&clock_node));
                     sub_stats.received.fetch_add(1, Ordering::Relaxed);
                     target_tx.send_replace(Some(msg));
                 }
@@ -264,10 +333,11 @@ pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> 
     let srv_log = Logger {
         handle: node.logging_handle(),
     };
+    let srv_clock = Arc::clone(&node);
     let service_task = tokio::spawn(async move {
         let mut stream = pin!(server.receive_request_stream());
         while let Some(item) = stream.next().await {
-            let (id, request) = match item {
+            let (id, mut request) = match item {
                 Ok(r) => r,
                 Err(e) => {
                     srv_log.warn(&format!("/rod/solve: dropped a bad request: {e:?}"));
@@ -275,6 +345,7 @@ pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> 
                 }
             };
             srv_stats.service_calls.fetch_add(1, Ordering::Relaxed);
+            stamp_if_zero(&mut request.target, || ros_now(&srv_clock));
             let (reply_tx, reply_rx) = oneshot::channel();
             if job_tx.send((request, reply_tx)).await.is_err() {
                 break; // solver task gone: shutting down
@@ -301,13 +372,27 @@ pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> 
     ));
 
     logger.info(&format!(
-        "{NODE_NAME} ready: domain {}{}, rod_length {} m, path_samples {}, method {}; \
-         subscribed /rod/target, publishing /rod/path /rod/solution /rod/marker, service /rod/solve",
+        "{} ready: domain {}{}, rod_length {} m, path_samples {}, method {}{}; \
+         subscribed {}, publishing {} {} {}, service {solve_full}",
+        identity.fully_qualified_name(),
         mw.domain_id,
-        if mw.localhost_only { " (loopback only)" } else { "" },
+        if mw.localhost_only {
+            " (loopback only)"
+        } else {
+            ""
+        },
         params.rod_length,
         params.path_samples,
-        params.method.as_str()
+        params.method.as_str(),
+        if params.use_sim_time {
+            ", sim time (/clock)"
+        } else {
+            ""
+        },
+        resolved[0],
+        resolved[1],
+        resolved[2],
+        resolved[3],
     ));
 
     let signal = wait_for_signal().await;
@@ -318,9 +403,11 @@ pub async fn run(params: Params, mw: MiddlewareConfig) -> Result<(), NodeError> 
         stats.failed.load(Ordering::Relaxed),
         stats.service_calls.load(Ordering::Relaxed),
     ));
-    subscriber_task.abort();
-    service_task.abort();
-    solver_task.abort();
+    for task in [subscriber_task, service_task, solver_task] {
+        task.abort();
+        // Awaited so that the tasks' clones of the node are dropped before the node.
+        let _ = task.await;
+    }
     // Dropping the node tells the spinner to stop (stop_spinner() too, but then the drop
     // would log an error).
     drop(node);

@@ -1,14 +1,17 @@
 //! The node's parameters: defaults, validation, start-up parsing (command line and ROS 2
 //! parameter YAML files) and conversion to and from ROS `ParameterValue`s.
 //!
-//! ros2-client does not parse `--ros-args`; [`parse_args`] handles the subset a user needs:
-//! `--ros-args`, `-p name:=value` / `--param name:=value`, `--params-file FILE`, `-h`/`--help`.
-//! At run time the same validation ([`Params::apply`]) guards the ROS parameter services.
+//! ros2-client does not parse `--ros-args`; [`parse_args`] reads the command line with
+//! [`crate::ros_args`] (remapping, namespaces, `-p`, `--params-file`, `--log-level`, ...) and
+//! applies the parameter sources in order. At run time the same validation
+//! ([`Params::apply`]) guards the ROS parameter services.
 
 use std::path::{Path, PathBuf};
 
 use ros2_client::ParameterValue;
 use thiserror::Error;
+
+use crate::ros_args::{self, NodeIdentity, ParamSource};
 
 /// Solver method, as named in the `method` parameter.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -71,6 +74,9 @@ pub struct Params {
     /// `deadline_ms` in (0, 10000]: wall-time budget of one solve (default 250 ms, the
     /// library's `ig::DEFAULT_DEADLINE`); a solve that runs out answers "deadline reached".
     pub deadline_ms: f64,
+    /// `use_sim_time` (rclcpp's built-in): stamp outputs of targets stamped zero with the time
+    /// of `/clock` (rosgraph_msgs/msg/Clock) instead of the system clock.
+    pub use_sim_time: bool,
 }
 
 impl Default for Params {
@@ -88,6 +94,7 @@ impl Default for Params {
             marker_width: 0.01,
             solve_3d: false,
             deadline_ms: rod_ig_core::ig::DEFAULT_DEADLINE.as_secs_f64() * 1e3,
+            use_sim_time: false,
         }
     }
 }
@@ -130,7 +137,7 @@ pub enum ParamError {
 }
 
 /// The names of all parameters, in declaration order.
-pub const NAMES: [&str; 12] = [
+pub const NAMES: [&str; 13] = [
     "rod_length",
     "base_frame",
     "path_samples",
@@ -143,6 +150,7 @@ pub const NAMES: [&str; 12] = [
     "marker_width",
     "solve_3d",
     "deadline_ms",
+    "use_sim_time",
 ];
 
 fn type_name(v: &ParameterValue) -> String {
@@ -287,6 +295,7 @@ impl Params {
                 })?;
                 self.deadline_ms = v;
             }
+            "use_sim_time" => self.use_sim_time = boolean(name, value)?,
             _ => return Err(ParamError::Unknown(name.into())),
         }
         Ok(())
@@ -312,6 +321,7 @@ impl Params {
             "marker_width" => ParameterValue::Double(self.marker_width),
             "solve_3d" => ParameterValue::Boolean(self.solve_3d),
             "deadline_ms" => ParameterValue::Double(self.deadline_ms),
+            "use_sim_time" => ParameterValue::Boolean(self.use_sim_time),
             _ => return None,
         })
     }
@@ -328,10 +338,23 @@ impl Params {
 /// What the command line asks for.
 #[derive(Debug, PartialEq)]
 pub enum Command {
-    /// Run the node with these parameters.
-    Run(Params),
+    /// Run the node.
+    Run(Box<Startup>),
     /// Print the usage text and exit.
     Help,
+}
+
+/// Everything the node starts with.
+#[derive(Debug, PartialEq)]
+pub struct Startup {
+    /// Parameters after every `-p` and `--params-file`, in order.
+    pub params: Params,
+    /// Node name, namespace and remapping rules.
+    pub identity: NodeIdentity,
+    /// Console log filter from `--log-level`, if given.
+    pub log_filter: Option<String>,
+    /// Publish logs on /rosout (`--disable-rosout-logs` turns it off).
+    pub rosout_logs: bool,
 }
 
 /// Usage text for `--help`.
@@ -339,8 +362,11 @@ pub fn usage() -> String {
     let d = Params::default();
     format!(
         "rod_ig_node: ROS 2 node serving elastic-rod inverse geometry.\n\n\
-         Usage: rod_ig_node [--ros-args] [-p NAME:=VALUE]... [--params-file FILE]...\n\n\
-         Later settings override earlier ones. Parameters (default):\n\
+         Usage: rod_ig_node [--ros-args [-r FROM:=TO]... [-p NAME:=VALUE]... [--params-file FILE]...\n\
+         \x20                  [--log-level [LOGGER:=]LEVEL]... [--]]\n\n\
+         ROS 2 arguments as rcl reads them: -r __ns:=/NS and -r __node:=NAME move and rename the\n\
+         node, -r rod/target:=/arm/goal remaps a topic or service (names are relative: rod/...\n\
+         in the node's namespace). Later settings override earlier ones. Parameters (default):\n\
          \x20 rod_length        m, > 0 ({})\n\
          \x20 base_frame        frame_id when a target has none ({:?})\n\
          \x20 path_samples      poses per path, 2..100000 ({})\n\
@@ -352,7 +378,8 @@ pub fn usage() -> String {
          \x20 publish_marker    publish /rod/marker ({})\n\
          \x20 marker_width      m ({})\n\
          \x20 solve_3d          answer non-planar targets with the 3-D solver ({})\n\
-         \x20 deadline_ms       wall-time budget of one solve, ms, <= 10000 ({})\n\n\
+         \x20 deadline_ms       wall-time budget of one solve, ms, <= 10000 ({})\n\
+         \x20 use_sim_time      stamp with /clock time (rosgraph_msgs/Clock) ({})\n\n\
          Environment: ROS_DOMAIN_ID (0..232), ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST or\n\
          ROS_LOCALHOST_ONLY=1 (loopback only), RUST_LOG (console log level).\n",
         d.rod_length,
@@ -367,6 +394,7 @@ pub fn usage() -> String {
         d.marker_width,
         d.solve_3d,
         d.deadline_ms,
+        d.use_sim_time,
     )
 }
 
@@ -397,41 +425,61 @@ fn yaml_to_value(v: &serde_yaml::Value) -> Option<ParameterValue> {
     })
 }
 
-/// Parses the command line (without the program name) into a [`Command`].
+/// Parses the command line (without the program name) into a [`Command`]: the node's
+/// identity (default `rod_ig_node` in `/`, see [`crate::node::NODE_NAME`]), then every
+/// parameter source in order.
 pub fn parse_args<I, S>(args: I) -> Result<Command, ParamError>
 where
     I: IntoIterator<Item = S>,
     S: AsRef<str>,
 {
+    let ros = ros_args::parse(args).map_err(|e| ParamError::Args(e.to_string()))?;
+    if ros.help {
+        return Ok(Command::Help);
+    }
+    if let Some(extra) = ros.unparsed.first() {
+        return Err(ParamError::Args(format!(
+            "unexpected argument {extra:?} (see --help)"
+        )));
+    }
+    let identity = ros
+        .identity(crate::node::NODE_NAME, "/")
+        .map_err(|e| ParamError::Args(e.to_string()))?;
     let mut params = Params::default();
-    let mut it = args.into_iter().map(|s| s.as_ref().to_string());
-    while let Some(arg) = it.next() {
-        match arg.as_str() {
-            "-h" | "--help" => return Ok(Command::Help),
-            "--ros-args" | "--" => {}
-            "-p" | "--param" => {
-                let kv = it
-                    .next()
-                    .ok_or_else(|| ParamError::Args(format!("{arg} needs NAME:=VALUE")))?;
-                let (name, value) = kv
-                    .split_once(":=")
-                    .ok_or_else(|| ParamError::Args(format!("{arg} {kv}: expected NAME:=VALUE")))?;
+    let keys = node_keys(&identity);
+    for source in &ros.params {
+        match source {
+            ParamSource::Value { node, name, value } => {
+                if node
+                    .as_deref()
+                    .is_some_and(|n| n != identity.name && n != crate::node::NODE_NAME)
+                {
+                    continue; // for another node
+                }
                 params.apply(name.trim(), &parse_value(value))?;
             }
-            "--params-file" => {
-                let file = it
-                    .next()
-                    .ok_or_else(|| ParamError::Args("--params-file needs a FILE".into()))?;
-                load_params_file(&mut params, Path::new(&file))?;
-            }
-            other => {
-                return Err(ParamError::Args(format!(
-                    "unsupported argument {other:?} (see --help)"
-                )))
-            }
+            ParamSource::File(path) => load_params_file_for(&mut params, path, &keys)?,
         }
     }
-    Ok(Command::Run(params))
+    Ok(Command::Run(Box::new(Startup {
+        params,
+        identity,
+        log_filter: ros.log_filter(),
+        rosout_logs: ros.rosout_logs.unwrap_or(true),
+    })))
+}
+
+/// The keys a parameters file may use for this node: its name, its fully qualified name (with
+/// and without the leading `/`), and the wildcards `/**` and `**`.
+fn node_keys(identity: &NodeIdentity) -> Vec<String> {
+    let fq = identity.fully_qualified_name();
+    vec![
+        identity.name.clone(),
+        fq.trim_start_matches('/').to_string(),
+        fq,
+        "/**".into(),
+        "**".into(),
+    ]
 }
 
 /// Node-name keys a ROS 2 parameters file may use for this node.
@@ -442,12 +490,22 @@ const NODE_KEYS: [&str; 4] = ["rod_ig_node", "/rod_ig_node", "/**", "**"];
 /// warning (a shared file may configure other nodes' parameters, e.g. `use_sim_time`, under
 /// `/**`); invalid values of known ones are errors.
 pub fn load_params_file(params: &mut Params, path: &Path) -> Result<(), ParamError> {
+    let keys: Vec<String> = NODE_KEYS.iter().map(|k| k.to_string()).collect();
+    load_params_file_for(params, path, &keys)
+}
+
+/// [`load_params_file`] for a node known under `keys` (see `node_keys`).
+fn load_params_file_for(
+    params: &mut Params,
+    path: &Path,
+    keys: &[String],
+) -> Result<(), ParamError> {
     let file_err = |reason: String| ParamError::File {
         path: path.to_path_buf(),
         reason,
     };
     let text = std::fs::read_to_string(path).map_err(|e| file_err(e.to_string()))?;
-    apply_params_yaml(params, &text).map_err(|e| match e {
+    apply_params_yaml_for(params, &text, keys).map_err(|e| match e {
         ParamError::File { reason, .. } => file_err(reason),
         other => file_err(other.to_string()),
     })
@@ -455,6 +513,15 @@ pub fn load_params_file(params: &mut Params, path: &Path) -> Result<(), ParamErr
 
 /// Applies the text of a ROS 2 parameters file (see [`load_params_file`]).
 pub fn apply_params_yaml(params: &mut Params, text: &str) -> Result<(), ParamError> {
+    let keys: Vec<String> = NODE_KEYS.iter().map(|k| k.to_string()).collect();
+    apply_params_yaml_for(params, text, &keys)
+}
+
+fn apply_params_yaml_for(
+    params: &mut Params,
+    text: &str,
+    keys: &[String],
+) -> Result<(), ParamError> {
     let err = |reason: String| ParamError::File {
         path: PathBuf::new(),
         reason,
@@ -466,7 +533,7 @@ pub fn apply_params_yaml(params: &mut Params, text: &str) -> Result<(), ParamErr
     let mut found = false;
     for (key, section) in top {
         let Some(key) = key.as_str() else { continue };
-        if !NODE_KEYS.contains(&key) {
+        if !keys.iter().any(|k| k == key) {
             continue;
         }
         let Some(ros_params) = section.get("ros__parameters") else {
@@ -498,7 +565,7 @@ pub fn apply_params_yaml(params: &mut Params, text: &str) -> Result<(), ParamErr
     } else {
         Err(err(format!(
             "no section for this node (expected one of {})",
-            NODE_KEYS.join(", ")
+            keys.join(", ")
         )))
     }
 }
@@ -509,7 +576,7 @@ mod tests {
 
     fn run(args: &[&str]) -> Result<Params, ParamError> {
         match parse_args(args)? {
-            Command::Run(p) => Ok(p),
+            Command::Run(s) => Ok(s.params),
             Command::Help => panic!("unexpected help"),
         }
     }

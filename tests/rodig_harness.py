@@ -153,9 +153,12 @@ class Client:
     """An rclpy node on `domain` talking to rod_ig_node; callbacks run in a background thread."""
 
     def __init__(self, domain: int, name: str = "rod_ig_test_client", keep: int = 100_000,
-                 path_only: bool = False):
+                 path_only: bool = False, ns: str = "", node_fqn: str = "/rod_ig_node",
+                 target_topic: str | None = None):
         """path_only: subscribe to /rod/path alone (the latency benchmark), so the client's
-        executor does not spend time on /rod/solution, /rod/marker and /rosout messages."""
+        executor does not spend time on /rod/solution, /rod/marker and /rosout messages.
+        ns: the node's namespace (its topics are {ns}/rod/...); node_fqn: its fully qualified
+        name (parameter services); target_topic: where targets go if remapped."""
         self.context = Context()
         self.context.init(domain_id=domain)
         self.node = rclpy.create_node(name, context=self.context)
@@ -167,15 +170,16 @@ class Client:
         self.path_times: dict = {}
         self.keep = keep
         self.on_path = None
-        self.pub = self.node.create_publisher(PoseStamped, "/rod/target", topic_qos())
-        self.node.create_subscription(PathMsg, "/rod/path", self._path_cb, topic_qos())
+        self.ns = ns
+        self.pub = self.node.create_publisher(PoseStamped, target_topic or f"{ns}/rod/target", topic_qos())
+        self.node.create_subscription(PathMsg, f"{ns}/rod/path", self._path_cb, topic_qos())
         if not path_only:
-            self.node.create_subscription(RodSolution, "/rod/solution", self._solution_cb, topic_qos())
-            self.node.create_subscription(Marker, "/rod/marker", self._marker_cb, topic_qos())
+            self.node.create_subscription(RodSolution, f"{ns}/rod/solution", self._solution_cb, topic_qos())
+            self.node.create_subscription(Marker, f"{ns}/rod/marker", self._marker_cb, topic_qos())
             self.node.create_subscription(Log, "/rosout", self._log_cb, topic_qos(1000))
-        self.solve_client = self.node.create_client(SolveRod, "/rod/solve")
-        self.set_client = self.node.create_client(SetParameters, "/rod_ig_node/set_parameters")
-        self.get_client = self.node.create_client(GetParameters, "/rod_ig_node/get_parameters")
+        self.solve_client = self.node.create_client(SolveRod, f"{ns}/rod/solve")
+        self.set_client = self.node.create_client(SetParameters, f"{node_fqn}/set_parameters")
+        self.get_client = self.node.create_client(GetParameters, f"{node_fqn}/get_parameters")
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin, daemon=True)
@@ -226,8 +230,8 @@ class Client:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if (self.pub.get_subscription_count() > 0
-                    and self.node.count_publishers("/rod/path") > 0
-                    and self.node.count_publishers("/rod/solution") > 0
+                    and self.node.count_publishers(f"{self.ns}/rod/path") > 0
+                    and self.node.count_publishers(f"{self.ns}/rod/solution") > 0
                     and self.solve_client.service_is_ready()):
                 time.sleep(0.2)  # let the matching settle on both sides
                 return True
@@ -238,7 +242,7 @@ class Client:
         """Until /rod/target and /rod/path are matched both ways (no service: for the echo)."""
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
-            if self.pub.get_subscription_count() > 0 and self.node.count_publishers("/rod/path") > 0:
+            if self.pub.get_subscription_count() > 0 and self.node.count_publishers(f"{self.ns}/rod/path") > 0:
                 time.sleep(0.2)
                 return True
             time.sleep(0.02)
