@@ -357,19 +357,46 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         }
     });
 
-    // Solver task: owns the Processor (and so the warm start).
+    // Solver thread: owns the Processor (and so the warm start). Solving is CPU-bound (up to
+    // the deadline per call), so it runs on a thread of its own, not on the async runtime's
+    // workers that serve DDS; it builds the inverse-geometry atlas first, so that the first
+    // target costs what later ones do, and the node announces readiness only then.
     let solver_log = Logger {
         handle: node.logging_handle(),
     };
-    let solver_task = tokio::spawn(solver_loop(
-        Processor::new(&params),
-        params_rx,
-        target_rx,
-        job_rx,
-        outputs,
-        Arc::clone(&stats),
-        solver_log,
-    ));
+    let (warm_tx, warm_rx) = oneshot::channel::<usize>();
+    let solver_stats = Arc::clone(&stats);
+    let solver_params = params.clone();
+    let solver_thread = std::thread::Builder::new()
+        .name("rod_ig_solver".into())
+        .spawn(move || {
+            let t0 = std::time::Instant::now();
+            let seeds = rod_ig_core::ig::warm_up();
+            log::debug!("atlas of {seeds} stable rods built in {:?}", t0.elapsed());
+            let _ = warm_tx.send(seeds);
+            let rt = match tokio::runtime::Builder::new_current_thread()
+                .enable_all()
+                .build()
+            {
+                Ok(rt) => rt,
+                Err(e) => {
+                    solver_log.error(&format!("cannot start the solver thread's runtime: {e}"));
+                    return;
+                }
+            };
+            rt.block_on(solver_loop(
+                Processor::new(&solver_params),
+                params_rx,
+                target_rx,
+                job_rx,
+                outputs,
+                solver_stats,
+                solver_log,
+            ));
+        })
+        .map_err(create_err("solver thread"))?;
+    let atlas_seeds = warm_rx.await.unwrap_or(0);
+    log::debug!("solver warm: {atlas_seeds} atlas seeds");
 
     logger.info(&format!(
         "{} ready: domain {}{}, rod_length {} m, path_samples {}, method {}{}; \
@@ -403,11 +430,14 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         stats.failed.load(Ordering::Relaxed),
         stats.service_calls.load(Ordering::Relaxed),
     ));
-    for task in [subscriber_task, service_task, solver_task] {
+    for task in [subscriber_task, service_task] {
         task.abort();
         // Awaited so that the tasks' clones of the node are dropped before the node.
         let _ = task.await;
     }
+    // With the subscriber and the service task gone, the solver loop's channels close and it
+    // returns (after the solve in progress, bounded by its deadline).
+    let _ = tokio::task::spawn_blocking(move || solver_thread.join()).await;
     // Dropping the node tells the spinner to stop (stop_spinner() too, but then the drop
     // would log an error).
     drop(node);

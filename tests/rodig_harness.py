@@ -100,7 +100,9 @@ class NodeProcess:
         self.domain = domain
         log_dir = log_dir or Path(os.environ.get("ROD_IG_TEST_LOGS", REPO / "build" / "test-logs"))
         log_dir.mkdir(parents=True, exist_ok=True)
-        self.log_path = log_dir / f"{binary_name}-domain{domain}-{int(time.time() * 1000)}.log"
+        # Two nodes may start in the same millisecond (namespaced pairs): a counter keeps their
+        # logs apart.
+        self.log_path = log_dir / f"{binary_name}-domain{domain}-{int(time.time() * 1000)}-{next_seq()}.log"
         self._log = open(self.log_path, "wb")
         env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
                    ROS_DISTRO=os.environ.get("ROS_DISTRO", "kilted"),
