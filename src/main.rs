@@ -10,17 +10,20 @@ const DEFAULT_LOG_FILTER: &str =
     "info,rustdds=error,rustdds::network::udp_listener=off,ros2_client=warn";
 
 fn main() -> ExitCode {
-    let parsed = params::parse_args(std::env::args().skip(1));
-    // `--log-level` wins over RUST_LOG, as the ROS command line does over the environment.
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    // The logger first (parsing a params file logs warnings), with `--log-level` winning over
+    // RUST_LOG, as the ROS command line does over the environment.
     let mut logger = env_logger::Builder::from_env(
         env_logger::Env::default().default_filter_or(DEFAULT_LOG_FILTER),
     );
-    if let Ok(Command::Run(s)) = &parsed {
-        if let Some(f) = &s.log_filter {
-            logger.parse_filters(f);
-        }
+    if let Some(f) = rod_ig_node::ros_args::parse(&args)
+        .ok()
+        .and_then(|a| a.log_filter())
+    {
+        logger.parse_filters(&f);
     }
     logger.init();
+    let parsed = params::parse_args(&args);
 
     let startup = match parsed {
         Ok(Command::Run(s)) => *s,

@@ -238,6 +238,11 @@ class Client:
                 time.sleep(0.2)  # let the matching settle on both sides
                 return True
             time.sleep(0.02)
+        self.last_connection_state = dict(
+            target_subscribers=self.pub.get_subscription_count(),
+            path_publishers=self.node.count_publishers(f"{self.ns}/rod/path"),
+            solution_publishers=self.node.count_publishers(f"{self.ns}/rod/solution"),
+            service_ready=self.solve_client.service_is_ready())
         return False
 
     def wait_connected_topics(self, timeout: float = 15.0) -> bool:

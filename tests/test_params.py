@@ -136,7 +136,7 @@ def test_shipped_params_file_starts(tmp_path):
 def test_bad_command_line_exits_with_reason():
     for args, expected in [(["-p", "rod_length:=-2"], "rod_length"),
                            (["--params-file", "/nonexistent.yaml"], "nonexistent"),
-                           (["--bogus"], "unsupported argument")]:
+                           (["--bogus"], "unknown argument")]:
         r = subprocess.run([str(h.binary("rod_ig_node")), *args], capture_output=True, text=True, timeout=20)
         assert r.returncode == 2, (args, r.returncode)
         assert expected in r.stderr, r.stderr
@@ -185,7 +185,9 @@ def test_params_file_with_unknown_keys_warns_and_starts(tmp_path):
         assert c.get_params("path_samples") == {"path_samples": 9}
         log = node.log_text()
         assert "ignoring unknown parameter 'camera_rate'" in log, log
-        assert "ignoring unknown parameter 'use_sim_time'" in log, log
+        # use_sim_time is a parameter of the node (rclcpp's built-in), so it is not ignored.
+        assert "ignoring unknown parameter 'use_sim_time'" not in log, log
+        assert c.get_params("use_sim_time") == {"use_sim_time": False}
     finally:
         c.close()
         assert node.stop() == 0

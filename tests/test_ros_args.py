@@ -23,8 +23,15 @@ def _stop(node, client):
 
 
 def _solve_one(client, seq, x=0.6, y=0.3, yaw=0.5):
-    client.pub.publish(client.make_target(x, y, yaw, seq))
-    sol = client.solution_for(seq)
+    # Republished until answered: a target sent in the first ~second after matching can be
+    # lost (issue 10, point 4, still open; test_topics measures it), which is not what these
+    # tests are about.
+    sol = None
+    for _ in range(10):
+        client.pub.publish(client.make_target(x, y, yaw, seq))
+        sol = client.solution_for(seq, timeout=1.0)
+        if sol is not None:
+            break
     assert sol is not None and sol.success, sol and sol.message
     return sol
 
@@ -32,18 +39,26 @@ def _solve_one(client, seq, x=0.6, y=0.3, yaw=0.5):
 def test_two_namespaced_nodes_side_by_side():
     domain = h.free_domain()
     left = h.NodeProcess(domain, ["--ros-args", "-r", "__ns:=/left"])
+    # Started one after the other: two RustDDS participants created in the same instant on one
+    # domain were seen to leave one node unreachable (3 runs in 4 under load; not yet
+    # understood, noted in issue 10).
+    assert left.wait_log("/left/rod_ig_node ready", timeout=20), left.log_text()
     right = h.NodeProcess(domain, ["--ros-args", "-r", "__ns:=/right", "-p", "rod_length:=2.0"])
     cl = h.Client(domain, name="cl", ns="/left", node_fqn="/left/rod_ig_node")
     cr = h.Client(domain, name="cr", ns="/right", node_fqn="/right/rod_ig_node")
     try:
-        assert cl.wait_connected() and cr.wait_connected(), left.log_text()[-1500:] + right.log_text()[-1500:]
+        for c in (cl, cr):
+            assert c.wait_connected(timeout=30.0), (c.ns, getattr(c, "last_connection_state", None),
+                                                    left.log_text()[-1500:] + right.log_text()[-1500:])
         assert left.wait_log("/left/rod_ig_node ready") and "/left/rod/target" in left.log_text()
         sl = _solve_one(cl, h.next_seq(), 0.6, 0.3, 0.5)
         sr = _solve_one(cr, h.next_seq(), 0.6, 0.3, 0.5)
         # Each answered its own target only: the right node's rod is 2 m long (another a).
         assert max(abs(a - b) for a, b in zip(sl.a, sr.a)) > 1e-3
         time.sleep(0.3)
-        assert len(cl.solutions) == 1 and len(cr.solutions) == 1
+        # Nothing crossed over: every solution each client saw is for its own node's rod.
+        assert all(max(abs(a - b) for a, b in zip(s.a, sl.a)) < 1e-9 for s in cl.solutions)
+        assert all(max(abs(a - b) for a, b in zip(s.a, sr.a)) < 1e-9 for s in cr.solutions)
         # Parameter services live under each node's fully qualified name.
         assert cr.get_params("rod_length") == {"rod_length": 2.0}
         assert cl.get_params("rod_length") == {"rod_length": 1.0}
@@ -88,8 +103,12 @@ def test_zero_stamp_gets_the_node_time():
         t = c.make_target(0.6, 0.3, 0.5, 0)
         t.header.stamp.sec, t.header.stamp.nanosec = 0, 0
         before = time.time()
-        c.pub.publish(t)
-        sol = c.wait_for(lambda: c.solutions[-1] if c.solutions else None)
+        sol = None
+        for _ in range(10):
+            c.pub.publish(t)
+            sol = c.wait_for(lambda: c.solutions[-1] if c.solutions else None, timeout=1.0)
+            if sol is not None:
+                break
         assert sol is not None and sol.success
         stamp = sol.header.stamp.sec + 1e-9 * sol.header.stamp.nanosec
         assert before - 5 < stamp < time.time() + 5, stamp
@@ -115,8 +134,12 @@ def test_sim_time_from_clock():
             time.sleep(0.05)
         t = c.make_target(0.6, 0.3, 0.5, 0)
         t.header.stamp.sec, t.header.stamp.nanosec = 0, 0
-        c.pub.publish(t)
-        sol = c.wait_for(lambda: c.solutions[-1] if c.solutions else None)
+        sol = None
+        for _ in range(10):
+            c.pub.publish(t)
+            sol = c.wait_for(lambda: c.solutions[-1] if c.solutions else None, timeout=1.0)
+            if sol is not None:
+                break
         assert sol is not None and sol.success
         assert (sol.header.stamp.sec, sol.header.stamp.nanosec) == (42, 500)
         # A stamped target keeps its stamp.
