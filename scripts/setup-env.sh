@@ -37,7 +37,7 @@ fi
 PACKAGES=(
     ros-kilted-rclpy ros-kilted-rmw-fastrtps-cpp
     ros-kilted-std-msgs ros-kilted-geometry-msgs ros-kilted-nav-msgs ros-kilted-std-srvs
-    ros-kilted-rcl-interfaces ros-kilted-visualization-msgs
+    ros-kilted-rcl-interfaces ros-kilted-visualization-msgs ros-kilted-diagnostic-msgs ros-kilted-rosgraph-msgs
     ros-kilted-ament-cmake ros-kilted-rosidl-default-generators ros-kilted-ament-package
     ros-kilted-ament-cmake-include-directories ros-kilted-rosidl-core-generators
     ros-kilted-ament-cmake-ros-core catkin_pkg cmake pytest

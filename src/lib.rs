@@ -8,10 +8,12 @@
 //! - [`convert`]: pose ↔ planar target, scaling by rod length and stiffness, path building.
 //! - [`solver`]: the only module that calls `rod_ig_core`.
 //! - [`pipeline`]: one target in, the messages to publish out (no DDS).
+//! - [`diagnostics`]: the solve statistics reported on `/diagnostics`.
 //! - [`node`]: DDS context, topics, service, parameters and tasks.
 #![warn(missing_docs)]
 
 pub mod convert;
+pub mod diagnostics;
 pub mod messages;
 pub mod node;
 pub mod params;

@@ -22,7 +22,8 @@ fn main() -> ExitCode {
     {
         logger.parse_filters(&f);
     }
-    logger.init();
+    // Milliseconds: start-up and matching events are a few ms apart (ROS logs stamp finer).
+    logger.format_timestamp_millis().init();
     let parsed = params::parse_args(&args);
 
     let startup = match parsed {

@@ -288,6 +288,40 @@ pub struct SolveRodResponse {
 }
 impl Message for SolveRodResponse {}
 
+/// `diagnostic_msgs/msg/KeyValue`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct KeyValue {
+    /// What the value is.
+    pub key: String,
+    /// The value, as text.
+    pub value: String,
+}
+
+/// `diagnostic_msgs/msg/DiagnosticStatus`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DiagnosticStatus {
+    /// OK = 0, WARN = 1, ERROR = 2, STALE = 3.
+    pub level: u8,
+    /// What is reported on ("<node>: <task>", as diagnostic_updater names it).
+    pub name: String,
+    /// A human-readable summary.
+    pub message: String,
+    /// The hardware it concerns (empty for software).
+    pub hardware_id: String,
+    /// The figures.
+    pub values: Vec<KeyValue>,
+}
+
+/// `diagnostic_msgs/msg/DiagnosticArray`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DiagnosticArray {
+    /// Stamp of the report.
+    pub header: Header,
+    /// One status per reported task.
+    pub status: Vec<DiagnosticStatus>,
+}
+impl Message for DiagnosticArray {}
+
 /// DDS type names of the topics and the service.
 pub mod type_names {
     use super::*;
@@ -307,6 +341,10 @@ pub mod type_names {
     /// `rod_ig_msgs/msg/RodSolution`.
     pub fn rod_solution() -> MessageTypeName {
         MessageTypeName::new("rod_ig_msgs", "RodSolution")
+    }
+    /// `diagnostic_msgs/msg/DiagnosticArray`.
+    pub fn diagnostic_array() -> MessageTypeName {
+        MessageTypeName::new("diagnostic_msgs", "DiagnosticArray")
     }
     /// `rod_ig_msgs/srv/SolveRod`.
     pub fn solve_rod() -> ServiceTypeName {

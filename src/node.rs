@@ -27,6 +27,7 @@ use ros2_client::{
 use thiserror::Error;
 use tokio::sync::{mpsc, oneshot, watch};
 
+use crate::diagnostics::SolveStats;
 use crate::messages::{
     type_names, Marker, Path, PoseStamped, RodSolution, SolveRodRequest, SolveRodResponse,
 };
@@ -100,12 +101,73 @@ impl MiddlewareConfig {
     }
 }
 
-/// QoS of the topics: reliable, volatile, keep last 10 (rclpy's `create_publisher(T, t, 10)`).
+/// QoS of the topics and the service: reliable, volatile, keep last 10 (rclpy's
+/// `create_publisher(T, topic, 10)`).
 pub fn topic_qos() -> QosProfile {
     QosProfile::publisher_default()
         .reliability_reliable(WhenFull::DEFAULT)
         .durability(Durability::Volatile)
         .history(History::KeepLast { depth: 10 })
+}
+
+/// QoS of the outputs (path, solution, marker): as the service's. Not TRANSIENT_LOCAL:
+/// RustDDS 0.15.1 hands a transient-local writer's history to *volatile* readers too (Fast
+/// DDS does not), so a client that takes "the next solution" would get the previous one.
+pub fn output_qos() -> QosProfile {
+    topic_qos()
+}
+
+/// QoS of the target subscription, from the `qos_overrides` parameters.
+pub fn target_qos(q: &crate::params::TargetQos) -> QosProfile {
+    let base = QosProfile::publisher_default();
+    let base = if q.best_effort {
+        base.reliability_best_effort()
+    } else {
+        base.reliability_reliable(WhenFull::DEFAULT)
+    };
+    base.durability(if q.transient_local {
+        Durability::TransientLocal
+    } else {
+        Durability::Volatile
+    })
+    .history(if q.keep_all {
+        History::KeepAll
+    } else {
+        History::KeepLast {
+            depth: usize::try_from(q.depth).unwrap_or(10),
+        }
+    })
+}
+
+/// A [`crate::params::Descriptor`] as ros2-client's.
+fn ros_descriptor(
+    name: &str,
+    value: &ParameterValue,
+    d: crate::params::Descriptor,
+) -> ros2_client::parameters::ParameterDescriptor {
+    use crate::params::Range;
+    use ros2_client::parameters::NumericRange;
+    ros2_client::parameters::ParameterDescriptor {
+        name: name.to_string(),
+        param_type: value.to_parameter_type(),
+        description: d.description,
+        additional_constraints: d.constraints,
+        read_only: d.read_only,
+        dynamic_typing: false,
+        range: match d.range {
+            Range::Unbounded => NumericRange::NotSpecified,
+            Range::Integer(from_value, to_value) => NumericRange::IntegerRange {
+                from_value,
+                to_value,
+                step: 0,
+            },
+            Range::Double(from_value, to_value) => NumericRange::FloatingPointRange {
+                from_value,
+                to_value,
+                step: 0.0,
+            },
+        },
+    }
 }
 
 /// Console (env_logger) plus /rosout logging.
@@ -131,14 +193,18 @@ impl Logger {
     }
 }
 
-/// Counters reported at shutdown.
+/// Counters reported at shutdown and, with the solve record, on /diagnostics.
 #[derive(Default)]
 struct Stats {
     received: AtomicU64,
     solved: AtomicU64,
     failed: AtomicU64,
     service_calls: AtomicU64,
+    solves: std::sync::Mutex<SolveStats>,
 }
+
+/// Period of the /diagnostics report (diagnostic_updater's default, 1 Hz).
+const DIAGNOSTICS_PERIOD: std::time::Duration = std::time::Duration::from_secs(1);
 
 /// A service request on its way to the solver task, with the slot for the answer.
 type ServiceJob = (SolveRodRequest, oneshot::Sender<SolveRodResponse>);
@@ -172,6 +238,8 @@ pub mod names {
     pub const MARKER: &str = "rod/marker";
     /// The service (rod_ig_msgs/srv/SolveRod).
     pub const SOLVE: &str = "rod/solve";
+    /// Diagnostics out (diagnostic_msgs/DiagnosticArray): absolute, as diagnostic_updater's.
+    pub const DIAGNOSTICS: &str = "/diagnostics";
 }
 
 /// `identity.resolve_split(name)` as a ros2-client [`Name`].
@@ -238,7 +306,10 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
             result
         }));
     for (name, value) in params.to_declarations() {
-        options = options.declare_parameter(name, value);
+        if let Some(d) = params.descriptor(&name) {
+            options = options.describe_parameter(ros_descriptor(&name, &value, d));
+        }
+        options = options.declare_parameter(&name, value);
     }
 
     let node_name =
@@ -251,6 +322,7 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
     };
 
     let qos = topic_qos();
+    let out_qos = output_qos();
     let mut resolved = Vec::new();
     let mut topic = |node: &mut ros2_client::Node, name: &str, ty| {
         let (n, full) = resolved_name(&identity, name)?;
@@ -262,30 +334,26 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
     let solution_topic = topic(&mut node, names::SOLUTION, type_names::rod_solution())?;
     let marker_topic = topic(&mut node, names::MARKER, type_names::marker())?;
     let (solve_name, solve_full) = resolved_name(&identity, names::SOLVE)?;
+    let diagnostics_topic = topic(
+        &mut node,
+        names::DIAGNOSTICS,
+        type_names::diagnostic_array(),
+    )?;
+    let diagnostics_pub = node
+        .create_publisher::<crate::messages::DiagnosticArray>(&diagnostics_topic, Some(qos.clone()))
+        .map_err(create_err("/diagnostics publisher"))?;
 
-    let subscription = node
-        .create_subscription::<PoseStamped>(&target_topic, Some(qos.clone()))
-        .map_err(create_err("/rod/target subscription"))?;
     let outputs = Outputs {
         path: node
-            .create_publisher(&path_topic, Some(qos.clone()))
+            .create_publisher(&path_topic, Some(out_qos.clone()))
             .map_err(create_err("/rod/path publisher"))?,
         solution: node
-            .create_publisher(&solution_topic, Some(qos.clone()))
+            .create_publisher(&solution_topic, Some(out_qos.clone()))
             .map_err(create_err("/rod/solution publisher"))?,
         marker: node
-            .create_publisher(&marker_topic, Some(qos.clone()))
+            .create_publisher(&marker_topic, Some(out_qos.clone()))
             .map_err(create_err("/rod/marker publisher"))?,
     };
-    let server = node
-        .create_server::<SolveRodRequest, SolveRodResponse>(
-            ServiceMapping::Enhanced,
-            &solve_name,
-            &type_names::solve_rod(),
-            qos.clone(),
-            qos.clone(),
-        )
-        .map_err(create_err("/rod/solve service"))?;
 
     let spinner = node.spinner().map_err(create_err("spinner"))?;
     if params.use_sim_time {
@@ -306,56 +374,6 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
     let stats = Arc::new(Stats::default());
     let (target_tx, target_rx) = watch::channel::<Option<PoseStamped>>(None);
     let (job_tx, job_rx) = mpsc::channel::<ServiceJob>(16);
-
-    // Subscriber task: overwrite the single slot with the newest target.
-    let sub_stats = Arc::clone(&stats);
-    let sub_log = Logger {
-        handle: node.logging_handle(),
-    };
-    let node = Arc::new(node);
-    let clock_node = Arc::clone(&node);
-    let subscriber_task = tokio::spawn(async move {
-        let mut stream = pin!(subscription.async_stream());
-        while let Some(item) = stream.next().await {
-            match item {
-                Ok((mut msg, _info)) => {
-                    stamp_if_zero(&mut msg, || ros_now(&clock_node));
-                    sub_stats.received.fetch_add(1, Ordering::Relaxed);
-                    target_tx.send_replace(Some(msg));
-                }
-                Err(e) => sub_log.warn(&format!("/rod/target: dropped a bad message: {e:?}")),
-            }
-        }
-    });
-
-    // Service task: forward each request to the solver task, send back its answer.
-    let srv_stats = Arc::clone(&stats);
-    let srv_log = Logger {
-        handle: node.logging_handle(),
-    };
-    let srv_clock = Arc::clone(&node);
-    let service_task = tokio::spawn(async move {
-        let mut stream = pin!(server.receive_request_stream());
-        while let Some(item) = stream.next().await {
-            let (id, mut request) = match item {
-                Ok(r) => r,
-                Err(e) => {
-                    srv_log.warn(&format!("/rod/solve: dropped a bad request: {e:?}"));
-                    continue;
-                }
-            };
-            srv_stats.service_calls.fetch_add(1, Ordering::Relaxed);
-            stamp_if_zero(&mut request.target, || ros_now(&srv_clock));
-            let (reply_tx, reply_rx) = oneshot::channel();
-            if job_tx.send((request, reply_tx)).await.is_err() {
-                break; // solver task gone: shutting down
-            }
-            let Ok(response) = reply_rx.await else { break };
-            if let Err(e) = server.async_send_response(id, response).await {
-                srv_log.warn(&format!("/rod/solve: cannot send the response: {e:?}"));
-            }
-        }
-    });
 
     // Solver thread: owns the Processor (and so the warm start). Solving is CPU-bound (up to
     // the deadline per call), so it runs on a thread of its own, not on the async runtime's
@@ -398,6 +416,115 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
     let atlas_seeds = warm_rx.await.unwrap_or(0);
     log::debug!("solver warm: {atlas_seeds} atlas seeds");
 
+    // The inputs only now: a client that sees the subscription or the service can count on
+    // an answer at steady-state cost, instead of its first targets being coalesced (latest
+    // wins) behind the warm-up.
+    let subscription = node
+        .create_subscription::<PoseStamped>(&target_topic, Some(target_qos(&params.target_qos)))
+        .map_err(create_err("/rod/target subscription"))?;
+    let server = node
+        .create_server::<SolveRodRequest, SolveRodResponse>(
+            ServiceMapping::Enhanced,
+            &solve_name,
+            &type_names::solve_rod(),
+            qos.clone(),
+            qos.clone(),
+        )
+        .map_err(create_err("/rod/solve service"))?;
+
+    // Subscriber task: overwrite the single slot with the newest target.
+    let sub_stats = Arc::clone(&stats);
+    let sub_log = Logger {
+        handle: node.logging_handle(),
+    };
+    let node = Arc::new(node);
+    let clock_node = Arc::clone(&node);
+    let subscriber_task = tokio::spawn(async move {
+        let mut stream = pin!(subscription.async_stream());
+        while let Some(item) = stream.next().await {
+            match item {
+                Ok((mut msg, _info)) => {
+                    stamp_if_zero(&mut msg, || ros_now(&clock_node));
+                    let t = &msg.header.stamp;
+                    log::debug!(
+                        "/rod/target: received the target stamped {}.{:09}",
+                        t.sec,
+                        t.nanosec
+                    );
+                    sub_stats.received.fetch_add(1, Ordering::Relaxed);
+                    target_tx.send_replace(Some(msg));
+                }
+                Err(e) => sub_log.warn(&format!("/rod/target: dropped a bad message: {e:?}")),
+            }
+        }
+    });
+
+    // Diagnostics task: one DiagnosticArray per period from the solve record.
+    let diag_stats = Arc::clone(&stats);
+    let diag_clock = Arc::clone(&node);
+    let diag_name = format!("{}: inverse geometry", identity.fully_qualified_name());
+    let diagnostics_task = tokio::spawn(async move {
+        let mut tick = tokio::time::interval(DIAGNOSTICS_PERIOD);
+        tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+        tick.tick().await; // the first tick is immediate
+        let mut last = tokio::time::Instant::now();
+        loop {
+            tick.tick().await;
+            let now = tokio::time::Instant::now();
+            let status = {
+                let Ok(mut solves) = diag_stats.solves.lock() else {
+                    break;
+                };
+                solves.report(
+                    &diag_name,
+                    (now - last).as_secs_f64(),
+                    diag_stats.received.load(Ordering::Relaxed),
+                    diag_stats.service_calls.load(Ordering::Relaxed),
+                )
+            };
+            last = now;
+            let msg = crate::messages::DiagnosticArray {
+                header: crate::messages::Header {
+                    stamp: ros_now(&diag_clock),
+                    frame_id: String::new(),
+                },
+                status: vec![status],
+            };
+            if let Err(e) = diagnostics_pub.publish(msg) {
+                log::warn!("cannot publish /diagnostics: {e:?}");
+            }
+        }
+    });
+
+    // Service task: forward each request to the solver task, send back its answer.
+    let srv_stats = Arc::clone(&stats);
+    let srv_log = Logger {
+        handle: node.logging_handle(),
+    };
+    let srv_clock = Arc::clone(&node);
+    let service_task = tokio::spawn(async move {
+        let mut stream = pin!(server.receive_request_stream());
+        while let Some(item) = stream.next().await {
+            let (id, mut request) = match item {
+                Ok(r) => r,
+                Err(e) => {
+                    srv_log.warn(&format!("/rod/solve: dropped a bad request: {e:?}"));
+                    continue;
+                }
+            };
+            srv_stats.service_calls.fetch_add(1, Ordering::Relaxed);
+            stamp_if_zero(&mut request.target, || ros_now(&srv_clock));
+            let (reply_tx, reply_rx) = oneshot::channel();
+            if job_tx.send((request, reply_tx)).await.is_err() {
+                break; // solver task gone: shutting down
+            }
+            let Ok(response) = reply_rx.await else { break };
+            if let Err(e) = server.async_send_response(id, response).await {
+                srv_log.warn(&format!("/rod/solve: cannot send the response: {e:?}"));
+            }
+        }
+    });
+
     logger.info(&format!(
         "{} ready: domain {}{}, rod_length {} m, path_samples {}, method {}{}; \
          subscribed {}, publishing {} {} {}, service {solve_full}",
@@ -430,7 +557,7 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         stats.failed.load(Ordering::Relaxed),
         stats.service_calls.load(Ordering::Relaxed),
     ));
-    for task in [subscriber_task, service_task] {
+    for task in [subscriber_task, service_task, diagnostics_task] {
         task.abort();
         // Awaited so that the tasks' clones of the node are dropped before the node.
         let _ = task.await;
@@ -480,8 +607,9 @@ async fn solver_loop(
                 let params = params_rx.borrow_and_update().clone();
                 let response = match Overrides::from_request(&request) {
                     Ok(overrides) => {
+                        let started = std::time::Instant::now();
                         let outcome = processor.process(&request.target, &params, &overrides);
-                        report(&log, &stats, "/rod/solve", &outcome);
+                        report(&log, &stats, "/rod/solve", &outcome, started.elapsed());
                         SolveRodResponse {
                             path: outcome.path.unwrap_or_else(|| Path {
                                 header: outcome.solution.header.clone(),
@@ -511,15 +639,29 @@ async fn solver_loop(
                     log.info(&format!("parameters now: {:?}", *params_rx.borrow_and_update()));
                 }
                 let params = params_rx.borrow().clone();
+                let started = std::time::Instant::now();
                 let outcome = processor.process(&target, &params, &Overrides::default());
-                report(&log, &stats, "/rod/target", &outcome);
+                report(&log, &stats, "/rod/target", &outcome, started.elapsed());
                 publish(&log, &outputs, outcome);
             }
         }
     }
 }
 
-fn report(log: &Logger, stats: &Stats, source: &str, outcome: &Outcome) {
+fn report(
+    log: &Logger,
+    stats: &Stats,
+    source: &str,
+    outcome: &Outcome,
+    elapsed: std::time::Duration,
+) {
+    if let Ok(mut solves) = stats.solves.lock() {
+        solves.record(
+            outcome.solution.success,
+            &outcome.solution.message,
+            elapsed.as_secs_f64(),
+        );
+    }
     if outcome.solution.success {
         stats.solved.fetch_add(1, Ordering::Relaxed);
         log::debug!("{source}: {}", outcome.solution.message);

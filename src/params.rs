@@ -77,7 +77,43 @@ pub struct Params {
     /// `use_sim_time` (rclcpp's built-in): stamp outputs of targets stamped zero with the time
     /// of `/clock` (rosgraph_msgs/msg/Clock) instead of the system clock.
     pub use_sim_time: bool,
+    /// `qos_overrides.<target topic>.subscription.{reliability,durability,history,depth}`:
+    /// the QoS of the target subscription, read-only (set at start-up), as rclcpp's
+    /// `QosOverridingOptions`.
+    pub target_qos: TargetQos,
+    /// The resolved name of the target topic (`/rod/target` unless remapped or namespaced):
+    /// it names the `qos_overrides` parameters.
+    pub target_topic: String,
 }
+
+/// QoS of the `/rod/target` subscription (see [`Params::target_qos`]). The default,
+/// reliable + volatile + keep last 10, matches rclpy's `create_publisher(T, topic, 10)`; a
+/// BEST_EFFORT (sensor data) publisher needs `reliability: best_effort` here.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TargetQos {
+    /// `reliable` (default) or `best_effort`.
+    pub best_effort: bool,
+    /// `volatile` (default) or `transient_local`.
+    pub transient_local: bool,
+    /// `keep_last` (default) or `keep_all`.
+    pub keep_all: bool,
+    /// `depth` in [1, 10000] for keep_last (default 10).
+    pub depth: i64,
+}
+
+impl Default for TargetQos {
+    fn default() -> Self {
+        Self {
+            best_effort: false,
+            transient_local: false,
+            keep_all: false,
+            depth: 10,
+        }
+    }
+}
+
+/// The QoS policies a `qos_overrides` parameter may set, in declaration order.
+pub const QOS_POLICIES: [&str; 4] = ["reliability", "durability", "history", "depth"];
 
 impl Default for Params {
     fn default() -> Self {
@@ -95,6 +131,8 @@ impl Default for Params {
             solve_3d: false,
             deadline_ms: rod_ig_core::ig::DEFAULT_DEADLINE.as_secs_f64() * 1e3,
             use_sim_time: false,
+            target_qos: TargetQos::default(),
+            target_topic: "/rod/target".into(),
         }
     }
 }
@@ -214,9 +252,74 @@ fn check(name: &str, ok: bool, reason: impl FnOnce() -> String) -> Result<(), Pa
     }
 }
 
+/// One of `choices` (case-insensitive), as a string parameter.
+fn choice(name: &str, v: &ParameterValue, choices: [&str; 2]) -> Result<bool, ParamError> {
+    match v {
+        ParameterValue::String(s) if s.trim().eq_ignore_ascii_case(choices[0]) => Ok(false),
+        ParameterValue::String(s) if s.trim().eq_ignore_ascii_case(choices[1]) => Ok(true),
+        ParameterValue::String(s) => Err(ParamError::Invalid {
+            name: name.into(),
+            reason: format!("{s:?} is not {} or {}", choices[0], choices[1]),
+        }),
+        other => Err(ParamError::WrongType {
+            name: name.into(),
+            expected: "a string",
+            got: type_name(other),
+        }),
+    }
+}
+
 impl Params {
+    /// The name of the `qos_overrides` parameter for `policy` (one of [`QOS_POLICIES`]).
+    pub fn qos_parameter(&self, policy: &str) -> String {
+        format!("qos_overrides.{}.subscription.{policy}", self.target_topic)
+    }
+
+    /// The policy a `qos_overrides` parameter name sets, if it is one of this node's.
+    fn qos_policy_of<'a>(&self, name: &'a str) -> Option<&'a str> {
+        name.strip_prefix("qos_overrides.")?
+            .strip_prefix(self.target_topic.as_str())?
+            .strip_prefix(".subscription.")
+            .filter(|p| QOS_POLICIES.contains(p))
+    }
+
+    /// Every parameter name of this node: [`NAMES`], then the `qos_overrides` ones.
+    pub fn names(&self) -> Vec<String> {
+        NAMES
+            .iter()
+            .map(|n| n.to_string())
+            .chain(QOS_POLICIES.iter().map(|p| self.qos_parameter(p)))
+            .collect()
+    }
+
+    /// Whether `name` is one of this node's parameters.
+    pub fn is_known(&self, name: &str) -> bool {
+        NAMES.contains(&name) || self.qos_policy_of(name).is_some()
+    }
+
+    fn apply_qos(
+        &mut self,
+        name: &str,
+        policy: &str,
+        value: &ParameterValue,
+    ) -> Result<(), ParamError> {
+        let q = &mut self.target_qos;
+        match policy {
+            "reliability" => q.best_effort = choice(name, value, ["reliable", "best_effort"])?,
+            "durability" => {
+                q.transient_local = choice(name, value, ["volatile", "transient_local"])?
+            }
+            "history" => q.keep_all = choice(name, value, ["keep_last", "keep_all"])?,
+            _ => q.depth = integer(name, value, 1, 10_000)?,
+        }
+        Ok(())
+    }
+
     /// Sets parameter `name` to `value` after validating it; on error `self` is unchanged.
     pub fn apply(&mut self, name: &str, value: &ParameterValue) -> Result<(), ParamError> {
+        if let Some(policy) = self.qos_policy_of(name) {
+            return self.apply_qos(name, policy, value);
+        }
         match name {
             "rod_length" => {
                 let v = double(name, value)?;
@@ -308,6 +411,17 @@ impl Params {
 
     /// The value of `name` as a ROS parameter value (the type it is declared with).
     pub fn get(&self, name: &str) -> Option<ParameterValue> {
+        if let Some(policy) = self.qos_policy_of(name) {
+            let q = &self.target_qos;
+            let pick =
+                |b: bool, [a, z]: [&str; 2]| ParameterValue::String(if b { z } else { a }.into());
+            return Some(match policy {
+                "reliability" => pick(q.best_effort, ["reliable", "best_effort"]),
+                "durability" => pick(q.transient_local, ["volatile", "transient_local"]),
+                "history" => pick(q.keep_all, ["keep_last", "keep_all"]),
+                _ => ParameterValue::Integer(q.depth),
+            });
+        }
         Some(match name {
             "rod_length" => ParameterValue::Double(self.rod_length),
             "base_frame" => ParameterValue::String(self.base_frame.clone()),
@@ -327,12 +441,84 @@ impl Params {
     }
 
     /// All parameters as (name, value), to declare them on the node.
-    pub fn to_declarations(&self) -> Vec<(&'static str, ParameterValue)> {
-        NAMES
-            .iter()
-            .filter_map(|n| self.get(n).map(|v| (*n, v)))
+    pub fn to_declarations(&self) -> Vec<(String, ParameterValue)> {
+        self.names()
+            .into_iter()
+            .filter_map(|n| self.get(&n).map(|v| (n, v)))
             .collect()
     }
+
+    /// What `describe_parameters` (`ros2 param describe`) says about `name`.
+    pub fn descriptor(&self, name: &str) -> Option<Descriptor> {
+        use Range::{Double, Integer, Unbounded};
+        let max_deadline = rod_ig_core::ig::MAX_DEADLINE.as_secs_f64() * 1e3;
+        let (description, constraints, range): (&str, String, Range) = if let Some(policy) =
+            self.qos_policy_of(name)
+        {
+            let (what, allowed, range) = match policy {
+                "reliability" => ("reliability", "reliable or best_effort", Unbounded),
+                "durability" => ("durability", "volatile or transient_local", Unbounded),
+                "history" => ("history", "keep_last or keep_all", Unbounded),
+                _ => ("keep_last depth", "1..10000", Integer(1, 10_000)),
+            };
+            return Some(Descriptor {
+                description: format!(
+                    "QoS {what} of the target subscription ({}); start-up only",
+                    self.target_topic
+                ),
+                constraints: allowed.into(),
+                read_only: true,
+                range,
+            });
+        } else {
+            match name {
+                "rod_length" => ("Physical length L of the rod (m); outputs are scaled by it", "> 0".into(), Unbounded),
+                "base_frame" => ("frame_id used when a target's frame_id is empty (the base gripper's frame)", String::new(), Unbounded),
+                "path_samples" => ("Poses per published nav_msgs/Path", String::new(), Integer(2, 100_000)),
+                "tolerance" => ("Solver convergence tolerance on the tip pose (normalised by rod length)", format!("[{:e}, 1)", rod_ig_core::ig::MIN_TOLERANCE), Unbounded),
+                "max_iterations" => ("Solver iteration limit per solve", String::new(), Integer(1, 100_000)),
+                "method" => ("Solver: robust (stable, default) or newton (the paper's iteration)", "robust or newton".into(), Unbounded),
+                "bending_stiffness" => ("Bending stiffness EI (N m^2) for the wrench and energy in joules; 0 = unknown", ">= 0".into(), Unbounded),
+                "planar_tolerance" => ("Largest |z| (m) and tilt out of the plane (rad) accepted as planar", String::new(), Double(0.0, 0.5)),
+                "publish_marker" => ("Publish the RViz line strip on rod/marker", String::new(), Unbounded),
+                "marker_width" => ("Line width of the marker (m)", "> 0".into(), Unbounded),
+                "solve_3d" => ("Answer non-planar targets with the 3-D solver instead of rejecting them", String::new(), Unbounded),
+                "deadline_ms" => ("Wall-time budget of one solve (ms); a solve that runs out answers 'deadline reached'", "> 0".into(), Double(0.0, max_deadline)),
+                "use_sim_time" => ("Use /clock (rosgraph_msgs/Clock) as the node's time", String::new(), Unbounded),
+                _ => return None,
+            }
+        };
+        Some(Descriptor {
+            description: description.into(),
+            constraints,
+            read_only: false,
+            range,
+        })
+    }
+}
+
+/// A parameter's ROS descriptor (`rcl_interfaces/ParameterDescriptor`), without ROS types.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Descriptor {
+    /// What the parameter does, with its unit.
+    pub description: String,
+    /// Constraints a range cannot express ("> 0", the allowed strings), or empty.
+    pub constraints: String,
+    /// Set at start-up only (`-p`, `--params-file`).
+    pub read_only: bool,
+    /// Numeric range, bounds included.
+    pub range: Range,
+}
+
+/// Numeric range of a [`Descriptor`] (bounds included, as in ROS).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Range {
+    /// No range (or not numeric).
+    Unbounded,
+    /// Integer bounds.
+    Integer(i64, i64),
+    /// Floating-point bounds.
+    Double(f64, f64),
 }
 
 /// What the command line asks for.
@@ -445,7 +631,12 @@ where
     let identity = ros
         .identity(crate::node::NODE_NAME, "/")
         .map_err(|e| ParamError::Args(e.to_string()))?;
-    let mut params = Params::default();
+    let mut params = Params {
+        target_topic: identity
+            .resolve(crate::node::names::TARGET)
+            .map_err(|e| ParamError::Args(e.to_string()))?,
+        ..Params::default()
+    };
     let keys = node_keys(&identity);
     for source in &ros.params {
         match source {
@@ -539,24 +730,25 @@ fn apply_params_yaml_for(
         let Some(ros_params) = section.get("ros__parameters") else {
             return Err(err(format!("section '{key}' has no 'ros__parameters'")));
         };
-        let map = ros_params
-            .as_mapping()
-            .ok_or_else(|| err(format!("'{key}.ros__parameters' must be a mapping")))?;
-        for (name, value) in map {
-            let name = name
-                .as_str()
-                .ok_or_else(|| err("parameter names must be strings".into()))?;
-            if !NAMES.contains(&name) {
+        if !ros_params.is_mapping() {
+            return Err(err(format!("'{key}.ros__parameters' must be a mapping")));
+        }
+        // Nested mappings name parameters with dots, as rcl reads them
+        // (`qos_overrides: {/rod/target: {subscription: {depth: 1}}}`).
+        let mut flat = Vec::new();
+        flatten_yaml("", ros_params, &mut flat).map_err(err)?;
+        for (name, value) in flat {
+            if !params.is_known(&name) {
                 log::warn!(
                     "parameters file: ignoring unknown parameter '{name}' in section '{key}' \
                      (known: {})",
-                    NAMES.join(", ")
+                    params.names().join(", ")
                 );
                 continue;
             }
             let value = yaml_to_value(value)
                 .ok_or_else(|| err(format!("parameter '{name}': unsupported value {value:?}")))?;
-            params.apply(name, &value)?;
+            params.apply(&name, &value)?;
         }
         found = true;
     }
@@ -568,6 +760,31 @@ fn apply_params_yaml_for(
             keys.join(", ")
         )))
     }
+}
+
+/// The leaves of a `ros__parameters` mapping, named by their dotted paths.
+fn flatten_yaml<'a>(
+    prefix: &str,
+    value: &'a serde_yaml::Value,
+    out: &mut Vec<(String, &'a serde_yaml::Value)>,
+) -> Result<(), String> {
+    match value.as_mapping() {
+        Some(map) => {
+            for (k, v) in map {
+                let k = k
+                    .as_str()
+                    .ok_or_else(|| format!("parameter names must be strings, got {k:?}"))?;
+                let name = if prefix.is_empty() {
+                    k.to_string()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                flatten_yaml(&name, v, out)?;
+            }
+        }
+        None => out.push((prefix.to_string(), value)),
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -781,7 +998,7 @@ mod tests {
     fn declarations_round_trip() {
         let p = Params::default();
         let decl = p.to_declarations();
-        assert_eq!(decl.len(), NAMES.len());
+        assert_eq!(decl.len(), NAMES.len() + QOS_POLICIES.len());
         let mut q = Params {
             rod_length: 9.0,
             ..Params::default()

@@ -23,9 +23,8 @@ def _stop(node, client):
 
 
 def _solve_one(client, seq, x=0.6, y=0.3, yaw=0.5):
-    # Republished until answered: a target sent in the first ~second after matching can be
-    # lost (issue 10, point 4, still open; test_topics measures it), which is not what these
-    # tests are about.
+    # Republished until answered (belt and braces: the first target after matching is now
+    # answered, test_ros_citizen checks it; these tests are about names and time).
     sol = None
     for _ in range(10):
         client.pub.publish(client.make_target(x, y, yaw, seq))

@@ -1,0 +1,210 @@
+//! What the node reports on `/diagnostics` (diagnostic_msgs/DiagnosticArray, 1 Hz): solve
+//! rate, failures by reason, latency percentiles, the last error. No DDS here: the node's
+//! solver thread records every solve, a timer task turns the record into a message.
+
+use std::collections::{BTreeMap, VecDeque};
+
+use crate::messages::{DiagnosticStatus, KeyValue};
+
+/// Solve latencies kept for the percentiles: the last this many solves.
+pub const LATENCY_WINDOW: usize = 1000;
+
+/// `DiagnosticStatus.level` values.
+pub mod level {
+    /// All well.
+    pub const OK: u8 = 0;
+    /// Some targets failed in the last period.
+    pub const WARN: u8 = 1;
+}
+
+/// Running record of the node's solves.
+#[derive(Debug, Default)]
+pub struct SolveStats {
+    latencies_s: VecDeque<f64>,
+    solved: u64,
+    failed: u64,
+    failures_by_reason: BTreeMap<String, u64>,
+    last_error: Option<String>,
+    solved_in_period: u64,
+    failed_in_period: u64,
+}
+
+/// The short reason of a failure message, for counting: the text before the first `:`,
+/// and for "solver failed: <reason>: ..." the solver's reason (e.g. "deadline reached").
+pub fn reason_key(message: &str) -> String {
+    let mut parts = message.split(':').map(str::trim);
+    let first = parts.next().unwrap_or_default();
+    let key = match (first, parts.next()) {
+        ("solver failed", Some(reason)) if !reason.is_empty() => reason,
+        _ => first,
+    };
+    let key = key.split(" (").next().unwrap_or(key).trim();
+    let key: String = key.chars().take(48).collect();
+    if key.is_empty() {
+        "unknown".into()
+    } else {
+        key
+    }
+}
+
+impl SolveStats {
+    /// Records one solve: its success, its message (the reason when it failed) and its wall
+    /// time in seconds.
+    pub fn record(&mut self, success: bool, message: &str, seconds: f64) {
+        if seconds.is_finite() && seconds >= 0.0 {
+            if self.latencies_s.len() == LATENCY_WINDOW {
+                self.latencies_s.pop_front();
+            }
+            self.latencies_s.push_back(seconds);
+        }
+        if success {
+            self.solved += 1;
+            self.solved_in_period += 1;
+        } else {
+            self.failed += 1;
+            self.failed_in_period += 1;
+            *self
+                .failures_by_reason
+                .entry(reason_key(message))
+                .or_default() += 1;
+            self.last_error = Some(message.to_string());
+        }
+    }
+
+    /// The `q`-quantile (0..=1) of the kept latencies in seconds, nearest rank; None when no
+    /// solve was recorded.
+    pub fn latency_quantile(&self, q: f64) -> Option<f64> {
+        if self.latencies_s.is_empty() {
+            return None;
+        }
+        let mut v: Vec<f64> = self.latencies_s.iter().copied().collect();
+        v.sort_by(f64::total_cmp);
+        let rank = (q.clamp(0.0, 1.0) * v.len() as f64).ceil() as usize;
+        Some(v[rank.saturating_sub(1).min(v.len() - 1)])
+    }
+
+    /// The status for the period since the last report (`period_s` long), and starts a new
+    /// period. WARN when a target failed in the period, OK otherwise.
+    pub fn report(
+        &mut self,
+        name: &str,
+        period_s: f64,
+        received: u64,
+        service_calls: u64,
+    ) -> DiagnosticStatus {
+        let done = self.solved_in_period + self.failed_in_period;
+        let rate = if period_s > 0.0 {
+            done as f64 / period_s
+        } else {
+            0.0
+        };
+        let ms = |q: f64| {
+            self.latency_quantile(q)
+                .map_or_else(|| "n/a".to_string(), |s| format!("{:.3}", s * 1e3))
+        };
+        let (level, message) = if self.failed_in_period > 0 {
+            (
+                level::WARN,
+                format!(
+                    "{} of {done} solves failed in the last {period_s:.1} s; last error: {}",
+                    self.failed_in_period,
+                    self.last_error.as_deref().unwrap_or("")
+                ),
+            )
+        } else {
+            (
+                level::OK,
+                format!("{done} solves in the last {period_s:.1} s, none failed"),
+            )
+        };
+        let mut values = vec![
+            kv("solves_per_second", format!("{rate:.2}")),
+            kv("solved_total", self.solved.to_string()),
+            kv("failed_total", self.failed.to_string()),
+            kv("targets_received", received.to_string()),
+            kv("service_calls", service_calls.to_string()),
+            kv("latency_p50_ms", ms(0.5)),
+            kv("latency_p99_ms", ms(0.99)),
+            kv("latency_window", self.latencies_s.len().to_string()),
+            kv("last_error", self.last_error.clone().unwrap_or_default()),
+        ];
+        values.extend(
+            self.failures_by_reason
+                .iter()
+                .map(|(reason, n)| kv(&format!("failed: {reason}"), n.to_string())),
+        );
+        self.solved_in_period = 0;
+        self.failed_in_period = 0;
+        DiagnosticStatus {
+            level,
+            name: name.to_string(),
+            message,
+            hardware_id: String::new(),
+            values,
+        }
+    }
+}
+
+fn kv(key: &str, value: String) -> KeyValue {
+    KeyValue {
+        key: key.to_string(),
+        value,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn value<'a>(s: &'a DiagnosticStatus, key: &str) -> &'a str {
+        &s.values.iter().find(|kv| kv.key == key).unwrap().value
+    }
+
+    #[test]
+    fn reasons_are_short_and_grouped() {
+        assert_eq!(
+            reason_key("solver failed: deadline reached (250 ms)"),
+            "deadline reached"
+        );
+        assert_eq!(reason_key("out of reach: |p| = 1.2 > 1"), "out of reach");
+        assert_eq!(reason_key("bad target: NaN in position"), "bad target");
+        assert_eq!(reason_key(""), "unknown");
+    }
+
+    #[test]
+    fn report_counts_rates_and_percentiles() {
+        let mut s = SolveStats::default();
+        for i in 1..=100 {
+            s.record(true, "", f64::from(i) * 1e-3); // 1..100 ms
+        }
+        s.record(false, "out of reach: far", 0.5e-3);
+        s.record(false, "solver failed: deadline reached", 0.25);
+        let r = s.report("/rod_ig_node: inverse geometry", 2.0, 102, 0);
+        assert_eq!(r.level, level::WARN);
+        assert!(r.message.contains("2 of 102"), "{}", r.message);
+        assert_eq!(value(&r, "solves_per_second"), "51.00");
+        assert_eq!(value(&r, "failed: out of reach"), "1");
+        assert_eq!(value(&r, "failed: deadline reached"), "1");
+        assert_eq!(value(&r, "last_error"), "solver failed: deadline reached");
+        // Nearest rank over 102 latencies: p50 is the 51st smallest (50 ms), p99 the 101st
+        // (100 ms).
+        assert_eq!(value(&r, "latency_p50_ms"), "50.000");
+        assert_eq!(value(&r, "latency_p99_ms"), "100.000");
+        // A quiet period is OK, and the totals stay.
+        let r = s.report("n", 1.0, 102, 0);
+        assert_eq!(r.level, level::OK);
+        assert_eq!(value(&r, "solves_per_second"), "0.00");
+        assert_eq!(value(&r, "failed_total"), "2");
+    }
+
+    #[test]
+    fn latency_window_is_bounded() {
+        let mut s = SolveStats::default();
+        for _ in 0..3 * LATENCY_WINDOW {
+            s.record(true, "", 1e-3);
+        }
+        s.record(true, "", f64::NAN);
+        assert_eq!(s.latencies_s.len(), LATENCY_WINDOW);
+        assert_eq!(s.latency_quantile(0.99), Some(1e-3));
+    }
+}
