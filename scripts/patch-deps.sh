@@ -12,6 +12,8 @@ set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="$REPO/build/patched"
 mkdir -p "$OUT"
+# build/ holds Cargo packages (the patched crates) and rod_ig_msgs' build: not for colcon.
+touch "$REPO/build/COLCON_IGNORE"
 
 fetch_crate() { # name version expected_sha -> path of the verified .crate
     local name=$1 version=$2 sha=$3 file

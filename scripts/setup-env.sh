@@ -53,6 +53,10 @@ else
     log "venv $VENV up to date"
 fi
 
+# The venv holds the wheels' share/*/package.xml: a colcon workspace must not take them for
+# its own packages.
+touch "$VENV/COLCON_IGNORE"
+
 # The wheels' exported CMake files hard-code the wheel builder's Python and numpy include
 # paths: point them at this venv's own.
 venv_py_include="$("$VENV/bin/python3" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')"

@@ -48,7 +48,7 @@ cargo_rc=${PIPESTATUS[0]}
 
 echo "== pytest tests/"
 # The binaries built above (rodig_harness.py would otherwise run its own `cargo build -p
-# rod-ig-node`, whose feature set differs from the workspace build's and relinks everything).
+# rod_ig`, whose feature set differs from the workspace build's and relinks everything).
 TARGET="${CARGO_TARGET_DIR:-$REPO/target}"
 export ROD_IG_NODE_BIN="$TARGET/release/rod_ig_node" ROD_IG_ECHO_BIN="$TARGET/release/rod_ig_echo"
 # shellcheck disable=SC2086

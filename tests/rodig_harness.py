@@ -56,7 +56,7 @@ def binary(name: str) -> Path:
         return Path(override)
     if not _built:
         subprocess.run(["bash", str(REPO / "scripts" / "patch-deps.sh")], check=True)
-        subprocess.run(["cargo", "build", "--release", "-p", "rod-ig-node", "--bins"], cwd=REPO, check=True)
+        subprocess.run(["cargo", "build", "--release", "-p", "rod_ig", "--bins"], cwd=REPO, check=True)
         _built = True
     target_dir = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
     return target_dir / "release" / name

@@ -362,9 +362,17 @@ mod tests {
     /// Reads `tests/fixtures/cdr/<name>.hex` and strips the 4-byte encapsulation header
     /// (00 01 00 00 = CDR little endian) that rclpy's `serialize_message` prepends.
     fn fixture(name: &str) -> Vec<u8> {
-        let path: PathBuf = [env!("CARGO_MANIFEST_DIR"), "tests", "fixtures", "cdr", name]
-            .iter()
-            .collect();
+        let path: PathBuf = [
+            env!("CARGO_MANIFEST_DIR"),
+            "..",
+            "..",
+            "tests",
+            "fixtures",
+            "cdr",
+            name,
+        ]
+        .iter()
+        .collect();
         let text = std::fs::read_to_string(&path)
             .unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
         let hex: String = text.split_whitespace().collect();
