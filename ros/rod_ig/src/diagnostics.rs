@@ -30,7 +30,7 @@ pub struct SolveStats {
 }
 
 /// The short reason of a failure message, for counting: the text before the first `:`,
-/// and for "solver failed: <reason>: ..." the solver's reason (e.g. "deadline reached").
+/// and for `"solver failed: <reason>: ..."` the solver's reason (e.g. "deadline reached").
 pub fn reason_key(message: &str) -> String {
     let mut parts = message.split(':').map(str::trim);
     let first = parts.next().unwrap_or_default();
