@@ -73,6 +73,39 @@ def run(binary_name, args, n, warmup):
         node.stop()
 
 
+def first_target(starts, follow=100):
+    """For `starts` fresh nodes: the round trip (publish -> RodSolution seen by rclpy) and the
+    node's solve_time of the first target after "ready", and the medians of both over the
+    `follow` targets after it (the same sweep, tracked)."""
+    first_rt, first_solve, steady_rt, steady_solve = [], [], [], []
+    for _ in range(starts):
+        domain = h.free_domain()
+        node = h.NodeProcess(domain, [])
+        client = h.Client(domain, name="rod_ig_first_target_bench")
+        try:
+            if not client.wait_connected():
+                raise SystemExit(f"no connection; log {node.log_path}")
+            rts, solves = [], []
+            for i in range(follow + 1):
+                u = i / follow
+                seq = h.next_seq()
+                t0 = time.perf_counter()
+                client.pub.publish(client.make_target(0.75 - 0.3 * u, 0.1 + 0.35 * u, 0.2 + 1.2 * u, seq))
+                sol = client.solution_for(seq, timeout=5.0)
+                if sol is None:
+                    raise SystemExit(f"target {i} not answered; log {node.log_path}")
+                rts.append(time.perf_counter() - t0)
+                solves.append(sol.solve_time)
+            first_rt.append(rts[0])
+            first_solve.append(solves[0])
+            steady_rt.append(statistics.median(rts[1:]))
+            steady_solve.append(statistics.median(solves[1:]))
+        finally:
+            client.close()
+            node.stop()
+    return first_rt, first_solve, steady_rt, steady_solve
+
+
 def summary(name, lat, lost):
     return (f"{name:<28} n={len(lat):5d} lost={lost:3d}  p50={percentile(lat, 0.5):7.3f} ms  "
             f"p90={percentile(lat, 0.9):7.3f} ms  p99={percentile(lat, 0.99):7.3f} ms  "
@@ -84,10 +117,21 @@ def main():
     ap.add_argument("--n", type=int, default=1200, help="measured targets per binary, in total (default 1200)")
     ap.add_argument("--warmup", type=int, default=100, help="unmeasured targets first (default 100)")
     ap.add_argument("--samples", type=int, default=100, help="path_samples (default 100)")
+    ap.add_argument("--starts", type=int, default=3,
+                    help="fresh node starts for the first-target figure (default 3)")
     ap.add_argument("--rounds", type=int, default=3,
                     help="alternate echo and node runs this many times, pooling the samples, so "
                          "drifting machine load affects both alike (default 3)")
     a = ap.parse_args()
+
+    first_rt, first_solve, steady_rt, steady_solve = first_target(a.starts)
+    us = lambda xs: ", ".join(f"{x * 1e6:.0f}" for x in xs)  # noqa: E731
+    ratio = max(f / s for f, s in zip(first_rt, steady_rt))
+    print(f"first target after start, {a.starts} fresh nodes: round trip {us(first_rt)} us "
+          f"vs median of the next 100 {us(steady_rt)} us, worst ratio {ratio:.2f} "
+          f"(goal <= 3: {'met' if ratio <= 3 else 'NOT met'}); node solve_time {us(first_solve)} us "
+          f"(a cold start: every stable solution near the target, the best-conditioned kept) vs "
+          f"{us(steady_solve)} us tracked")
 
     echo, node, echo_lost, node_lost = [], [], 0, 0
     per_round = max(1, a.n // a.rounds)
