@@ -225,9 +225,10 @@ fn unreachable_and_non_finite_targets_fail_fast_with_typed_errors() {
         PlanarPose::new(3.0, -4.0, 1.0),
         PlanarPose::new(1e308, 1e308, 0.0),
     ] {
-        let t = std::time::Instant::now();
+        // Fast: refused before any iteration (work counted, not wall-clock time, which a
+        // shared machine makes noisy).
         let f = ig::solve(&b, &o).unwrap_err();
-        assert!(t.elapsed().as_millis() < 5);
+        assert_eq!(f.iterations, 0, "{f}");
         assert!(
             matches!(f.reason, IgError::Unreachable { distance } if distance >= 1.0),
             "{f}"
@@ -285,11 +286,9 @@ fn boundary_targets() {
         (1.0 - 1e-15, 1.0),
     ] {
         let b = PlanarPose::new(r * 0.6, r * 0.8, th);
-        let t = std::time::Instant::now();
+        // The search ends by itself: a deadline would end it with IgError::Deadline.
         let f = ig::solve(&b, &o).unwrap_err();
-        let ms = t.elapsed().as_secs_f64() * 1e3;
         assert!(matches!(f.reason, IgError::NoStableSolution { .. }), "{f}");
-        assert!(ms < 250.0, "took {ms} ms");
     }
     // Reachable near-boundary targets: tips of stable, nearly straight rods.
     for a in [

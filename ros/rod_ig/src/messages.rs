@@ -359,6 +359,89 @@ mod tests {
     use byteorder::LittleEndian;
     use std::path::PathBuf;
 
+    /// Fields (type, name) of a ROS interface definition, in order: comments, blank lines
+    /// and constants skipped, `---` separating the parts of a service.
+    fn interface_fields(text: &str) -> Vec<Vec<(String, String)>> {
+        let mut parts = vec![Vec::new()];
+        for line in text.lines() {
+            let line = line.split('#').next().unwrap_or("").trim();
+            if line == "---" {
+                parts.push(Vec::new());
+                continue;
+            }
+            let mut words = line.split_whitespace();
+            if let (Some(ty), Some(name)) = (words.next(), words.next()) {
+                if !name.contains('=') && !words.any(|w| w.starts_with('=')) {
+                    parts
+                        .last_mut()
+                        .unwrap()
+                        .push((ty.to_string(), name.to_string()));
+                }
+            }
+        }
+        parts
+    }
+
+    /// The hand-written type has the definition's fields, in its order, each of a matching
+    /// kind (bool, number, string, fixed or unbounded array, nested message).
+    fn check_matches_definition<T: Serialize>(value: &T, fields: &[(String, String)], what: &str) {
+        let json = serde_json::to_value(value).unwrap();
+        let obj = json.as_object().unwrap();
+        let names: Vec<&str> = obj.keys().map(String::as_str).collect();
+        let want: Vec<&str> = fields.iter().map(|(_, n)| n.as_str()).collect();
+        assert_eq!(
+            names, want,
+            "{what}: fields differ from its definition in msg/"
+        );
+        for (ty, name) in fields {
+            let v = &obj[name.as_str()];
+            let (base, dims) = match ty.find('[') {
+                Some(i) => (&ty[..i], Some(ty[i + 1..].trim_end_matches(']'))),
+                None => (ty.as_str(), None),
+            };
+            let ok = match dims {
+                Some(n) if n.parse::<usize>().is_ok() => {
+                    v.as_array().map(|a| a.len().to_string()).as_deref() == Some(n)
+                }
+                Some(_) => v.is_array(), // unbounded or bounded (<=N)
+                None => match base {
+                    "bool" => v.is_boolean(),
+                    "string" => v.is_string(),
+                    "float32" | "float64" | "int8" | "uint8" | "int16" | "uint16" | "int32"
+                    | "uint32" | "int64" | "uint64" | "byte" | "char" => v.is_number(),
+                    _ => v.is_object(), // a nested message
+                },
+            };
+            assert!(ok, "{what}.{name}: {v} is not a {ty}");
+        }
+    }
+
+    #[test]
+    fn hand_written_messages_match_their_definitions() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../msg");
+        let read = |p: &str| std::fs::read_to_string(root.join(p)).unwrap();
+        let msg = interface_fields(&read("msg/RodSolution.msg"));
+        assert_eq!(msg.len(), 1);
+        check_matches_definition(&RodSolution::default(), &msg[0], "RodSolution");
+        let srv = interface_fields(&read("srv/SolveRod.srv"));
+        assert_eq!(srv.len(), 2, "SolveRod.srv: request --- response");
+        check_matches_definition(&SolveRodRequest::default(), &srv[0], "SolveRod request");
+        check_matches_definition(&SolveRodResponse::default(), &srv[1], "SolveRod response");
+        // The check itself catches a drift: a field renamed, dropped or retyped.
+        let mut drifted = msg[0].clone();
+        drifted[1].1 = "succeeded".into();
+        let renamed = std::panic::catch_unwind(|| {
+            check_matches_definition(&RodSolution::default(), &drifted, "drifted")
+        });
+        assert!(renamed.is_err());
+        let mut retyped = msg[0].clone();
+        retyped[3].0 = "float64[6]".into();
+        let retyped = std::panic::catch_unwind(|| {
+            check_matches_definition(&RodSolution::default(), &retyped, "retyped")
+        });
+        assert!(retyped.is_err());
+    }
+
     /// Reads `tests/fixtures/cdr/<name>.hex` and strips the 4-byte encapsulation header
     /// (00 01 00 00 = CDR little endian) that rclpy's `serialize_message` prepends.
     fn fixture(name: &str) -> Vec<u8> {
