@@ -48,12 +48,18 @@ pub(crate) enum Stop {
     Deadline,
 }
 
-const MAX_DA3: f64 = 4.0;
+/// Half-width in a3 of the box a step may move in (trust region of one Newton/LM step). a3 is
+/// a moment and a4, a5 forces: the paper's sampling box is |a3| ≤ 2π, |a4|, |a5| ≤ 100, so
+/// the box keeps the same ratio of about 1:10 ([`MAX_DA45`]), ~2/3 and ~2/5 of each half-range.
+/// An engineering choice, not a derivation: it bounds how far one step can jump across
+/// branches while leaving Newton's full step free in the interior of the box.
+pub(crate) const MAX_DA3: f64 = 4.0;
 /// Trials of the backtracking on the Newton direction before switching to LM steps.
 const NEWTON_TRIALS: usize = 5;
 /// LM trials (μ × 10 each) per iteration.
 const LM_TRIALS: usize = 10;
-const MAX_DA45: f64 = 40.0;
+/// Half-width in a4 and a5 of the box a step may move in (see [`MAX_DA3`]).
+pub(crate) const MAX_DA45: f64 = 40.0;
 
 /// Runs the globalised Newton from `a0` for at most `max_iterations` accepted steps.
 pub(crate) fn solve(

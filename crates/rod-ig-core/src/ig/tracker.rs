@@ -25,7 +25,9 @@ pub struct Tracker {
     prev: Option<(PlanarParams, PlanarPose)>,
 }
 
-/// Largest predictor step accepted (scaled like the trust box of the local solver).
+/// Largest predictor step accepted, in units of the local solver's step box
+/// (`local::MAX_DA3`, `local::MAX_DA45`): a prediction larger than one step of the solver is
+/// no better than a restart.
 const MAX_PREDICT: f64 = 1.0;
 
 impl Tracker {
@@ -77,9 +79,9 @@ impl Tracker {
                 }
             }
         }
-        let size = (da[0].abs() / 4.0)
-            .max(da[1].abs() / 40.0)
-            .max(da[2].abs() / 40.0);
+        let size = (da[0].abs() / local::MAX_DA3)
+            .max(da[1].abs() / local::MAX_DA45)
+            .max(da[2].abs() / local::MAX_DA45);
         (size <= MAX_PREDICT && da.iter().all(|v| v.is_finite())).then(|| (a + da, db.norm()))
     }
 
