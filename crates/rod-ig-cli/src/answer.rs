@@ -1,6 +1,11 @@
 //! The answer line of `solve` and `solve3d` (the CLI contract of issue #3 and its 3-D twin):
-//! one shape for both, generic over how a and the tip are written.
+//! one shape for both, built from the solver crate's one `Solution` type, and one request
+//! handler ([`answer`]) for every rod model.
 
+use nalgebra::SVector;
+use rod_ig_core::solver::{
+    self, observe, Event, InverseGeometry, IterationLog, Solution, SolveOptions,
+};
 use serde::Serialize;
 
 /// One solve answer. On failure `a`, `tip` and `energy` are null and `reason` says why.
@@ -21,54 +26,48 @@ pub struct SolveAnswer<A, T> {
     stability_margin: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     reason: Option<String>,
-    /// Every distinct stable solution found (`solve` with `"all": true`).
+    /// Why the solve ended ("converged", "deadline", "no_stable_solution", ...): the typed
+    /// termination reason of the solver.
+    termination: &'static str,
+    /// Starts tried (multi-start strategies; 1 for Newton).
+    starts: u32,
+    /// Every distinct stable solution found (`"all": true`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub solutions: Option<Vec<SolveAnswer<A, T>>>,
 }
 
-/// The numbers of a converged solve, as both solvers report them.
-pub struct Converged<A, T> {
-    /// Rod parameters a*.
-    pub a: A,
-    /// Tip reached.
-    pub tip: T,
-    /// Stability verdict of a*.
-    pub stable: bool,
-    /// Iterations used.
-    pub iterations: u32,
-    /// Solver residual.
-    pub residual: f64,
-    /// Elastic energy.
-    pub energy: f64,
-    /// Position error.
-    pub position_error: f64,
-    /// Orientation error (rad).
-    pub orientation_error: f64,
-    /// Stability margin.
-    pub stability_margin: f64,
-}
-
 impl<A, T> SolveAnswer<A, T> {
-    /// A successful answer.
-    pub fn success(c: Converged<A, T>) -> Self {
+    /// A successful answer, a and the tip written by `a_of` and `tip_of`.
+    pub fn success<P, X>(
+        s: &Solution<P, X>,
+        a_of: impl Fn(&P) -> A,
+        tip_of: impl Fn(&X) -> T,
+    ) -> Self {
         SolveAnswer {
             success: true,
-            a: Some(c.a),
-            tip: Some(c.tip),
-            stable: c.stable,
-            iterations: c.iterations,
-            residual: c.residual,
-            energy: Some(c.energy),
-            position_error: Some(c.position_error),
-            orientation_error: Some(c.orientation_error),
-            stability_margin: Some(c.stability_margin),
+            a: Some(a_of(&s.a)),
+            tip: Some(tip_of(&s.tip)),
+            stable: s.stable,
+            iterations: s.iterations,
+            residual: s.residual,
+            energy: Some(s.energy),
+            position_error: Some(s.position_error),
+            orientation_error: Some(s.orientation_error),
+            stability_margin: Some(s.stability_margin),
             reason: None,
+            termination: solver::Termination::Converged.as_str(),
+            starts: s.starts,
             solutions: None,
         }
     }
 
     /// A failed answer: work done and why.
-    pub fn failure(iterations: u32, residual: f64, reason: String) -> Self {
+    pub fn failure(
+        iterations: u32,
+        residual: f64,
+        reason: String,
+        termination: solver::Termination,
+    ) -> Self {
         SolveAnswer {
             success: false,
             a: None,
@@ -81,7 +80,98 @@ impl<A, T> SolveAnswer<A, T> {
             orientation_error: None,
             stability_margin: None,
             reason: Some(reason),
+            termination: termination.as_str(),
+            starts: 0,
             solutions: None,
         }
+    }
+}
+
+/// Solves one request on `model` and writes the answer: the solve with `options`, then, with
+/// `all`, every distinct stable solution (`solutions`, least energy first). With `verbose`,
+/// the solver's events (starts, iterations, end) go to stderr as JSON lines.
+pub fn answer<const N: usize, M, A, T>(
+    model: &M,
+    target: &M::Pose,
+    options: &SolveOptions<SVector<f64, N>>,
+    all: bool,
+    verbose: bool,
+    a_of: impl Fn(&SVector<f64, N>) -> A,
+    tip_of: impl Fn(&M::Pose) -> T,
+) -> SolveAnswer<A, T>
+where
+    M: InverseGeometry<N>,
+{
+    let run = || {
+        let first = solver::solve(model, target, options);
+        let solutions = all.then(|| solver::solve_all(model, target, options));
+        (first, solutions)
+    };
+    let (first, solutions) = if verbose {
+        let (r, log) = observe(IterationLog::default(), run);
+        for event in &log.events {
+            eprintln!("{}", event_json(event));
+        }
+        r
+    } else {
+        run()
+    };
+    let mut answer = match &first {
+        Ok(s) => SolveAnswer::success(s, &a_of, &tip_of),
+        Err(f) => SolveAnswer::failure(
+            f.iterations,
+            f.residual,
+            f.reason.to_string(),
+            f.termination(),
+        ),
+    };
+    if let Some(solutions) = solutions {
+        if solutions.is_empty() && answer.success {
+            // solve_all includes the first-found answer, so this is unreachable in practice;
+            // guarded so that success never comes with an empty list.
+            answer = SolveAnswer::failure(
+                answer.iterations,
+                f64::INFINITY,
+                "no stable solution found".into(),
+                solver::Termination::NoStableSolution,
+            );
+        }
+        answer.solutions = Some(
+            solutions
+                .iter()
+                .map(|s| SolveAnswer::success(s, &a_of, &tip_of))
+                .collect(),
+        );
+    }
+    answer
+}
+
+/// One observer event as a JSON line for `--verbose`.
+fn event_json(event: &Event) -> serde_json::Value {
+    match *event {
+        Event::StartBegun { index, a0_norm } => {
+            serde_json::json!({"event": "start", "index": index, "a0_norm": a0_norm})
+        }
+        Event::Iteration {
+            iteration,
+            residual,
+            step,
+            alpha,
+        } => serde_json::json!({
+            "event": "iteration", "iteration": iteration, "residual": residual,
+            "step": step, "alpha": alpha
+        }),
+        Event::StartEnded { index, termination } => serde_json::json!({
+            "event": "start_end", "index": index, "termination": termination.as_str()
+        }),
+        Event::Finished {
+            termination,
+            iterations,
+            starts,
+            elapsed_us,
+        } => serde_json::json!({
+            "event": "finished", "termination": termination.as_str(),
+            "iterations": iterations, "starts": starts, "elapsed_us": elapsed_us
+        }),
     }
 }

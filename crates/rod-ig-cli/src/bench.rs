@@ -1,7 +1,8 @@
 //! `rod-ig bench`: every speed figure of the README, measured in one run on this machine.
 
 use crate::timing::{measure, Timing};
-use rod_ig_core::ig::bench::{self as ig_bench, IgCase, ParamBox, SplitMix64};
+use rod_ig_bench::planar::{self as ig_bench, IgCase, ParamBox};
+use rod_ig_bench::SplitMix64;
 use rod_ig_core::ig::SolveOptions;
 use rod_ig_core::ode::planar_reference as reference;
 use rod_ig_core::{planar, PlanarParams};
@@ -252,7 +253,8 @@ pub fn inverse_geometry(quick: bool, cases_path: &Path) {
 /// 3-D rod: forward + J by integration at 1e-8, stability, and the robust 3-D solver on
 /// random reachable targets of stable rods.
 pub fn spatial(quick: bool) {
-    use rod_ig_core::spatial::{self, ig as ig3d, StabilityOptions, Stiffness, PRODUCTION_RTOL};
+    use rod_ig_bench::spatial as ig3d;
+    use rod_ig_core::spatial::{self, StabilityOptions, Stiffness, PRODUCTION_RTOL};
     let k = Stiffness::default();
     let (n, rounds) = if quick { (16, 3) } else { (64, 9) };
     let (a_box, f_box) = ig3d::TARGET_BOX;

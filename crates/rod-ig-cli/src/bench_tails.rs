@@ -2,7 +2,8 @@
 //! forward map and of the robust solve on the uniform box next to log-scale samples of the
 //! regime a cable lives in (issue 9), with the ratio log-scale / box.
 
-use rod_ig_core::ig::{self, bench::SplitMix64, SolveOptions};
+use rod_ig_bench::SplitMix64;
+use rod_ig_core::ig::{self, SolveOptions};
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use std::hint::black_box;
 use std::time::Instant;

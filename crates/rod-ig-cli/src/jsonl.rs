@@ -97,6 +97,81 @@ pub fn apply_newton_knobs(
 /// The message for a Newton request without a start.
 pub const NEWTON_NEEDS_A0: &str = "method \"newton\" needs an initial guess \"a0\"";
 
+/// Solver choice as spelled in requests.
+#[derive(serde::Deserialize, Clone, Copy, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum MethodName {
+    /// Multi-start robust search.
+    #[default]
+    Robust,
+    /// The paper's fixed-step Newton.
+    Newton,
+}
+
+/// Objective as spelled in requests.
+#[derive(serde::Deserialize, Clone, Copy, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ObjectiveName {
+    /// The first stable solution found.
+    #[default]
+    First,
+    /// The least elastic energy among the solutions found.
+    LeastEnergy,
+}
+
+/// The solver fields every solve request shares (`solve` and `solve3d`).
+pub struct Knobs<P> {
+    /// "method".
+    pub method: MethodName,
+    /// "objective".
+    pub objective: ObjectiveName,
+    /// "alpha".
+    pub alpha: Option<f64>,
+    /// "max_iterations".
+    pub max_iterations: Option<u32>,
+    /// "tolerance".
+    pub tolerance: Option<f64>,
+    /// "deadline_ms".
+    pub deadline_ms: Option<f64>,
+    /// "a0".
+    pub a0: Option<P>,
+}
+
+/// The solver options of a request, from the model's defaults.
+pub fn solve_options<P>(
+    knobs: Knobs<P>,
+    defaults: rod_ig_core::solver::SolveOptions<P>,
+) -> Result<rod_ig_core::solver::SolveOptions<P>, String> {
+    use rod_ig_core::solver::{Method, Objective};
+    let mut options = rod_ig_core::solver::SolveOptions {
+        method: match knobs.method {
+            MethodName::Robust => Method::Robust,
+            MethodName::Newton => Method::Newton,
+        },
+        objective: match knobs.objective {
+            ObjectiveName::First => Objective::FirstFound,
+            ObjectiveName::LeastEnergy => Objective::LeastEnergy,
+        },
+        initial_guess: knobs.a0,
+        ..defaults
+    };
+    apply_newton_knobs(
+        (knobs.alpha, knobs.max_iterations, knobs.tolerance),
+        (
+            &mut options.alpha,
+            &mut options.max_iterations,
+            &mut options.tolerance,
+        ),
+    )?;
+    if let Some(ms) = knobs.deadline_ms {
+        options.deadline = deadline_from_ms(ms)?;
+    }
+    if options.method == Method::Newton && options.initial_guess.is_none() {
+        return Err(NEWTON_NEEDS_A0.to_string());
+    }
+    Ok(options)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -37,8 +37,14 @@ enum Command {
     /// "objective"?: "first"|"least_energy", "all"?: bool, "deadline_ms"? (default 250, at
     /// most 10000)}; writes one line each:
     /// {"success", "a", "tip", "stable", "iterations", "residual", "energy", "position_error",
-    /// "orientation_error", "stability_margin", "reason" (on failure), "solutions" (with all)}.
-    Solve,
+    /// "orientation_error", "stability_margin", "reason" (on failure), "termination"
+    /// ("converged", "deadline", "no_stable_solution", ...), "starts", "solutions" (with all)}.
+    Solve {
+        /// Print the solver's events (starts, iterations with residual and step, end) on
+        /// stderr as JSON lines.
+        #[arg(long)]
+        verbose: bool,
+    },
     /// 3-D forward map by numerical integration. Reads JSON lines {"a": [a1, .., a6],
     /// "stiffness"?: [c1, c2, c3], "rtol"?}; writes {"tip": {"position": [x, y, z],
     /// "quaternion": [qx, qy, qz, qw]}, "jacobian" (6×6, body twists, rows ω1 ω2 ω3 v1 v2 v3),
@@ -46,9 +52,13 @@ enum Command {
     Forward3d,
     /// 3-D inverse geometry. Reads JSON lines {"target": {"position": [..], "quaternion":
     /// [qx, qy, qz, qw]}, "a0"?: [6 numbers], "method"?, "alpha"?, "max_iterations"?,
-    /// "tolerance"?, "stiffness"?, "deadline_ms"? (default 1000)}; writes the fields of `solve`
-    /// with 3-D a and tip.
-    Solve3d,
+    /// "tolerance"?, "objective"?, "all"?, "stiffness"?, "deadline_ms"? (default 1000)};
+    /// writes the fields of `solve` with 3-D a and tip.
+    Solve3d {
+        /// Print the solver's events on stderr as JSON lines (as `solve --verbose`).
+        #[arg(long)]
+        verbose: bool,
+    },
     /// Samples or draws rods: given parameters (--a, repeatable) or a target pose (--target:
     /// every distinct stable solution found). JSON lines of poses, or an SVG picture.
     Shape {
@@ -175,15 +185,17 @@ fn main() -> ExitCode {
         Command::Forward => {
             jsonl::run(stdin, stdout, planar_cmds::forward_line).map_err(|e| e.to_string())
         }
-        Command::Solve => {
-            jsonl::run(stdin, stdout, planar_cmds::solve_line).map_err(|e| e.to_string())
+        Command::Solve { verbose } => {
+            jsonl::run(stdin, stdout, |line| planar_cmds::solve_line(line, verbose))
+                .map_err(|e| e.to_string())
         }
         Command::Forward3d => {
             jsonl::run(stdin, stdout, spatial_cmds::forward3d_line).map_err(|e| e.to_string())
         }
-        Command::Solve3d => {
-            jsonl::run(stdin, stdout, spatial_cmds::solve3d_line).map_err(|e| e.to_string())
-        }
+        Command::Solve3d { verbose } => jsonl::run(stdin, stdout, |line| {
+            spatial_cmds::solve3d_line(line, verbose)
+        })
+        .map_err(|e| e.to_string()),
         Command::Shape {
             params,
             target,

@@ -1,8 +1,9 @@
 //! `rod-ig forward`, `rod-ig solve` and `rod-ig shape`: JSON in, JSON out, no math here.
 
-use crate::answer::{Converged, SolveAnswer};
-use crate::jsonl;
-use rod_ig_core::ig::{self, Method, Objective, SolveOptions};
+use crate::answer::answer;
+use crate::jsonl::{self, Knobs, MethodName, ObjectiveName};
+use rod_ig_core::ig::{self, SolveOptions};
+use rod_ig_core::solver::PlanarClosedForm;
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -48,24 +49,6 @@ pub fn forward_line(line: &str) -> Result<Value, String> {
     })
 }
 
-/// Solver choice as spelled in requests.
-#[derive(Deserialize, Clone, Copy, Default)]
-#[serde(rename_all = "snake_case")]
-enum MethodName {
-    #[default]
-    Robust,
-    Newton,
-}
-
-/// Objective as spelled in requests.
-#[derive(Deserialize, Clone, Copy, Default)]
-#[serde(rename_all = "snake_case")]
-enum ObjectiveName {
-    #[default]
-    First,
-    LeastEnergy,
-}
-
 /// One `rod-ig solve` request.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -82,85 +65,32 @@ struct SolveRequest {
     /// When true, also list every distinct stable solution found (`solutions`).
     #[serde(default)]
     all: bool,
-    /// Wall-time budget of the request in ms (default 50, at most 10000).
+    /// Wall-time budget of the request in ms (default 250, at most 10000).
     deadline_ms: Option<f64>,
 }
 
-type PlanarAnswer = SolveAnswer<[f64; 3], PlanarPose>;
-
-fn answer_of(s: &ig::Solution) -> PlanarAnswer {
-    SolveAnswer::success(Converged {
-        a: [s.a[0], s.a[1], s.a[2]],
-        tip: s.tip,
-        stable: s.stable,
-        iterations: s.iterations,
-        residual: s.residual,
-        energy: s.energy,
-        position_error: s.position_error,
-        orientation_error: s.orientation_error,
-        stability_margin: s.stability_margin,
-    })
-}
-
-fn options(request: &SolveRequest) -> Result<SolveOptions, String> {
-    let mut options = SolveOptions {
-        method: match request.method {
-            MethodName::Robust => Method::Robust,
-            MethodName::Newton => Method::Newton,
-        },
-        objective: match request.objective {
-            ObjectiveName::First => Objective::FirstFound,
-            ObjectiveName::LeastEnergy => Objective::LeastEnergy,
-        },
-        ..SolveOptions::default()
-    };
-    jsonl::apply_newton_knobs(
-        (request.alpha, request.max_iterations, request.tolerance),
-        (
-            &mut options.alpha,
-            &mut options.max_iterations,
-            &mut options.tolerance,
-        ),
-    )?;
-    if let Some(ms) = request.deadline_ms {
-        options.deadline = jsonl::deadline_from_ms(ms)?;
-    }
-    if let Some(a0) = request.a0 {
-        options.initial_guess = Some(PlanarParams::from(a0));
-    }
-    if matches!(options.method, Method::Newton) && options.initial_guess.is_none() {
-        return Err(jsonl::NEWTON_NEEDS_A0.to_string());
-    }
-    Ok(options)
-}
-
-/// Answers one `solve` line.
-pub fn solve_line(line: &str) -> Result<Value, String> {
+/// Answers one `solve` line (`verbose`: the solver's events on stderr).
+pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
     let request: SolveRequest = jsonl::parse(line)?;
-    let options = options(&request)?;
-    let first = ig::solve(&request.target, &options);
-    let mut answer = match &first {
-        Ok(s) => answer_of(s),
-        Err(f) => PlanarAnswer::failure(f.iterations, f.residual, f.reason.to_string()),
+    let knobs = Knobs {
+        method: request.method,
+        objective: request.objective,
+        alpha: request.alpha,
+        max_iterations: request.max_iterations,
+        tolerance: request.tolerance,
+        deadline_ms: request.deadline_ms,
+        a0: request.a0.map(PlanarParams::from),
     };
-    if request.all {
-        let mut all = ig::solve_all(&request.target, &options);
-        if let Ok(s) = &first {
-            // The answer itself is one of the solutions (solve_all's cell search may have
-            // missed the branch the first-found search reached).
-            if !all
-                .iter()
-                .any(|o| (o.a - s.a).norm() <= 1e-6 * (1.0 + s.a.norm()))
-            {
-                all.push(*s);
-            }
-        }
-        if all.is_empty() {
-            answer = PlanarAnswer::failure(0, f64::INFINITY, "no stable solution found".into());
-        }
-        answer.solutions = Some(all.iter().map(answer_of).collect());
-    }
-    jsonl::to_value(&answer)
+    let options = jsonl::solve_options(knobs, SolveOptions::default())?;
+    jsonl::to_value(&answer(
+        &PlanarClosedForm,
+        &request.target,
+        &options,
+        request.all,
+        verbose,
+        |a| [a[0], a[1], a[2]],
+        |tip| *tip,
+    ))
 }
 
 /// Most samples `shape` draws per rod: 1e6 poses are ≈ 24 MB of f64 and far beyond any screen
@@ -181,14 +111,14 @@ pub fn sample_shape(a: [f64; 3], samples: usize) -> Result<Vec<PlanarPose>, Stri
 /// Every distinct stable solution found for the target (x, y, θ), least energy first.
 pub fn all_stable_solutions(x: f64, y: f64, theta: f64) -> Result<Vec<[f64; 3]>, String> {
     let target = PlanarPose::new(x, y, theta);
-    let mut found = ig::solve_all(&target, &SolveOptions::default());
+    let found = ig::solve_all(&target, &SolveOptions::default());
     if found.is_empty() {
+        // Say why: the first-found search's own reason.
         return match ig::solve(&target, &SolveOptions::default()) {
             Ok(s) => Ok(vec![[s.a[0], s.a[1], s.a[2]]]),
             Err(f) => Err(format!("no stable rod reaches the target: {}", f.reason)),
         };
     }
-    found.sort_by(|p, q| p.energy.total_cmp(&q.energy));
     Ok(found.iter().map(|s| [s.a[0], s.a[1], s.a[2]]).collect())
 }
 

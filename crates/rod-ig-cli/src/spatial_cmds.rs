@@ -1,10 +1,10 @@
 //! `rod-ig forward3d` and `rod-ig solve3d`: the 3-D twins of `forward` and `solve`.
 //! Poses are {"position": [x, y, z], "quaternion": [qx, qy, qz, qw]} (scalar last, qw ≥ 0).
 
-use crate::answer::{Converged, SolveAnswer};
-use crate::jsonl;
+use crate::answer::answer;
+use crate::jsonl::{self, Knobs, MethodName, ObjectiveName};
 use nalgebra::Vector3;
-use rod_ig_core::spatial::ig::{self as ig3d, Method3d, SolveOptions3d};
+use rod_ig_core::solver::{SolveOptions, Spatial};
 use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -84,14 +84,6 @@ pub fn forward3d_line(line: &str) -> Result<Value, String> {
     })
 }
 
-#[derive(Deserialize, Clone, Copy, Default)]
-#[serde(rename_all = "snake_case")]
-enum MethodName {
-    #[default]
-    Robust,
-    Newton,
-}
-
 /// One `solve3d` request.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -103,51 +95,38 @@ struct Solve3dRequest {
     alpha: Option<f64>,
     max_iterations: Option<u32>,
     tolerance: Option<f64>,
+    #[serde(default)]
+    objective: ObjectiveName,
+    /// When true, also list every distinct stable solution found (`solutions`).
+    #[serde(default)]
+    all: bool,
     stiffness: Option<[f64; 3]>,
     /// Wall-time budget of the request in ms (default 1000, at most 10000).
     deadline_ms: Option<f64>,
 }
 
-/// Answers one `solve3d` line.
-pub fn solve3d_line(line: &str) -> Result<Value, String> {
+/// Answers one `solve3d` line (`verbose`: the solver's events on stderr).
+pub fn solve3d_line(line: &str, verbose: bool) -> Result<Value, String> {
     let request: Solve3dRequest = jsonl::parse(line)?;
     let target = request.target.to_pose()?;
-    let mut options = SolveOptions3d {
-        stiffness: stiffness(request.stiffness)?,
-        initial_guess: request.a0.map(SpatialParams::from),
-        method: match request.method {
-            MethodName::Robust => Method3d::Robust,
-            MethodName::Newton => Method3d::Newton,
-        },
-        ..SolveOptions3d::default()
+    let model = Spatial::with_stiffness(stiffness(request.stiffness)?);
+    let knobs = Knobs {
+        method: request.method,
+        objective: request.objective,
+        alpha: request.alpha,
+        max_iterations: request.max_iterations,
+        tolerance: request.tolerance,
+        deadline_ms: request.deadline_ms,
+        a0: request.a0.map(SpatialParams::from),
     };
-    jsonl::apply_newton_knobs(
-        (request.alpha, request.max_iterations, request.tolerance),
-        (
-            &mut options.alpha,
-            &mut options.max_iterations,
-            &mut options.tolerance,
-        ),
-    )?;
-    if let Some(ms) = request.deadline_ms {
-        options.deadline = jsonl::deadline_from_ms(ms)?;
-    }
-    if options.method == Method3d::Newton && options.initial_guess.is_none() {
-        return Err(jsonl::NEWTON_NEEDS_A0.to_string());
-    }
-    let answer = match ig3d::solve(&target, &options) {
-        Ok(s) => SolveAnswer::success(Converged {
-            a: std::array::from_fn::<f64, 6, _>(|i| s.a[i]),
-            tip: PoseJson::from_pose(&s.tip),
-            stable: s.stable,
-            iterations: s.iterations,
-            residual: s.residual,
-            energy: s.energy,
-            position_error: s.position_error,
-            orientation_error: s.orientation_error,
-            stability_margin: s.stability_margin,
-        }),
-        Err(f) => SolveAnswer::failure(f.iterations, f.residual, f.reason.to_string()),
-    };
-    jsonl::to_value(&answer)
+    let options = jsonl::solve_options(knobs, SolveOptions::default())?;
+    jsonl::to_value(&answer(
+        &model,
+        &target,
+        &options,
+        request.all,
+        verbose,
+        |a| std::array::from_fn::<f64, 6, _>(|i| a[i]),
+        PoseJson::from_pose,
+    ))
 }

@@ -260,3 +260,71 @@ fn solve3d_with_scaled_stiffness() {
         assert!(dev < 1e-4 * s * 200.0, "s = {s}: a deviates by {dev}");
     }
 }
+
+#[test]
+fn solve3d_has_every_option_of_solve() {
+    // A planar target lifted to 3-D (rotation about z by θ): the same request fields as
+    // `solve`, objective and all included; answers carry the typed termination.
+    let theta: f64 = 0.8;
+    let (s, c) = ((theta / 2.0).sin(), (theta / 2.0).cos());
+    let target = format!(
+        "{{\"position\": [0.5, 0.4, 0.0], \"quaternion\": [0.0, 0.0, {s}, {c}]}}"
+    );
+    let input = format!(
+        "{{\"target\": {target}, \"all\": true}}\n\
+         {{\"target\": {target}, \"objective\": \"least_energy\"}}\n\
+         {{\"target\": {target}, \"objective\": \"sideways\"}}\n\
+         {{\"target\": {{\"position\": [0.0, 2.0, 0.0], \"quaternion\": [0, 0, 0, 1]}}}}\n"
+    );
+    let out = run(&["solve3d"], &input);
+    assert_eq!(out.len(), 4);
+    let all = &out[0];
+    assert_eq!(all["success"], true);
+    assert_eq!(all["termination"], "converged");
+    let solutions = all["solutions"].as_array().expect("solutions listed");
+    assert!(!solutions.is_empty());
+    let energies: Vec<f64> = solutions
+        .iter()
+        .map(|s| s["energy"].as_f64().unwrap())
+        .collect();
+    assert!(energies.windows(2).all(|w| w[0] <= w[1]), "{energies:?}");
+    let least = &out[1];
+    assert_eq!(least["success"], true);
+    assert!(least["energy"].as_f64().unwrap() <= all["energy"].as_f64().unwrap() + 1e-9);
+    assert!(least["energy"].as_f64().unwrap() <= energies[0] + 1e-9);
+    assert!(out[2]["error"].as_str().unwrap().contains("sideways"));
+    assert_eq!(out[3]["success"], false);
+    assert_eq!(out[3]["termination"], "unreachable");
+}
+
+#[test]
+fn verbose_prints_the_solver_events_on_stderr() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
+        .args(["solve", "--verbose"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("rod-ig starts");
+    child
+        .stdin
+        .take()
+        .expect("stdin")
+        .write_all(b"{\"target\": {\"x\": 0.5, \"y\": 0.3, \"theta\": 0.8}}\n")
+        .expect("write stdin");
+    let out = child.wait_with_output().expect("rod-ig exits");
+    assert!(out.status.success());
+    let answer: Value = serde_json::from_slice(&out.stdout).expect("one JSON answer");
+    let events: Vec<Value> = String::from_utf8(out.stderr)
+        .expect("UTF-8")
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("each event is JSON"))
+        .collect();
+    let iterations = events.iter().filter(|e| e["event"] == "iteration").count();
+    assert_eq!(iterations as u64, answer["iterations"].as_u64().unwrap());
+    let starts = events.iter().filter(|e| e["event"] == "start").count();
+    assert_eq!(starts as u64, answer["starts"].as_u64().unwrap());
+    let last = events.last().expect("events");
+    assert_eq!(last["event"], "finished");
+    assert_eq!(last["termination"], "converged");
+}

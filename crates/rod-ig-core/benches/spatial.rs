@@ -2,10 +2,13 @@
 //! stability, and the robust 3-D solve (goal median ≤ 1 ms, ≥ 99 % success).
 
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, Criterion};
-use rod_ig_core::spatial::{self, ig, SpatialParams, StabilityOptions, Stiffness};
+use rod_ig_bench::spatial::random_targets;
+use rod_ig_bench::SplitMix64;
+use rod_ig_core::solver::{self, SolveOptions, Spatial};
+use rod_ig_core::spatial::{self, SpatialParams, StabilityOptions, Stiffness};
 
 fn params(n: usize) -> Vec<SpatialParams> {
-    let mut rng = ig::SplitMix64::new(17);
+    let mut rng = SplitMix64::new(17);
     (0..n)
         .map(|_| {
             SpatialParams::from_fn(|i, _| {
@@ -49,8 +52,9 @@ fn forward(c: &mut Criterion) {
 
 fn solve(c: &mut Criterion) {
     let k = Stiffness::default();
-    let targets = ig::random_targets(200, 99, &k);
-    let opts = ig::SolveOptions3d::default();
+    let targets = random_targets(200, 99, &k);
+    let opts = SolveOptions::default();
+    let model = Spatial::with_stiffness(k);
     let mut i = 0;
     let mut group = c.benchmark_group("spatial ig");
     group.sample_size(50);
@@ -60,7 +64,7 @@ fn solve(c: &mut Criterion) {
                 i = (i + 1) % targets.len();
                 targets[i].1
             },
-            |t| black_box(ig::solve(&t, &opts).ok()),
+            |t| black_box(solver::solve(&model, &t, &opts).ok()),
             BatchSize::SmallInput,
         )
     });

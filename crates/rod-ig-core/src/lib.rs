@@ -17,7 +17,10 @@
 //! - [`planar`]: closed-form shape q(t), sensitivity J(t, a), stability and energy.
 //! - [`ode`]: numerical integrators (adaptive Dormand–Prince 8(5,3) and fixed-step RK4) and the
 //!   planar ODE reference with variational equations.
-//! - [`ig`]: planar inverse geometry (paper's Newton, robust solver, tracking).
+//! - [`solver`]: one inverse-geometry API for every rod model (the [`solver::RodModel`]
+//!   trait, the paper's Newton, the robust search, least energy, all solutions, deadlines,
+//!   observers).
+//! - [`ig`]: the planar closed forms' search behind it (atlas, multi-start, tracking).
 //! - [`rng`]: a small deterministic generator for reproducible samples.
 //! - [`spatial`]: the 3-D rod by numerical integration, and its inverse geometry.
 #![warn(missing_docs)]
@@ -31,6 +34,7 @@ pub mod ode;
 pub mod planar;
 pub mod rng;
 pub mod scalar;
+pub mod solver;
 pub mod spatial;
 mod types;
 

@@ -5,11 +5,8 @@
 //! environment variable `ROD_IG_SHARED`, else by walking up from this crate's directory to the
 //! first ancestor holding `shared/oracle`.
 
-use rod_ig_core::ig::{
-    self,
-    bench::{self, IgCase, ParamBox},
-    IgError, Method, Objective, SolveOptions, Tracker,
-};
+use rod_ig_bench::planar::{self as bench, IgCase, ParamBox};
+use rod_ig_core::ig::{self, IgError, Method, Objective, SolveOptions, Tracker};
 use rod_ig_core::{wrap_angle, PlanarParams, PlanarPose};
 
 mod common;

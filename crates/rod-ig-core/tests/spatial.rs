@@ -3,8 +3,10 @@
 
 use nalgebra::{Rotation3, UnitQuaternion, Vector3, Vector6};
 use proptest::prelude::*;
+use rod_ig_bench::spatial::{benchmark_random_targets, random_targets};
 use rod_ig_core::ode::planar_reference as pr;
-use rod_ig_core::spatial::{self, ig, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
+use rod_ig_core::solver::{self, IgError, Method, SolveOptions, Spatial};
+use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
 
 const RTOL: f64 = 1e-12;
 
@@ -381,13 +383,13 @@ fn shape_and_energy() {
 fn ig_random_targets_robust() {
     // Box |a1..3| <= 5, |a4..6| <= 30 (FINDINGS3D: ~70 % stable); targets = tips of stable a.
     let k = Stiffness::default();
-    let targets = ig::random_targets(150, 2024, &k);
+    let targets = random_targets(150, 2024, &k);
     assert_eq!(targets.len(), 150);
-    let opts = ig::SolveOptions3d::default();
+    let opts = SolveOptions::default();
     let mut ok = 0;
     let mut worst_pos = 0.0f64;
     for (_, target) in &targets {
-        match ig::solve(target, &opts) {
+        match solver::solve(&Spatial::default(), target, &opts) {
             Ok(sol) => {
                 assert!(sol.stable && sol.residual <= 2.0 * opts.tolerance);
                 // Independent check at reference accuracy: tip and stability (full grid).
@@ -412,16 +414,16 @@ fn ig_random_targets_robust() {
 #[test]
 fn ig_newton_and_failures() {
     let k = Stiffness::default();
-    let targets = ig::random_targets(20, 99, &k);
+    let targets = random_targets(20, 99, &k);
     // Paper's Newton from a nearby guess converges to the same rod.
     let mut converged = 0;
     for (a, target) in &targets {
-        let opts = ig::SolveOptions3d {
-            method: ig::Method3d::Newton,
+        let opts = SolveOptions {
+            method: Method::Newton,
             initial_guess: Some(a + Vector6::repeat(0.05)),
             ..Default::default()
         };
-        if let Ok(sol) = ig::solve(target, &opts) {
+        if let Ok(sol) = solver::solve(&Spatial::default(), target, &opts) {
             assert!(sol.residual < 1e-5);
             converged += 1;
         }
@@ -432,42 +434,49 @@ fn ig_newton_and_failures() {
         position: Vector3::new(2.0, 0.0, 0.0),
         rotation: UnitQuaternion::identity(),
     };
-    let f = ig::solve(&far, &Default::default()).unwrap_err();
-    assert!(matches!(f.reason, ig::IgError3d::Unreachable { .. }));
+    let f = solver::solve(&Spatial::default(), &far, &SolveOptions::default()).unwrap_err();
+    assert!(matches!(f.reason, IgError::Unreachable { .. }));
     let nan = SpatialPose {
         position: Vector3::new(f64::NAN, 0.0, 0.0),
         rotation: UnitQuaternion::identity(),
     };
     assert!(matches!(
-        ig::solve(&nan, &Default::default()).unwrap_err().reason,
-        ig::IgError3d::NonFiniteTarget
+        solver::solve(&Spatial::default(), &nan, &SolveOptions::default())
+            .unwrap_err()
+            .reason,
+        IgError::NonFiniteTarget { .. }
     ));
-    let bad = ig::SolveOptions3d {
+    let bad = SolveOptions {
         alpha: 0.0,
         ..Default::default()
     };
     assert!(matches!(
-        ig::solve(&targets[0].1, &bad).unwrap_err().reason,
-        ig::IgError3d::InvalidOptions(_)
+        solver::solve(&Spatial::default(), &targets[0].1, &bad)
+            .unwrap_err()
+            .reason,
+        IgError::InvalidOptions(_)
     ));
     // The straight target is only reached by an unstable (straight) rod: bounded failure.
     let straight = SpatialPose {
         position: Vector3::new(1.0, 0.0, 0.0),
         rotation: UnitQuaternion::identity(),
     };
-    let opts = ig::SolveOptions3d {
+    let opts = SolveOptions {
         max_iterations: 30,
-        max_starts: 3,
         ..Default::default()
     };
-    if let Ok(sol) = ig::solve(&straight, &opts) {
+    let model = Spatial {
+        max_starts: 3,
+        ..Spatial::default()
+    };
+    if let Ok(sol) = solver::solve(&model, &straight, &opts) {
         assert!(sol.stable);
     }
 }
 
 #[test]
 fn ig_benchmark_report() {
-    let r = ig::benchmark_random_targets(30, 5);
+    let r = benchmark_random_targets(30, 5);
     println!("{r:?}");
     assert_eq!(r.targets, 30);
     assert!(r.success_rate >= 0.9 && r.median_us > 0.0);

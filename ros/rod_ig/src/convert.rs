@@ -11,6 +11,7 @@ use crate::messages::{
 };
 use crate::params::Params;
 use crate::solver::{Failed, PlanarPose, Solved, Solved3d, SpatialParams, SpatialPose};
+use rod_ig_core::solver::Solution;
 
 /// Why a target pose cannot be solved for (answered with success = false).
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -310,16 +311,10 @@ pub fn base_wrench_3d(a: &SpatialParams, rod_length: f64, bending_stiffness: f64
     }
 }
 
-/// What a converged RodSolution says, from either solver, before scaling to physical units.
-struct Converged {
+/// The model-dependent parts of a converged RodSolution (the rest comes from the solver's
+/// one `Solution` type, whichever model produced it).
+struct ModelParts {
     what: &'static str,
-    iterations: u32,
-    stable: bool,
-    stability_margin: f64,
-    position_error: f64,
-    orientation_error: f64,
-    residual: f64,
-    energy: f64,
     /// (a3, a4, a5).
     a: [f64; 3],
     /// (a1..a6) for the 3-D solver, zeros for the planar one.
@@ -332,8 +327,9 @@ struct Converged {
 }
 
 /// Scales a converged answer to physical units (rod length L, bending stiffness EI).
-fn converged_message(
-    c: Converged,
+fn converged_message<P, X>(
+    s: &Solution<P, X>,
+    c: ModelParts,
     header: &Header,
     params: &Params,
     solve_time: f64,
@@ -347,19 +343,19 @@ fn converged_message(
         message: format!(
             "{} in {} iterations, {}",
             c.what,
-            c.iterations,
-            if c.stable { "stable" } else { "UNSTABLE" }
+            s.iterations,
+            if s.stable { "stable" } else { "UNSTABLE" }
         ),
         a: c.a,
-        stable: c.stable,
-        stability_margin: c.stability_margin,
-        iterations: c.iterations,
-        position_error: c.position_error * l,
-        orientation_error: c.orientation_error,
-        residual: c.residual,
-        elastic_energy: c.energy,
+        stable: s.stable,
+        stability_margin: s.stability_margin,
+        iterations: s.iterations,
+        position_error: s.position_error * l,
+        orientation_error: s.orientation_error,
+        residual: s.residual,
+        elastic_energy: s.energy,
         elastic_energy_joules: if wrench_valid {
-            c.energy * ei / l
+            s.energy * ei / l
         } else {
             f64::NAN
         },
@@ -388,22 +384,15 @@ pub fn solution_message_3d(
     let s = &s.solution;
     let (l, ei) = (params.rod_length, params.bending_stiffness);
     let a_spatial: [f64; 6] = std::array::from_fn(|i| s.a[i]);
-    let c = Converged {
+    let parts = ModelParts {
         what: "3-D solver converged",
-        iterations: s.iterations,
-        stable: s.stable,
-        stability_margin: s.stability_margin,
-        position_error: s.position_error,
-        orientation_error: s.orientation_error,
-        residual: s.residual,
-        energy: s.energy,
         a: [a_spatial[2], a_spatial[3], a_spatial[4]],
         a_spatial,
         spatial: true,
         wrench: base_wrench_3d(&s.a, l, ei),
         tip: spatial_to_pose(&s.tip, l),
     };
-    converged_message(c, header, params, solve_time)
+    converged_message(s, parts, header, params, solve_time)
 }
 
 /// The RodSolution of a converged (planar) solve.
@@ -416,22 +405,15 @@ pub fn solution_message(
     let s = &s.solution;
     let (l, ei) = (params.rod_length, params.bending_stiffness);
     let a = [s.a[0], s.a[1], s.a[2]];
-    let c = Converged {
+    let parts = ModelParts {
         what: "converged",
-        iterations: s.iterations,
-        stable: s.stable,
-        stability_margin: s.stability_margin,
-        position_error: s.position_error,
-        orientation_error: s.orientation_error,
-        residual: s.residual,
-        energy: s.energy,
         a,
         a_spatial: [0.0; 6],
         spatial: false,
         wrench: base_wrench(&a, l, ei),
         tip: planar_to_pose(&s.tip, l),
     };
-    converged_message(c, header, params, solve_time)
+    converged_message(s, parts, header, params, solve_time)
 }
 
 /// The RodSolution of a rejected target or a failed solve (success = false). `spatial` is

@@ -5,6 +5,7 @@
 use std::collections::{BTreeMap, VecDeque};
 
 use crate::messages::{DiagnosticStatus, KeyValue};
+use rod_ig_core::solver::Counters;
 
 /// Solve latencies kept for the percentiles: the last this many solves.
 pub const LATENCY_WINDOW: usize = 1000;
@@ -27,6 +28,8 @@ pub struct SolveStats {
     last_error: Option<String>,
     solved_in_period: u64,
     failed_in_period: u64,
+    /// The solver's own counts (starts, iterations, deadlines), from its observer.
+    work: Counters,
 }
 
 /// The short reason of a failure message, for counting: the text before the first `:`,
@@ -69,6 +72,18 @@ impl SolveStats {
                 .or_default() += 1;
             self.last_error = Some(message.to_string());
         }
+    }
+
+    /// Adds the solver's counts of one solve (its observer's [`Counters`]).
+    pub fn record_work(&mut self, work: &Counters) {
+        self.work.iterations += work.iterations;
+        self.work.starts += work.starts;
+        self.work.solves += work.solves;
+        self.work.deadlines += work.deadlines;
+        self.work.max_starts_per_solve = self
+            .work
+            .max_starts_per_solve
+            .max(work.max_starts_per_solve);
     }
 
     /// The `q`-quantile (0..=1) of the kept latencies in seconds, nearest rank; None when no
@@ -127,6 +142,13 @@ impl SolveStats {
             kv("latency_p99_ms", ms(0.99)),
             kv("latency_window", self.latencies_s.len().to_string()),
             kv("last_error", self.last_error.clone().unwrap_or_default()),
+            kv("solver_iterations_total", self.work.iterations.to_string()),
+            kv("solver_starts_total", self.work.starts.to_string()),
+            kv("solver_deadlines_total", self.work.deadlines.to_string()),
+            kv(
+                "solver_max_starts_per_solve",
+                self.work.max_starts_per_solve.to_string(),
+            ),
         ];
         values.extend(
             self.failures_by_reason
@@ -206,5 +228,26 @@ mod tests {
         s.record(true, "", f64::NAN);
         assert_eq!(s.latencies_s.len(), LATENCY_WINDOW);
         assert_eq!(s.latency_quantile(0.99), Some(1e-3));
+    }
+
+    #[test]
+    fn solver_work_comes_from_the_observer() {
+        use rod_ig_core::ig::{self, SolveOptions};
+        use rod_ig_core::solver::observe;
+        use rod_ig_core::PlanarPose;
+        let mut s = SolveStats::default();
+        for target in [PlanarPose::new(0.5, 0.3, 0.8), PlanarPose::new(0.2, 0.6, 2.0)] {
+            let (r, work) = observe(Counters::default(), || {
+                ig::solve(&target, &SolveOptions::default())
+            });
+            let solution = r.expect("reachable targets");
+            assert_eq!(work.iterations, u64::from(solution.iterations));
+            s.record_work(&work);
+        }
+        let r = s.report("n", 1.0, 2, 0);
+        let iterations: u64 = value(&r, "solver_iterations_total").parse().unwrap();
+        let starts: u64 = value(&r, "solver_starts_total").parse().unwrap();
+        assert!(iterations > 0 && starts >= 2, "{iterations} {starts}");
+        assert_eq!(value(&r, "solver_deadlines_total"), "0");
     }
 }

@@ -17,6 +17,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use futures::StreamExt;
+use rod_ig_core::solver::{observe, Counters};
 use ros2_client::dds::rustdds::DomainParticipantBuilder;
 use ros2_client::log::LogLevel;
 use ros2_client::qos::{Durability, History, WhenFull};
@@ -608,8 +609,10 @@ async fn solver_loop(
                 let response = match Overrides::from_request(&request) {
                     Ok(overrides) => {
                         let started = std::time::Instant::now();
-                        let outcome = processor.process(&request.target, &params, &overrides);
-                        report(&log, &stats, "/rod/solve", &outcome, started.elapsed());
+                        let (outcome, work) = observe(Counters::default(), || {
+                            processor.process(&request.target, &params, &overrides)
+                        });
+                        report(&log, &stats, "/rod/solve", &outcome, &work, started.elapsed());
                         SolveRodResponse {
                             path: outcome.path.unwrap_or_else(|| Path {
                                 header: outcome.solution.header.clone(),
@@ -640,8 +643,10 @@ async fn solver_loop(
                 }
                 let params = params_rx.borrow().clone();
                 let started = std::time::Instant::now();
-                let outcome = processor.process(&target, &params, &Overrides::default());
-                report(&log, &stats, "/rod/target", &outcome, started.elapsed());
+                let (outcome, work) = observe(Counters::default(), || {
+                    processor.process(&target, &params, &Overrides::default())
+                });
+                report(&log, &stats, "/rod/target", &outcome, &work, started.elapsed());
                 publish(&log, &outputs, outcome);
             }
         }
@@ -653,9 +658,11 @@ fn report(
     stats: &Stats,
     source: &str,
     outcome: &Outcome,
+    work: &Counters,
     elapsed: std::time::Duration,
 ) {
     if let Ok(mut solves) = stats.solves.lock() {
+        solves.record_work(work);
         solves.record(
             outcome.solution.success,
             &outcome.solution.message,

@@ -10,7 +10,8 @@
 
 use rod_ig_core::ig::{self, Failure, Solution, SolveOptions, Tracker};
 use rod_ig_core::planar::PlanarRod;
-use rod_ig_core::spatial::ig::{self as ig3d, Failure3d, Method3d, Solution3d, SolveOptions3d};
+use rod_ig_core::solver::{self as rod_solver, Spatial};
+use rod_ig_core::spatial::ig::{Failure3d, Solution3d, SolveOptions3d};
 use rod_ig_core::spatial::{self, Stiffness};
 pub use rod_ig_core::spatial::{SpatialParams, SpatialPose};
 pub use rod_ig_core::{PlanarParams, PlanarPose};
@@ -116,8 +117,8 @@ fn options(s: &SolverSettings, initial_guess: Option<PlanarParams>) -> SolveOpti
 fn options_3d(s: &SolverSettings, initial_guess: Option<SpatialParams>) -> SolveOptions3d {
     SolveOptions3d {
         method: match s.method {
-            Method::Robust => Method3d::Robust,
-            Method::Newton => Method3d::Newton,
+            Method::Robust => rod_solver::Method::Robust,
+            Method::Newton => rod_solver::Method::Newton,
         },
         tolerance: s.tolerance,
         max_iterations: s.max_iterations,
@@ -187,7 +188,7 @@ impl RodSolver {
         } else {
             self.last_3d
         };
-        let solution = ig3d::solve(target, &options_3d(&s, guess))?;
+        let solution = rod_solver::solve(&Spatial::default(), target, &options_3d(&s, guess))?;
         if !one_off_solve {
             self.last_3d = Some(solution.a);
         }

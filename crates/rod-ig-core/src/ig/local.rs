@@ -17,6 +17,7 @@
 use super::model::Precision;
 use super::newton::{eval, solve3, Eval};
 use super::scan;
+use crate::solver::{emit, Event};
 use crate::{PlanarParams, PlanarPose};
 
 /// Outcome of one local solve.
@@ -46,6 +47,27 @@ pub(crate) enum Stop {
     MaxIterations,
     /// The solve's deadline passed.
     Deadline,
+}
+
+impl Stop {
+    /// The error a start that stopped this way reports (through the robust solver's
+    /// `NoStableSolution::last`) after `iterations` iterations.
+    pub(crate) fn to_error(self, iterations: u32) -> super::IgError {
+        use super::IgError;
+        match self {
+            // A converged point that failed the verification or the full stability test.
+            Stop::Converged | Stop::BadStart => IgError::LeftStableSet {
+                iteration: iterations,
+            },
+            Stop::Stalled => IgError::Stalled {
+                iteration: iterations,
+            },
+            Stop::MaxIterations => IgError::MaxIterations { iterations },
+            Stop::Deadline => IgError::Deadline {
+                iteration: iterations,
+            },
+        }
+    }
 }
 
 /// Half-width in a3 of the box a step may move in (trust region of one Newton/LM step). a3 is
@@ -89,6 +111,12 @@ pub(crate) fn solve_predicted(
         if max_iterations > 0 {
             if let Some(e1) = eval(&a1, target, Precision::for_start(a0)) {
                 if e1.jac.determinant() > 0.0 && e1.norm < (1.0 - 1e-4) * r0 {
+                    emit(Event::Iteration {
+                        iteration: 1,
+                        residual: r0,
+                        step: (a1 - a0).norm(),
+                        alpha: 1.0,
+                    });
                     let precision = Precision::for_start(a0);
                     let mut out = run(
                         target,
@@ -181,7 +209,7 @@ fn run(
                 out.evaluations += 1;
                 if let Some(et) = eval(&trial, target, precision) {
                     if et.jac.determinant() > 0.0 && et.norm <= (1.0 - 1e-4 * lambda) * e.norm {
-                        accepted = Some((trial, et));
+                        accepted = Some((trial, et, lambda));
                         break;
                     }
                     // Quadratic model of ‖f‖² along the step: φ(λ) ≈ φ0 − 2λφ0 + cλ² (the
@@ -226,7 +254,7 @@ fn run(
                 out.evaluations += 1;
                 if let Some(et) = eval(&trial, target, precision) {
                     if et.jac.determinant() > 0.0 && et.norm <= (1.0 - 1e-4) * e.norm {
-                        accepted = Some((trial, et));
+                        accepted = Some((trial, et, 1.0));
                         mu *= 0.1;
                         break;
                     }
@@ -235,10 +263,16 @@ fn run(
             }
         }
         match accepted {
-            Some((na, ne)) => {
+            Some((na, ne, factor)) => {
+                out.iterations += 1;
+                emit(Event::Iteration {
+                    iteration: out.iterations,
+                    residual: e.norm,
+                    step: (na - a).norm(),
+                    alpha: factor,
+                });
                 a = na;
                 e = ne;
-                out.iterations += 1;
                 out.residual = e.norm;
                 out.last_a = a;
             }

@@ -1,12 +1,10 @@
-//! The paper's inverse geometry (§3.1): Newton's method with a fixed step length α,
-//! p_k = −α J(1, a_k)⁻¹ f(a_k), a_{k+1} = a_k + p_k (eq. 3.1), f(a) = Υ(a) − b.
-//!
-//! Protocol of FINDINGS §8: every iterate (a0 included) must be a stable equilibrium
-//! (det J(t, a) > 0 on (0, 1]); the run fails as soon as one is not. Convergence: position
-//! error and wrapped angle error both ≤ tolerance. A NaN residual never counts as converged.
+//! Building blocks of the planar Newton iterations (paper §3.1, eq. 3.1: the step solves
+//! J(1, a) p = −f(a), f(a) = Υ(a) − b): the 3×3 solve, one evaluated iterate, its verification
+//! at full accuracy. The paper's Newton itself is written once for every model in
+//! `crate::solver::newton`.
 
 use super::model::Precision;
-use super::{model, Failure, IgError, Solution};
+use super::{model, Solution};
 use crate::{PlanarJacobian, PlanarParams, PlanarPose};
 use nalgebra::Vector3;
 
@@ -91,96 +89,5 @@ pub(crate) fn make_solution(
         evaluations: iterations + 1,
         starts: 1,
         elapsed_us: 0.0,
-    }
-}
-
-/// The paper's Newton (§3.1) from `a0`, FINDINGS §8 protocol. `iterations` counts Newton steps
-/// taken (0 when a0 already solves the problem).
-pub(crate) fn solve(
-    target: &PlanarPose,
-    a0: &PlanarParams,
-    alpha: f64,
-    max_iterations: u32,
-    tolerance: f64,
-) -> Result<Solution, Failure> {
-    let mut a = *a0;
-    let precision = Precision::for_start(a0);
-    let mut last_res = f64::INFINITY;
-    let fail = |reason, k, res, a| Failure {
-        reason,
-        iterations: k,
-        residual: res,
-        last_a: Some(a),
-        elapsed_us: 0.0,
-    };
-    let mut k: u32 = 0;
-    loop {
-        if super::deadline::expired() {
-            return Err(fail(IgError::Deadline { iteration: k }, k, last_res, a));
-        }
-        let e = match eval(&a, target, precision) {
-            Some(e) => e,
-            None => {
-                return Err(fail(
-                    IgError::NonFinite {
-                        iteration: k,
-                        detail: "Υ(a), J(1, a) or the residual is not finite".into(),
-                    },
-                    k,
-                    last_res,
-                    a,
-                ))
-            }
-        };
-        last_res = e.norm;
-        let st = match model::stability(&a) {
-            Ok(s) => s,
-            Err(err) => {
-                return Err(fail(
-                    IgError::NonFinite {
-                        iteration: k,
-                        detail: format!("stability test failed: {err}"),
-                    },
-                    k,
-                    last_res,
-                    a,
-                ))
-            }
-        };
-        if !st.stable {
-            return Err(fail(
-                IgError::LeftStableSet { iteration: k },
-                k,
-                last_res,
-                a,
-            ));
-        }
-        if e.pos_err <= tolerance && e.ang_err <= tolerance {
-            if let Some(e) = verify(&a, target, tolerance) {
-                return Ok(make_solution(&a, &e, true, st.margin, k));
-            }
-        }
-        if k >= max_iterations {
-            return Err(fail(
-                IgError::MaxIterations {
-                    iterations: max_iterations,
-                },
-                k,
-                last_res,
-                a,
-            ));
-        }
-        match solve3(&e.jac, &e.f) {
-            Ok(p) => a -= alpha * p,
-            Err(det) => {
-                return Err(fail(
-                    IgError::SingularJacobian { iteration: k, det },
-                    k,
-                    last_res,
-                    a,
-                ))
-            }
-        }
-        k += 1;
     }
 }

@@ -7,6 +7,7 @@ use super::{
     atlas, fronts, local, model, newton, newton::make_solution, straight, Failure, IgError,
     Solution, SolveOptions,
 };
+use crate::solver::{emit, Event, Termination};
 use crate::{PlanarParams, PlanarPose};
 
 /// Total start budget of one robust solve.
@@ -31,6 +32,10 @@ struct Counts {
     evaluations: u32,
     /// Best residual reached by any start, and where.
     best: (f64, Option<PlanarParams>),
+    /// Why the last start that did not produce a solution stopped.
+    last_stop: Option<IgError>,
+    /// Starts run (the observer's start index).
+    starts: u32,
 }
 
 impl Default for Counts {
@@ -39,6 +44,8 @@ impl Default for Counts {
             iterations: 0,
             evaluations: 0,
             best: (f64::INFINITY, None),
+            last_stop: None,
+            starts: 0,
         }
     }
 }
@@ -51,6 +58,12 @@ fn run_counted(
     budget: u32,
     counts: &mut Counts,
 ) -> local::Local {
+    let index = counts.starts;
+    counts.starts += 1;
+    emit(Event::StartBegun {
+        index,
+        a0_norm: start.a.norm(),
+    });
     let r = local::solve_predicted(
         target,
         &start.a,
@@ -61,6 +74,16 @@ fn run_counted(
     );
     counts.iterations += r.iterations;
     counts.evaluations += r.evaluations;
+    if r.found.is_none() {
+        counts.last_stop = Some(r.stop.to_error(r.iterations));
+    }
+    emit(Event::StartEnded {
+        index,
+        termination: match r.found {
+            Some(_) => Termination::Converged,
+            None => r.stop.to_error(r.iterations).termination(),
+        },
+    });
     r
 }
 
@@ -282,7 +305,10 @@ pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solut
         }
     }
     Err(Failure {
-        reason: IgError::NoStableSolution { starts: n as u32 },
+        reason: IgError::NoStableSolution {
+            starts: n as u32,
+            last: counts.last_stop.map(Box::new),
+        },
         iterations: counts.iterations,
         residual: counts.best.0,
         last_a: counts.best.1,

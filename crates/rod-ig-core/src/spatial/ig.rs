@@ -5,9 +5,10 @@
 //! p = −α J⁻¹ f with f = −e). Convergence: position error |p* − p| ≤ tol and rotation angle
 //! ∠(R, R*) ≤ tol; the reported residual is their sum.
 //!
-//! * [`Method3d::Newton`]: the paper's iteration a ← a + α J⁻¹ e from one guess; as in the
-//!   paper's protocol (FINDINGS §8) it fails as soon as an iterate is unstable.
-//! * [`Method3d::Robust`]: damped Newton with backtracking (the merit |e|² must decrease, and
+//! This module is the 3-D model's search behind [`crate::solver`] ([`Spatial`] implements
+//! [`InverseGeometry`]); the paper's Newton is the generic `crate::solver` one.
+//!
+//! * The robust search: damped Newton with backtracking (the merit |e|² must decrease, and
 //!   trial points that leave the stable set are rejected), a Levenberg–Marquardt fallback when J
 //!   is singular, a cap on the step length, and multi-start from a short list of stable seeds
 //!   derived from the target. Every returned solution has passed the stability test.
@@ -15,163 +16,47 @@
 //! All loops are bounded (iterations × backtracking steps × starts).
 
 use super::stability::evaluate_if_stable;
-use super::{
-    check_rtol, Evaluation3d, SpatialParams, SpatialPose, StabilityOptions, Stiffness,
-    PRODUCTION_RTOL,
+use super::{Evaluation3d, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
+use crate::solver::{
+    emit, Event, Failure, Found, IgError, InverseGeometry, Solution, SolveOptions, Spatial,
+    Termination,
 };
-use crate::RodError;
 use nalgebra::{Matrix6, Vector3, Vector6};
-use thiserror::Error;
 
-/// Which iteration to run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Method3d {
-    /// Damped, stability-preserving Newton with multi-start (default).
-    #[default]
-    Robust,
-    /// The paper's fixed-step Newton from one guess.
-    Newton,
-}
+/// Seeds tried at most by the robust search (the length of [`seeds_for`]'s list).
+pub const DEFAULT_MAX_STARTS: u32 = 12;
 
-/// Options of [`solve`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SolveOptions3d {
-    /// Iteration to run.
-    pub method: Method3d,
-    /// Newton step length α ∈ (0, 1] (paper §3.1); the robust method starts its line search here.
-    pub alpha: f64,
-    /// Iteration limit per start.
-    pub max_iterations: u32,
-    /// Tolerance on the position error (rod lengths) and on the rotation angle (rad).
-    pub tolerance: f64,
-    /// Starting point (tried first by the robust method; required by nothing).
-    pub initial_guess: Option<SpatialParams>,
-    /// Rod stiffnesses.
-    pub stiffness: Stiffness,
-    /// Relative tolerance of the integrations (default [`PRODUCTION_RTOL`] = 1e-8).
-    pub rtol: f64,
-    /// Robust method: number of seeds tried at most.
-    pub max_starts: u32,
-    /// Wall-time budget of one call ([`DEFAULT_DEADLINE_3D`], at most
-    /// [`crate::ig::MAX_DEADLINE`]); every evaluation polls it.
-    pub deadline: std::time::Duration,
-}
+/// A 3-D solution.
+pub type Solution3d = Solution<SpatialParams, SpatialPose>;
+/// A failed 3-D solve.
+pub type Failure3d = Failure<SpatialParams>;
+/// Options of a 3-D solve.
+pub type SolveOptions3d = SolveOptions<SpatialParams>;
 
-/// Default wall-time budget of one 3-D solve: 1 s. The robust 3-D solve takes 0.3 ms median,
-/// 1.2 ms p90 on random stable rods (`rod-ig bench --only spatial`); each evaluation integrates
-/// 44 variational states, so a hard target may need a few hundred ms.
-pub const DEFAULT_DEADLINE_3D: std::time::Duration = std::time::Duration::from_secs(1);
-
-impl Default for SolveOptions3d {
-    fn default() -> Self {
-        Self {
-            method: Method3d::Robust,
-            alpha: 1.0,
-            max_iterations: 100,
-            tolerance: 1e-6,
-            initial_guess: None,
-            stiffness: Stiffness::default(),
-            rtol: PRODUCTION_RTOL,
-            max_starts: 12,
-            deadline: DEFAULT_DEADLINE_3D,
+/// Checks a 3-D target: finite, and ‖p*‖ ≤ 1 (the unit rod is inextensible).
+pub fn check_target(target: &SpatialPose) -> Result<(), IgError> {
+    let p = target.position;
+    for (component, value) in [
+        ("position.x", p.x),
+        ("position.y", p.y),
+        ("position.z", p.z),
+    ] {
+        if !value.is_finite() {
+            return Err(IgError::NonFiniteTarget { component, value });
         }
     }
-}
-
-/// A converged, stable solution.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Solution3d {
-    /// Parameters a = μ(0).
-    pub a: SpatialParams,
-    /// Tip pose q(1, a).
-    pub tip: SpatialPose,
-    /// Stability verdict (always true for the robust method).
-    pub stable: bool,
-    /// Normalised stability margin ([`super::det_leading_term`]).
-    pub stability_margin: f64,
-    /// Newton iterations of the successful start.
-    pub iterations: u32,
-    /// Rod integrations used in total (all starts).
-    pub evaluations: u32,
-    /// Index of the successful start (0 = first seed).
-    pub start: u32,
-    /// |p* − p|.
-    pub position_error: f64,
-    /// ∠(R, R*) in rad.
-    pub orientation_error: f64,
-    /// position_error + orientation_error.
-    pub residual: f64,
-    /// Elastic energy ½∫ Σ μ_i²/c_i.
-    pub energy: f64,
-}
-
-/// Why the 3-D solver failed.
-#[derive(Clone, Debug, PartialEq, Error)]
-pub enum IgError3d {
-    /// The target has a non-finite component.
-    #[error("target is not finite")]
-    NonFiniteTarget,
-    /// The target position is farther than the rod length (1).
-    #[error("target out of reach: |p| = {distance} > 1")]
-    Unreachable {
-        /// |p*|.
-        distance: f64,
-    },
-    /// Invalid options (α, tolerance, rtol, stiffness).
-    #[error("invalid options: {0}")]
-    InvalidOptions(String),
-    /// J(1, a) is singular (Newton).
-    #[error("singular Jacobian")]
-    SingularJacobian,
-    /// An iterate (Newton) or every trial step (robust) left the stable set.
-    #[error("iterate left the stable set")]
-    LeftStableSet,
-    /// The line search found no decrease of the residual.
-    #[error("no decrease of the residual along the Newton direction")]
-    Stalled,
-    /// The iteration limit was reached.
-    #[error("iteration limit reached")]
-    MaxIterations,
-    /// The deadline ([`SolveOptions3d::deadline`]) passed before convergence.
-    #[error("deadline reached without convergence")]
-    Deadline,
-    /// An integration failed or produced non-finite values.
-    #[error("rod evaluation failed: {0}")]
-    Evaluation(String),
-    /// No start of the robust method reached a stable solution.
-    #[error("no stable solution found from {starts} starts (last: {last})")]
-    NoStableSolution {
-        /// Starts tried.
-        starts: u32,
-        /// The failure of the last start.
-        last: Box<IgError3d>,
-    },
-}
-
-/// A failed solve: reason, work done, and the best iterate seen.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Failure3d {
-    /// Why.
-    pub reason: IgError3d,
-    /// Iterations (all starts).
-    pub iterations: u32,
-    /// Smallest residual (position + angle) seen, ∞ if none.
-    pub residual: f64,
-    /// The iterate with that residual.
-    pub last_a: Option<SpatialParams>,
-}
-
-impl std::fmt::Display for Failure3d {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "{} after {} iterations (best residual {:e})",
-            self.reason, self.iterations, self.residual
-        )
+    if let Some(&value) = target.rotation.coords.iter().find(|v| !v.is_finite()) {
+        return Err(IgError::NonFiniteTarget {
+            component: "orientation",
+            value,
+        });
     }
+    let distance = p.norm();
+    if distance > 1.0 {
+        return Err(IgError::Unreachable { distance });
+    }
+    Ok(())
 }
-
-impl std::error::Error for Failure3d {}
 
 struct Ctx<'a> {
     target: &'a SpatialPose,
@@ -180,6 +65,9 @@ struct Ctx<'a> {
     /// Tolerance on the current goal.
     goal_tol: f64,
     opts: &'a SolveOptions3d,
+    model: &'a Spatial,
+    /// Starts begun (for the observer's events).
+    starts: u32,
     evaluations: u32,
     iterations: u32,
     best: (f64, Option<SpatialParams>),
@@ -200,14 +88,14 @@ impl Ctx<'_> {
     /// Integration tolerance for an iterate with residual `res`: about 1e-3·res, within
     /// [opts.rtol, 1e-5] — far from the target, tip and J need few digits.
     fn rtol_for(&self, res: f64) -> f64 {
-        let lo = self.opts.rtol;
+        let lo = self.model.rtol;
         (1e-3 * res).clamp(lo, LOOSE_RTOL.max(lo))
     }
 
     fn stab_options(&self, rtol: f64, verify: bool) -> StabilityOptions {
         if verify {
             StabilityOptions {
-                rtol: self.opts.rtol,
+                rtol: self.model.rtol,
                 ..StabilityOptions::production()
             }
         } else {
@@ -219,30 +107,24 @@ impl Ctx<'_> {
         }
     }
 
-    fn eval(
-        &mut self,
-        a: &SpatialParams,
-        rtol: f64,
-        verify: bool,
-    ) -> Result<EvalOutcome, IgError3d> {
+    fn eval(&mut self, a: &SpatialParams, rtol: f64, verify: bool) -> Result<EvalOutcome, IgError> {
         if crate::ig::deadline::expired() {
-            return Err(IgError3d::Deadline);
+            return Err(IgError::Deadline {
+                iteration: self.iterations,
+            });
         }
         self.evaluations += 1;
         let so = self.stab_options(rtol, verify);
-        match evaluate_if_stable(a, &self.opts.stiffness, &so) {
+        match evaluate_if_stable(a, &self.model.stiffness, &so) {
             Ok((Some(ev), _)) => {
                 let (pe, ang) = ev.tip.distance_to(self.target);
-                if pe + ang < self.best.0 {
-                    self.best = (pe + ang, Some(*a));
+                if pe.hypot(ang) < self.best.0 {
+                    self.best = (pe.hypot(ang), Some(*a));
                 }
                 Ok(EvalOutcome::Stable(Box::new(ev)))
             }
             Ok((None, _)) => Ok(EvalOutcome::Unstable),
-            Err(RodError::Integration(m)) | Err(RodError::Overflow(m)) => {
-                Err(IgError3d::Evaluation(m))
-            }
-            Err(e) => Err(IgError3d::Evaluation(e.to_string())),
+            Err(e) => Err(IgError::Evaluation(e)),
         }
     }
 
@@ -261,29 +143,32 @@ impl Ctx<'_> {
         self.goal_tol = self.opts.tolerance;
     }
 
-    fn solution(&self, a: SpatialParams, ev: &Evaluation3d, it: u32, start: u32) -> Solution3d {
+    /// The solution `a` (evaluated as `ev`) found by start number `start` (0-based).
+    fn solution(&self, a: SpatialParams, ev: &Evaluation3d, start: u32) -> Solution3d {
         let (pe, ang) = ev.tip.distance_to(self.target);
-        Solution3d {
+        Solution {
             a,
             tip: ev.tip,
             stable: ev.stability.stable,
             stability_margin: ev.stability.margin,
-            iterations: it,
+            iterations: self.iterations,
             evaluations: self.evaluations,
-            start,
+            starts: start + 1,
             position_error: pe,
             orientation_error: ang,
-            residual: pe + ang,
+            residual: pe.hypot(ang),
             energy: ev.energy,
+            elapsed_us: 0.0,
         }
     }
 
-    fn failure(&self, reason: IgError3d) -> Failure3d {
-        Failure3d {
+    fn failure(&self, reason: IgError) -> Failure3d {
+        Failure {
             reason,
             iterations: self.iterations,
             residual: self.best.0,
             last_a: self.best.1,
+            elapsed_us: 0.0,
         }
     }
 }
@@ -308,109 +193,6 @@ fn newton_direction(j: &Matrix6<f64>, e: &Vector6<f64>, allow_lm: bool) -> Optio
         .filter(|d| d.iter().all(|v| v.is_finite()))
 }
 
-fn validate(target: &SpatialPose, opts: &SolveOptions3d) -> Result<(), IgError3d> {
-    if !target.is_finite() {
-        return Err(IgError3d::NonFiniteTarget);
-    }
-    let dist = target.position.norm();
-    if dist > 1.0 {
-        return Err(IgError3d::Unreachable { distance: dist });
-    }
-    if !(opts.alpha.is_finite() && opts.alpha > 0.0 && opts.alpha <= 1.0) {
-        return Err(IgError3d::InvalidOptions(format!(
-            "alpha must be in (0, 1] (got {})",
-            opts.alpha
-        )));
-    }
-    if !(opts.tolerance.is_finite() && opts.tolerance >= crate::ig::MIN_TOLERANCE) {
-        return Err(IgError3d::InvalidOptions(format!(
-            "tolerance must be a finite number >= {:e} (got {:e})",
-            crate::ig::MIN_TOLERANCE,
-            opts.tolerance
-        )));
-    }
-    if opts.max_iterations > crate::ig::MAX_ITERATIONS_LIMIT {
-        return Err(IgError3d::InvalidOptions(format!(
-            "max_iterations = {} exceeds the limit {}",
-            opts.max_iterations,
-            crate::ig::MAX_ITERATIONS_LIMIT
-        )));
-    }
-    if opts.deadline.is_zero() || opts.deadline > crate::ig::MAX_DEADLINE {
-        return Err(IgError3d::InvalidOptions(format!(
-            "deadline = {:?} is not in (0, {:?}]",
-            opts.deadline,
-            crate::ig::MAX_DEADLINE
-        )));
-    }
-    if let Some(g) = &opts.initial_guess {
-        if g.iter().any(|v| !v.is_finite()) {
-            return Err(IgError3d::InvalidOptions(
-                "initial guess is not finite".into(),
-            ));
-        }
-    }
-    check_rtol(opts.rtol).map_err(|e| IgError3d::InvalidOptions(e.to_string()))?;
-    opts.stiffness
-        .validate()
-        .map_err(|e| IgError3d::InvalidOptions(e.to_string()))
-}
-
-/// Solves the 3-D inverse geometry for `target` (base frame, unit rod length).
-///
-/// Errors are typed ([`IgError3d`]) and carry the best iterate seen; the work is bounded by
-/// `max_iterations` per start (each with at most 12 trial evaluations) and `max_starts`.
-pub fn solve(target: &SpatialPose, options: &SolveOptions3d) -> Result<Solution3d, Failure3d> {
-    let mut ctx = Ctx {
-        target,
-        goal: *target,
-        goal_tol: options.tolerance,
-        opts: options,
-        evaluations: 0,
-        iterations: 0,
-        best: (f64::INFINITY, None),
-    };
-    if let Err(e) = validate(target, options) {
-        return Err(ctx.failure(e));
-    }
-    let _deadline = crate::ig::deadline::scope(options.deadline);
-    match options.method {
-        Method3d::Newton => {
-            let a0 = options
-                .initial_guess
-                .unwrap_or_else(|| seeds_for(target, &options.stiffness)[0]);
-            newton(&mut ctx, a0).map_err(|e| ctx.failure(e))
-        }
-        Method3d::Robust => robust(&mut ctx),
-    }
-}
-
-/// The paper's Newton iteration a ← a + α J⁻¹ e, failing when an iterate is unstable.
-fn newton(ctx: &mut Ctx, a0: SpatialParams) -> Result<Solution3d, IgError3d> {
-    let mut a = a0;
-    let mut ev = match ctx.eval(&a, ctx.opts.rtol, true)? {
-        EvalOutcome::Stable(ev) => ev,
-        EvalOutcome::Unstable => return Err(IgError3d::LeftStableSet),
-    };
-    for it in 0..=ctx.opts.max_iterations {
-        if ctx.converged(&ev).is_some() {
-            return Ok(ctx.solution(a, &ev, it, 0));
-        }
-        if it == ctx.opts.max_iterations {
-            break;
-        }
-        ctx.iterations += 1;
-        let e = ev.tip.body_error_to(ctx.target);
-        let d = newton_direction(&ev.jacobian, &e, false).ok_or(IgError3d::SingularJacobian)?;
-        a += ctx.opts.alpha * d;
-        ev = match ctx.eval(&a, ctx.opts.rtol, true)? {
-            EvalOutcome::Stable(ev) => ev,
-            EvalOutcome::Unstable => return Err(IgError3d::LeftStableSet),
-        };
-    }
-    Err(IgError3d::MaxIterations)
-}
-
 /// Largest step ‖δa‖₂ the robust method takes at once.
 fn step_cap(a: &SpatialParams) -> f64 {
     10.0 + 0.5 * a.norm()
@@ -430,7 +212,7 @@ fn damped_newton(
     ev0: Box<Evaluation3d>,
     budget: u32,
     verify: bool,
-) -> Result<(SpatialParams, Box<Evaluation3d>, u32), IgError3d> {
+) -> Result<(SpatialParams, Box<Evaluation3d>, u32), IgError> {
     let mut a = a0;
     let mut ev = ev0;
     let mut e = ev.tip.body_error_to(&ctx.goal);
@@ -443,7 +225,7 @@ fn damped_newton(
                 return Ok((a, ev, it));
             }
             // Verify at the requested accuracy with the fine stability scan.
-            match ctx.eval(&a, ctx.opts.rtol, true)? {
+            match ctx.eval(&a, ctx.model.rtol, true)? {
                 EvalOutcome::Stable(vev) => {
                     if ctx.converged(&vev).is_some() {
                         return Ok((a, vev, it));
@@ -452,16 +234,25 @@ fn damped_newton(
                     e = ev.tip.body_error_to(&ctx.goal);
                     merit = e.norm_squared();
                 }
-                EvalOutcome::Unstable => return Err(IgError3d::LeftStableSet),
+                EvalOutcome::Unstable => {
+                    return Err(IgError::LeftStableSet {
+                        iteration: ctx.iterations,
+                    })
+                }
             }
         }
         if it >= ctx.opts.max_iterations || ctx.evaluations >= budget_end {
-            return Err(IgError3d::MaxIterations);
+            return Err(IgError::MaxIterations {
+                iterations: ctx.opts.max_iterations,
+            });
         }
         it += 1;
         ctx.iterations += 1;
         let Some(mut d) = newton_direction(&ev.jacobian, &e, true) else {
-            return Err(IgError3d::SingularJacobian);
+            return Err(IgError::SingularJacobian {
+                iteration: ctx.iterations,
+                det: ev.jacobian.determinant(),
+            });
         };
         let n = d.norm();
         let cap = step_cap(&a);
@@ -494,6 +285,15 @@ fn damped_newton(
         }
         match accepted {
             Some((ta, tev, te, tm)) => {
+                crate::solver::emit(crate::solver::Event::Iteration {
+                    iteration: it,
+                    residual: {
+                        let (pe, ang) = ev.tip.distance_to(&ctx.goal);
+                        pe.hypot(ang)
+                    },
+                    step: (ta - a).norm(),
+                    alpha,
+                });
                 a = ta;
                 ev = tev;
                 e = te;
@@ -501,9 +301,13 @@ fn damped_newton(
             }
             None => {
                 return Err(if last_unstable {
-                    IgError3d::LeftStableSet
+                    IgError::LeftStableSet {
+                        iteration: ctx.iterations,
+                    }
                 } else {
-                    IgError3d::Stalled
+                    IgError::Stalled {
+                        iteration: ctx.iterations,
+                    }
                 })
             }
         }
@@ -525,14 +329,16 @@ fn continuation(
     ctx: &mut Ctx,
     a0: SpatialParams,
     ev0: Box<Evaluation3d>,
-) -> Result<(SpatialParams, Box<Evaluation3d>, u32), IgError3d> {
+) -> Result<(SpatialParams, Box<Evaluation3d>, u32), IgError> {
     let q0 = ev0.tip;
     let dp = ctx.target.position - q0.position;
     let dr = (q0.rotation.inverse() * ctx.target.rotation).scaled_axis();
     let (mut a, mut ev) = (a0, ev0);
     let (mut s, mut ds) = (0.0f64, 0.25f64);
     let mut its = 0;
-    let mut last = IgError3d::Stalled;
+    let mut last = IgError::Stalled {
+        iteration: ctx.iterations,
+    };
     for _ in 0..64 {
         let s_new = (s + ds).min(1.0);
         let last_step = s_new >= 1.0;
@@ -561,7 +367,7 @@ fn continuation(
                 s = s_new;
                 ds = (ds * 2.0).min(0.5);
             }
-            Err(e @ IgError3d::Evaluation(_)) => return Err(e),
+            Err(e @ IgError::Evaluation(_)) => return Err(e),
             Err(e) => {
                 last = e;
                 ds *= 0.5;
@@ -575,6 +381,66 @@ fn continuation(
     Err(last)
 }
 
+/// Stable seeds already evaluated, reused by the continuation.
+type StableSeeds = Vec<(SpatialParams, Box<Evaluation3d>)>;
+
+/// Damped Newton from the seed `a0` (evaluated at `rtol0`): the solution, or `None` with the
+/// reason in `last`. Stable seeds are remembered in `stable_seeds`.
+fn attempt_plain(
+    ctx: &mut Ctx,
+    a0: SpatialParams,
+    rtol0: f64,
+    stable_seeds: &mut StableSeeds,
+    last: &mut IgError,
+) -> Option<(SpatialParams, Box<Evaluation3d>, u32)> {
+    let index = ctx.starts;
+    ctx.starts += 1;
+    emit(Event::StartBegun {
+        index,
+        a0_norm: a0.norm(),
+    });
+    let r = attempt_plain_inner(ctx, a0, rtol0, stable_seeds, last);
+    emit(Event::StartEnded {
+        index,
+        termination: match &r {
+            Some(_) => Termination::Converged,
+            None => last.termination(),
+        },
+    });
+    r
+}
+
+fn attempt_plain_inner(
+    ctx: &mut Ctx,
+    a0: SpatialParams,
+    rtol0: f64,
+    stable_seeds: &mut StableSeeds,
+    last: &mut IgError,
+) -> Option<(SpatialParams, Box<Evaluation3d>, u32)> {
+    let ev0 = match ctx.eval(&a0, rtol0, false) {
+        Ok(EvalOutcome::Stable(ev)) => ev,
+        Ok(EvalOutcome::Unstable) => {
+            *last = IgError::LeftStableSet {
+                iteration: ctx.iterations,
+            };
+            return None;
+        }
+        Err(e) => {
+            *last = e;
+            return None;
+        }
+    };
+    stable_seeds.push((a0, ev0.clone()));
+    ctx.final_goal();
+    match damped_newton(ctx, a0, ev0, START_BUDGET, true) {
+        Ok(r) => Some(r),
+        Err(e) => {
+            *last = e;
+            None
+        }
+    }
+}
+
 /// Number of seeds tried by plain damped Newton before the first continuation attempt.
 const PLAIN_FIRST: usize = 4;
 
@@ -583,44 +449,20 @@ fn robust(ctx: &mut Ctx) -> Result<Solution3d, Failure3d> {
     if let Some(g) = ctx.opts.initial_guess {
         list.push(g);
     }
-    list.extend(seeds_for(ctx.target, &ctx.opts.stiffness));
-    list.truncate(ctx.opts.max_starts.max(1) as usize);
-    let mut last = IgError3d::LeftStableSet;
-    let mut tried: u32 = 0;
-    let rtol0 = LOOSE_RTOL.max(ctx.opts.rtol);
-    // Stable seeds (evaluated lazily), reused by the continuation.
-    let mut stable_seeds: Vec<(SpatialParams, Box<Evaluation3d>)> = Vec::new();
-    let attempt_plain = |ctx: &mut Ctx,
-                         a0: SpatialParams,
-                         stable_seeds: &mut Vec<(SpatialParams, Box<Evaluation3d>)>,
-                         last: &mut IgError3d|
-     -> Option<(SpatialParams, Box<Evaluation3d>, u32)> {
-        let ev0 = match ctx.eval(&a0, rtol0, false) {
-            Ok(EvalOutcome::Stable(ev)) => ev,
-            Ok(EvalOutcome::Unstable) => {
-                *last = IgError3d::LeftStableSet;
-                return None;
-            }
-            Err(e) => {
-                *last = e;
-                return None;
-            }
-        };
-        stable_seeds.push((a0, ev0.clone()));
-        ctx.final_goal();
-        match damped_newton(ctx, a0, ev0, START_BUDGET, true) {
-            Ok(r) => Some(r),
-            Err(e) => {
-                *last = e;
-                None
-            }
-        }
+    list.extend(seeds_for(ctx.target, &ctx.model.stiffness));
+    list.truncate(ctx.model.max_starts.max(1) as usize);
+    let mut last = IgError::LeftStableSet {
+        iteration: ctx.iterations,
     };
+    let mut tried: u32 = 0;
+    let rtol0 = LOOSE_RTOL.max(ctx.model.rtol);
+    // Stable seeds (evaluated lazily), reused by the continuation.
+    let mut stable_seeds: StableSeeds = Vec::new();
     let n_first = PLAIN_FIRST.min(list.len());
     for (i, a0) in list.iter().take(n_first).enumerate() {
         tried += 1;
-        if let Some((a, ev, it)) = attempt_plain(ctx, *a0, &mut stable_seeds, &mut last) {
-            return Ok(ctx.solution(a, &ev, it, i as u32));
+        if let Some((a, ev, _)) = attempt_plain(ctx, *a0, rtol0, &mut stable_seeds, &mut last) {
+            return Ok(ctx.solution(a, &ev, i as u32));
         }
     }
     // Continuation from the closest stable rod seen so far.
@@ -628,29 +470,102 @@ fn robust(ctx: &mut Ctx) -> Result<Solution3d, Failure3d> {
         tried += 1;
         if let Ok(EvalOutcome::Stable(evb)) = ctx.eval(&ab, rtol0, false) {
             match continuation(ctx, ab, evb) {
-                Ok((a, ev, it)) => return Ok(ctx.solution(a, &ev, it, tried - 1)),
+                Ok((a, ev, _)) => return Ok(ctx.solution(a, &ev, tried - 1)),
                 Err(e) => last = e,
             }
         }
     }
     for a0 in list.iter().skip(n_first) {
         tried += 1;
-        if let Some((a, ev, it)) = attempt_plain(ctx, *a0, &mut stable_seeds, &mut last) {
-            return Ok(ctx.solution(a, &ev, it, tried - 1));
+        if let Some((a, ev, _)) = attempt_plain(ctx, *a0, rtol0, &mut stable_seeds, &mut last) {
+            return Ok(ctx.solution(a, &ev, tried - 1));
         }
     }
     // Continuation from the first stable seeds.
     for (a0, ev0) in stable_seeds.into_iter().take(2) {
         tried += 1;
         match continuation(ctx, a0, ev0) {
-            Ok((a, ev, it)) => return Ok(ctx.solution(a, &ev, it, tried - 1)),
+            Ok((a, ev, _)) => return Ok(ctx.solution(a, &ev, tried - 1)),
             Err(e) => last = e,
         }
     }
-    Err(ctx.failure(IgError3d::NoStableSolution {
+    if matches!(last, IgError::Deadline { .. }) {
+        // Every start after the deadline ended at once: the deadline is the reason.
+        return Err(ctx.failure(last));
+    }
+    Err(ctx.failure(IgError::NoStableSolution {
         starts: tried,
-        last: Box::new(last),
+        last: Some(Box::new(last)),
     }))
+}
+
+impl Ctx<'_> {
+    fn new<'a>(model: &'a Spatial, target: &'a SpatialPose, opts: &'a SolveOptions3d) -> Ctx<'a> {
+        Ctx {
+            target,
+            goal: *target,
+            goal_tol: opts.tolerance,
+            opts,
+            model,
+            starts: 0,
+            evaluations: 0,
+            iterations: 0,
+            best: (f64::INFINITY, None),
+        }
+    }
+}
+
+impl InverseGeometry<6> for Spatial {
+    /// Damped Newton from the seeds (continuation when plain Newton fails), module docs.
+    fn robust(
+        &self,
+        target: &SpatialPose,
+        options: &SolveOptions3d,
+    ) -> Result<Solution3d, Failure3d> {
+        robust(&mut Ctx::new(self, target, options))
+    }
+
+    /// Damped Newton from the initial guess and every seed, each run to the end; the distinct
+    /// stable solutions.
+    fn robust_all(
+        &self,
+        target: &SpatialPose,
+        options: &SolveOptions3d,
+    ) -> Found<SpatialParams, SpatialPose> {
+        let mut ctx = Ctx::new(self, target, options);
+        let mut list: Vec<SpatialParams> = options.initial_guess.into_iter().collect();
+        list.extend(seeds_for(target, &self.stiffness));
+        list.truncate(
+            self.max_starts.max(1) as usize + usize::from(options.initial_guess.is_some()),
+        );
+        let rtol0 = LOOSE_RTOL.max(self.rtol);
+        let scale = crate::solver::RodModel::param_scale(self);
+        let mut solutions: Vec<Solution3d> = Vec::new();
+        let (mut seeds, mut last) = (Vec::new(), IgError::LeftStableSet { iteration: 0 });
+        for a0 in list {
+            if crate::ig::deadline::expired() {
+                break;
+            }
+            if let Some((a, ev, _)) = attempt_plain(&mut ctx, a0, rtol0, &mut seeds, &mut last) {
+                if solutions.iter().all(|s| {
+                    crate::solver::relative_distance(&s.a, &a, &scale) > crate::solver::DISTINCT
+                }) {
+                    let starts = ctx.starts;
+                    solutions.push(ctx.solution(a, &ev, starts - 1));
+                }
+            }
+        }
+        Found {
+            solutions,
+            iterations: ctx.iterations,
+            evaluations: ctx.evaluations,
+            starts: ctx.starts,
+        }
+    }
+
+    fn default_start(&self, target: &SpatialPose) -> Option<SpatialParams> {
+        seeds_for(target, &self.stiffness).first().copied()
+    }
 }
 
 /// Starting points for the target, most promising first:
@@ -729,138 +644,4 @@ pub fn seeds(target: &SpatialPose) -> Vec<SpatialParams> {
         mk(arc, Vector3::new(-5.0, 0.0, 0.0)),
         mk(rot * 0.5, z),
     ]
-}
-
-pub use crate::rng::SplitMix64;
-
-/// Half-widths of the random-target box: |a1..3| ≤ 5, |a4..6| ≤ 30 (FINDINGS3D: ≈ 70 % stable,
-/// straddles the Euler load 4π² and the twist limit 8.99).
-pub const TARGET_BOX: (f64, f64) = (5.0, 30.0);
-
-/// `n` random stable rods from [`TARGET_BOX`] (rejection sampling with the production
-/// stability test, at most 100·n draws) and their tips.
-pub fn random_targets(n: usize, seed: u64, k: &Stiffness) -> Vec<(SpatialParams, SpatialPose)> {
-    let mut rng = SplitMix64::new(seed);
-    let mut out = Vec::with_capacity(n);
-    let (m, f) = TARGET_BOX;
-    let opts = StabilityOptions::production();
-    for _ in 0..n.saturating_mul(100) {
-        if out.len() >= n {
-            break;
-        }
-        let a = SpatialParams::from_fn(|i, _| {
-            let h = if i < 3 { m } else { f };
-            rng.range(-h, h)
-        });
-        if let Ok(ev) = super::evaluate(&a, k, &opts) {
-            if ev.stability.stable {
-                out.push((a, ev.tip));
-            }
-        }
-    }
-    out
-}
-
-/// Success rate and timings of the robust solver on random reachable targets.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BenchmarkReport3d {
-    /// Targets attempted.
-    pub targets: usize,
-    /// Solves that returned a stable solution within tolerance.
-    pub successes: usize,
-    /// successes / targets.
-    pub success_rate: f64,
-    /// Median wall time per solve (µs).
-    pub median_us: f64,
-    /// 90th percentile wall time (µs).
-    pub p90_us: f64,
-    /// Largest wall time (µs).
-    pub max_us: f64,
-    /// Mean Newton iterations of the successful solves.
-    pub mean_iterations: f64,
-    /// Mean rod integrations per solve.
-    pub mean_evaluations: f64,
-    /// Successful solves that needed more than one start.
-    pub restarts_used: usize,
-    /// Failure reasons (Display strings) with counts.
-    pub failures: Vec<(String, usize)>,
-}
-
-/// Runs the robust solver (default options) on `n` random stable targets ([`random_targets`])
-/// and returns the success rate and timings (no I/O; the CLI prints them).
-pub fn benchmark_random_targets(n: usize, seed: u64) -> BenchmarkReport3d {
-    let k = Stiffness::default();
-    let targets = random_targets(n, seed, &k);
-    let opts = SolveOptions3d::default();
-    let mut times = Vec::with_capacity(targets.len());
-    let mut successes = 0;
-    let mut iters = 0u64;
-    let mut evals = 0u64;
-    let mut restarts = 0;
-    let mut failures: Vec<(String, usize)> = Vec::new();
-    for (_, target) in &targets {
-        let t0 = std::time::Instant::now();
-        let r = solve(target, &opts);
-        times.push(t0.elapsed().as_secs_f64() * 1e6);
-        match r {
-            Ok(sol) if sol.stable => {
-                successes += 1;
-                iters += sol.iterations as u64;
-                evals += sol.evaluations as u64;
-                if sol.start > 0 {
-                    restarts += 1;
-                }
-            }
-            Ok(_) => failures.push(("unstable solution".into(), 1)),
-            Err(f) => {
-                let key = match &f.reason {
-                    IgError3d::NoStableSolution { last, .. } => {
-                        format!("no stable solution ({last})")
-                    }
-                    other => other.to_string(),
-                };
-                failures.push((key, 1));
-            }
-        }
-    }
-    let mut merged: Vec<(String, usize)> = Vec::new();
-    for (k, c) in failures {
-        match merged.iter_mut().find(|(m, _)| *m == k) {
-            Some(e) => e.1 += c,
-            None => merged.push((k, c)),
-        }
-    }
-    times.sort_by(f64::total_cmp);
-    let pct = |p: f64| -> f64 {
-        if times.is_empty() {
-            0.0
-        } else {
-            times[((times.len() - 1) as f64 * p).round() as usize]
-        }
-    };
-    let m = targets.len();
-    BenchmarkReport3d {
-        targets: m,
-        successes,
-        success_rate: if m > 0 {
-            successes as f64 / m as f64
-        } else {
-            0.0
-        },
-        median_us: pct(0.5),
-        p90_us: pct(0.9),
-        max_us: times.last().copied().unwrap_or(0.0),
-        mean_iterations: if successes > 0 {
-            iters as f64 / successes as f64
-        } else {
-            0.0
-        },
-        mean_evaluations: if successes > 0 {
-            evals as f64 / successes as f64
-        } else {
-            0.0
-        },
-        restarts_used: restarts,
-        failures: merged,
-    }
 }

@@ -2,10 +2,10 @@
 //! function returns a plain report struct; the CLI prints it.
 //!
 //! Timings are wall-clock per solve on the calling thread, with the atlas built beforehand
-//! ([`super::warm_up`]) so that its one-off construction is not charged to the first solve.
+//! ([`ig::warm_up`]) so that its one-off construction is not charged to the first solve.
 
-use super::{model, solve, IgError, Method, Objective, SolveOptions, Tracker};
-use crate::{PlanarParams, PlanarPose};
+use rod_ig_core::ig::{self, solve, IgError, Method, Objective, SolveOptions, Tracker};
+use rod_ig_core::{planar, wrap_angle, PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -95,7 +95,7 @@ pub struct RobustRow {
     pub failures: Vec<(PlanarPose, String)>,
 }
 
-pub use crate::rng::SplitMix64;
+pub use rod_ig_core::rng::SplitMix64;
 
 fn median(v: &mut [f64]) -> f64 {
     if v.is_empty() {
@@ -138,12 +138,16 @@ fn pct(k: usize, n: usize) -> f64 {
 /// Independent re-check of a returned solution: stable by the stability test (FINDINGS §5)
 /// and Υ(a) within `tolerance` of the target (position and wrapped angle).
 pub fn verify(target: &PlanarPose, a: &PlanarParams, tolerance: f64) -> bool {
-    let Ok((tip, _)) = model::tip_and_jacobian(a, model::Precision::Fast) else {
+    let Ok((tip, _)) = planar::tip_and_jacobian(a) else {
         return false;
     };
-    let f = model::residual(&tip, target);
+    let f = [
+        tip.x - target.x,
+        tip.y - target.y,
+        wrap_angle(tip.theta - target.theta),
+    ];
     let ok_pose = f[0].hypot(f[1]) <= tolerance && f[2].abs() <= tolerance;
-    let ok_stable = model::stability(a).map(|s| s.stable).unwrap_or(false);
+    let ok_stable = planar::stability(a).map(|s| s.stable).unwrap_or(false);
     ok_pose && ok_stable
 }
 
@@ -155,7 +159,7 @@ pub fn table1(
     max_iterations: u32,
     tolerance: f64,
 ) -> Vec<Table1Row> {
-    let _ = super::warm_up();
+    let _ = ig::warm_up();
     alphas
         .iter()
         .map(|&alpha| {
@@ -166,7 +170,7 @@ pub fn table1(
                 tolerance,
                 initial_guess: None,
                 objective: Objective::FirstFound,
-                deadline: super::DEFAULT_DEADLINE,
+                deadline: ig::DEFAULT_DEADLINE,
             };
             let (mut ok, mut unst, mut maxit, mut sing, mut nonf) = (0, 0, 0, 0, 0);
             let mut iters = Vec::new();
@@ -217,7 +221,7 @@ pub fn robust_runs(
     runs: &[(PlanarPose, Option<PlanarParams>)],
     options: &SolveOptions,
 ) -> RobustRow {
-    let _ = super::warm_up();
+    let _ = ig::warm_up();
     let mut ok = 0;
     let mut verified = 0;
     let mut iters = Vec::new();
@@ -299,13 +303,13 @@ pub fn random_stable_targets(n: usize, seed: u64, bx: ParamBox) -> Vec<(PlanarPa
             rng.range(-bx.a45_max, bx.a45_max),
             rng.range(-bx.a45_max, bx.a45_max),
         );
-        let Ok(st) = model::stability(&a) else {
+        let Ok(st) = planar::stability(&a) else {
             continue;
         };
         if !st.stable {
             continue;
         }
-        let Ok((tip, _)) = model::tip_and_jacobian(&a, model::Precision::Fast) else {
+        let Ok((tip, _)) = planar::tip_and_jacobian(&a) else {
             continue;
         };
         out.push((a, tip));
@@ -360,8 +364,8 @@ pub fn ellipse_path(
 pub fn random_stable_path(seed: u64, bx: ParamBox, steps: usize, db: f64) -> Vec<PlanarPose> {
     let mut rng = SplitMix64::new(seed);
     let tip_of = |a: &PlanarParams| -> Option<PlanarPose> {
-        let st = model::stability(a).ok()?;
-        let (tip, _) = model::tip_and_jacobian(a, model::Precision::Fast).ok()?;
+        let st = planar::stability(a).ok()?;
+        let (tip, _) = planar::tip_and_jacobian(a).ok()?;
         (st.stable && st.margin > 1e-3).then_some(tip)
     };
     for _ in 0..1000 {
@@ -430,7 +434,7 @@ pub struct TrackingRow {
 
 /// Runs a fresh [`Tracker`] along `path`.
 pub fn tracking(label: &str, path: &[PlanarPose], options: &SolveOptions) -> TrackingRow {
-    let _ = super::warm_up();
+    let _ = ig::warm_up();
     let mut tr = Tracker::new(*options);
     let (mut ok, mut verified) = (0, 0);
     let mut iters = Vec::new();

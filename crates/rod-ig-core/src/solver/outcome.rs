@@ -1,0 +1,228 @@
+//! What a solve returns: one [`Solution`] type, one [`Failure`] type and one error enum
+//! ([`IgError`]) for every rod model, with a typed [`Termination`] reason.
+
+use crate::RodError;
+use thiserror::Error;
+
+/// A converged solve of the inverse geometry, for any rod model: `P` is the model's parameter
+/// vector a (ℝ³ planar, ℝ⁶ 3-D), `X` its tip pose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Solution<P, X> {
+    /// The rod parameters a* = μ(0).
+    pub a: P,
+    /// Υ(a*) (planar: θ unwrapped, ∫κ).
+    pub tip: X,
+    /// Verdict of the stability test on a* (always true: every strategy returns only stable
+    /// rods).
+    pub stable: bool,
+    /// Normalised stability margin g_min (FINDINGS §5; positive when stable, ≈ 1 when gently
+    /// bent).
+    pub stability_margin: f64,
+    /// Newton iterations, summed over every start tried.
+    pub iterations: u32,
+    /// Position error ‖p(a*) − p*‖ (rod lengths).
+    pub position_error: f64,
+    /// Orientation error (rad): planar |wrap(θ − θ*)|, 3-D the rotation angle ∠(R, R*).
+    pub orientation_error: f64,
+    /// Residual ‖(position_error, orientation_error)‖₂ (planar: ‖f(a*)‖₂ with the angle
+    /// wrapped, the same number).
+    pub residual: f64,
+    /// Elastic energy ½∫ μᵀC⁻¹μ (planar ½∫κ²).
+    pub energy: f64,
+    /// Evaluations of the model (tip and Jacobian), line-search trials included, over every
+    /// start.
+    pub evaluations: u32,
+    /// Number of starts tried (1 for the paper's Newton and a tracker warm start).
+    pub starts: u32,
+    /// Wall time of the solve, µs.
+    pub elapsed_us: f64,
+}
+
+/// Why a solve ended, as a small copyable code (for logs, metrics and the CLI's
+/// `termination` field). [`IgError::termination`] maps every error to one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Termination {
+    /// The residual met the tolerance at a stable rod.
+    Converged,
+    /// The target, the initial guess or an option was rejected before any work.
+    InvalidInput,
+    /// The target is out of the rod's reach.
+    Unreachable,
+    /// The iteration budget ran out.
+    IterationLimit,
+    /// The wall-time budget ran out.
+    Deadline,
+    /// J(1, a) was singular: no Newton step.
+    Singular,
+    /// An iterate left the stable set (paper's protocol, FINDINGS §8), or every trial step did.
+    LeftStableSet,
+    /// The line search found no decrease of the residual.
+    Stalled,
+    /// No start of a multi-start strategy reached a stable solution.
+    NoStableSolution,
+    /// The model could not be evaluated (non-finite values, overflow, integration failure).
+    EvaluationFailed,
+}
+
+impl Termination {
+    /// The snake_case name used in JSON answers and logs.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Converged => "converged",
+            Self::InvalidInput => "invalid_input",
+            Self::Unreachable => "unreachable",
+            Self::IterationLimit => "iteration_limit",
+            Self::Deadline => "deadline",
+            Self::Singular => "singular",
+            Self::LeftStableSet => "left_stable_set",
+            Self::Stalled => "stalled",
+            Self::NoStableSolution => "no_stable_solution",
+            Self::EvaluationFailed => "evaluation_failed",
+        }
+    }
+}
+
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Why an inverse-geometry solve failed (every model, every strategy).
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum IgError {
+    /// A target coordinate is NaN or infinite.
+    #[error("target {component} is not finite ({value})")]
+    NonFiniteTarget {
+        /// "x", "y", "theta" (planar); "position", "orientation" (3-D).
+        component: &'static str,
+        /// The offending value.
+        value: f64,
+    },
+    /// The target position is out of the inextensible unit rod's reach.
+    #[error("target is unreachable: distance {distance} from the base is >= 1, the rod length")]
+    Unreachable {
+        /// ‖p*‖.
+        distance: f64,
+    },
+    /// The initial guess has a non-finite component.
+    #[error("initial guess a0[{index}] is not finite ({value})")]
+    NonFiniteGuess {
+        /// Component index (planar: 0 = a3; 3-D: 0 = a1).
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// The options are unusable (e.g. α ∉ (0, 1], tolerance below the rounding bound).
+    #[error("invalid options: {0}")]
+    InvalidOptions(String),
+    /// J(1, a) is singular at an iterate: the Newton step is undefined.
+    #[error("Jacobian J(1, a) is singular at iteration {iteration} (|det| = {det:e})")]
+    SingularJacobian {
+        /// Iteration at which it happened.
+        iteration: u32,
+        /// det J(1, a) there.
+        det: f64,
+    },
+    /// An iterate is not a stable equilibrium (det J(t, a) ≤ 0 somewhere on (0, 1]).
+    #[error("iterate {iteration} left the stable set (det J(t, a) <= 0 on (0, 1])")]
+    LeftStableSet {
+        /// Iteration of the first unstable iterate (0 = the initial guess).
+        iteration: u32,
+    },
+    /// The line search found no decrease of the residual along the Newton direction.
+    #[error("no decrease of the residual along the Newton direction at iteration {iteration}")]
+    Stalled {
+        /// Iteration at which it happened.
+        iteration: u32,
+    },
+    /// The residual did not reach the tolerance within the iteration budget.
+    #[error("no convergence within {iterations} iterations")]
+    MaxIterations {
+        /// The budget.
+        iterations: u32,
+    },
+    /// The forward map or the residual became non-finite.
+    #[error("non-finite values at iteration {iteration}: {detail}")]
+    NonFinite {
+        /// Iteration at which it happened.
+        iteration: u32,
+        /// What was non-finite.
+        detail: String,
+    },
+    /// The solve's deadline ([`super::SolveOptions::deadline`]) passed before it converged.
+    #[error("deadline reached after {iteration} iterations without convergence")]
+    Deadline {
+        /// Iterations spent.
+        iteration: u32,
+    },
+    /// A multi-start strategy found no stable solution from any of its starts.
+    #[error(
+        "no stable solution found from {starts} starts (target may be outside the stable \
+         workspace){}",
+        last.as_ref().map(|l| format!("; last start: {l}")).unwrap_or_default()
+    )]
+    NoStableSolution {
+        /// Starts tried.
+        starts: u32,
+        /// Why the last start failed, when known.
+        last: Option<Box<IgError>>,
+    },
+    /// A forward evaluation failed.
+    #[error("rod evaluation failed: {0}")]
+    Evaluation(#[from] RodError),
+}
+
+impl IgError {
+    /// The typed termination reason of this error.
+    pub fn termination(&self) -> Termination {
+        match self {
+            Self::NonFiniteTarget { .. }
+            | Self::NonFiniteGuess { .. }
+            | Self::InvalidOptions(_) => Termination::InvalidInput,
+            Self::Unreachable { .. } => Termination::Unreachable,
+            Self::SingularJacobian { .. } => Termination::Singular,
+            Self::LeftStableSet { .. } => Termination::LeftStableSet,
+            Self::Stalled { .. } => Termination::Stalled,
+            Self::MaxIterations { .. } => Termination::IterationLimit,
+            Self::Deadline { .. } => Termination::Deadline,
+            Self::NoStableSolution { .. } => Termination::NoStableSolution,
+            Self::NonFinite { .. } | Self::Evaluation(_) => Termination::EvaluationFailed,
+        }
+    }
+}
+
+/// A failed solve: the reason and where the solver stopped (`P`: the model's parameters).
+#[derive(Clone, Debug, PartialEq, Error)]
+#[error("{reason} (after {iterations} iterations, residual {residual:e})")]
+pub struct Failure<P> {
+    /// Why.
+    pub reason: IgError,
+    /// Iterations spent (every start).
+    pub iterations: u32,
+    /// Residual ‖(position error, orientation error)‖₂ at the best iterate seen (∞ when none
+    /// was evaluated).
+    pub residual: f64,
+    /// That best iterate (possibly a converged but unstable point), when there was one.
+    pub last_a: Option<P>,
+    /// Wall time, µs.
+    pub elapsed_us: f64,
+}
+
+impl<P> Failure<P> {
+    /// A failure before any work (invalid input).
+    pub fn early(reason: IgError) -> Self {
+        Self {
+            reason,
+            iterations: 0,
+            residual: f64::INFINITY,
+            last_a: None,
+            elapsed_us: 0.0,
+        }
+    }
+
+    /// The typed termination reason.
+    pub fn termination(&self) -> Termination {
+        self.reason.termination()
+    }
+}
