@@ -267,9 +267,7 @@ fn solve3d_has_every_option_of_solve() {
     // `solve`, objective and all included; answers carry the typed termination.
     let theta: f64 = 0.8;
     let (s, c) = ((theta / 2.0).sin(), (theta / 2.0).cos());
-    let target = format!(
-        "{{\"position\": [0.5, 0.4, 0.0], \"quaternion\": [0.0, 0.0, {s}, {c}]}}"
-    );
+    let target = format!("{{\"position\": [0.5, 0.4, 0.0], \"quaternion\": [0.0, 0.0, {s}, {c}]}}");
     let input = format!(
         "{{\"target\": {target}, \"all\": true}}\n\
          {{\"target\": {target}, \"objective\": \"least_energy\"}}\n\

@@ -39,7 +39,9 @@ pub mod spatial;
 mod types;
 
 pub use error::RodError;
-pub use types::{wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, StabilityReport};
+pub use types::{
+    wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, StabilityReport, STABILITY_T_MIN,
+};
 
 // The README's Rust example is compiled and run as a doc-test.
 #[cfg(doctest)]

@@ -67,6 +67,11 @@ pub struct StabilityReport {
 
 pub use crate::angle::wrap_angle;
 
+/// Smallest t at which the sign of det J(t, a) is trusted by the stability tests (FINDINGS §5):
+/// det J(t) ~ t⁹ near the base, so below t ≈ 0.02 its absolute rounding error swamps it. Every
+/// stability test (closed form, series, RK4 scan, 3-D grid) starts here.
+pub const STABILITY_T_MIN: f64 = 0.02;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -236,7 +236,10 @@ mod tests {
         use rod_ig_core::solver::observe;
         use rod_ig_core::PlanarPose;
         let mut s = SolveStats::default();
-        for target in [PlanarPose::new(0.5, 0.3, 0.8), PlanarPose::new(0.2, 0.6, 2.0)] {
+        for target in [
+            PlanarPose::new(0.5, 0.3, 0.8),
+            PlanarPose::new(0.2, 0.6, 2.0),
+        ] {
             let (r, work) = observe(Counters::default(), || {
                 ig::solve(&target, &SolveOptions::default())
             });

@@ -272,22 +272,15 @@ fn ros_now(node: &ros2_client::Node) -> crate::messages::Time {
     }
 }
 
-/// Runs the node until SIGINT or SIGTERM.
-pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError> {
-    let Startup {
-        params,
-        identity,
-        rosout_logs,
-        ..
-    } = startup;
-    let context = create_context(&mw)?;
-
-    // Parameters: the node's parameter store validates through `Params::validate` and
-    // applies through `Params::apply`, then the solver task sees the new `Params`.
-    let (params_tx, params_rx) = watch::channel(params.clone());
-    let params_tx = Arc::new(params_tx);
-    let validator_rx = params_rx.clone();
-    let setter_tx = Arc::clone(&params_tx);
+/// The node's options: /rosout, the parameter services, and a parameter store that validates
+/// through `Params::validate`, applies through `Params::apply` and announces the new `Params`
+/// to the solver thread; every parameter declared with its descriptor.
+fn node_options(
+    params: &Params,
+    rosout_logs: bool,
+    validator_rx: watch::Receiver<Params>,
+    setter_tx: Arc<watch::Sender<Params>>,
+) -> NodeOptions {
     let mut options = NodeOptions::new()
         .enable_rosout(rosout_logs)
         .start_parameter_services(true)
@@ -312,6 +305,67 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         }
         options = options.declare_parameter(&name, value);
     }
+    options
+}
+
+/// Starts the solver thread: it builds the inverse-geometry atlas (the receiver fires when it
+/// is built, with its number of seeds), then runs [`solver_loop`] on a runtime of its own.
+#[allow(clippy::too_many_arguments)]
+fn spawn_solver_thread(
+    processor: Processor,
+    params_rx: watch::Receiver<Params>,
+    target_rx: watch::Receiver<Option<PoseStamped>>,
+    job_rx: mpsc::Receiver<ServiceJob>,
+    outputs: Outputs,
+    stats: Arc<Stats>,
+    log: Logger,
+) -> Result<(std::thread::JoinHandle<()>, oneshot::Receiver<usize>), NodeError> {
+    let (warm_tx, warm_rx) = oneshot::channel::<usize>();
+    let thread = std::thread::Builder::new()
+        .name("rod_ig_solver".into())
+        .spawn(move || {
+            let t0 = std::time::Instant::now();
+            let seeds = rod_ig_core::ig::warm_up();
+            log::debug!("atlas of {seeds} stable rods built in {:?}", t0.elapsed());
+            let _ = warm_tx.send(seeds);
+            let rt = match tokio::runtime::Builder::new_current_thread()
+                .enable_all()
+                .build()
+            {
+                Ok(rt) => rt,
+                Err(e) => {
+                    log.error(&format!("cannot start the solver thread's runtime: {e}"));
+                    return;
+                }
+            };
+            rt.block_on(solver_loop(
+                processor, params_rx, target_rx, job_rx, outputs, stats, log,
+            ));
+        })
+        .map_err(create_err("solver thread"))?;
+    Ok((thread, warm_rx))
+}
+
+/// Runs the node until SIGINT or SIGTERM.
+pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError> {
+    let Startup {
+        params,
+        identity,
+        rosout_logs,
+        ..
+    } = startup;
+    let context = create_context(&mw)?;
+
+    // Parameters: the node's parameter store validates through `Params::validate` and
+    // applies through `Params::apply`, then the solver task sees the new `Params`.
+    let (params_tx, params_rx) = watch::channel(params.clone());
+    let params_tx = Arc::new(params_tx);
+    let options = node_options(
+        &params,
+        rosout_logs,
+        params_rx.clone(),
+        Arc::clone(&params_tx),
+    );
 
     let node_name =
         NodeName::new(&identity.namespace, &identity.name).map_err(create_err("node name"))?;
@@ -383,37 +437,15 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
     let solver_log = Logger {
         handle: node.logging_handle(),
     };
-    let (warm_tx, warm_rx) = oneshot::channel::<usize>();
-    let solver_stats = Arc::clone(&stats);
-    let solver_params = params.clone();
-    let solver_thread = std::thread::Builder::new()
-        .name("rod_ig_solver".into())
-        .spawn(move || {
-            let t0 = std::time::Instant::now();
-            let seeds = rod_ig_core::ig::warm_up();
-            log::debug!("atlas of {seeds} stable rods built in {:?}", t0.elapsed());
-            let _ = warm_tx.send(seeds);
-            let rt = match tokio::runtime::Builder::new_current_thread()
-                .enable_all()
-                .build()
-            {
-                Ok(rt) => rt,
-                Err(e) => {
-                    solver_log.error(&format!("cannot start the solver thread's runtime: {e}"));
-                    return;
-                }
-            };
-            rt.block_on(solver_loop(
-                Processor::new(&solver_params),
-                params_rx,
-                target_rx,
-                job_rx,
-                outputs,
-                solver_stats,
-                solver_log,
-            ));
-        })
-        .map_err(create_err("solver thread"))?;
+    let (solver_thread, warm_rx) = spawn_solver_thread(
+        Processor::new(&params),
+        params_rx,
+        target_rx,
+        job_rx,
+        outputs,
+        Arc::clone(&stats),
+        solver_log,
+    )?;
     let atlas_seeds = warm_rx.await.unwrap_or(0);
     log::debug!("solver warm: {atlas_seeds} atlas seeds");
 
@@ -434,97 +466,38 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         .map_err(create_err("/rod/solve service"))?;
 
     // Subscriber task: overwrite the single slot with the newest target.
-    let sub_stats = Arc::clone(&stats);
     let sub_log = Logger {
         handle: node.logging_handle(),
     };
     let node = Arc::new(node);
-    let clock_node = Arc::clone(&node);
-    let subscriber_task = tokio::spawn(async move {
-        let mut stream = pin!(subscription.async_stream());
-        while let Some(item) = stream.next().await {
-            match item {
-                Ok((mut msg, _info)) => {
-                    stamp_if_zero(&mut msg, || ros_now(&clock_node));
-                    let t = &msg.header.stamp;
-                    log::debug!(
-                        "/rod/target: received the target stamped {}.{:09}",
-                        t.sec,
-                        t.nanosec
-                    );
-                    sub_stats.received.fetch_add(1, Ordering::Relaxed);
-                    target_tx.send_replace(Some(msg));
-                }
-                Err(e) => sub_log.warn(&format!("/rod/target: dropped a bad message: {e:?}")),
-            }
-        }
-    });
+    let subscriber_task = tokio::spawn(receive_targets(
+        subscription,
+        target_tx,
+        Arc::clone(&stats),
+        sub_log,
+        Arc::clone(&node),
+    ));
 
     // Diagnostics task: one DiagnosticArray per period from the solve record.
-    let diag_stats = Arc::clone(&stats);
-    let diag_clock = Arc::clone(&node);
     let diag_name = format!("{}: inverse geometry", identity.fully_qualified_name());
-    let diagnostics_task = tokio::spawn(async move {
-        let mut tick = tokio::time::interval(DIAGNOSTICS_PERIOD);
-        tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
-        tick.tick().await; // the first tick is immediate
-        let mut last = tokio::time::Instant::now();
-        loop {
-            tick.tick().await;
-            let now = tokio::time::Instant::now();
-            let status = {
-                let Ok(mut solves) = diag_stats.solves.lock() else {
-                    break;
-                };
-                solves.report(
-                    &diag_name,
-                    (now - last).as_secs_f64(),
-                    diag_stats.received.load(Ordering::Relaxed),
-                    diag_stats.service_calls.load(Ordering::Relaxed),
-                )
-            };
-            last = now;
-            let msg = crate::messages::DiagnosticArray {
-                header: crate::messages::Header {
-                    stamp: ros_now(&diag_clock),
-                    frame_id: String::new(),
-                },
-                status: vec![status],
-            };
-            if let Err(e) = diagnostics_pub.publish(msg) {
-                log::warn!("cannot publish /diagnostics: {e:?}");
-            }
-        }
-    });
+    let diagnostics_task = tokio::spawn(report_diagnostics(
+        diagnostics_pub,
+        Arc::clone(&stats),
+        Arc::clone(&node),
+        diag_name,
+    ));
 
     // Service task: forward each request to the solver task, send back its answer.
-    let srv_stats = Arc::clone(&stats);
     let srv_log = Logger {
         handle: node.logging_handle(),
     };
-    let srv_clock = Arc::clone(&node);
-    let service_task = tokio::spawn(async move {
-        let mut stream = pin!(server.receive_request_stream());
-        while let Some(item) = stream.next().await {
-            let (id, mut request) = match item {
-                Ok(r) => r,
-                Err(e) => {
-                    srv_log.warn(&format!("/rod/solve: dropped a bad request: {e:?}"));
-                    continue;
-                }
-            };
-            srv_stats.service_calls.fetch_add(1, Ordering::Relaxed);
-            stamp_if_zero(&mut request.target, || ros_now(&srv_clock));
-            let (reply_tx, reply_rx) = oneshot::channel();
-            if job_tx.send((request, reply_tx)).await.is_err() {
-                break; // solver task gone: shutting down
-            }
-            let Ok(response) = reply_rx.await else { break };
-            if let Err(e) = server.async_send_response(id, response).await {
-                srv_log.warn(&format!("/rod/solve: cannot send the response: {e:?}"));
-            }
-        }
-    });
+    let service_task = tokio::spawn(serve_requests(
+        server,
+        job_tx,
+        Arc::clone(&stats),
+        srv_log,
+        Arc::clone(&node),
+    ));
 
     logger.info(&format!(
         "{} ready: domain {}{}, rod_length {} m, path_samples {}, method {}{}; \
@@ -572,6 +545,103 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
     let _ = tokio::time::timeout(std::time::Duration::from_secs(2), spin_task).await;
     drop(params_tx);
     Ok(())
+}
+/// The subscriber task: every valid target replaces the one waiting in the slot (latest wins);
+/// unstamped targets get the node's clock time.
+async fn receive_targets(
+    subscription: ros2_client::Subscription<PoseStamped>,
+    target_tx: watch::Sender<Option<PoseStamped>>,
+    stats: Arc<Stats>,
+    log: Logger,
+    clock_node: Arc<ros2_client::Node>,
+) {
+    let mut stream = pin!(subscription.async_stream());
+    while let Some(item) = stream.next().await {
+        match item {
+            Ok((mut msg, _info)) => {
+                stamp_if_zero(&mut msg, || ros_now(&clock_node));
+                let t = &msg.header.stamp;
+                log::debug!(
+                    "/rod/target: received the target stamped {}.{:09}",
+                    t.sec,
+                    t.nanosec
+                );
+                stats.received.fetch_add(1, Ordering::Relaxed);
+                target_tx.send_replace(Some(msg));
+            }
+            Err(e) => log.warn(&format!("/rod/target: dropped a bad message: {e:?}")),
+        }
+    }
+}
+
+/// The diagnostics task: one DiagnosticArray per [`DIAGNOSTICS_PERIOD`] from the solve record.
+async fn report_diagnostics(
+    publisher: Publisher<crate::messages::DiagnosticArray>,
+    stats: Arc<Stats>,
+    clock_node: Arc<ros2_client::Node>,
+    name: String,
+) {
+    let mut tick = tokio::time::interval(DIAGNOSTICS_PERIOD);
+    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    tick.tick().await; // the first tick is immediate
+    let mut last = tokio::time::Instant::now();
+    loop {
+        tick.tick().await;
+        let now = tokio::time::Instant::now();
+        let status = {
+            let Ok(mut solves) = stats.solves.lock() else {
+                break;
+            };
+            solves.report(
+                &name,
+                (now - last).as_secs_f64(),
+                stats.received.load(Ordering::Relaxed),
+                stats.service_calls.load(Ordering::Relaxed),
+            )
+        };
+        last = now;
+        let msg = crate::messages::DiagnosticArray {
+            header: crate::messages::Header {
+                stamp: ros_now(&clock_node),
+                frame_id: String::new(),
+            },
+            status: vec![status],
+        };
+        if let Err(e) = publisher.publish(msg) {
+            log::warn!("cannot publish /diagnostics: {e:?}");
+        }
+    }
+}
+
+/// The service task: each `/rod/solve` request goes to the solver thread, its answer back to
+/// the caller.
+async fn serve_requests(
+    server: ros2_client::Server<SolveRodRequest, SolveRodResponse>,
+    job_tx: mpsc::Sender<ServiceJob>,
+    stats: Arc<Stats>,
+    log: Logger,
+    clock_node: Arc<ros2_client::Node>,
+) {
+    let mut stream = pin!(server.receive_request_stream());
+    while let Some(item) = stream.next().await {
+        let (id, mut request) = match item {
+            Ok(r) => r,
+            Err(e) => {
+                log.warn(&format!("/rod/solve: dropped a bad request: {e:?}"));
+                continue;
+            }
+        };
+        stats.service_calls.fetch_add(1, Ordering::Relaxed);
+        stamp_if_zero(&mut request.target, || ros_now(&clock_node));
+        let (reply_tx, reply_rx) = oneshot::channel();
+        if job_tx.send((request, reply_tx)).await.is_err() {
+            break; // solver task gone: shutting down
+        }
+        let Ok(response) = reply_rx.await else { break };
+        if let Err(e) = server.async_send_response(id, response).await {
+            log.warn(&format!("/rod/solve: cannot send the response: {e:?}"));
+        }
+    }
 }
 
 /// Waits for SIGINT or SIGTERM; returns its name.

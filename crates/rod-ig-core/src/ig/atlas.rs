@@ -166,7 +166,7 @@ fn build() -> Atlas {
         buf.clear();
         let mut t1 = f64::INFINITY;
         let ok = scan::integrate(&a, STEPS, |t, x, y, th, j, det| {
-            if t >= 0.02 && det <= 0.0 {
+            if t >= crate::STABILITY_T_MIN && det <= 0.0 {
                 t1 = t;
                 return false;
             }

@@ -68,7 +68,7 @@ pub(crate) struct Scan {
 
 /// Smallest t at which the sign of det J(t) is trusted (FINDINGS §5: below ~0.02 rounding
 /// swamps det J, and a conjugate point that early needs |a| far outside any practical range).
-const T_MIN: f64 = 0.02;
+const T_MIN: f64 = crate::STABILITY_T_MIN;
 
 /// Number of RK4 steps for parameters `a`: about `per_rad` steps per radian of the fastest
 /// local frequency (max curvature √α3 and pendulum frequency √F), bounded.

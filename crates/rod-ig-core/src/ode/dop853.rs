@@ -398,6 +398,229 @@ impl<const N: usize> Dop853<N> {
         }
     }
 
+    /// Stages k1..k12 of the step of size `h` from (t, y) (Hairer's DOP853 tableau; k1 is the
+    /// stored FSAL derivative), the last evaluated at `t_new` = t + h exactly.
+    #[inline(always)]
+    fn stages<F>(&self, f: &mut F, t: f64, h: f64, t_new: f64, k: &mut [[f64; N]; 12])
+    where
+        F: FnMut(f64, &[f64; N], &mut [f64; N]),
+    {
+        let y = &self.y;
+        let k1 = &self.k1;
+        k[0] = *k1;
+        f(t + C2 * h, &combine!(y, h; (A21, k1)), &mut k[1]);
+        f(
+            t + C3 * h,
+            &combine!(y, h; (A31, k1), (A32, &k[1])),
+            &mut k[2],
+        );
+        f(
+            t + C4 * h,
+            &combine!(y, h; (A41, k1), (A43, &k[2])),
+            &mut k[3],
+        );
+        f(
+            t + C5 * h,
+            &combine!(y, h; (A51, k1), (A53, &k[2]), (A54, &k[3])),
+            &mut k[4],
+        );
+        f(
+            t + C6 * h,
+            &combine!(y, h; (A61, k1), (A64, &k[3]), (A65, &k[4])),
+            &mut k[5],
+        );
+        f(
+            t + C7 * h,
+            &combine!(y, h; (A71, k1), (A74, &k[3]), (A75, &k[4]), (A76, &k[5])),
+            &mut k[6],
+        );
+        f(
+            t + C8 * h,
+            &combine!(y, h; (A81, k1), (A84, &k[3]), (A85, &k[4]), (A86, &k[5]), (A87, &k[6])),
+            &mut k[7],
+        );
+        f(
+            t + C9 * h,
+            &combine!(y, h;
+                (A91, k1),
+                (A94, &k[3]),
+                (A95, &k[4]),
+                (A96, &k[5]),
+                (A97, &k[6]),
+                (A98, &k[7]),
+            ),
+            &mut k[8],
+        );
+        f(
+            t + C10 * h,
+            &combine!(y, h;
+                (A101, k1),
+                (A104, &k[3]),
+                (A105, &k[4]),
+                (A106, &k[5]),
+                (A107, &k[6]),
+                (A108, &k[7]),
+                (A109, &k[8]),
+            ),
+            &mut k[9],
+        );
+        f(
+            t + C11 * h,
+            &combine!(y, h;
+                (A111, k1),
+                (A114, &k[3]),
+                (A115, &k[4]),
+                (A116, &k[5]),
+                (A117, &k[6]),
+                (A118, &k[7]),
+                (A119, &k[8]),
+                (A1110, &k[9]),
+            ),
+            &mut k[10],
+        );
+        f(
+            t_new,
+            &combine!(y, h;
+                (A121, k1),
+                (A124, &k[3]),
+                (A125, &k[4]),
+                (A126, &k[5]),
+                (A127, &k[6]),
+                (A128, &k[7]),
+                (A129, &k[8]),
+                (A1210, &k[9]),
+                (A1211, &k[10]),
+            ),
+            &mut k[11],
+        );
+    }
+
+    /// The 8th-order solution of the step and its scaled error norm (Hairer's combination of
+    /// the 5th- and 3rd-order estimates: err = |h| err5 / √(n (err5² + 0.01 err3²))).
+    #[inline(always)]
+    fn solution_and_error(&self, h: f64, habs: f64, k: &[[f64; N]; 12]) -> ([f64; N], f64) {
+        let y = &self.y;
+        let [k1, _, _, _, _, k6, k7, k8, k9, k10, k11, k12] = k;
+        let mut y_new = [0.0; N];
+        let mut err5 = 0.0;
+        let mut err3 = 0.0;
+        let ne = self.opts.error_components.min(N).max(1);
+        for i in 0..N {
+            let bk = B1 * k1[i]
+                + B6 * k6[i]
+                + B7 * k7[i]
+                + B8 * k8[i]
+                + B9 * k9[i]
+                + B10 * k10[i]
+                + B11 * k11[i]
+                + B12 * k12[i];
+            y_new[i] = y[i] + h * bk;
+            if i >= ne {
+                continue;
+            }
+            let inv = 1.0 / self.weight(y[i], y_new[i]);
+            let e3 = bk - BHH1 * k1[i] - BHH2 * k9[i] - BHH3 * k12[i];
+            let e5 = ER1 * k1[i]
+                + ER6 * k6[i]
+                + ER7 * k7[i]
+                + ER8 * k8[i]
+                + ER9 * k9[i]
+                + ER10 * k10[i]
+                + ER11 * k11[i]
+                + ER12 * k12[i];
+            err3 += (e3 * inv).powi(2);
+            err5 += (e5 * inv).powi(2);
+        }
+        let mut deno = err5 + 0.01 * err3;
+        if deno <= 0.0 {
+            deno = 1.0;
+        }
+        (y_new, habs * err5 * (1.0 / (ne as f64 * deno)).sqrt())
+    }
+
+    /// The 7th-order continuous extension of an accepted step (Hairer's `CONTD8`): three more
+    /// stages k14..k16 and the coefficients r₁..r₈ of [`DenseStep`].
+    #[inline(always)]
+    fn dense_output<F>(
+        &self,
+        f: &mut F,
+        t: f64,
+        h: f64,
+        k: &[[f64; N]; 12],
+        k13: &[f64; N],
+        y_new: &[f64; N],
+    ) -> DenseStep<N>
+    where
+        F: FnMut(f64, &[f64; N], &mut [f64; N]),
+    {
+        let y = &self.y;
+        let [k1, _, _, _, _, k6, k7, k8, k9, k10, k11, k12] = k;
+        let mut k14 = [0.0; N];
+        let mut k15 = [0.0; N];
+        let mut k16 = [0.0; N];
+        f(
+            t + C14 * h,
+            &combine!(y, h;
+                (A141, k1),
+                (A147, &k7),
+                (A148, &k8),
+                (A149, &k9),
+                (A1410, &k10),
+                (A1411, &k11),
+                (A1412, &k12),
+                (A1413, k13),
+            ),
+            &mut k14,
+        );
+        f(
+            t + C15 * h,
+            &combine!(y, h;
+                (A151, k1),
+                (A156, &k6),
+                (A157, &k7),
+                (A158, &k8),
+                (A1511, &k11),
+                (A1512, &k12),
+                (A1513, k13),
+                (A1514, &k14),
+            ),
+            &mut k15,
+        );
+        f(
+            t + C16 * h,
+            &combine!(y, h;
+                (A161, k1),
+                (A166, &k6),
+                (A167, &k7),
+                (A168, &k8),
+                (A169, &k9),
+                (A1613, k13),
+                (A1614, &k14),
+                (A1615, &k15),
+            ),
+            &mut k16,
+        );
+        let ks: [&[f64; N]; 12] = [k1, k6, k7, k8, k9, k10, k11, k12, k13, &k14, &k15, &k16];
+        debug_assert_eq!(DSTAGE.len(), ks.len());
+        let mut r = [[0.0; N]; 8];
+        for i in 0..N {
+            let ydiff = y_new[i] - y[i];
+            let bspl = h * k1[i] - ydiff;
+            r[0][i] = y[i];
+            r[1][i] = ydiff;
+            r[2][i] = bspl;
+            r[3][i] = ydiff - h * k13[i] - bspl;
+            for (row, drow) in D.iter().enumerate() {
+                let mut s = 0.0;
+                for (c, k) in drow.iter().zip(ks.iter()) {
+                    s += c * k[i];
+                }
+                r[4 + row][i] = h * s;
+            }
+        }
+        DenseStep { t0: t, h, r }
+    }
+
     /// Performs one accepted step towards `t_end` (a no-op once there).
     ///
     /// Errors: [`OdeError::StepBudget`] when `max_steps` attempts are used up,
@@ -410,6 +633,7 @@ impl<const N: usize> Dop853<N> {
         if self.finished() {
             return Ok(());
         }
+        let mut k = [[0.0; N]; 12];
         loop {
             if self.stats.attempts >= self.opts.max_steps {
                 return Err(OdeError::StepBudget {
@@ -429,134 +653,10 @@ impl<const N: usize> Dop853<N> {
             }
             let h = self.dir * habs;
             let t = self.t;
-            let y = &self.y;
-            let k1 = &self.k1;
-            let mut k2 = [0.0; N];
-            let mut k3 = [0.0; N];
-            let mut k4 = [0.0; N];
-            let mut k5 = [0.0; N];
-            let mut k6 = [0.0; N];
-            let mut k7 = [0.0; N];
-            let mut k8 = [0.0; N];
-            let mut k9 = [0.0; N];
-            let mut k10 = [0.0; N];
-            let mut k11 = [0.0; N];
-            let mut k12 = [0.0; N];
-            f(t + C2 * h, &combine!(y, h; (A21, k1)), &mut k2);
-            f(t + C3 * h, &combine!(y, h; (A31, k1), (A32, &k2)), &mut k3);
-            f(t + C4 * h, &combine!(y, h; (A41, k1), (A43, &k3)), &mut k4);
-            f(
-                t + C5 * h,
-                &combine!(y, h; (A51, k1), (A53, &k3), (A54, &k4)),
-                &mut k5,
-            );
-            f(
-                t + C6 * h,
-                &combine!(y, h; (A61, k1), (A64, &k4), (A65, &k5)),
-                &mut k6,
-            );
-            f(
-                t + C7 * h,
-                &combine!(y, h; (A71, k1), (A74, &k4), (A75, &k5), (A76, &k6)),
-                &mut k7,
-            );
-            f(
-                t + C8 * h,
-                &combine!(y, h; (A81, k1), (A84, &k4), (A85, &k5), (A86, &k6), (A87, &k7)),
-                &mut k8,
-            );
-            f(
-                t + C9 * h,
-                &combine!(y, h;
-                    (A91, k1),
-                    (A94, &k4),
-                    (A95, &k5),
-                    (A96, &k6),
-                    (A97, &k7),
-                    (A98, &k8),
-                ),
-                &mut k9,
-            );
-            f(
-                t + C10 * h,
-                &combine!(y, h;
-                    (A101, k1),
-                    (A104, &k4),
-                    (A105, &k5),
-                    (A106, &k6),
-                    (A107, &k7),
-                    (A108, &k8),
-                    (A109, &k9),
-                ),
-                &mut k10,
-            );
-            f(
-                t + C11 * h,
-                &combine!(y, h;
-                    (A111, k1),
-                    (A114, &k4),
-                    (A115, &k5),
-                    (A116, &k6),
-                    (A117, &k7),
-                    (A118, &k8),
-                    (A119, &k9),
-                    (A1110, &k10),
-                ),
-                &mut k11,
-            );
             let t_new = if last { self.t_end } else { t + h };
-            f(
-                t_new,
-                &combine!(y, h;
-                    (A121, k1),
-                    (A124, &k4),
-                    (A125, &k5),
-                    (A126, &k6),
-                    (A127, &k7),
-                    (A128, &k8),
-                    (A129, &k9),
-                    (A1210, &k10),
-                    (A1211, &k11),
-                ),
-                &mut k12,
-            );
+            self.stages(f, t, h, t_new, &mut k);
             self.stats.evaluations += 11;
-            // 8th-order solution and the two error estimates.
-            let mut y_new = [0.0; N];
-            let mut err5 = 0.0;
-            let mut err3 = 0.0;
-            let ne = self.opts.error_components.min(N).max(1);
-            for i in 0..N {
-                let bk = B1 * k1[i]
-                    + B6 * k6[i]
-                    + B7 * k7[i]
-                    + B8 * k8[i]
-                    + B9 * k9[i]
-                    + B10 * k10[i]
-                    + B11 * k11[i]
-                    + B12 * k12[i];
-                y_new[i] = y[i] + h * bk;
-                if i >= ne {
-                    continue;
-                }
-                let inv = 1.0 / self.weight(y[i], y_new[i]);
-                let e3 = bk - BHH1 * k1[i] - BHH2 * k9[i] - BHH3 * k12[i];
-                let e5 = ER1 * k1[i]
-                    + ER6 * k6[i]
-                    + ER7 * k7[i]
-                    + ER8 * k8[i]
-                    + ER9 * k9[i]
-                    + ER10 * k10[i]
-                    + ER11 * k11[i]
-                    + ER12 * k12[i];
-                err3 += (e3 * inv).powi(2);
-                err5 += (e5 * inv).powi(2);
-            }
-            let mut deno = err5 + 0.01 * err3;
-            if deno <= 0.0 {
-                deno = 1.0;
-            }
-            let err = habs * err5 * (1.0 / (ne as f64 * deno)).sqrt();
+            let (y_new, err) = self.solution_and_error(h, habs, &k);
             if !err.is_finite() || y_new.iter().any(|v| !v.is_finite()) {
                 // Treat as a hard rejection: shrink and retry (bounded by the budget).
                 self.stats.rejected += 1;
@@ -575,73 +675,8 @@ impl<const N: usize> Dop853<N> {
                     continue;
                 }
                 if self.want_dense {
-                    let mut k14 = [0.0; N];
-                    let mut k15 = [0.0; N];
-                    let mut k16 = [0.0; N];
-                    f(
-                        t + C14 * h,
-                        &combine!(y, h;
-                            (A141, k1),
-                            (A147, &k7),
-                            (A148, &k8),
-                            (A149, &k9),
-                            (A1410, &k10),
-                            (A1411, &k11),
-                            (A1412, &k12),
-                            (A1413, &k13),
-                        ),
-                        &mut k14,
-                    );
-                    f(
-                        t + C15 * h,
-                        &combine!(y, h;
-                            (A151, k1),
-                            (A156, &k6),
-                            (A157, &k7),
-                            (A158, &k8),
-                            (A1511, &k11),
-                            (A1512, &k12),
-                            (A1513, &k13),
-                            (A1514, &k14),
-                        ),
-                        &mut k15,
-                    );
-                    f(
-                        t + C16 * h,
-                        &combine!(y, h;
-                            (A161, k1),
-                            (A166, &k6),
-                            (A167, &k7),
-                            (A168, &k8),
-                            (A169, &k9),
-                            (A1613, &k13),
-                            (A1614, &k14),
-                            (A1615, &k15),
-                        ),
-                        &mut k16,
-                    );
+                    self.dense = Some(self.dense_output(f, t, h, &k, &k13, &y_new));
                     self.stats.evaluations += 3;
-                    let ks: [&[f64; N]; 12] = [
-                        k1, &k6, &k7, &k8, &k9, &k10, &k11, &k12, &k13, &k14, &k15, &k16,
-                    ];
-                    debug_assert_eq!(DSTAGE.len(), ks.len());
-                    let mut r = [[0.0; N]; 8];
-                    for i in 0..N {
-                        let ydiff = y_new[i] - y[i];
-                        let bspl = h * k1[i] - ydiff;
-                        r[0][i] = y[i];
-                        r[1][i] = ydiff;
-                        r[2][i] = bspl;
-                        r[3][i] = ydiff - h * k13[i] - bspl;
-                        for (row, drow) in D.iter().enumerate() {
-                            let mut s = 0.0;
-                            for (c, k) in drow.iter().zip(ks.iter()) {
-                                s += c * k[i];
-                            }
-                            r[4 + row][i] = h * s;
-                        }
-                    }
-                    self.dense = Some(DenseStep { t0: t, h, r });
                 }
                 // Accept.
                 let fac = if err == 0.0 {

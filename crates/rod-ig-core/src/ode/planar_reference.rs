@@ -27,7 +27,7 @@ pub const STABILITY_RTOL: f64 = 1e-12;
 pub const STABILITY_ATOL: f64 = 1e-30;
 /// Smallest t at which the fixed-step [`rk4_stability`] tests det J (FINDINGS §5: absolute
 /// rounding swamps det J below t ≈ 0.02).
-pub const RK4_STABILITY_T_MIN: f64 = 0.02;
+pub const RK4_STABILITY_T_MIN: f64 = crate::STABILITY_T_MIN;
 /// Smallest t entering the normalised margin `det_min` (FINDINGS §5).
 pub const MARGIN_T_MIN: f64 = 0.05;
 

@@ -234,6 +234,23 @@ pub(crate) enum SeriesNeed {
 /// 8.2e-11 relative over 2000 box cases, rounded up).
 pub(crate) const CLOSED_J_REL: f64 = 1e-10;
 
+/// Largest phase |Γ| = r + |φ| of the Jacobi functions the closed form accepts: their
+/// argument carries an absolute rounding error ~ε|Γ|, which at 1e9 is ~1e-7 rad, the edge of
+/// the 1e-6 accuracy the solvers need; beyond, the rod is left to the fallbacks.
+const MAX_PHASE: f64 = 1e9;
+
+/// The invariants of a rod's base wrench that select and parametrise its case (FINDINGS §2):
+/// F = ‖(a4, a5)‖, F ± a4 (each without cancellation), α3 = a3² + 2(F + a4) and
+/// λ4 = a5² − a3²(a3²/4 + a4).
+#[derive(Clone, Copy)]
+struct Invariants<T> {
+    f: T,
+    fp: T,
+    fm: T,
+    alpha3: T,
+    lambda4: T,
+}
+
 impl<T: Real> Closed<T> {
     /// A-priori estimate of the relative error of the J entries: the base accuracy
     /// [`CLOSED_J_REL`], or the cancellation losses ≈ ε/m1 near the separatrix and ≈ ε/m at small
@@ -364,122 +381,185 @@ impl<T: Real> Closed<T> {
         let lambda4 = a5 * a5 - a3s * (a3s * 0.25 + a4);
         s.chat = a4 / f;
         s.shat = a5 / f;
-        let sqa3 = alpha3.sqrt();
-        s.sqa3 = sqa3;
+        s.sqa3 = alpha3.sqrt();
         let l4 = lambda4.re();
         if !(f.re().is_finite() && alpha3.re().is_finite() && l4.is_finite()) {
             return None;
         }
-        // Phase pair (s, c) of cases I and III: cn φ = |a3|/√α3, sn φ = sgn(ε a5)√(2(F+a4)/α3).
-        let phase_i = || {
-            let c = a3 * eps / sqa3;
-            let sn = if a4r < 0.0 {
-                a5 * eps * (fm * alpha3 / 2.0).sqrt().recip()
-            } else {
-                let sg = if a5r < 0.0 { -eps } else { eps };
-                (fp * 2.0 / alpha3).sqrt() * sg
-            };
-            (sn, c)
+        let invariants = Invariants {
+            f,
+            fp,
+            fm,
+            alpha3,
+            lambda4,
         };
         if l4 > 0.0 {
-            s.case = Case::I;
-            let m = alpha3 / (f * 4.0);
-            let m1 = lambda4 / (f * alpha3);
-            let landen = Duplication::new(m, m1);
-            if !landen.converged() {
-                return None;
-            }
-            let (sn, cn) = phase_i();
-            let (phi, zm0) = inverse_phase_zeta(sn, cn, m1, landen.k(), landen.d_over_k());
-            s.r = f.sqrt();
-            s.phi = phi;
-            s.m = m;
-            s.m1 = m1.re();
-            s.sqm = m.sqrt();
-            s.lin = m1 - m * landen.q();
-            let dn = (m1 + m * cn * cn).sqrt();
-            s.j0 = JacobiValues {
-                sn,
-                cn,
-                dn,
-                am: zero, // unused in case I
-                zm: zm0,
-            };
-            // θ0/(2ε) = atan2(√m sn φ, dn φ) is folded into the single atan2 of `pose`.
-            s.inv_r = s.r.recip();
-            s.zcoef = m * s.inv_r * 2.0;
-            s.b2coef = -s.sqm * s.inv_r;
-            s.y0 = s.sqm * sn;
-            s.landen = landen;
+            s.init_case_i(&invariants)?;
         } else if l4 < 0.0 {
-            s.case = Case::II;
-            let m = f * 4.0 / alpha3;
-            if m.re() < SMALL_FORCE_M {
-                s.case = Case::SmallForce;
+            s.init_case_ii(&invariants)?;
+            if s.case == Case::SmallForce {
                 return Some(s);
             }
-            let m1 = -lambda4 * 4.0 / (alpha3 * alpha3);
-            let landen = Duplication::new(m, m1);
-            if !landen.converged() {
-                return None;
-            }
-            let two_f = f * 2.0;
-            let (sn, cn) = if a4r <= 0.0 {
-                (a5 * eps / (two_f * fm).sqrt(), (fm / two_f).sqrt())
-            } else {
-                ((fp / two_f).sqrt(), a5 * eps / (two_f * fp).sqrt())
-            };
-            let (phi, zm0) = inverse_phase_zeta(sn, cn, m1, landen.k(), landen.d_over_k());
-            s.r = sqa3 * 0.5;
-            s.phi = phi;
-            s.m = m;
-            s.m1 = m1.re();
-            s.lin = -landen.q();
-            let dn = (m1 + m * cn * cn).sqrt();
-            // φ ∈ (−2K, 2K) ⇒ am φ = atan2(sn, cn) ∈ (−π, π)
-            let am = sn.atan2_fast(cn);
-            s.j0 = JacobiValues {
-                sn,
-                cn,
-                dn,
-                am,
-                zm: zm0,
-            };
-            s.th0 = am;
-            s.inv_r = s.r.recip();
-            s.zcoef = s.inv_r * 2.0;
-            s.b2coef = (m * s.r).recip();
-            s.landen = landen;
         } else {
-            s.case = Case::III;
-            // δ = 1 − m_I = λ4/(F α3): value 0, derivative carried (FINDINGS §2 table).
-            let delta = lambda4 / (f * alpha3);
-            let (sn, cn) = phase_i();
-            let ratio = sn / cn;
-            let phi0 = ratio.asinh();
-            // F(ψ|1 − δ) ≈ asinh(tan ψ) − (δ/4)(tan ψ sec ψ − asinh(tan ψ)).
-            let phi = phi0 - delta * 0.25 * (ratio / cn - phi0);
-            s.r = f.sqrt();
-            s.phi = phi;
-            s.m = delta;
-            s.sqm = one - delta * 0.5;
-            let (sn0, cn0, dn0, e0) = near_one(phi, delta);
-            s.j0 = JacobiValues {
-                sn: sn0,
-                cn: cn0,
-                dn: dn0,
-                am: zero,
-                zm: zero,
-            };
-            s.th0 = (s.sqm * sn0).atan2(dn0);
-            s.e0 = e0;
+            s.init_case_iii(&invariants);
         }
+        s.checked()
+    }
+
+    /// Phase pair (sn φ, cn φ) of cases I and III: cn φ = |a3|/√α3,
+    /// sn φ = sgn(ε a5)√(2(F+a4)/α3).
+    fn phase_i(&self, fp: T, fm: T, alpha3: T) -> (T, T) {
+        let (a3, a5, eps) = (self.a3, self.a5, self.eps);
+        let c = a3 * eps / self.sqa3;
+        let sn = if self.a4.re() < 0.0 {
+            a5 * eps * (fm * alpha3 / 2.0).sqrt().recip()
+        } else {
+            let sg = if a5.re() < 0.0 { -eps } else { eps };
+            (fp * 2.0 / alpha3).sqrt() * sg
+        };
+        (sn, c)
+    }
+
+    /// Case I (λ4 > 0, FINDINGS §2): parameter m = α3/(4F), r = √F.
+    fn init_case_i(&mut self, inv: &Invariants<T>) -> Option<()> {
+        let Invariants {
+            f,
+            fp,
+            fm,
+            alpha3,
+            lambda4,
+        } = *inv;
+        let zero = T::from_f64(0.0);
+        self.case = Case::I;
+        let m = alpha3 / (f * 4.0);
+        let m1 = lambda4 / (f * alpha3);
+        let landen = Duplication::new(m, m1);
+        if !landen.converged() {
+            return None;
+        }
+        let (sn, cn) = self.phase_i(fp, fm, alpha3);
+        let (phi, zm0) = inverse_phase_zeta(sn, cn, m1, landen.k(), landen.d_over_k());
+        self.r = f.sqrt();
+        self.phi = phi;
+        self.m = m;
+        self.m1 = m1.re();
+        self.sqm = m.sqrt();
+        self.lin = m1 - m * landen.q();
+        let dn = (m1 + m * cn * cn).sqrt();
+        self.j0 = JacobiValues {
+            sn,
+            cn,
+            dn,
+            am: zero, // unused in case I
+            zm: zm0,
+        };
+        // θ0/(2ε) = atan2(√m sn φ, dn φ) is folded into the single atan2 of `pose`.
+        self.inv_r = self.r.recip();
+        self.zcoef = m * self.inv_r * 2.0;
+        self.b2coef = -self.sqm * self.inv_r;
+        self.y0 = self.sqm * sn;
+        self.landen = landen;
+        Some(())
+    }
+
+    /// Case II (λ4 < 0, FINDINGS §2): parameter m = 4F/α3, r = √α3 / 2; tiny m is the
+    /// small-force series ([`Case::SmallForce`]).
+    fn init_case_ii(&mut self, inv: &Invariants<T>) -> Option<()> {
+        let Invariants {
+            f,
+            fp,
+            fm,
+            alpha3,
+            lambda4,
+        } = *inv;
+        let (a5, eps) = (self.a5, self.eps);
+        let a4r = self.a4.re();
+        let sqa3 = self.sqa3;
+        self.case = Case::II;
+        let m = f * 4.0 / alpha3;
+        if m.re() < SMALL_FORCE_M {
+            self.case = Case::SmallForce;
+            return Some(());
+        }
+        let m1 = -lambda4 * 4.0 / (alpha3 * alpha3);
+        let landen = Duplication::new(m, m1);
+        if !landen.converged() {
+            return None;
+        }
+        let two_f = f * 2.0;
+        let (sn, cn) = if a4r <= 0.0 {
+            (a5 * eps / (two_f * fm).sqrt(), (fm / two_f).sqrt())
+        } else {
+            ((fp / two_f).sqrt(), a5 * eps / (two_f * fp).sqrt())
+        };
+        let (phi, zm0) = inverse_phase_zeta(sn, cn, m1, landen.k(), landen.d_over_k());
+        self.r = sqa3 * 0.5;
+        self.phi = phi;
+        self.m = m;
+        self.m1 = m1.re();
+        self.lin = -landen.q();
+        let dn = (m1 + m * cn * cn).sqrt();
+        // φ ∈ (−2K, 2K) ⇒ am φ = atan2(sn, cn) ∈ (−π, π)
+        let am = sn.atan2_fast(cn);
+        self.j0 = JacobiValues {
+            sn,
+            cn,
+            dn,
+            am,
+            zm: zm0,
+        };
+        self.th0 = am;
+        self.inv_r = self.r.recip();
+        self.zcoef = self.inv_r * 2.0;
+        self.b2coef = (m * self.r).recip();
+        self.landen = landen;
+        Some(())
+    }
+
+    /// Case III (λ4 = 0, the separatrix): the m → 1 limit with its first-order term in
+    /// δ = 1 − m carried for the derivatives (FINDINGS §2 table).
+    fn init_case_iii(&mut self, inv: &Invariants<T>) {
+        let Invariants {
+            f,
+            fp,
+            fm,
+            alpha3,
+            lambda4,
+        } = *inv;
+        let one = T::from_f64(1.0);
+        let zero = T::from_f64(0.0);
+        self.case = Case::III;
+        // δ = 1 − m_I = λ4/(F α3): value 0, derivative carried (FINDINGS §2 table).
+        let delta = lambda4 / (f * alpha3);
+        let (sn, cn) = self.phase_i(fp, fm, alpha3);
+        let ratio = sn / cn;
+        let phi0 = ratio.asinh();
+        // F(ψ|1 − δ) ≈ asinh(tan ψ) − (δ/4)(tan ψ sec ψ − asinh(tan ψ)).
+        let phi = phi0 - delta * 0.25 * (ratio / cn - phi0);
+        self.r = f.sqrt();
+        self.phi = phi;
+        self.m = delta;
+        self.sqm = one - delta * 0.5;
+        let (sn0, cn0, dn0, e0) = near_one(phi, delta);
+        self.j0 = JacobiValues {
+            sn: sn0,
+            cn: cn0,
+            dn: dn0,
+            am: zero,
+            zm: zero,
+        };
+        self.th0 = (self.sqm * sn0).atan2(dn0);
+        self.e0 = e0;
+    }
+
+    /// The constructed rod, or `None` when a field is not finite or the phase is lost.
+    fn checked(self) -> Option<Self> {
+        let s = self;
         let fields = [
             s.phi, s.r, s.sqa3, s.chat, s.shat, s.lin, s.sqm, s.th0, s.e0, s.j0.sn, s.j0.cn,
             s.j0.dn, s.j0.zm,
         ];
-        // Beyond |Γ| ~ 1e9 the phase of the Jacobi functions is lost in f64 rounding.
-        if s.r.re() + s.phi.re().abs() > 1e9 {
+        if s.r.re() + s.phi.re().abs() > MAX_PHASE {
             return None;
         }
         if !fields.iter().all(|v| v.re().is_finite())

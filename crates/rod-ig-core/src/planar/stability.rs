@@ -7,7 +7,7 @@ use crate::{PlanarParams, RodError, StabilityReport};
 
 /// Below this t the closed-form det J is dominated by rounding; it is positive there by its
 /// leading term (FINDINGS §5).
-const T_MIN: f64 = 0.02;
+const T_MIN: f64 = crate::STABILITY_T_MIN;
 /// Smallest t entering the margin `det_min` (FINDINGS §5).
 const T_MARGIN: f64 = 0.05;
 /// First t of the scan on the Taylor series. Its J entries are accurate relative to

@@ -28,12 +28,16 @@
 //! assert!(s.stable && s.orientation_error <= 1e-6);
 //! ```
 
+mod continuation;
 mod model;
 pub(crate) mod newton;
 mod observer;
 mod options;
 mod outcome;
 
+pub use continuation::{
+    BranchEvent, BranchFollower, Move, CORRECTOR_ITERATIONS, MAX_SNAPS, MIN_STEP, SUBSTEP_TOLERANCE,
+};
 pub use model::{
     relative_distance, ModelEvaluation, PlanarClosedForm, PlanarReference, RodModel, Spatial,
     DISTINCT,

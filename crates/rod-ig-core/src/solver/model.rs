@@ -81,6 +81,15 @@ pub trait RodModel<const N: usize> {
     /// Checks that `target` is finite and within reach.
     fn check_target(&self, target: &Self::Pose) -> Result<(), IgError>;
 
+    /// det J(1, a): its sign changes exactly where a branch of equilibria folds (and where
+    /// stability can be lost along it, FINDINGS §5).
+    fn jacobian_det(&self, jacobian: &SMatrix<f64, N, N>) -> f64;
+
+    /// The pose a fraction `s` ∈ [0, 1] of the way from `from` to `to` along the shortest
+    /// motion (planar: straight line and shortest wrapped rotation; 3-D: straight line and
+    /// slerp): the gripper path between two targets.
+    fn interpolate(&self, from: &Self::Pose, to: &Self::Pose, s: f64) -> Self::Pose;
+
     /// Checks the model's own settings (stiffness, integration tolerance).
     fn check_settings(&self) -> Result<(), IgError> {
         Ok(())
@@ -151,6 +160,16 @@ fn planar_check_target(target: &PlanarPose) -> Result<(), IgError> {
     crate::ig::check_target(target)
 }
 
+/// Planar gripper motion: position on the segment, angle turned the short way (θ stays
+/// unwrapped from `from`).
+fn planar_interpolate(from: &PlanarPose, to: &PlanarPose, s: f64) -> PlanarPose {
+    PlanarPose::new(
+        from.x + (to.x - from.x) * s,
+        from.y + (to.y - from.y) * s,
+        from.theta + wrap_angle(to.theta - from.theta) * s,
+    )
+}
+
 fn planar_pose_error(tip: &PlanarPose, target: &PlanarPose) -> (f64, f64) {
     let f = planar_error(tip, target);
     (f[0].hypot(f[1]), f[2].abs())
@@ -214,6 +233,14 @@ impl RodModel<3> for PlanarClosedForm {
     fn check_target(&self, target: &PlanarPose) -> Result<(), IgError> {
         planar_check_target(target)
     }
+
+    fn interpolate(&self, from: &PlanarPose, to: &PlanarPose, s: f64) -> PlanarPose {
+        planar_interpolate(from, to, s)
+    }
+
+    fn jacobian_det(&self, jacobian: &SMatrix<f64, 3, 3>) -> f64 {
+        jacobian.determinant()
+    }
 }
 
 impl RodModel<3> for PlanarReference {
@@ -258,6 +285,14 @@ impl RodModel<3> for PlanarReference {
 
     fn check_target(&self, target: &PlanarPose) -> Result<(), IgError> {
         planar_check_target(target)
+    }
+
+    fn interpolate(&self, from: &PlanarPose, to: &PlanarPose, s: f64) -> PlanarPose {
+        planar_interpolate(from, to, s)
+    }
+
+    fn jacobian_det(&self, jacobian: &SMatrix<f64, 3, 3>) -> f64 {
+        jacobian.determinant()
     }
 
     fn check_settings(&self) -> Result<(), IgError> {
@@ -362,6 +397,17 @@ impl RodModel<6> for Spatial {
 
     fn check_target(&self, target: &SpatialPose) -> Result<(), IgError> {
         crate::spatial::ig::check_target(target)
+    }
+
+    fn jacobian_det(&self, jacobian: &SMatrix<f64, 6, 6>) -> f64 {
+        jacobian.determinant()
+    }
+
+    fn interpolate(&self, from: &SpatialPose, to: &SpatialPose, s: f64) -> SpatialPose {
+        SpatialPose {
+            position: from.position + (to.position - from.position) * s,
+            rotation: from.rotation.slerp(&to.rotation, s),
+        }
     }
 
     fn check_settings(&self) -> Result<(), IgError> {

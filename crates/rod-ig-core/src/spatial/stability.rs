@@ -21,7 +21,7 @@ use crate::ode::{DenseStep, Dop853};
 use crate::{RodError, StabilityReport};
 
 /// Start of the scanned range (FINDINGS3D trap 2: atol 1e-16 cannot resolve det below 0.01).
-pub const STABILITY_T_MIN: f64 = 0.02;
+pub const STABILITY_T_MIN: f64 = crate::STABILITY_T_MIN;
 /// Number of intervals of the rule's grid on [0, 1].
 pub const GRID_N: u32 = 2000;
 /// Smallest t entering the normalised margin.

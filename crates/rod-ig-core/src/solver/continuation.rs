@@ -1,0 +1,422 @@
+//! Quasi-static motion: the rod held by the grippers follows its equilibrium branch as the tip
+//! gripper moves, and snaps when that branch loses stability.
+//!
+//! Between the previous gripper pose b₀ and the next one b₁ the gripper moves along
+//! b(s) = [`RodModel::interpolate`](b₀, b₁, s), s ∈ [0, 1]. [`BranchFollower::follow`] walks s
+//! with a predictor–corrector: the tangent predictor δa = J(1, a)⁻¹ (b(s + Δs) − b(s)) (the
+//! derivative of the branch a(s), since Υ(a(s)) = b(s)), then Newton corrections towards
+//! b(s + Δs), accepted only if they contract (each step at most half the previous one: a step
+//! that does not contract may be converging to another branch) and end at a stable rod. On
+//! failure Δs is halved; on success doubled (at most the whole remaining segment).
+//!
+//! Along a continuous branch, stability can only be lost where det J(1, a) = 0 (a conjugate
+//! point enters (0, 1] through t = 1: FINDINGS §5, paper §3.1), and there the branch folds: it
+//! cannot be continued in s. So when Δs falls below [`MIN_STEP`] with the corrector failing,
+//! the branch has ended at the last accepted rod: the **critical** rod and pose, located to
+//! within [`MIN_STEP`] of the segment.
+//!
+//! **Snap rule.** At the critical pose the rod jumps, at fixed grippers, to another stable
+//! equilibrium; the jump dissipates energy, so the rod settles into a stable equilibrium of
+//! lower elastic energy. Among the stable equilibria at the pose just past the critical one
+//! (`solve_all`) with energy below the critical rod's, the one nearest the critical rod
+//! (relative parameter distance) is taken: the end of a descent of the energy from the
+//! critical shape, which moves the rod the least. Then the motion goes on from there to b₁.
+//! When no such equilibrium exists the rod is **lost** (`success: false`).
+
+use super::model::{relative_distance, ModelEvaluation, RodModel};
+use super::{
+    solve, solve_all, Failure, IgError, InverseGeometry, Solution, SolutionOf, SolveOptions,
+};
+use nalgebra::SVector;
+
+/// Smallest continuation step, as a fraction of the gripper's move: the critical pose of a
+/// snap is located to within this fraction (1/4096 of a 1 cm move is 2.4 µm).
+pub const MIN_STEP: f64 = 1.0 / 4096.0;
+/// Tolerance of the intermediate poses of the continuation (the last one uses the solve's
+/// tolerance): loose enough to take long steps, tight enough that the predictor from an
+/// intermediate rod stays within Newton's basin (its error adds O(1e-6) to O(Δs²)).
+pub const SUBSTEP_TOLERANCE: f64 = 1e-6;
+/// Newton corrections per continuation step: from the tangent predictor the error is O(Δs²)
+/// and Newton converges quadratically, so a step that needs more is too long.
+pub const CORRECTOR_ITERATIONS: u32 = 8;
+/// Contraction required of successive Newton corrections (Kantorovich: in the basin of the
+/// branch's own solution successive steps shrink at least geometrically).
+const CONTRACTION: f64 = 0.5;
+/// Most snaps followed within one move (each needs a fold and a lower-energy equilibrium).
+pub const MAX_SNAPS: u32 = 8;
+
+/// What happened to the rod during one gripper move.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BranchEvent<P, X> {
+    /// The rod stayed on its branch (or this was the first pose: a fresh solve).
+    None,
+    /// The branch lost stability (fold) at the `critical` gripper pose; the rod snapped to
+    /// another stable equilibrium (module docs: the snap rule) and followed it to the target.
+    Snap {
+        /// The gripper pose where the branch ended.
+        critical: X,
+        /// The last stable rod of the old branch.
+        critical_a: P,
+        /// Elastic energy released by the snap (critical rod minus the rod it settled into).
+        energy_released: f64,
+        /// Snaps during this move (1 unless the new branch folded too).
+        snaps: u32,
+    },
+    /// No stable equilibrium to follow or snap into: the rod's state is unknown.
+    Lost,
+}
+
+impl<P, X> BranchEvent<P, X> {
+    /// "none", "snap" or "lost" (the CLI's and the node's `event` field).
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Self::None => "none",
+            Self::Snap { .. } => "snap",
+            Self::Lost => "lost",
+        }
+    }
+}
+
+/// One move of the gripper: the rod it ends with (or why not) and what happened on the way.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Move<P, X> {
+    /// The equilibrium at the target (stable, within the tolerance), or the failure.
+    pub result: Result<Solution<P, X>, Failure<P>>,
+    /// Branch event of the move.
+    pub event: BranchEvent<P, X>,
+}
+
+/// The rod held by the grippers: current equilibrium and the gripper pose it is held at.
+#[derive(Clone, Copy, Debug)]
+struct Held<const N: usize, X> {
+    a: SVector<f64, N>,
+    eval: ModelEvaluation<N, X>,
+}
+
+/// Why a continuation stopped before the target.
+enum Stop<const N: usize, X> {
+    /// The branch folded: the last stable rod, at gripper pose fraction `s`.
+    Fold(Held<N, X>, f64),
+    /// The solve's deadline or an evaluation failure.
+    Error(IgError),
+}
+
+/// Follows the rod's equilibrium branch as the gripper moves (module docs). Works for every
+/// model (planar and 3-D).
+#[derive(Clone, Debug)]
+pub struct BranchFollower<const N: usize, M: RodModel<N>> {
+    model: M,
+    options: SolveOptions<SVector<f64, N>>,
+    held: Option<Held<N, M::Pose>>,
+}
+
+impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
+    /// A follower with no rod yet: the first [`Self::follow`] is a fresh solve with `options`.
+    pub fn new(model: M, options: SolveOptions<SVector<f64, N>>) -> Self {
+        Self {
+            model,
+            options,
+            held: None,
+        }
+    }
+
+    /// A follower holding the rod `a0` (the gripper is at its tip). Fails when `a0` is not a
+    /// stable equilibrium (a held rod must be one).
+    pub fn holding(
+        model: M,
+        options: SolveOptions<SVector<f64, N>>,
+        a0: SVector<f64, N>,
+    ) -> Result<Self, IgError> {
+        if let Some(index) = a0.iter().position(|v| !v.is_finite()) {
+            return Err(IgError::NonFiniteGuess {
+                index,
+                value: a0[index],
+            });
+        }
+        let eval = model.evaluate(&a0)?;
+        if !eval.stability.stable {
+            return Err(IgError::LeftStableSet { iteration: 0 });
+        }
+        Ok(Self {
+            model,
+            options,
+            held: Some(Held { a: a0, eval }),
+        })
+    }
+
+    /// The rod held now, if any.
+    pub fn rod(&self) -> Option<SVector<f64, N>> {
+        self.held.map(|h| h.a)
+    }
+
+    /// The gripper pose the rod is held at now, if any.
+    pub fn gripper(&self) -> Option<M::Pose> {
+        self.held.map(|h| h.eval.tip)
+    }
+
+    /// The model.
+    pub fn model(&self) -> &M {
+        &self.model
+    }
+
+    /// Moves the gripper to `target` and returns the rod it ends with. Without a held rod: a
+    /// fresh [`solve`] (event `None`). After `Lost` the follower holds nothing.
+    pub fn follow(&mut self, target: &M::Pose) -> Move<SVector<f64, N>, M::Pose> {
+        let t0 = std::time::Instant::now();
+        let mut m = self.follow_inner(target);
+        let us = t0.elapsed().as_secs_f64() * 1e6;
+        match &mut m.result {
+            Ok(s) => s.elapsed_us = us,
+            Err(f) => f.elapsed_us = us,
+        }
+        m
+    }
+
+    fn follow_inner(&mut self, target: &M::Pose) -> Move<SVector<f64, N>, M::Pose> {
+        let Some(held) = self.held else {
+            let result = solve(&self.model, target, &self.options);
+            self.held = result.as_ref().ok().and_then(|s| {
+                let eval = self.model.evaluate(&s.a).ok()?;
+                Some(Held { a: s.a, eval })
+            });
+            let event = match result {
+                Ok(_) => BranchEvent::None,
+                Err(_) => BranchEvent::Lost,
+            };
+            return Move { result, event };
+        };
+        if let Err(e) = self
+            .model
+            .check_target(target)
+            .and_then(|_| super::check_options(&self.options))
+            .and_then(|_| self.model.check_settings())
+        {
+            // An invalid request changes nothing: the rod is still held where it was.
+            return Move {
+                result: Err(Failure::early(e)),
+                event: BranchEvent::None,
+            };
+        }
+        self.model.prepare();
+        let _deadline = crate::ig::deadline::scope(self.options.deadline);
+        let mut work = Work::default();
+        let mut current = held;
+        let mut first_snap: Option<(M::Pose, SVector<f64, N>, f64)> = None;
+        let mut snaps = 0;
+        loop {
+            match self.continue_to(&current, target, &mut work) {
+                Ok(end) => {
+                    self.held = Some(end);
+                    let s = self.solution(&end, target, &work);
+                    let event = match first_snap {
+                        None => BranchEvent::None,
+                        Some((critical, critical_a, released)) => BranchEvent::Snap {
+                            critical,
+                            critical_a,
+                            energy_released: released,
+                            snaps,
+                        },
+                    };
+                    return Move {
+                        result: Ok(s),
+                        event,
+                    };
+                }
+                Err(Stop::Error(e)) => {
+                    // Deadline or evaluation failure mid-move: the gripper is somewhere on
+                    // the way, the rod's state is not known.
+                    self.held = None;
+                    return self.lost(e, &work, current.a);
+                }
+                Err(Stop::Fold(critical, s)) => {
+                    snaps += 1;
+                    let start = self.gripper_start(&current);
+                    let critical_pose = critical.eval.tip;
+                    let past =
+                        self.model
+                            .interpolate(&start, target, (s + 2.0 * MIN_STEP).min(1.0));
+                    let past = if snaps > MAX_SNAPS { None } else { Some(past) };
+                    let settled = past.and_then(|p| self.settle(&critical, &p, &mut work));
+                    let Some(settled) = settled else {
+                        self.held = None;
+                        let e = IgError::NoStableSolution {
+                            starts: work.starts,
+                            last: Some(Box::new(IgError::LeftStableSet {
+                                iteration: work.iterations,
+                            })),
+                        };
+                        return self.lost(e, &work, critical.a);
+                    };
+                    if first_snap.is_none() {
+                        let released = critical.eval.energy - settled.eval.energy;
+                        first_snap = Some((critical_pose, critical.a, released));
+                    }
+                    current = settled;
+                }
+            }
+        }
+    }
+
+    /// The gripper pose a held rod is at.
+    fn gripper_start(&self, held: &Held<N, M::Pose>) -> M::Pose {
+        held.eval.tip
+    }
+
+    fn lost(
+        &self,
+        reason: IgError,
+        work: &Work,
+        last: SVector<f64, N>,
+    ) -> Move<SVector<f64, N>, M::Pose> {
+        Move {
+            result: Err(Failure {
+                reason,
+                iterations: work.iterations,
+                residual: f64::INFINITY,
+                last_a: Some(last),
+                elapsed_us: 0.0,
+            }),
+            event: BranchEvent::Lost,
+        }
+    }
+
+    /// The snap rule (module docs): the stable equilibrium at `pose` with energy below the
+    /// critical rod's, nearest to it.
+    fn settle(
+        &self,
+        critical: &Held<N, M::Pose>,
+        pose: &M::Pose,
+        work: &mut Work,
+    ) -> Option<Held<N, M::Pose>> {
+        let options = SolveOptions {
+            initial_guess: None,
+            ..self.options
+        };
+        let candidates = solve_all(&self.model, pose, &options);
+        work.starts += candidates.iter().map(|c| c.starts).sum::<u32>();
+        let scale = self.model.param_scale();
+        let best = candidates
+            .iter()
+            .filter(|c| c.energy < critical.eval.energy)
+            .min_by(|p, q| {
+                relative_distance(&p.a, &critical.a, &scale).total_cmp(&relative_distance(
+                    &q.a,
+                    &critical.a,
+                    &scale,
+                ))
+            })?;
+        let eval = self.model.evaluate(&best.a).ok()?;
+        eval.stability.stable.then_some(Held { a: best.a, eval })
+    }
+
+    /// Predictor–corrector from `held` (at its gripper pose) to `target` (module docs).
+    fn continue_to(
+        &self,
+        held: &Held<N, M::Pose>,
+        target: &M::Pose,
+        work: &mut Work,
+    ) -> Result<Held<N, M::Pose>, Stop<N, M::Pose>> {
+        let start = held.eval.tip;
+        let mut current = *held;
+        let (mut s, mut ds) = (0.0f64, 1.0f64);
+        while s < 1.0 {
+            if crate::ig::deadline::expired() {
+                return Err(Stop::Error(IgError::Deadline {
+                    iteration: work.iterations,
+                }));
+            }
+            let s_new = (s + ds).min(1.0);
+            let last = s_new >= 1.0;
+            let goal = if last {
+                *target
+            } else {
+                self.model.interpolate(&start, target, s_new)
+            };
+            let tolerance = if last {
+                self.options.tolerance
+            } else {
+                SUBSTEP_TOLERANCE.max(self.options.tolerance)
+            };
+            match self.correct(&current, &goal, tolerance, work) {
+                Some(next) => {
+                    current = next;
+                    s = s_new;
+                    ds = (2.0 * ds).min(1.0);
+                }
+                None => {
+                    ds *= 0.5;
+                    if ds < MIN_STEP {
+                        return Err(Stop::Fold(current, s));
+                    }
+                }
+            }
+        }
+        Ok(current)
+    }
+
+    /// Tangent predictor and contracting Newton corrections from `from` to `goal`; the rod
+    /// reached if it meets `tolerance` and is stable.
+    fn correct(
+        &self,
+        from: &Held<N, M::Pose>,
+        goal: &M::Pose,
+        tolerance: f64,
+        work: &mut Work,
+    ) -> Option<Held<N, M::Pose>> {
+        let mut a = from.a;
+        let mut eval = from.eval;
+        let mut previous_step = f64::INFINITY;
+        for _ in 0..=CORRECTOR_ITERATIONS {
+            let (pe, oe) = self.model.pose_error(&eval.tip, goal);
+            if pe <= tolerance && oe <= tolerance && a != from.a {
+                return eval.stability.stable.then_some(Held { a, eval });
+            }
+            let d = self
+                .model
+                .newton_increment(&eval.tip, &eval.jacobian, goal)
+                .ok()?;
+            let step = d.norm();
+            if step > CONTRACTION * previous_step {
+                return None;
+            }
+            previous_step = step;
+            a += d;
+            work.iterations += 1;
+            work.evaluations += 1;
+            eval = self.model.evaluate(&a).ok()?;
+            // The stable set is left only through det J(1, a) = 0: a sign change means the
+            // step crossed the fold.
+            let det = self.model.jacobian_det(&eval.jacobian);
+            if det * self.model.jacobian_det(&from.eval.jacobian) <= 0.0 {
+                return None;
+            }
+        }
+        None
+    }
+
+    fn solution(&self, end: &Held<N, M::Pose>, target: &M::Pose, work: &Work) -> SolutionOf<N, M> {
+        let (pe, oe) = self.model.pose_error(&end.eval.tip, target);
+        Solution {
+            a: end.a,
+            tip: end.eval.tip,
+            stable: end.eval.stability.stable,
+            stability_margin: end.eval.stability.margin,
+            iterations: work.iterations,
+            position_error: pe,
+            orientation_error: oe,
+            residual: pe.hypot(oe),
+            energy: end.eval.energy,
+            evaluations: work.evaluations,
+            starts: work.starts.max(1),
+            elapsed_us: 0.0,
+        }
+    }
+}
+
+/// Work counted over one move.
+#[derive(Clone, Copy, Debug, Default)]
+struct Work {
+    iterations: u32,
+    evaluations: u32,
+    starts: u32,
+}

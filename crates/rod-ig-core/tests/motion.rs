@@ -1,0 +1,234 @@
+//! Quasi-static motion (issue 12): the rod follows its branch as the gripper moves and snaps
+//! where the branch folds. Checked against the reference integrator (an independent model of
+//! the same rod) and against the mirror symmetry of the planar rod.
+
+use nalgebra::Vector3;
+use rod_ig_bench::SplitMix64;
+use rod_ig_core::planar::PlanarRod;
+use rod_ig_core::solver::{
+    self, relative_distance, BranchEvent, BranchFollower, PlanarClosedForm, PlanarReference,
+    RodModel, SolveOptions,
+};
+use rod_ig_core::{PlanarParams, PlanarPose};
+
+/// Mirror image of a planar rod in the x axis: (x, y, θ) ↦ (x, −y, −θ) maps the base wrench
+/// (a3, a4, a5) ↦ (−a3, a4, −a5) (paper eq. 2.9 is invariant under it).
+fn mirror(a: &PlanarParams) -> PlanarParams {
+    PlanarParams::new(-a[0], a[1], -a[2])
+}
+
+fn mid_height(a: &PlanarParams) -> f64 {
+    PlanarRod::new(a).expect("evaluates").pose(0.5).y
+}
+
+/// The clamped–clamped buckled rod with its bump up: grippers 0.8 apart, tangents aligned.
+fn buckled_up() -> PlanarParams {
+    let target = PlanarPose::new(0.8, 0.0, 0.0);
+    let all = solver::solve_all(&PlanarClosedForm, &target, &SolveOptions::default());
+    all.iter()
+        .filter(|s| mid_height(&s.a) > 0.0)
+        .min_by(|p, q| p.energy.total_cmp(&q.energy))
+        .expect("the buckled rod exists")
+        .a
+}
+
+#[test]
+fn a_buckled_rod_snaps_when_its_tip_gripper_turns() {
+    // The classic experiment: turn the tip gripper of a buckled rod; at a critical angle the
+    // bump flips to the other side.
+    let up = buckled_up();
+    let mut follower =
+        BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), up).expect("stable");
+    let step = 0.02;
+    let mut snap = None;
+    let mut before = up;
+    for k in 1..=75 {
+        let theta = step * f64::from(k);
+        let m = follower.follow(&PlanarPose::new(0.8, 0.0, theta));
+        let s = m.result.expect("the rod is never lost on this path");
+        assert!(s.stable && s.position_error <= 1e-6 && s.orientation_error <= 1e-6);
+        match m.event {
+            BranchEvent::None => {
+                assert!(mid_height(&s.a) * mid_height(&before) > 0.0, "same side");
+            }
+            BranchEvent::Snap {
+                critical,
+                critical_a,
+                energy_released,
+                snaps,
+            } => {
+                assert!(snap.is_none(), "one snap on this path");
+                assert_eq!(snaps, 1);
+                assert!(
+                    mid_height(&before) > 0.0 && mid_height(&s.a) < 0.0,
+                    "bump flipped"
+                );
+                assert!(energy_released > 0.0);
+                // The critical pose lies on the gripper's path, between the two targets.
+                assert!((critical.x - 0.8).abs() < 1e-6 && critical.y.abs() < 1e-6);
+                assert!(critical.theta > theta - step - 1e-9 && critical.theta <= theta + 1e-9);
+                snap = Some((critical, critical_a, s.a, theta));
+            }
+            BranchEvent::Lost => panic!("lost at θ = {theta}"),
+        }
+        before = s.a;
+    }
+    let (critical, critical_a, settled, theta) = snap.expect("the bump flips before θ = 1.5");
+    // Independent check by the reference integrator (DOP853, rtol 1e-12): the critical rod
+    // is a fold of the branch, stable with a margin at rounding level of zero (the fold is
+    // located to MIN_STEP of a 0.02 rad turn; det J(1) ~ √distance to the fold there), while
+    // the starting rod's margin is 0.02.
+    let reference = PlanarReference::default();
+    let start = reference.stability(&up).expect("evaluates");
+    let at_fold = reference.stability(&critical_a).expect("evaluates");
+    println!(
+        "snap at θ = {:.6}: reference margin {:.3e} (start {:.3e})",
+        critical.theta, at_fold.margin, start.margin
+    );
+    assert!(start.stable && start.margin > 0.01, "{start:?}");
+    assert!(
+        at_fold.margin.abs() < 2e-4 && at_fold.margin < 0.01 * start.margin,
+        "{at_fold:?}"
+    );
+    let tip = reference.tip(&critical_a).expect("evaluates");
+    assert!(
+        (tip.theta - critical.theta).abs() < 1e-6,
+        "the critical rod holds the pose"
+    );
+    // Past the critical angle the up branch does not exist any more: the paper's Newton on the
+    // reference model from the critical rod does not find a stable rod on that side.
+    let past = PlanarPose::new(0.8, 0.0, critical.theta + 0.02);
+    let newton = SolveOptions {
+        method: solver::Method::Newton,
+        initial_guess: Some(critical_a),
+        ..SolveOptions::default()
+    };
+    if let Ok(s) = solver::solve(&reference, &past, &newton) {
+        assert!(
+            mid_height(&s.a) < 0.0,
+            "no stable up rod past the fold: {:?}",
+            s.a
+        );
+    }
+    // The settled rod is the mirror image of the up branch turned the other way (symmetry),
+    // and it is stable for the reference integrator.
+    let mut mirrored =
+        BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), up).expect("stable");
+    let m = mirrored.follow(&PlanarPose::new(0.8, 0.0, -theta));
+    assert!(
+        matches!(m.event, BranchEvent::None),
+        "no snap turning the other way"
+    );
+    let other = m.result.expect("follows").a;
+    let scale = PlanarClosedForm.param_scale();
+    assert!(relative_distance(&settled, &mirror(&other), &scale) < 1e-5);
+    assert!(reference.stability(&settled).expect("evaluates").stable);
+}
+
+#[test]
+fn long_random_walks_never_jump_branches_silently() {
+    // Random gripper walks from random stable rods, then the same walk back: on a branch
+    // followed without a snap the way back returns to the very rod the walk started from (a
+    // silent jump to another branch would not be undone). Every rod is checked stable by the
+    // reference integrator every 25 steps.
+    let reference = PlanarReference::default();
+    let mut rng = SplitMix64::new(12);
+    let mut walks = 0;
+    let mut checked = 0;
+    let (mut snaps, mut returned) = (0, 0);
+    while walks < 6 {
+        let a0 = PlanarParams::new(
+            rng.range(-4.0, 4.0),
+            rng.range(-20.0, 20.0),
+            rng.range(-20.0, 20.0),
+        );
+        let Ok(e) = rod_ig_core::planar::evaluate(&a0) else {
+            continue;
+        };
+        if !e.stability.stable || e.stability.margin < 0.05 {
+            continue;
+        }
+        walks += 1;
+        let mut follower =
+            BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), a0).expect("held");
+        let mut path = vec![e.tip];
+        let mut b = e.tip;
+        let mut snapped = false;
+        for k in 0..120 {
+            let step = Vector3::new(
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            );
+            let next = PlanarPose::new(
+                b.x + 0.004 * step.x,
+                b.y + 0.004 * step.y,
+                b.theta + 0.01 * step.z,
+            );
+            if next.x.hypot(next.y) >= 0.97 {
+                continue;
+            }
+            let m = follower.follow(&next);
+            match m.event {
+                BranchEvent::None => {
+                    let s = m.result.expect("followed");
+                    if k % 25 == 0 {
+                        assert!(reference.stability(&s.a).expect("evaluates").stable);
+                        checked += 1;
+                    }
+                }
+                _ => {
+                    snapped = true;
+                    break;
+                }
+            }
+            b = next;
+            path.push(b);
+        }
+        if snapped {
+            snaps += 1;
+            continue;
+        }
+        returned += 1;
+        for p in path.iter().rev().skip(1) {
+            let m = follower.follow(p);
+            assert!(
+                matches!(m.event, BranchEvent::None),
+                "no snap on the way back"
+            );
+        }
+        let back = follower.rod().expect("held");
+        let scale = PlanarClosedForm.param_scale();
+        assert!(
+            relative_distance(&back, &a0, &scale) < 1e-5,
+            "walk back from {a0:?} ended at {back:?}"
+        );
+    }
+    println!("{returned} walks returned to their start, {snaps} ended in a snap, {checked} reference checks");
+    assert!(checked > 0 && returned >= 3);
+}
+
+#[test]
+fn followers_work_on_the_3d_model_and_report_bad_input() {
+    use rod_ig_bench::spatial::random_targets;
+    use rod_ig_core::solver::Spatial;
+    use rod_ig_core::spatial::Stiffness;
+    let (a0, tip) = random_targets(1, 5, &Stiffness::default())[0];
+    let mut follower =
+        BranchFollower::holding(Spatial::default(), SolveOptions::default(), a0).expect("held");
+    let mut target = tip;
+    target.position.x += 0.01;
+    let m = follower.follow(&target);
+    assert!(matches!(m.event, BranchEvent::None));
+    let s = m.result.expect("a small move is followed");
+    assert!(s.position_error <= 1e-6 && s.stable);
+    assert!((s.a - a0).norm() < 0.5 * (1.0 + a0.norm()));
+    // A NaN target changes nothing: an error, and the rod is still held.
+    let mut bad = target;
+    bad.position.y = f64::NAN;
+    let m = follower.follow(&bad);
+    assert!(m.result.is_err() && follower.rod() == Some(s.a));
+    // An unstable rod cannot be held.
+    let straight = PlanarParams::zeros();
+    assert!(BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), straight).is_err());
+}
