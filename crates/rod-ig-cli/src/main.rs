@@ -5,6 +5,7 @@ mod answer;
 mod bench;
 mod bench_tails;
 mod jsonl;
+mod motion_cmds;
 mod planar_cmds;
 mod spatial_cmds;
 mod svg;
@@ -58,6 +59,27 @@ enum Command {
         /// Print the solver's events on stderr as JSON lines (as `solve --verbose`).
         #[arg(long)]
         verbose: bool,
+    },
+    /// Quasi-static motion: the rod follows its equilibrium branch as the tip gripper moves.
+    /// Reads JSON lines {"target": {"x", "y", "theta"}, "a0"?: [a3, a4, a5] (first line: the
+    /// rod held at the start; without it the first target is a fresh solve), "tolerance"?,
+    /// "deadline_ms"?}; writes the fields of `solve` plus "event": "none" | "snap" | "lost"
+    /// and, after a snap, "critical": {"x", "y", "theta"} (where the branch folded),
+    /// "critical_a" and "energy_released".
+    Track {
+        /// Draw the sequence of rods (snaps marked) into this SVG file at the end.
+        #[arg(long)]
+        svg: Option<PathBuf>,
+    },
+    /// Plans a stable gripper path. Reads JSON lines {"start": [a3, a4, a5], "goal": {"x",
+    /// "y", "theta"}, "obstacles"?: [{"type": "disc", "center": [x, y], "radius": r} |
+    /// {"type": "polygon", "points": [[x, y], ...]}], "deadline_ms"? (default 500)}; writes
+    /// {"success", "rods": [[a3, a4, a5], ...], "gripper": [{"x", "y", "theta"}, ...],
+    /// "min_margin", "reason" (on failure), "elapsed_ms"}. One roadmap serves every line.
+    Plan {
+        /// Draw the last plan (rods, gripper path, obstacles) into this SVG file.
+        #[arg(long)]
+        svg: Option<PathBuf>,
     },
     /// Samples or draws rods: given parameters (--a, repeatable) or a target pose (--target:
     /// every distinct stable solution found). JSON lines of poses, or an SVG picture.
@@ -177,6 +199,10 @@ fn shape_command(
     }
 }
 
+fn write_svg(path: &std::path::Path, text: &str) -> Result<(), String> {
+    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let stdin = io::stdin().lock();
@@ -196,6 +222,38 @@ fn main() -> ExitCode {
             spatial_cmds::solve3d_line(line, verbose)
         })
         .map_err(|e| e.to_string()),
+        Command::Track { svg } => {
+            let mut tracking = motion_cmds::Tracking::default();
+            jsonl::run(stdin, stdout, |line| tracking.line(line))
+                .map_err(|e| e.to_string())
+                .and_then(|()| match svg {
+                    Some(path) => write_svg(
+                        &path,
+                        &svg::draw_sequence(
+                            &tracking.drawn,
+                            &[],
+                            "rod-ig track: the rod following the gripper",
+                        ),
+                    ),
+                    None => Ok(()),
+                })
+        }
+        Command::Plan { svg } => {
+            let mut planning = motion_cmds::Planning::default();
+            jsonl::run(stdin, stdout, |line| planning.line(line))
+                .map_err(|e| e.to_string())
+                .and_then(|()| match svg {
+                    Some(path) => write_svg(
+                        &path,
+                        &svg::draw_sequence(
+                            &planning.drawn,
+                            &planning.obstacles,
+                            "rod-ig plan: a stable gripper path",
+                        ),
+                    ),
+                    None => Ok(()),
+                })
+        }
         Command::Shape {
             params,
             target,

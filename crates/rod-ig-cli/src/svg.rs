@@ -113,6 +113,141 @@ pub fn draw(rods: &[DrawnRod], title: &str) -> String {
     s
 }
 
+/// What a rod of a sequence (`track`, `plan`) is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SequenceKind {
+    /// The rod held at the start.
+    Start,
+    /// A rod along the motion.
+    Step,
+    /// The last stable rod of a branch that folded (snap-through starts here).
+    Critical,
+    /// The rod a snap settled into.
+    Snapped,
+}
+
+/// One rod of a motion.
+#[derive(Clone, Debug)]
+pub struct SequenceRod {
+    /// Sampled poses, base to tip.
+    pub poses: Vec<PlanarPose>,
+    /// Its role.
+    pub kind: SequenceKind,
+}
+
+/// An obstacle to draw.
+#[derive(Clone, Debug)]
+pub enum Obstacle {
+    /// Centre and radius.
+    Disc([f64; 2], f64),
+    /// Vertices.
+    Polygon(Vec<[f64; 2]>),
+}
+
+impl From<&rod_ig_core::plan::Obstacle> for Obstacle {
+    fn from(o: &rod_ig_core::plan::Obstacle) -> Self {
+        match o {
+            rod_ig_core::plan::Obstacle::Disc { center, radius } => Self::Disc(*center, *radius),
+            rod_ig_core::plan::Obstacle::Polygon { points } => Self::Polygon(points.clone()),
+        }
+    }
+}
+
+/// Draws a motion: rods from light to dark blue in order, the start in black, critical rods
+/// (where a branch folded) dashed red, the rod each snap settled into solid red, the
+/// gripper's path through the tips, and the obstacles in grey.
+pub fn draw_sequence(rods: &[SequenceRod], obstacles: &[Obstacle], title: &str) -> String {
+    let size = 640.0;
+    let margin = 40.0;
+    let scale = (size - 2.0 * margin) / 2.2;
+    let px = |x: f64| margin + (x + 1.1) * scale;
+    let py = |y: f64| margin + (1.1 - y) * scale;
+    let h = size + 30.0;
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{h}" viewBox="0 0 {size} {h}" font-family="sans-serif" font-size="13">"#
+    );
+    let _ = write!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    let _ = write!(
+        s,
+        r#"<text x="{margin}" y="24" font-size="15">{}</text>"#,
+        escape(title)
+    );
+    let _ = write!(
+        s,
+        r##"<circle cx="{}" cy="{}" r="{}" fill="#f4f4f4" stroke="#bbb" stroke-dasharray="4 4"/>"##,
+        px(0.0),
+        py(0.0),
+        scale
+    );
+    for o in obstacles {
+        match o {
+            Obstacle::Disc(c, r) => {
+                let _ = write!(
+                    s,
+                    r##"<circle cx="{:.2}" cy="{:.2}" r="{:.2}" fill="#999"/>"##,
+                    px(c[0]),
+                    py(c[1]),
+                    r * scale
+                );
+            }
+            Obstacle::Polygon(points) => {
+                let pts: Vec<String> = points
+                    .iter()
+                    .map(|p| format!("{:.2},{:.2}", px(p[0]), py(p[1])))
+                    .collect();
+                let _ = write!(s, r##"<polygon points="{}" fill="#999"/>"##, pts.join(" "));
+            }
+        }
+    }
+    let polyline = |poses: &[PlanarPose]| -> String {
+        poses
+            .iter()
+            .filter(|p| p.is_finite())
+            .map(|p| format!("{:.2},{:.2}", px(p.x), py(p.y)))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let steps = rods.len().max(2) as f64;
+    let mut tips = Vec::new();
+    for (i, rod) in rods.iter().enumerate() {
+        let (colour, width, dash) = match rod.kind {
+            SequenceKind::Start => ("#000".to_string(), 2.5, ""),
+            SequenceKind::Step => {
+                // Light to dark blue along the motion.
+                let f = i as f64 / (steps - 1.0);
+                let light = (200.0 - 150.0 * f) as u8;
+                (format!("rgb({light},{light},255)"), 1.2, "")
+            }
+            SequenceKind::Critical => ("#d62728".to_string(), 2.5, r#" stroke-dasharray="7 4""#),
+            SequenceKind::Snapped => ("#d62728".to_string(), 2.5, ""),
+        };
+        let _ = write!(
+            s,
+            r#"<polyline points="{}" fill="none" stroke="{colour}" stroke-width="{width}"{dash}/>"#,
+            polyline(&rod.poses)
+        );
+        if let Some(t) = rod.poses.last().filter(|p| p.is_finite()) {
+            tips.push(*t);
+        }
+    }
+    let _ = write!(
+        s,
+        r##"<polyline points="{}" fill="none" stroke="#2ca02c" stroke-width="1.5"/>"##,
+        polyline(&tips)
+    );
+    let legend = "black: start · blue: rods along the motion · green: gripper path ·                   red dashed: critical rod · red: after the snap";
+    let _ = write!(
+        s,
+        r#"<text x="{margin}" y="{}" font-size="12">{}</text>"#,
+        size + 14.0,
+        escape(legend)
+    );
+    s.push_str("</svg>\n");
+    s
+}
+
 fn escape(text: &str) -> String {
     text.replace('&', "&amp;")
         .replace('<', "&lt;")

@@ -326,3 +326,59 @@ fn verbose_prints_the_solver_events_on_stderr() {
     assert_eq!(last["event"], "finished");
     assert_eq!(last["termination"], "converged");
 }
+
+#[test]
+fn track_reports_the_snap_of_a_buckled_rod() {
+    // The buckled rod (bump up) held by grippers 0.8 apart; the tip gripper turns by 0.02 rad
+    // per line. One line reports the snap with the critical pose; the others stay on a branch.
+    let mut input = String::from(
+        "{\"a0\": [5.849576446834202, -43.929163868139426, 0.0], \"target\": {\"x\": 0.8, \"y\": 0.0, \"theta\": 0.0}}\n",
+    );
+    for k in 1..=50 {
+        input.push_str(&format!(
+            "{{\"target\": {{\"x\": 0.8, \"y\": 0.0, \"theta\": {}}}}}\n",
+            0.02 * f64::from(k)
+        ));
+    }
+    input.push_str("{\"target\": {\"x\": 0.8, \"y\": 0.0, \"theta\": 0.5}, \"a0\": [1, 2, 3]}\n");
+    let svg = std::env::temp_dir().join(format!("rod-ig-track-{}.svg", std::process::id()));
+    let out = run(&["track", "--svg", svg.to_str().unwrap()], &input);
+    assert_eq!(out.len(), 52);
+    let snaps: Vec<&Value> = out.iter().filter(|o| o["event"] == "snap").collect();
+    assert_eq!(snaps.len(), 1, "one snap");
+    let snap = snaps[0];
+    assert_eq!(snap["success"], true);
+    let critical = snap["critical"]["theta"].as_f64().unwrap();
+    assert!(critical > 0.7 && critical < 0.9, "{critical}");
+    assert!(snap["energy_released"].as_f64().unwrap() > 0.0);
+    assert!(out[..51]
+        .iter()
+        .all(|o| o["success"] == true && o["event"] != "lost"));
+    assert!(out[51]["error"].as_str().unwrap().contains("first line"));
+    let picture = std::fs::read_to_string(&svg).expect("svg written");
+    assert!(
+        picture.contains("stroke-dasharray=\"7 4\""),
+        "critical rod drawn"
+    );
+    let _ = std::fs::remove_file(svg);
+}
+
+#[test]
+fn plan_answers_with_stable_rods_or_a_reason() {
+    let input = "{\"start\": [1.0, 2.0, -1.0], \"goal\": {\"x\": 0.3, \"y\": 0.6, \"theta\": 2.5}, \"obstacles\": [{\"type\": \"disc\", \"center\": [0.5, 0.35], \"radius\": 0.1}]}\n\
+                 {\"start\": [1.0, 2.0, -1.0], \"goal\": {\"x\": 1.5, \"y\": 0.0, \"theta\": 0.0}}\n\
+                 {\"start\": [1.0, 2.0, -1.0], \"goal\": {\"x\": 0.3, \"y\": 0.6, \"theta\": 2.5}, \"obstacles\": [{\"type\": \"cloud\"}]}\n";
+    let out = run(&["plan"], input);
+    assert_eq!(out.len(), 3);
+    assert_eq!(out[0]["success"], true);
+    let rods = out[0]["rods"].as_array().unwrap();
+    let gripper = out[0]["gripper"].as_array().unwrap();
+    assert_eq!(rods.len(), gripper.len());
+    assert_eq!(rods[0], serde_json::json!([1.0, 2.0, -1.0]));
+    let last = gripper.last().unwrap();
+    assert!((last["x"].as_f64().unwrap() - 0.3).abs() < 1e-6);
+    assert!(out[0]["min_margin"].as_f64().unwrap() >= 1e-3);
+    assert_eq!(out[1]["success"], false);
+    assert!(out[1]["reason"].as_str().unwrap().contains("unreachable"));
+    assert!(out[2]["error"].as_str().unwrap().contains("cloud"));
+}

@@ -21,6 +21,8 @@
 //!   trait, the paper's Newton, the robust search, least energy, all solutions, deadlines,
 //!   observers).
 //! - [`ig`]: the planar closed forms' search behind it (atlas, multi-start, tracking).
+//! - [`plan`]: stable gripper paths for the planar rod, planned over a roadmap of stable rods
+//!   in a-space.
 //! - [`rng`]: a small deterministic generator for reproducible samples.
 //! - [`spatial`]: the 3-D rod by numerical integration, and its inverse geometry.
 #![warn(missing_docs)]
@@ -31,6 +33,7 @@ pub mod elliptic;
 mod error;
 pub mod ig;
 pub mod ode;
+pub mod plan;
 pub mod planar;
 pub mod rng;
 pub mod scalar;

