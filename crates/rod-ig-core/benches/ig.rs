@@ -8,14 +8,16 @@
 //!
 //! Run: `cargo bench -p rod-ig-core --bench ig -- --quick`.
 
+#[path = "../tests/workloads/mod.rs"]
+mod workloads;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use rod_ig_bench::planar::{self as workloads, ParamBox};
 use rod_ig_core::ig::{self, Method, SolveOptions, Tracker};
 use rod_ig_core::PlanarParams;
+use workloads::planar::{self as planar_workloads, ParamBox};
 
 fn bench(c: &mut Criterion) {
     let _ = ig::warm_up();
-    let targets = workloads::random_stable_targets(256, 42, ParamBox::PAPER);
+    let targets = planar_workloads::random_stable_targets(256, 42, ParamBox::PAPER);
     let n = targets.len().max(1);
     let mut g = c.benchmark_group("ig");
 
@@ -43,7 +45,7 @@ fn bench(c: &mut Criterion) {
         })
     });
 
-    let path = workloads::random_stable_path(5, ParamBox::PAPER, 400, 0.01);
+    let path = planar_workloads::random_stable_path(5, ParamBox::PAPER, 400, 0.01);
     if !path.is_empty() {
         let mut tracker = Tracker::new(SolveOptions::default());
         let mut k = 0;

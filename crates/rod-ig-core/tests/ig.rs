@@ -5,9 +5,10 @@
 //! environment variable `ROD_IG_SHARED`, else by walking up from this crate's directory to the
 //! first ancestor holding `shared/oracle`.
 
-use rod_ig_bench::planar::{self as bench, IgCase, ParamBox};
+mod workloads;
 use rod_ig_core::ig::{self, IgError, Method, Objective, SolveOptions, Tracker};
 use rod_ig_core::{wrap_angle, PlanarParams, PlanarPose};
+use workloads::planar::{self as bench, IgCase, ParamBox};
 
 mod common;
 use common::shared_dir;

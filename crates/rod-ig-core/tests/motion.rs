@@ -2,14 +2,15 @@
 //! where the branch folds. Checked against the reference integrator (an independent model of
 //! the same rod) and against the mirror symmetry of the planar rod.
 
+mod workloads;
 use nalgebra::Vector3;
-use rod_ig_bench::SplitMix64;
 use rod_ig_core::planar::PlanarRod;
 use rod_ig_core::solver::{
     self, relative_distance, BranchEvent, BranchFollower, PlanarClosedForm, PlanarReference,
     RodModel, SolveOptions,
 };
 use rod_ig_core::{PlanarParams, PlanarPose};
+use workloads::SplitMix64;
 
 /// Mirror image of a planar rod in the x axis: (x, y, θ) ↦ (x, −y, −θ) maps the base wrench
 /// (a3, a4, a5) ↦ (−a3, a4, −a5) (paper eq. 2.9 is invariant under it).
@@ -210,9 +211,9 @@ fn long_random_walks_never_jump_branches_silently() {
 
 #[test]
 fn followers_work_on_the_3d_model_and_report_bad_input() {
-    use rod_ig_bench::spatial::random_targets;
     use rod_ig_core::solver::Spatial;
     use rod_ig_core::spatial::Stiffness;
+    use workloads::spatial::random_targets;
     let (a0, tip) = random_targets(1, 5, &Stiffness::default())[0];
     let mut follower =
         BranchFollower::holding(Spatial::default(), SolveOptions::default(), a0).expect("held");

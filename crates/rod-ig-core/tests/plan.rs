@@ -2,12 +2,13 @@
 //! closed form and the reference integrator, stability of every rod and every midpoint by the
 //! reference integrator, spacing, obstacles on a denser body sampling.
 
-use rod_ig_bench::SplitMix64;
+mod workloads;
 use rod_ig_core::plan::{Obstacle, PlanError, PlanRequest, Planner, MIN_MARGIN};
 use rod_ig_core::planar::{self, PlanarRod};
 use rod_ig_core::solver::{PlanarReference, RodModel};
 use rod_ig_core::{wrap_angle, PlanarParams, PlanarPose};
 use std::time::Duration;
+use workloads::SplitMix64;
 
 fn random_stable(rng: &mut SplitMix64, min_margin: f64) -> (PlanarParams, PlanarPose) {
     loop {

@@ -1,8 +1,8 @@
 //! The one solver API (issue 11): every strategy on every model, one Solution and error type,
 //! typed terminations, observers.
 
+mod workloads;
 use nalgebra::{Vector3, Vector6};
-use rod_ig_bench::spatial::random_targets;
 use rod_ig_core::solver::{
     self, observe, relative_distance, Counters, Event, IgError, InverseGeometry, IterationLog,
     Method, Objective, PlanarClosedForm, PlanarReference, RodModel, SolveOptions, Spatial,
@@ -11,6 +11,7 @@ use rod_ig_core::solver::{
 use rod_ig_core::spatial::{SpatialPose, Stiffness};
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use std::time::Duration;
+use workloads::spatial::random_targets;
 
 /// Stable planar rods spread over moments and forces, and their tips.
 fn planar_cases() -> Vec<(PlanarParams, PlanarPose)> {

@@ -1,12 +1,13 @@
 //! The 3-D rod: planar-subset agreement with the planar reference, first integrals, J against
 //! finite differences, stability (classical checks, fast scan vs full grid), inverse geometry.
 
+mod workloads;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3, Vector6};
 use proptest::prelude::*;
-use rod_ig_bench::spatial::{benchmark_random_targets, random_targets};
 use rod_ig_core::ode::planar_reference as pr;
 use rod_ig_core::solver::{self, IgError, Method, SolveOptions, Spatial};
 use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
+use workloads::spatial::{benchmark_random_targets, random_targets};
 
 const RTOL: f64 = 1e-12;
 

@@ -324,6 +324,9 @@ struct ModelParts {
     wrench: Wrench,
     /// The reached tip, metres.
     tip: Pose,
+    /// Branch event ("" when not followed) and the critical gripper pose after a snap (m).
+    event: &'static str,
+    critical: Option<Pose>,
 }
 
 /// Scales a converged answer to physical units (rod length L, bending stiffness EI).
@@ -370,6 +373,26 @@ fn converged_message<P, X>(
         solve_time,
         spatial: c.spatial,
         a_spatial: c.a_spatial,
+        event: c.event.to_string(),
+        critical_pose: c.critical.unwrap_or_else(nan_pose),
+    }
+}
+
+/// The pose of "no pose": every component NaN (RodSolution.critical_pose without a snap).
+fn nan_pose() -> Pose {
+    let nan = f64::NAN;
+    Pose {
+        position: Point {
+            x: nan,
+            y: nan,
+            z: nan,
+        },
+        orientation: Quaternion {
+            x: nan,
+            y: nan,
+            z: nan,
+            w: nan,
+        },
     }
 }
 
@@ -391,18 +414,20 @@ pub fn solution_message_3d(
         spatial: true,
         wrench: base_wrench_3d(&s.a, l, ei),
         tip: spatial_to_pose(&s.tip, l),
+        event: "",
+        critical: None,
     };
     converged_message(s, parts, header, params, solve_time)
 }
 
 /// The RodSolution of a converged (planar) solve.
 pub fn solution_message(
-    s: &Solved,
+    solved: &Solved,
     header: &Header,
     params: &Params,
     solve_time: f64,
 ) -> RodSolution {
-    let s = &s.solution;
+    let s = &solved.solution;
     let (l, ei) = (params.rod_length, params.bending_stiffness);
     let a = [s.a[0], s.a[1], s.a[2]];
     let parts = ModelParts {
@@ -412,6 +437,8 @@ pub fn solution_message(
         spatial: false,
         wrench: base_wrench(&a, l, ei),
         tip: planar_to_pose(&s.tip, l),
+        event: solved.event,
+        critical: solved.critical.map(|c| planar_to_pose(&c, l)),
     };
     converged_message(s, parts, header, params, solve_time)
 }
@@ -452,23 +479,13 @@ pub fn failure_message(
         elastic_energy_joules: nan,
         wrench_valid: false,
         base_wrench: Wrench::default(),
-        tip: Pose {
-            position: Point {
-                x: nan,
-                y: nan,
-                z: nan,
-            },
-            orientation: Quaternion {
-                x: nan,
-                y: nan,
-                z: nan,
-                w: nan,
-            },
-        },
+        tip: nan_pose(),
         rod_length: params.rod_length,
         solve_time,
         spatial,
         a_spatial,
+        event: failed.map_or("", |f| f.event).to_string(),
+        critical_pose: nan_pose(),
     }
 }
 
@@ -641,6 +658,8 @@ mod tests {
                 elapsed_us: 3.0,
             },
             shape: vec![],
+            event: "none",
+            critical: None,
         };
         let p = Params {
             rod_length: 0.5,

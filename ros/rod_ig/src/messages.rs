@@ -255,6 +255,10 @@ pub struct RodSolution {
     pub spatial: bool,
     /// Normalised 3-D base wrench (a1..a6); zeros for planar answers (appended field).
     pub a_spatial: [f64; 6],
+    /// Branch event of the move: "none", "snap", "lost", or "" (not a tracked target).
+    pub event: String,
+    /// After a snap: where the old branch ended (m); NaN otherwise.
+    pub critical_pose: Pose,
 }
 impl Message for RodSolution {}
 
@@ -626,6 +630,8 @@ mod tests {
             solve_time: 0.00025,
             spatial: true,
             a_spatial: [0.5, -0.25, 1.5, -2.25, 3.125, 0.75],
+            event: "snap".into(),
+            critical_pose: pose(2),
         }
     }
 

@@ -71,6 +71,10 @@ pub struct Params {
     /// `solve_3d`: answer non-planar targets (beyond `planar_tolerance`) with the 3-D solver
     /// instead of rejecting them (default false).
     pub solve_3d: bool,
+    /// `follow_branch`: targets on `rod/target` move the gripper and the rod follows its
+    /// equilibrium branch, snapping where it folds (`event` in RodSolution); false: each target
+    /// is solved on its own from the previous solution (default true).
+    pub follow_branch: bool,
     /// `deadline_ms` in (0, 10000]: wall-time budget of one solve (default 250 ms, the
     /// library's `ig::DEFAULT_DEADLINE`); a solve that runs out answers "deadline reached".
     pub deadline_ms: f64,
@@ -129,6 +133,7 @@ impl Default for Params {
             publish_marker: true,
             marker_width: 0.01,
             solve_3d: false,
+            follow_branch: true,
             deadline_ms: rod_ig_core::ig::DEFAULT_DEADLINE.as_secs_f64() * 1e3,
             use_sim_time: false,
             target_qos: TargetQos::default(),
@@ -175,7 +180,7 @@ pub enum ParamError {
 }
 
 /// The names of all parameters, in declaration order.
-pub const NAMES: [&str; 13] = [
+pub const NAMES: [&str; 14] = [
     "rod_length",
     "base_frame",
     "path_samples",
@@ -187,6 +192,7 @@ pub const NAMES: [&str; 13] = [
     "publish_marker",
     "marker_width",
     "solve_3d",
+    "follow_branch",
     "deadline_ms",
     "use_sim_time",
 ];
@@ -390,6 +396,7 @@ impl Params {
                 self.marker_width = v;
             }
             "solve_3d" => self.solve_3d = boolean(name, value)?,
+            "follow_branch" => self.follow_branch = boolean(name, value)?,
             "deadline_ms" => {
                 let v = double(name, value)?;
                 let max = rod_ig_core::ig::MAX_DEADLINE.as_secs_f64() * 1e3;
@@ -434,6 +441,7 @@ impl Params {
             "publish_marker" => ParameterValue::Boolean(self.publish_marker),
             "marker_width" => ParameterValue::Double(self.marker_width),
             "solve_3d" => ParameterValue::Boolean(self.solve_3d),
+            "follow_branch" => ParameterValue::Boolean(self.follow_branch),
             "deadline_ms" => ParameterValue::Double(self.deadline_ms),
             "use_sim_time" => ParameterValue::Boolean(self.use_sim_time),
             _ => return None,
@@ -483,6 +491,7 @@ impl Params {
                 "publish_marker" => ("Publish the RViz line strip on rod/marker", String::new(), Unbounded),
                 "marker_width" => ("Line width of the marker (m)", "> 0".into(), Unbounded),
                 "solve_3d" => ("Answer non-planar targets with the 3-D solver instead of rejecting them", String::new(), Unbounded),
+                "follow_branch" => ("rod/target moves the gripper: the rod follows its branch and snaps where it folds (event in RodSolution); false: independent solves", String::new(), Unbounded),
                 "deadline_ms" => ("Wall-time budget of one solve (ms); a solve that runs out answers 'deadline reached'", "> 0".into(), Double(0.0, max_deadline)),
                 "use_sim_time" => ("Use /clock (rosgraph_msgs/Clock) as the node's time", String::new(), Unbounded),
                 _ => return None,
@@ -564,6 +573,7 @@ pub fn usage() -> String {
          \x20 publish_marker    publish /rod/marker ({})\n\
          \x20 marker_width      m ({})\n\
          \x20 solve_3d          answer non-planar targets with the 3-D solver ({})\n\
+         \x20 follow_branch     the rod follows its branch, snaps where it folds ({})\n\
          \x20 deadline_ms       wall-time budget of one solve, ms, <= 10000 ({})\n\
          \x20 use_sim_time      stamp with /clock time (rosgraph_msgs/Clock) ({})\n\n\
          Environment: ROS_DOMAIN_ID (0..232), ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST or\n\
@@ -579,6 +589,7 @@ pub fn usage() -> String {
         d.publish_marker,
         d.marker_width,
         d.solve_3d,
+        d.follow_branch,
         d.deadline_ms,
         d.use_sim_time,
     )

@@ -126,6 +126,7 @@ pub fn settings_of(params: &Params) -> SolverSettings {
         tolerance: params.tolerance,
         max_iterations: params.max_iterations,
         deadline: std::time::Duration::from_secs_f64(params.deadline_ms / 1e3),
+        follow_branch: params.follow_branch,
     }
 }
 
@@ -165,6 +166,7 @@ impl Processor {
             tolerance: overrides.tolerance.unwrap_or(settings.tolerance),
             max_iterations: overrides.max_iterations.unwrap_or(settings.max_iterations),
             deadline: settings.deadline,
+            follow_branch: false,
         });
         let rejected = |message: String| Outcome {
             solution: failure_message(

@@ -10,7 +10,9 @@
 
 use rod_ig_core::ig::{self, Failure, Solution, SolveOptions, Tracker};
 use rod_ig_core::planar::PlanarRod;
-use rod_ig_core::solver::{self as rod_solver, Spatial};
+use rod_ig_core::solver::{
+    self as rod_solver, BranchEvent, BranchFollower, PlanarClosedForm, Spatial,
+};
 use rod_ig_core::spatial::ig::{Failure3d, Solution3d, SolveOptions3d};
 use rod_ig_core::spatial::{self, Stiffness};
 pub use rod_ig_core::spatial::{SpatialParams, SpatialPose};
@@ -29,6 +31,9 @@ pub struct SolverSettings {
     pub max_iterations: u32,
     /// Wall-time budget of one solve.
     pub deadline: std::time::Duration,
+    /// Warm-started planar targets move the gripper: the rod follows its branch (parameter
+    /// `follow_branch`).
+    pub follow_branch: bool,
 }
 
 /// A converged solve with its sampled shape, normalised units: the core crate's solution
@@ -39,6 +44,10 @@ pub struct WithShape<S, P> {
     pub solution: S,
     /// The rod's shape, base to tip.
     pub shape: Vec<P>,
+    /// Branch event of a followed move ("none", "snap"), "" when not followed.
+    pub event: &'static str,
+    /// After a snap: the gripper pose where the old branch ended (normalised).
+    pub critical: Option<PlanarPose>,
 }
 
 /// A converged planar solve and its shape.
@@ -62,6 +71,8 @@ pub struct Failed {
     pub last_a_spatial: Option<Box<SpatialParams>>,
     /// The 3-D solver answered (parameter `solve_3d`, non-planar target).
     pub spatial: bool,
+    /// "lost" when a followed move lost the rod, "" otherwise.
+    pub event: &'static str,
 }
 
 impl From<Failure> for Failed {
@@ -73,6 +84,7 @@ impl From<Failure> for Failed {
             last_a: f.last_a,
             last_a_spatial: None,
             spatial: false,
+            event: "",
         }
     }
 }
@@ -86,6 +98,7 @@ impl From<Failure3d> for Failed {
             last_a: f.last_a.as_ref().map(planar_part),
             last_a_spatial: f.last_a.map(Box::new),
             spatial: true,
+            event: "",
         }
     }
 }
@@ -132,6 +145,8 @@ fn options_3d(s: &SolverSettings, initial_guess: Option<SpatialParams>) -> Solve
 pub struct RodSolver {
     settings: SolverSettings,
     tracker: Tracker,
+    /// The rod held by the grippers (planar targets with `follow_branch`).
+    follower: BranchFollower<3, PlanarClosedForm>,
     /// Previous 3-D solution: the warm start of the next 3-D target.
     last_3d: Option<SpatialParams>,
 }
@@ -142,6 +157,7 @@ impl RodSolver {
         Self {
             settings,
             tracker: Tracker::new(options(&settings, None)),
+            follower: BranchFollower::new(PlanarClosedForm, options(&settings, None)),
             last_3d: None,
         }
     }
@@ -160,11 +176,13 @@ impl RodSolver {
     pub fn set_settings(&mut self, settings: SolverSettings) {
         self.settings = settings;
         self.tracker = Tracker::new(options(&settings, self.tracker.last()));
+        self.follower.set_options(options(&settings, None));
     }
 
     /// Forgets the warm starts (planar and 3-D).
     pub fn reset(&mut self) {
         self.tracker.reset();
+        self.follower = BranchFollower::new(PlanarClosedForm, options(&self.settings, None));
         self.last_3d = None;
     }
 
@@ -213,6 +231,22 @@ impl RodSolver {
             ig::solve(target, &options(&s, initial_guess))?
         } else {
             match self.settings.method {
+                Method::Robust if self.settings.follow_branch => {
+                    let m = self.follower.follow(target);
+                    let (event, critical) = match m.event {
+                        BranchEvent::Snap { critical, .. } => ("snap", Some(critical)),
+                        BranchEvent::Lost => ("lost", None),
+                        BranchEvent::None => ("none", None),
+                    };
+                    let s = m.result.map_err(|f| Failed {
+                        event,
+                        ..Failed::from(f)
+                    })?;
+                    let mut solved = with_shape(&s, samples)?;
+                    solved.event = event;
+                    solved.critical = critical;
+                    return Ok(solved);
+                }
                 Method::Robust => self.tracker.solve(target)?,
                 Method::Newton => {
                     let s = ig::solve(target, &options(&self.settings, self.tracker.last()))?;
@@ -233,10 +267,13 @@ fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
         last_a: Some(s.a),
         last_a_spatial: None,
         spatial: false,
+        event: "",
     })?;
     Ok(WithShape {
         solution: *s,
         shape: rod.shape(samples),
+        event: "",
+        critical: None,
     })
 }
 
@@ -248,9 +285,12 @@ fn with_shape_3d(s: &Solution3d, samples: usize) -> Result<Solved3d, Failed> {
         last_a: Some(planar_part(&s.a)),
         last_a_spatial: Some(Box::new(s.a)),
         spatial: true,
+        event: "",
     })?;
     Ok(WithShape {
         solution: *s,
         shape,
+        event: "",
+        critical: None,
     })
 }
