@@ -229,6 +229,19 @@ fn followers_work_on_the_3d_model_and_report_bad_input() {
     bad.position.y = f64::NAN;
     let m = follower.follow(&bad);
     assert!(m.result.is_err() && follower.rod() == Some(s.a));
+    // A move that runs out of time loses the rod (its state is unknown), with the reason.
+    let mut follower =
+        BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), buckled_up())
+            .expect("held");
+    follower.set_options(SolveOptions {
+        deadline: std::time::Duration::from_nanos(1),
+        ..SolveOptions::default()
+    });
+    let m = follower.follow(&PlanarPose::new(0.7, 0.1, 0.2));
+    assert!(matches!(m.event, BranchEvent::Lost));
+    let f = m.result.expect_err("no time to move");
+    assert_eq!(f.termination(), rod_ig_core::solver::Termination::Deadline);
+    assert!(follower.rod().is_none());
     // An unstable rod cannot be held.
     let straight = PlanarParams::zeros();
     assert!(BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), straight).is_err());

@@ -372,6 +372,9 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         let mut eval = from.eval;
         let mut previous_step = f64::INFINITY;
         for _ in 0..=CORRECTOR_ITERATIONS {
+            if crate::ig::deadline::expired() {
+                return None;
+            }
             let (pe, oe) = self.model.pose_error(&eval.tip, goal);
             if pe <= tolerance && oe <= tolerance && a != from.a {
                 return eval.stability.stable.then_some(Held { a, eval });
