@@ -31,7 +31,7 @@ from nav_msgs.msg import Path as PathMsg  # noqa: E402
 from rcl_interfaces.msg import Log, Parameter, ParameterType, ParameterValue  # noqa: E402
 from rcl_interfaces.srv import GetParameters, SetParameters  # noqa: E402
 from rod_ig_msgs.msg import RodSolution  # noqa: E402
-from rod_ig_msgs.srv import SolveRod  # noqa: E402
+from rod_ig_msgs.srv import PlanRod, SolveRod  # noqa: E402
 from visualization_msgs.msg import Marker  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
@@ -180,6 +180,7 @@ class Client:
             self.node.create_subscription(Marker, f"{ns}/rod/marker", self._marker_cb, topic_qos())
             self.node.create_subscription(Log, "/rosout", self._log_cb, topic_qos(1000))
         self.solve_client = self.node.create_client(SolveRod, f"{ns}/rod/solve")
+        self.plan_client = self.node.create_client(PlanRod, f"{ns}/rod/plan")
         self.set_client = self.node.create_client(SetParameters, f"{node_fqn}/set_parameters")
         self.get_client = self.node.create_client(GetParameters, f"{node_fqn}/get_parameters")
         self.executor = SingleThreadedExecutor(context=self.context)
@@ -300,6 +301,12 @@ class Client:
         for k, v in fields.items():
             setattr(req, k, v)
         return self.call(self.solve_client, req, timeout)
+
+    def plan(self, timeout: float = 15.0, **fields):
+        req = PlanRod.Request()
+        for k, v in fields.items():
+            setattr(req, k, v)
+        return self.call(self.plan_client, req, timeout)
 
     def set_params(self, **values):
         """Sets parameters through /rod_ig_node/set_parameters; returns the results list."""

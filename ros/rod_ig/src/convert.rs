@@ -274,6 +274,41 @@ pub fn shape_to_marker<S: ShapeSample>(
     }
 }
 
+/// Several rods as one RViz LINE_LIST (`rod/plan_rods`): consecutive samples of each rod as
+/// segments, in metres.
+pub fn rods_to_marker(shapes: &[Vec<PlanarPose>], header: &Header, params: &Params) -> Marker {
+    let l = params.rod_length;
+    let points = shapes
+        .iter()
+        .flat_map(|shape| {
+            shape
+                .windows(2)
+                .flat_map(|w| [w[0].to_pose(l).position, w[1].to_pose(l).position])
+        })
+        .collect();
+    Marker {
+        header: header.clone(),
+        ns: "plan".into(),
+        id: 0,
+        marker_type: Marker::LINE_LIST,
+        action: Marker::ADD,
+        pose: Pose::default(),
+        scale: Vector3 {
+            x: 0.5 * params.marker_width,
+            y: 0.0,
+            z: 0.0,
+        },
+        color: ColorRgba {
+            r: 0.2,
+            g: 0.4,
+            b: 1.0,
+            a: 0.8,
+        },
+        points,
+        ..Marker::default()
+    }
+}
+
 /// Base wrench in physical units: force = (a4, a5)·EI/L², torque z = a3·EI/L.
 pub fn base_wrench(a: &[f64; 3], rod_length: f64, bending_stiffness: f64) -> Wrench {
     let ei = bending_stiffness;

@@ -210,6 +210,8 @@ impl Message for Marker {}
 impl Marker {
     /// `Marker.LINE_STRIP`.
     pub const LINE_STRIP: i32 = 4;
+    /// `Marker.LINE_LIST`.
+    pub const LINE_LIST: i32 = 5;
     /// `Marker.ADD`.
     pub const ADD: i32 = 0;
 }
@@ -282,6 +284,62 @@ pub struct SolveRodRequest {
 }
 impl Message for SolveRodRequest {}
 
+/// `geometry_msgs/msg/Point32`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Point32 {
+    /// x (m).
+    pub x: f32,
+    /// y (m).
+    pub y: f32,
+    /// z (m).
+    pub z: f32,
+}
+
+/// `geometry_msgs/msg/Polygon`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Polygon {
+    /// Vertices in order.
+    pub points: Vec<Point32>,
+}
+
+/// Request of `rod_ig_msgs/srv/PlanRod`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlanRodRequest {
+    /// Start from the rod the node holds now.
+    pub use_current: bool,
+    /// Otherwise this rod (normalised a3, a4, a5).
+    pub start: [f64; 3],
+    /// Goal pose of the tip gripper.
+    pub goal: PoseStamped,
+    /// Disc centres x (m).
+    pub disc_x: Vec<f64>,
+    /// Disc centres y (m).
+    pub disc_y: Vec<f64>,
+    /// Disc radii (m).
+    pub disc_radius: Vec<f64>,
+    /// Polygons (m).
+    pub polygons: Vec<Polygon>,
+    /// Budget (ms), 0 = default.
+    pub deadline_ms: f64,
+}
+impl Message for PlanRodRequest {}
+
+/// Response of `rod_ig_msgs/srv/PlanRod`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlanRodResponse {
+    /// A plan was found.
+    pub success: bool,
+    /// Why not.
+    pub reason: String,
+    /// Tip poses along the plan (m).
+    pub gripper_path: Path,
+    /// Rods, 3 numbers each.
+    pub rods: Vec<f64>,
+    /// Smallest stability margin along the plan.
+    pub min_margin: f64,
+}
+impl Message for PlanRodResponse {}
+
 /// Response of `rod_ig_msgs/srv/SolveRod`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SolveRodResponse {
@@ -353,6 +411,10 @@ pub mod type_names {
     /// `rod_ig_msgs/srv/SolveRod`.
     pub fn solve_rod() -> ServiceTypeName {
         ServiceTypeName::new("rod_ig_msgs", "SolveRod")
+    }
+    /// `rod_ig_msgs/srv/PlanRod`.
+    pub fn plan_rod() -> ServiceTypeName {
+        ServiceTypeName::new("rod_ig_msgs", "PlanRod")
     }
 }
 
@@ -431,6 +493,10 @@ mod tests {
         assert_eq!(srv.len(), 2, "SolveRod.srv: request --- response");
         check_matches_definition(&SolveRodRequest::default(), &srv[0], "SolveRod request");
         check_matches_definition(&SolveRodResponse::default(), &srv[1], "SolveRod response");
+        let plan = interface_fields(&read("srv/PlanRod.srv"));
+        assert_eq!(plan.len(), 2, "PlanRod.srv: request --- response");
+        check_matches_definition(&PlanRodRequest::default(), &plan[0], "PlanRod request");
+        check_matches_definition(&PlanRodResponse::default(), &plan[1], "PlanRod response");
         // The check itself catches a drift: a field renamed, dropped or retyped.
         let mut drifted = msg[0].clone();
         drifted[1].1 = "succeeded".into();

@@ -30,7 +30,8 @@ use tokio::sync::{mpsc, oneshot, watch};
 
 use crate::diagnostics::SolveStats;
 use crate::messages::{
-    type_names, Marker, Path, PoseStamped, RodSolution, SolveRodRequest, SolveRodResponse,
+    type_names, Marker, Path, PlanRodRequest, PlanRodResponse, PoseStamped, RodSolution,
+    SolveRodRequest, SolveRodResponse,
 };
 use crate::params::{Params, Startup};
 use crate::pipeline::{Outcome, Overrides, Processor};
@@ -208,13 +209,22 @@ struct Stats {
 const DIAGNOSTICS_PERIOD: std::time::Duration = std::time::Duration::from_secs(1);
 
 /// A service request on its way to the solver task, with the slot for the answer.
-type ServiceJob = (SolveRodRequest, oneshot::Sender<SolveRodResponse>);
+type ServiceJob = Job;
+
+/// A service request on its way to the solver thread, with the slot for its answer.
+enum Job {
+    /// `rod/solve`.
+    Solve(SolveRodRequest, oneshot::Sender<SolveRodResponse>),
+    /// `rod/plan`.
+    Plan(PlanRodRequest, oneshot::Sender<PlanRodResponse>),
+}
 
 /// The node's publishers.
 struct Outputs {
     path: Publisher<Path>,
     solution: Publisher<RodSolution>,
     marker: Publisher<Marker>,
+    plan_rods: Publisher<Marker>,
 }
 
 /// Creates the DDS context for `mw` (domain, loopback restriction).
@@ -239,6 +249,10 @@ pub mod names {
     pub const MARKER: &str = "rod/marker";
     /// The service (rod_ig_msgs/srv/SolveRod).
     pub const SOLVE: &str = "rod/solve";
+    /// The planning service (rod_ig_msgs/srv/PlanRod).
+    pub const PLAN: &str = "rod/plan";
+    /// The planned rods (visualization_msgs/Marker, LINE_LIST).
+    pub const PLAN_RODS: &str = "rod/plan_rods";
     /// Diagnostics out (diagnostic_msgs/DiagnosticArray): absolute, as diagnostic_updater's.
     pub const DIAGNOSTICS: &str = "/diagnostics";
 }
@@ -389,6 +403,8 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
     let solution_topic = topic(&mut node, names::SOLUTION, type_names::rod_solution())?;
     let marker_topic = topic(&mut node, names::MARKER, type_names::marker())?;
     let (solve_name, solve_full) = resolved_name(&identity, names::SOLVE)?;
+    let (plan_name, plan_full) = resolved_name(&identity, names::PLAN)?;
+    let plan_rods_topic = topic(&mut node, names::PLAN_RODS, type_names::marker())?;
     let diagnostics_topic = topic(
         &mut node,
         names::DIAGNOSTICS,
@@ -408,6 +424,9 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         marker: node
             .create_publisher(&marker_topic, Some(out_qos.clone()))
             .map_err(create_err("/rod/marker publisher"))?,
+        plan_rods: node
+            .create_publisher(&plan_rods_topic, Some(out_qos.clone()))
+            .map_err(create_err("/rod/plan_rods publisher"))?,
     };
 
     let spinner = node.spinner().map_err(create_err("spinner"))?;
@@ -464,6 +483,15 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
             qos.clone(),
         )
         .map_err(create_err("/rod/solve service"))?;
+    let plan_server = node
+        .create_server::<PlanRodRequest, PlanRodResponse>(
+            ServiceMapping::Enhanced,
+            &plan_name,
+            &type_names::plan_rod(),
+            qos.clone(),
+            qos.clone(),
+        )
+        .map_err(create_err("/rod/plan service"))?;
 
     // Subscriber task: overwrite the single slot with the newest target.
     let sub_log = Logger {
@@ -491,17 +519,35 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
     let srv_log = Logger {
         handle: node.logging_handle(),
     };
+    let plan_log = Logger {
+        handle: node.logging_handle(),
+    };
+    let plan_clock = Arc::clone(&node);
+    let plan_task = tokio::spawn(serve_requests(
+        plan_server,
+        job_tx.clone(),
+        Arc::clone(&stats),
+        plan_log,
+        move |request: &mut PlanRodRequest| {
+            stamp_if_zero(&mut request.goal, || ros_now(&plan_clock))
+        },
+        Job::Plan,
+    ));
+    let solve_clock = Arc::clone(&node);
     let service_task = tokio::spawn(serve_requests(
         server,
         job_tx,
         Arc::clone(&stats),
         srv_log,
-        Arc::clone(&node),
+        move |request: &mut SolveRodRequest| {
+            stamp_if_zero(&mut request.target, || ros_now(&solve_clock))
+        },
+        Job::Solve,
     ));
 
     logger.info(&format!(
         "{} ready: domain {}{}, rod_length {} m, path_samples {}, method {}{}; \
-         subscribed {}, publishing {} {} {}, service {solve_full}",
+         subscribed {}, publishing {} {} {}, services {solve_full} {plan_full}",
         identity.fully_qualified_name(),
         mw.domain_id,
         if mw.localhost_only {
@@ -531,7 +577,7 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         stats.failed.load(Ordering::Relaxed),
         stats.service_calls.load(Ordering::Relaxed),
     ));
-    for task in [subscriber_task, service_task, diagnostics_task] {
+    for task in [subscriber_task, service_task, plan_task, diagnostics_task] {
         task.abort();
         // Awaited so that the tasks' clones of the node are dropped before the node.
         let _ = task.await;
@@ -613,33 +659,37 @@ async fn report_diagnostics(
     }
 }
 
-/// The service task: each `/rod/solve` request goes to the solver thread, its answer back to
-/// the caller.
-async fn serve_requests(
-    server: ros2_client::Server<SolveRodRequest, SolveRodResponse>,
+/// A service task: each request (stamped by `prepare` when unstamped) goes to the solver
+/// thread as the job `wrap` makes of it, its answer back to the caller.
+async fn serve_requests<Req, Resp>(
+    server: ros2_client::Server<Req, Resp>,
     job_tx: mpsc::Sender<ServiceJob>,
     stats: Arc<Stats>,
     log: Logger,
-    clock_node: Arc<ros2_client::Node>,
-) {
+    prepare: impl Fn(&mut Req),
+    wrap: fn(Req, oneshot::Sender<Resp>) -> Job,
+) where
+    Req: ros2_client::Message + 'static,
+    Resp: ros2_client::Message + 'static,
+{
     let mut stream = pin!(server.receive_request_stream());
     while let Some(item) = stream.next().await {
         let (id, mut request) = match item {
             Ok(r) => r,
             Err(e) => {
-                log.warn(&format!("/rod/solve: dropped a bad request: {e:?}"));
+                log.warn(&format!("service: dropped a bad request: {e:?}"));
                 continue;
             }
         };
         stats.service_calls.fetch_add(1, Ordering::Relaxed);
-        stamp_if_zero(&mut request.target, || ros_now(&clock_node));
+        prepare(&mut request);
         let (reply_tx, reply_rx) = oneshot::channel();
-        if job_tx.send((request, reply_tx)).await.is_err() {
+        if job_tx.send(wrap(request, reply_tx)).await.is_err() {
             break; // solver task gone: shutting down
         }
         let Ok(response) = reply_rx.await else { break };
         if let Err(e) = server.async_send_response(id, response).await {
-            log.warn(&format!("/rod/solve: cannot send the response: {e:?}"));
+            log.warn(&format!("service: cannot send the response: {e:?}"));
         }
     }
 }
@@ -674,8 +724,32 @@ async fn solver_loop(
         tokio::select! {
             biased;
             job = job_rx.recv() => {
-                let Some((request, reply)) = job else { break };
+                let Some(job) = job else { break };
                 let params = params_rx.borrow_and_update().clone();
+                let (request, reply) = match job {
+                    Job::Solve(request, reply) => (request, reply),
+                    Job::Plan(request, reply) => {
+                        let started = std::time::Instant::now();
+                        let planned = processor.plan(&request, &params);
+                        let r = &planned.response;
+                        if r.success {
+                            log::debug!(
+                                "/rod/plan: {} rods in {:?}",
+                                r.rods.len() / 3,
+                                started.elapsed()
+                            );
+                        } else {
+                            log.warn(&format!("/rod/plan: no plan: {}", r.reason));
+                        }
+                        if let Some(marker) = planned.marker {
+                            if let Err(e) = outputs.plan_rods.publish(marker) {
+                                log.error(&format!("cannot publish /rod/plan_rods: {e:?}"));
+                            }
+                        }
+                        let _ = reply.send(planned.response); // the caller may have gone
+                        continue;
+                    }
+                };
                 let response = match Overrides::from_request(&request) {
                     Ok(overrides) => {
                         let started = std::time::Instant::now();

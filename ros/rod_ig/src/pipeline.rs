@@ -8,7 +8,10 @@ use crate::convert::{
     failure_message, output_header, shape_to_marker, shape_to_path, solution_message,
     solution_message_3d, target_to_planar, target_to_spatial, ShapeSample,
 };
-use crate::messages::{Header, Marker, Path, PoseStamped, RodSolution, SolveRodRequest};
+use crate::messages::{
+    Header, Marker, Path, PlanRodRequest, PlanRodResponse, PoseStamped, RodSolution,
+    SolveRodRequest,
+};
 use crate::params::{Method, Params};
 use crate::solver::{spatial_of_planar, Failed, PlanarParams, RodSolver, SolverSettings};
 
@@ -130,9 +133,25 @@ pub fn settings_of(params: &Params) -> SolverSettings {
     }
 }
 
-/// Turns targets into solutions, warm-starting each solve from the previous solution.
+/// Turns targets into solutions, warm-starting each solve from the previous solution, and
+/// plans stable gripper paths (`rod/plan`).
 pub struct Processor {
     solver: RodSolver,
+    /// The roadmap planner, reused across `rod/plan` calls.
+    planner: rod_ig_core::plan::Planner,
+}
+
+/// Most rods drawn on `rod/plan_rods` (every k-th rod of a longer plan, and the last).
+const PLAN_RODS_DRAWN: usize = 25;
+/// Samples per rod drawn on `rod/plan_rods`.
+const PLAN_ROD_SAMPLES: usize = 30;
+
+/// A planned motion answered on `rod/plan`, and its rods drawn for RViz.
+pub struct Planned {
+    /// The service answer.
+    pub response: PlanRodResponse,
+    /// The planned rods as a LINE_LIST, on success.
+    pub marker: Option<Marker>,
 }
 
 impl Processor {
@@ -140,6 +159,7 @@ impl Processor {
     pub fn new(params: &Params) -> Self {
         Self {
             solver: RodSolver::new(settings_of(params)),
+            planner: rod_ig_core::plan::Planner::new(),
         }
     }
 
@@ -212,6 +232,113 @@ impl Processor {
                 })
             }
             Err(e) => rejected(e.to_string()),
+        }
+    }
+
+    /// Plans a stable gripper path (`rod/plan`): metres and the base frame in, the core
+    /// planner in normalised units, metres out.
+    pub fn plan(&mut self, request: &PlanRodRequest, params: &Params) -> Planned {
+        use rod_ig_core::plan::{Obstacle, PlanRequest, DEFAULT_PLAN_DEADLINE};
+        let header = output_header(&request.goal.header, params);
+        let l = params.rod_length;
+        let fail = |reason: String| Planned {
+            response: PlanRodResponse {
+                success: false,
+                reason,
+                gripper_path: Path {
+                    header: header.clone(),
+                    poses: Vec::new(),
+                },
+                rods: Vec::new(),
+                min_margin: f64::NAN,
+            },
+            marker: None,
+        };
+        let start = if request.use_current {
+            match self.solver.current_rod() {
+                Some(a) => a,
+                None => {
+                    return fail(
+                        "no current rod: send a target on rod/target first, or give start".into(),
+                    )
+                }
+            }
+        } else {
+            PlanarParams::from(request.start)
+        };
+        let goal = match target_to_planar(&request.goal.pose, params) {
+            Ok(g) => g,
+            Err(e) => return fail(format!("goal: {e}")),
+        };
+        let n = request.disc_x.len();
+        if request.disc_y.len() != n || request.disc_radius.len() != n {
+            return fail("disc_x, disc_y and disc_radius must have the same length".into());
+        }
+        let mut obstacles: Vec<Obstacle> = (0..n)
+            .map(|i| Obstacle::Disc {
+                center: [request.disc_x[i] / l, request.disc_y[i] / l],
+                radius: request.disc_radius[i] / l,
+            })
+            .collect();
+        obstacles.extend(request.polygons.iter().map(|p| {
+            Obstacle::Polygon {
+                points: p
+                    .points
+                    .iter()
+                    .map(|q| [f64::from(q.x) / l, f64::from(q.y) / l])
+                    .collect(),
+            }
+        }));
+        let deadline = if request.deadline_ms == 0.0 {
+            DEFAULT_PLAN_DEADLINE
+        } else if request.deadline_ms.is_finite()
+            && request.deadline_ms > 0.0
+            && request.deadline_ms <= 1e4
+        {
+            std::time::Duration::from_secs_f64(request.deadline_ms / 1e3)
+        } else {
+            return fail(format!(
+                "deadline_ms must be in (0, 10000] (0 = 500), got {}",
+                request.deadline_ms
+            ));
+        };
+        let query = PlanRequest {
+            start,
+            goal,
+            obstacles,
+            deadline,
+        };
+        let plan = match self.planner.plan(&query) {
+            Ok(p) => p,
+            Err(e) => return fail(e.to_string()),
+        };
+        let poses = plan
+            .gripper
+            .iter()
+            .map(|q| crate::messages::PoseStamped {
+                header: header.clone(),
+                pose: crate::convert::planar_to_pose(q, l),
+            })
+            .collect();
+        let stride = plan.rods.len().div_ceil(PLAN_RODS_DRAWN).max(1);
+        let mut drawn: Vec<&PlanarParams> = plan.rods.iter().step_by(stride).collect();
+        if let Some(last) = plan.rods.last() {
+            drawn.push(last);
+        }
+        let shapes: Vec<Vec<rod_ig_core::PlanarPose>> = drawn
+            .iter()
+            .filter_map(|a| rod_ig_core::planar::PlanarRod::new(a).ok())
+            .map(|r| r.shape(PLAN_ROD_SAMPLES))
+            .collect();
+        Planned {
+            marker: Some(crate::convert::rods_to_marker(&shapes, &header, params)),
+            response: PlanRodResponse {
+                success: true,
+                reason: String::new(),
+                gripper_path: Path { header, poses },
+                rods: plan.rods.iter().flat_map(|a| [a[0], a[1], a[2]]).collect(),
+                min_margin: plan.min_margin,
+            },
         }
     }
 

@@ -167,6 +167,11 @@ impl RodSolver {
         let _ = ig::warm_up();
     }
 
+    /// The planar rod held now: the branch follower's, else the last warm start.
+    pub fn current_rod(&self) -> Option<PlanarParams> {
+        self.follower.rod().or_else(|| self.tracker.last())
+    }
+
     /// Current settings.
     pub fn settings(&self) -> SolverSettings {
         self.settings
