@@ -1,7 +1,7 @@
 //! Benchmark figures of the 3-D inverse geometry on random stable rods. No I/O.
 
 use rod_ig_core::rng::SplitMix64;
-use rod_ig_core::solver::{self, IgError, SolveOptions, Spatial};
+use rod_ig_core::solver::{self, observe, Counters, IgError, SolveOptions, Spatial};
 use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
 
 /// Half-widths of the random-target box: |a1..3| ≤ 5, |a4..6| ≤ 30 (FINDINGS3D: ≈ 70 % stable,
@@ -55,6 +55,8 @@ pub struct BenchmarkReport3d {
     pub restarts_used: usize,
     /// Failure reasons (Display strings) with counts.
     pub failures: Vec<(String, usize)>,
+    /// Starts per solve and deadline hits, counted by the solver's observer.
+    pub work: Counters,
 }
 
 /// Runs the robust solver (default options) on `n` random stable targets ([`random_targets`])
@@ -70,9 +72,11 @@ pub fn benchmark_random_targets(n: usize, seed: u64) -> BenchmarkReport3d {
     let mut evals = 0u64;
     let mut restarts = 0;
     let mut failures: Vec<(String, usize)> = Vec::new();
+    let mut work = Counters::default();
     for (_, target) in &targets {
         let t0 = std::time::Instant::now();
-        let r = solver::solve(&model, target, &opts);
+        let (r, w) = observe(work, || solver::solve(&model, target, &opts));
+        work = w;
         times.push(t0.elapsed().as_secs_f64() * 1e6);
         match r {
             Ok(sol) if sol.stable => {
@@ -134,5 +138,6 @@ pub fn benchmark_random_targets(n: usize, seed: u64) -> BenchmarkReport3d {
         },
         restarts_used: restarts,
         failures: merged,
+        work,
     }
 }

@@ -301,6 +301,13 @@ pub fn spatial(quick: bool) {
         r.mean_iterations,
         r.mean_evaluations
     );
+    let solves = r.work.solves.max(1) as f64;
+    println!(
+        "    solver observer: {:.2} starts per solve (at most {}), {} deadline hits",
+        r.work.starts as f64 / solves,
+        r.work.max_starts_per_solve,
+        r.work.deadlines
+    );
     for (why, count) in &r.failures {
         println!("    failed ×{count}: {why}");
     }

@@ -481,4 +481,7 @@ fn ig_benchmark_report() {
     println!("{r:?}");
     assert_eq!(r.targets, 30);
     assert!(r.success_rate >= 0.9 && r.median_us > 0.0);
+    // The observer saw every solve and at least one start each.
+    assert_eq!(r.work.solves, 30);
+    assert!(r.work.starts >= 30);
 }

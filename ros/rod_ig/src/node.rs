@@ -360,6 +360,38 @@ fn spawn_solver_thread(
     Ok((thread, warm_rx))
 }
 
+/// The start-up line: identity, domain, the main parameters and every resolved name.
+fn ready_message(
+    identity: &NodeIdentity,
+    mw: &MiddlewareConfig,
+    params: &Params,
+    topics: &[String],
+    services: &[&str],
+) -> String {
+    format!(
+        "{} ready: domain {}{}, rod_length {} m, path_samples {}, method {}{}; \
+         subscribed {}, publishing {}, services {}",
+        identity.fully_qualified_name(),
+        mw.domain_id,
+        if mw.localhost_only {
+            " (loopback only)"
+        } else {
+            ""
+        },
+        params.rod_length,
+        params.path_samples,
+        params.method.as_str(),
+        if params.use_sim_time {
+            ", sim time (/clock)"
+        } else {
+            ""
+        },
+        topics.first().map_or("", String::as_str),
+        topics.get(1..).map_or(String::new(), |t| t.join(" ")),
+        services.join(" "),
+    )
+}
+
 /// Runs the node until SIGINT or SIGTERM.
 pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError> {
     let Startup {
@@ -545,28 +577,12 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         Job::Solve,
     ));
 
-    logger.info(&format!(
-        "{} ready: domain {}{}, rod_length {} m, path_samples {}, method {}{}; \
-         subscribed {}, publishing {} {} {}, services {solve_full} {plan_full}",
-        identity.fully_qualified_name(),
-        mw.domain_id,
-        if mw.localhost_only {
-            " (loopback only)"
-        } else {
-            ""
-        },
-        params.rod_length,
-        params.path_samples,
-        params.method.as_str(),
-        if params.use_sim_time {
-            ", sim time (/clock)"
-        } else {
-            ""
-        },
-        resolved[0],
-        resolved[1],
-        resolved[2],
-        resolved[3],
+    logger.info(&ready_message(
+        &identity,
+        &mw,
+        &params,
+        &resolved,
+        &[&solve_full, &plan_full],
     ));
 
     let signal = wait_for_signal().await;
