@@ -344,3 +344,20 @@ class Client:
         self.node.destroy_node()
         self.context.try_shutdown()
         self._thread.join(timeout=2.0)
+
+
+def start_node_and_client(args: list[str] | None = None, name: str = "rod_ig_test_client"):
+    """A fresh rod_ig_node on a free domain (with `args`) and a connected client."""
+    domain = free_domain()
+    node = NodeProcess(domain, args=args or [])
+    client = Client(domain, name=name)
+    assert client.wait_connected(), f"no connection to rod_ig_node; log:\n{node.log_text()}"
+    return node, client
+
+
+def stop_node_and_client(node: "NodeProcess", client: "Client"):
+    """Closes the client, stops the node and checks it exited cleanly."""
+    client.close()
+    code = node.stop()
+    assert code == 0, f"rod_ig_node exit code {code}; log:\n{node.log_text()[-3000:]}"
+

@@ -7,17 +7,11 @@ import rodig_harness as h
 
 
 def start(args=None):
-    domain = h.free_domain()
-    node = h.NodeProcess(domain, args=args or [])
-    client = h.Client(domain, name="rod_ig_motion_client")
-    assert client.wait_connected(), f"no connection to rod_ig_node; log:\n{node.log_text()}"
-    return node, client
+    return h.start_node_and_client(args, name="rod_ig_motion_client")
 
 
 def stop(node, client):
-    client.close()
-    code = node.stop()
-    assert code == 0, f"rod_ig_node exit code {code}; log:\n{node.log_text()[-3000:]}"
+    h.stop_node_and_client(node, client)
 
 
 def turn(c, yaws):

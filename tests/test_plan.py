@@ -11,19 +11,14 @@ import rodig_harness as h
 
 
 def start():
-    domain = h.free_domain()
-    node = h.NodeProcess(domain)
-    client = h.Client(domain, name="rod_ig_plan_client")
-    assert client.wait_connected(), f"no connection to rod_ig_node; log:\n{node.log_text()}"
+    node, client = h.start_node_and_client(name="rod_ig_plan_client")
     rods = []
     client.node.create_subscription(Marker, "/rod/plan_rods", rods.append, h.topic_qos())
     return node, client, rods
 
 
 def stop(node, client):
-    client.close()
-    code = node.stop()
-    assert code == 0, f"rod_ig_node exit code {code}; log:\n{node.log_text()[-3000:]}"
+    h.stop_node_and_client(node, client)
 
 
 def goal(c, x, y, yaw):

@@ -21,18 +21,12 @@ def tilted_quaternion():
 TARGET = dict(x=0.6, y=0.2, z=0.2, yaw=0.0, q=tilted_quaternion())
 
 
-def start(args):
-    domain = h.free_domain()
-    node = h.NodeProcess(domain, args=args)
-    client = h.Client(domain, name="rod_ig_spatial_client")
-    assert client.wait_connected(), f"no connection to rod_ig_node; log:\n{node.log_text()}"
-    return node, client
+def start(args=None):
+    return h.start_node_and_client(args, name="rod_ig_spatial_client")
 
 
 def stop(node, client):
-    client.close()
-    code = node.stop()
-    assert code == 0, f"rod_ig_node exit code {code}; log:\n{node.log_text()[-3000:]}"
+    h.stop_node_and_client(node, client)
 
 
 @pytest.fixture(scope="module")

@@ -26,25 +26,8 @@ pub fn draw(rods: &[DrawnRod], title: &str) -> String {
     let scale = (size - 2.0 * margin) / 2.2;
     let px = |x: f64| margin + (x + 1.1) * scale;
     let py = |y: f64| margin + (1.1 - y) * scale;
-    let mut s = String::new();
     let h = size + 30.0 + 18.0 * rods.len() as f64;
-    let _ = write!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{h}" viewBox="0 0 {size} {h}" font-family="sans-serif" font-size="13">"#
-    );
-    let _ = write!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    let _ = write!(
-        s,
-        r#"<text x="{margin}" y="24" font-size="15">{}</text>"#,
-        escape(title)
-    );
-    let _ = write!(
-        s,
-        r##"<circle cx="{}" cy="{}" r="{}" fill="#f4f4f4" stroke="#bbb" stroke-dasharray="4 4"/>"##,
-        px(0.0),
-        py(0.0),
-        scale
-    );
+    let mut s = open(size, h, margin, title, (px(0.0), py(0.0), scale));
     let _ = write!(
         s,
         r##"<line x1="{}" y1="{}" x2="{}" y2="{}" stroke="#999"/><line x1="{}" y1="{}" x2="{}" y2="{}" stroke="#999"/>"##,
@@ -163,24 +146,7 @@ pub fn draw_sequence(rods: &[SequenceRod], obstacles: &[Obstacle], title: &str) 
     let px = |x: f64| margin + (x + 1.1) * scale;
     let py = |y: f64| margin + (1.1 - y) * scale;
     let h = size + 30.0;
-    let mut s = String::new();
-    let _ = write!(
-        s,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{h}" viewBox="0 0 {size} {h}" font-family="sans-serif" font-size="13">"#
-    );
-    let _ = write!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    let _ = write!(
-        s,
-        r#"<text x="{margin}" y="24" font-size="15">{}</text>"#,
-        escape(title)
-    );
-    let _ = write!(
-        s,
-        r##"<circle cx="{}" cy="{}" r="{}" fill="#f4f4f4" stroke="#bbb" stroke-dasharray="4 4"/>"##,
-        px(0.0),
-        py(0.0),
-        scale
-    );
+    let mut s = open(size, h, margin, title, (px(0.0), py(0.0), scale));
     for o in obstacles {
         match o {
             Obstacle::Disc(c, r) => {
@@ -245,6 +211,28 @@ pub fn draw_sequence(rods: &[SequenceRod], obstacles: &[Obstacle], title: &str) 
         escape(legend)
     );
     s.push_str("</svg>\n");
+    s
+}
+
+/// The picture's opening: canvas, white background, title and the reachable disc ‖(x, y)‖ ≤ 1
+/// of the unit rod (`disc`: centre in pixels and radius).
+fn open(size: f64, h: f64, margin: f64, title: &str, disc: (f64, f64, f64)) -> String {
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{size}" height="{h}" viewBox="0 0 {size} {h}" font-family="sans-serif" font-size="13">"#
+    );
+    let _ = write!(s, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    let _ = write!(
+        s,
+        r#"<text x="{margin}" y="24" font-size="15">{}</text>"#,
+        escape(title)
+    );
+    let (cx, cy, r) = disc;
+    let _ = write!(
+        s,
+        r##"<circle cx="{cx}" cy="{cy}" r="{r}" fill="#f4f4f4" stroke="#bbb" stroke-dasharray="4 4"/>"##
+    );
     s
 }
 

@@ -6,10 +6,16 @@ use std::io::Write;
 use std::process::{Command, Stdio};
 
 fn run(args: &[&str], stdin: &str) -> Vec<Value> {
+    run_with_stderr(args, stdin).0
+}
+
+/// Runs `rod-ig args` on `stdin`: its JSON output lines and its stderr.
+fn run_with_stderr(args: &[&str], stdin: &str) -> (Vec<Value>, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
         .args(args)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
         .spawn()
         .expect("rod-ig starts");
     child
@@ -20,11 +26,12 @@ fn run(args: &[&str], stdin: &str) -> Vec<Value> {
         .expect("write stdin");
     let out = child.wait_with_output().expect("rod-ig exits");
     assert!(out.status.success(), "exit status {:?}", out.status);
-    String::from_utf8(out.stdout)
+    let lines = String::from_utf8(out.stdout)
         .expect("UTF-8 output")
         .lines()
         .map(|l| serde_json::from_str(l).expect("each output line is JSON"))
-        .collect()
+        .collect();
+    (lines, String::from_utf8(out.stderr).expect("UTF-8 stderr"))
 }
 
 #[test]
@@ -297,24 +304,12 @@ fn solve3d_has_every_option_of_solve() {
 
 #[test]
 fn verbose_prints_the_solver_events_on_stderr() {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
-        .args(["solve", "--verbose"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("rod-ig starts");
-    child
-        .stdin
-        .take()
-        .expect("stdin")
-        .write_all(b"{\"target\": {\"x\": 0.5, \"y\": 0.3, \"theta\": 0.8}}\n")
-        .expect("write stdin");
-    let out = child.wait_with_output().expect("rod-ig exits");
-    assert!(out.status.success());
-    let answer: Value = serde_json::from_slice(&out.stdout).expect("one JSON answer");
-    let events: Vec<Value> = String::from_utf8(out.stderr)
-        .expect("UTF-8")
+    let (out, stderr) = run_with_stderr(
+        &["solve", "--verbose"],
+        "{\"target\": {\"x\": 0.5, \"y\": 0.3, \"theta\": 0.8}}\n",
+    );
+    let answer = &out[0];
+    let events: Vec<Value> = stderr
         .lines()
         .map(|l| serde_json::from_str(l).expect("each event is JSON"))
         .collect();

@@ -175,6 +175,41 @@ fn planar_pose_error(tip: &PlanarPose, target: &PlanarPose) -> (f64, f64) {
     (f[0].hypot(f[1]), f[2].abs())
 }
 
+/// The pose geometry every planar model shares (the tip pose (x, y, θ), the residual of paper
+/// §3.1 with the angle wrapped): the same methods in each planar model's `RodModel` impl.
+macro_rules! planar_geometry {
+    () => {
+        fn param_scale(&self) -> Vector3<f64> {
+            Vector3::from(PLANAR_SCALE)
+        }
+
+        fn pose_error(&self, tip: &PlanarPose, target: &PlanarPose) -> (f64, f64) {
+            planar_pose_error(tip, target)
+        }
+
+        fn newton_increment(
+            &self,
+            tip: &PlanarPose,
+            jacobian: &SMatrix<f64, 3, 3>,
+            target: &PlanarPose,
+        ) -> Result<Vector3<f64>, f64> {
+            planar_increment(jacobian, &planar_error(tip, target))
+        }
+
+        fn check_target(&self, target: &PlanarPose) -> Result<(), IgError> {
+            planar_check_target(target)
+        }
+
+        fn interpolate(&self, from: &PlanarPose, to: &PlanarPose, s: f64) -> PlanarPose {
+            planar_interpolate(from, to, s)
+        }
+
+        fn jacobian_det(&self, jacobian: &SMatrix<f64, 3, 3>) -> f64 {
+            jacobian.determinant()
+        }
+    };
+}
+
 impl RodModel<3> for PlanarClosedForm {
     type Pose = PlanarPose;
 
@@ -213,34 +248,7 @@ impl RodModel<3> for PlanarClosedForm {
         crate::planar::energy(a)
     }
 
-    fn param_scale(&self) -> Vector3<f64> {
-        Vector3::from(PLANAR_SCALE)
-    }
-
-    fn pose_error(&self, tip: &PlanarPose, target: &PlanarPose) -> (f64, f64) {
-        planar_pose_error(tip, target)
-    }
-
-    fn newton_increment(
-        &self,
-        tip: &PlanarPose,
-        jacobian: &SMatrix<f64, 3, 3>,
-        target: &PlanarPose,
-    ) -> Result<Vector3<f64>, f64> {
-        planar_increment(jacobian, &planar_error(tip, target))
-    }
-
-    fn check_target(&self, target: &PlanarPose) -> Result<(), IgError> {
-        planar_check_target(target)
-    }
-
-    fn interpolate(&self, from: &PlanarPose, to: &PlanarPose, s: f64) -> PlanarPose {
-        planar_interpolate(from, to, s)
-    }
-
-    fn jacobian_det(&self, jacobian: &SMatrix<f64, 3, 3>) -> f64 {
-        jacobian.determinant()
-    }
+    planar_geometry!();
 }
 
 impl RodModel<3> for PlanarReference {
@@ -266,34 +274,7 @@ impl RodModel<3> for PlanarReference {
         })
     }
 
-    fn param_scale(&self) -> Vector3<f64> {
-        Vector3::from(PLANAR_SCALE)
-    }
-
-    fn pose_error(&self, tip: &PlanarPose, target: &PlanarPose) -> (f64, f64) {
-        planar_pose_error(tip, target)
-    }
-
-    fn newton_increment(
-        &self,
-        tip: &PlanarPose,
-        jacobian: &SMatrix<f64, 3, 3>,
-        target: &PlanarPose,
-    ) -> Result<Vector3<f64>, f64> {
-        planar_increment(jacobian, &planar_error(tip, target))
-    }
-
-    fn check_target(&self, target: &PlanarPose) -> Result<(), IgError> {
-        planar_check_target(target)
-    }
-
-    fn interpolate(&self, from: &PlanarPose, to: &PlanarPose, s: f64) -> PlanarPose {
-        planar_interpolate(from, to, s)
-    }
-
-    fn jacobian_det(&self, jacobian: &SMatrix<f64, 3, 3>) -> f64 {
-        jacobian.determinant()
-    }
+    planar_geometry!();
 
     fn check_settings(&self) -> Result<(), IgError> {
         if self.rtol.is_finite() && (1e-14..=1e-3).contains(&self.rtol) {
