@@ -229,6 +229,17 @@ fn followers_work_on_the_3d_model_and_report_bad_input() {
     bad.position.y = f64::NAN;
     let m = follower.follow(&bad);
     assert!(m.result.is_err() && follower.rod() == Some(s.a));
+    // The same gripper pose again (a client repeating its target, here the exact reached
+    // tip): nothing moves, no event.
+    let mut still =
+        BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), buckled_up())
+            .expect("held");
+    let here = still.gripper().expect("held");
+    for _ in 0..3 {
+        let m = still.follow(&here);
+        assert!(matches!(m.event, BranchEvent::None));
+        assert_eq!(m.result.expect("stays").a, buckled_up());
+    }
     // A move that runs out of time loses the rod (its state is unknown), with the reason.
     let mut follower =
         BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), buckled_up())

@@ -376,7 +376,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                 return None;
             }
             let (pe, oe) = self.model.pose_error(&eval.tip, goal);
-            if pe <= tolerance && oe <= tolerance && a != from.a {
+            if pe <= tolerance && oe <= tolerance {
                 return eval.stability.stable.then_some(Held { a, eval });
             }
             let d = self
