@@ -44,6 +44,8 @@ pub const MIN_MARGIN: f64 = 1e-3;
 pub const BODY_SAMPLES: usize = 48;
 /// Default planning budget (`rod-ig plan`, the node's service).
 pub const DEFAULT_PLAN_DEADLINE: Duration = Duration::from_millis(500);
+/// Samples between two polls of the deadline along an edge (~1 ms of stability tests).
+const DEADLINE_POLL: usize = 32;
 /// Goal tolerance: the last rod's tip is within this of the goal pose.
 pub const GOAL_TOLERANCE: f64 = 1e-7;
 
@@ -95,8 +97,13 @@ pub enum PlanError {
     /// The start rod, the goal pose or an obstacle is not usable.
     #[error("invalid request: {0}")]
     Invalid(String),
-    /// The start rod is not stable with the required margin.
-    #[error("the start rod is not stable (margin {margin:e} < {MIN_MARGIN:e})")]
+    /// The start rod is not stable with the required margin (unstable, or stable but too
+    /// close to the stability boundary by the normalised margin, as strongly tensioned rods
+    /// are).
+    #[error(
+        "the start rod is not stable with a margin (normalised margin {margin:e} < \
+         {MIN_MARGIN:e}: unstable, or too close to the stability boundary)"
+    )]
     StartUnstable {
         /// Its margin.
         margin: f64,
@@ -489,7 +496,12 @@ impl<'p> Query<'p> {
         }
         let samples = edge_samples(&a, &b);
         let mut min_margin = f64::INFINITY;
-        for r in &samples {
+        for (i, r) in samples.iter().enumerate() {
+            // Long edges (a start far from the roadmap) hold thousands of samples: the
+            // deadline is polled, and an edge cut short is not cached as unstable.
+            if i % DEADLINE_POLL == 0 && self.expired() {
+                return None;
+            }
             let m = margin_of(r);
             min_margin = min_margin.min(m);
             if m < MIN_MARGIN {
