@@ -7,6 +7,7 @@
 //! functions stay next to them in `rod-ig-core/benches`.
 #![warn(missing_docs)]
 
+pub mod families;
 pub mod planar;
 pub mod spatial;
 

@@ -2,9 +2,9 @@
 //! forward map and of the robust solve on the uniform box next to log-scale samples of the
 //! regime a cable lives in (issue 9), with the ratio log-scale / box.
 
-use rod_ig_bench::SplitMix64;
+use rod_ig_bench::families::samples;
 use rod_ig_core::ig::{self, SolveOptions};
-use rod_ig_core::{planar, PlanarParams, PlanarPose};
+use rod_ig_core::{planar, PlanarPose};
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -56,65 +56,6 @@ pub fn tails<T, R, E>(inputs: &[T], mut f: impl FnMut(&T) -> Result<R, E>) -> Ta
         max: us.last().copied().unwrap_or(0.0),
         errors,
     }
-}
-
-fn signed_pow10(rng: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
-    let v = 10f64.powf(rng.range(lo, hi));
-    if rng.range(0.0, 1.0) < 0.5 {
-        -v
-    } else {
-        v
-    }
-}
-
-/// The samples: the uniform box and issue 9's log-scale families.
-pub fn samples(n: usize) -> Vec<(&'static str, Vec<PlanarParams>)> {
-    let mut rng = SplitMix64::new(9);
-    let mut gen = |f: &mut dyn FnMut(&mut SplitMix64) -> PlanarParams| {
-        (0..n).map(|_| f(&mut rng)).collect::<Vec<_>>()
-    };
-    vec![
-        (
-            "uniform box",
-            gen(&mut |r| {
-                PlanarParams::new(
-                    r.range(-10.0, 10.0),
-                    r.range(-100.0, 100.0),
-                    r.range(-100.0, 100.0),
-                )
-            }),
-        ),
-        (
-            "log-scale",
-            gen(&mut |r| {
-                PlanarParams::new(
-                    signed_pow10(r, -8.0, 0.7),
-                    signed_pow10(r, -9.0, 1.5),
-                    signed_pow10(r, -9.0, 1.5),
-                )
-            }),
-        ),
-        (
-            "tiny (1e-60..1e-6)",
-            gen(&mut |r| {
-                PlanarParams::new(
-                    signed_pow10(r, -60.0, -6.0),
-                    signed_pow10(r, -60.0, -6.0),
-                    signed_pow10(r, -60.0, -6.0),
-                )
-            }),
-        ),
-        (
-            "strong force (|a4| 1e2..1e4)",
-            gen(&mut |r| {
-                PlanarParams::new(
-                    signed_pow10(r, -6.0, 0.0),
-                    signed_pow10(r, 2.0, 4.0),
-                    signed_pow10(r, -6.0, 0.0),
-                )
-            }),
-        ),
-    ]
 }
 
 fn print_row(what: &str, sample: &str, t: &Tails, box_mean: f64) {

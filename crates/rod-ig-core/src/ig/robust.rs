@@ -125,28 +125,39 @@ struct Starts<'t> {
     /// 0: short list not yet loaded; r ≥ 1: neighbourhood radius loaded.
     stage: usize,
     served: Vec<u32>,
-    /// Model-based starts ([`model_starts`]): served after the short list, and at the end.
-    model: Option<(Vec<PlanarParams>, Vec<PlanarParams>)>,
+    /// Model-based starts ([`model_starts`]): before the atlas, after the short list, and at
+    /// the end.
+    model: ModelStarts,
 }
 
 /// Most small-angle starts ([`straight`]) and strong-tension starts ([`fronts`]) per solve.
 const MODEL_STARTS: usize = 4;
 
-/// The model-based starts for `target`, each list in the order it is served by `pop`: first
-/// the small-angle starts with cheap f64 iterations and the strong-tension starts (double-double
-/// iterations, a few ms each, but only where the target fits the model); second, small-angle
-/// starts under strong tension, served after every atlas seed. Those come from targets so close
-/// to full extension that the small-angle model has roots up to a4 = 1e4; iterated precisely,
-/// they would spend the deadline that the atlas seeds after them need (seen: 5 % of log-scale
-/// targets near full extension lost to the deadline).
-fn model_starts(target: &PlanarPose) -> (Vec<PlanarParams>, Vec<PlanarParams>) {
-    let (mut late, mut early): (Vec<_>, Vec<_>) = straight::starts(target, MODEL_STARTS)
+/// The model-based starts for `target`, each list in the order it is served by `pop`:
+/// - `first`: small-angle starts ([`straight`]) with cheap f64 iterations, served before any
+///   atlas seed: near full extension the atlas (a grid over the paper's box) has few seeds in
+///   Newton's basin, and the model's start for a gently bent rod converges in a few steps;
+/// - `early`: strong-tension starts ([`fronts`]; double-double iterations, a few ms each, but
+///   only where the target fits the model), served after the target cell's short list;
+/// - `late`: small-angle starts under strong tension, served after every atlas seed. Those
+///   come from targets so close to full extension that the small-angle model has roots up to
+///   a4 = 1e4; iterated precisely, they would spend the deadline that the atlas seeds after
+///   them need (seen: 5 % of log-scale targets near full extension lost to the deadline).
+struct ModelStarts {
+    first: Vec<PlanarParams>,
+    early: Vec<PlanarParams>,
+    late: Vec<PlanarParams>,
+}
+
+fn model_starts(target: &PlanarPose) -> ModelStarts {
+    let (mut late, mut first): (Vec<_>, Vec<_>) = straight::starts(target, MODEL_STARTS)
         .into_iter()
         .partition(crate::planar::needs_precise_iterations);
-    early.extend(fronts::starts(target, MODEL_STARTS));
+    let mut early = fronts::starts(target, MODEL_STARTS);
+    first.reverse();
     early.reverse();
     late.reverse();
-    (early, late)
+    ModelStarts { first, early, late }
 }
 
 impl<'t> Starts<'t> {
@@ -187,7 +198,7 @@ impl<'t> Starts<'t> {
             pos: 0,
             stage: 0,
             served: Vec::new(),
-            model: None,
+            model: model_starts(target),
         };
         if guess.is_some() {
             let atlas = atlas::get();
@@ -219,6 +230,10 @@ impl<'t> Starts<'t> {
                 return Some(as_start(g));
             }
         }
+        let as_model_start = |a| Some((atlas::Start { a, predicted: None }, false));
+        if let Some(a) = self.model.first.pop() {
+            return as_model_start(a);
+        }
         let atlas = atlas::get();
         loop {
             while self.pos < self.buf.len() {
@@ -234,15 +249,12 @@ impl<'t> Starts<'t> {
             if let Some(g) = self.guess.take() {
                 return Some(as_start(g));
             }
-            let as_model_start = |a| Some((atlas::Start { a, predicted: None }, false));
             if self.stage >= 1 {
-                let target = self.target;
-                let (early, late) = self.model.get_or_insert_with(|| model_starts(target));
-                if let Some(a) = early.pop() {
+                if let Some(a) = self.model.early.pop() {
                     return as_model_start(a);
                 }
                 if self.stage >= 3 {
-                    return late.pop().and_then(as_model_start);
+                    return self.model.late.pop().and_then(as_model_start);
                 }
             }
             self.buf.clear();
@@ -357,12 +369,14 @@ pub(crate) fn solve_all(
     let mut idx = Vec::new();
     atlas.candidates(target, 1, &mut idx);
     list.extend(idx.iter().take(200).map(|&(_, k)| atlas.start(k, target)));
-    let (early, late) = model_starts(target);
+    let model = model_starts(target);
     list.extend(
-        early
+        model
+            .first
             .into_iter()
             .rev()
-            .chain(late.into_iter().rev())
+            .chain(model.early.into_iter().rev())
+            .chain(model.late.into_iter().rev())
             .map(|a| atlas::Start { a, predicted: None }),
     );
     let mut solutions: Vec<Solution> = Vec::new();

@@ -1,129 +1,223 @@
 //! Starts for targets near full extension (‖(x, y)‖ → 1), reachable only by nearly straight
-//! rods, often under strong tension near the separatrix λ4 = 0, where Υ is so anisotropic that
-//! atlas seeds rarely fall in Newton's basin.
+//! rods: gently bent ones with little force, and rods under strong tension near the separatrix
+//! λ4 = 0, where Υ is so anisotropic that atlas seeds rarely fall in Newton's basin.
 //!
 //! Small-angle model of the rod equation θ'' = κ' = a4 sin θ − a5 cos θ (FINDINGS §1) about the
-//! straight rod: θ'' = T θ − a5 with T = a4, θ(0) = 0, θ'(0) = a3. With c = a5/T and k = √|T|,
-//! - tension (T > 0): θ(t) = c (1 − cosh kt) + (a3/k) sinh kt,
-//! - compression (T < 0): θ(t) = c (1 − cos kt) + (a3/k) sin kt,
+//! straight rod: θ'' = T θ − a5 with T = a4, θ(0) = 0, θ'(0) = a3, solved by
 //!
-//! and y(1) ≈ ∫θ, x(1) ≈ 1 − ½∫θ². For each T, (c, a3) follow from (y, θ) of the target by a
-//! 2×2 linear solve; T is then chosen so that ½∫θ² matches the target's deficit 1 − x (a scan in
-//! log k and bisection). Each root gives a start a = (a3, T, c T) that Newton refines.
+//! θ(t) = a3 S(t) − a5 C(t),  S = sinh(kt)/k, C = (cosh(kt) − 1)/k² for T = k² ≥ 0
+//! (sin and 1 − cos for T = −k²),
+//!
+//! two entire functions of T (S = t, C = t²/2 at T = 0), so the model is continuous through
+//! the force-free rod. y(1) ≈ ∫θ and θ(1) are linear in (a3, a5): a 2×2 solve per T. The
+//! end-shortening 1 − x(1) ≈ ½∫θ² is a quadratic form in (a3, a5) whose coefficients depend on
+//! T only; T is chosen so that it matches the target's 1 − x (a scan over a fixed grid of T,
+//! whose coefficients are computed once, then regula falsi). Each root gives a start
+//! a = (a3, T, a5) that Newton refines.
 
 use crate::{wrap_angle, PlanarParams, PlanarPose};
+use std::sync::OnceLock;
 
-/// θ(t) of the small-angle model.
-#[inline]
-fn theta(t: f64, k: f64, tension: bool, c: f64, a3: f64) -> f64 {
-    let kt = k * t;
-    if tension {
-        c * (1.0 - kt.cosh()) + a3 / k * kt.sinh()
-    } else {
-        c * (1.0 - kt.cos()) + a3 / k * kt.sin()
-    }
+/// The T-dependent coefficients of the model: values at t = 1 and integrals over [0, 1].
+#[derive(Clone, Copy, Debug)]
+struct Basis {
+    t: f64,
+    s1: f64,
+    c1: f64,
+    int_s: f64,
+    int_c: f64,
+    int_ss: f64,
+    int_sc: f64,
+    int_cc: f64,
 }
 
-/// (c, a3) such that the model meets y(1) = y, θ(1) = th.
-fn coefficients(k: f64, tension: bool, y: f64, th: f64) -> Option<(f64, f64)> {
-    let (m11, m12, m21, m22) = if tension {
-        let (s, ch) = (k.sinh(), k.cosh());
-        (1.0 - s / k, (ch - 1.0) / (k * k), 1.0 - ch, s / k)
-    } else {
-        let (s, co) = (k.sin(), k.cos());
-        (1.0 - s / k, (1.0 - co) / (k * k), 1.0 - co, s / k)
-    };
-    let det = m11 * m22 - m12 * m21;
-    if !(det.is_finite() && det.abs() > 1e-300) {
-        return None;
-    }
-    let c = (y * m22 - m12 * th) / det;
-    let a3 = (m11 * th - m21 * y) / det;
-    (c.is_finite() && a3.is_finite()).then_some((c, a3))
+/// Terms of the power series in T of the coefficients (|T| ≤ [`SERIES_BELOW`]: the n-th term
+/// is below 4ⁿ/(2n)!, < 1e-17 of the first beyond n = 16).
+const SERIES_TERMS: usize = 18;
+
+/// Below this |T| the coefficients come from their power series in T; above it from their
+/// closed forms in sinh/cosh or sin/cos, whose cancellation costs at most ~1.5 digits at k = 2.
+const SERIES_BELOW: f64 = 4.0;
+
+/// Power-series coefficients (in T) of [S1, C1, ∫S, ∫C, ∫S², ∫SC, ∫C²]. With
+/// S(t) = Σ Tⁿ t^{2n+1}/(2n+1)! and C(t) = Σ Tⁿ t^{2n+2}/(2n+2)!, a product of two terms
+/// Tⁿ t^p and Tᵐ t^q integrates to T^{n+m}/(p + q + 1).
+fn series() -> &'static [[f64; SERIES_TERMS]; 7] {
+    static SERIES: OnceLock<[[f64; SERIES_TERMS]; 7]> = OnceLock::new();
+    SERIES.get_or_init(|| {
+        let mut fact = [1.0f64; 2 * SERIES_TERMS + 4];
+        for i in 1..fact.len() {
+            fact[i] = fact[i - 1] * i as f64;
+        }
+        let mut c = [[0.0; SERIES_TERMS]; 7];
+        for n in 0..SERIES_TERMS {
+            c[0][n] = 1.0 / fact[2 * n + 1];
+            c[1][n] = 1.0 / fact[2 * n + 2];
+            c[2][n] = 1.0 / fact[2 * n + 2];
+            c[3][n] = 1.0 / fact[2 * n + 3];
+            for i in 0..=n {
+                let j = n - i;
+                c[4][n] += 1.0 / (fact[2 * i + 1] * fact[2 * j + 1]) / (2 * n + 3) as f64;
+                c[5][n] += 1.0 / (fact[2 * i + 1] * fact[2 * j + 2]) / (2 * n + 4) as f64;
+                c[6][n] += 1.0 / (fact[2 * i + 2] * fact[2 * j + 2]) / (2 * n + 5) as f64;
+            }
+        }
+        c
+    })
 }
 
-/// ½∫₀¹θ² by composite Simpson (resolves boundary layers of width 1/k for k ≤ 100).
-fn half_energy(k: f64, tension: bool, c: f64, a3: f64) -> f64 {
-    const N: usize = 256;
-    let h = 1.0 / N as f64;
-    let mut s = 0.0;
-    for i in 0..=N {
-        let th = theta(i as f64 * h, k, tension, c, a3);
-        let w = if i == 0 || i == N {
-            1.0
-        } else if i % 2 == 1 {
-            4.0
+impl Basis {
+    /// The coefficients at T = `t` (series or closed form).
+    fn at(t: f64) -> Basis {
+        if t.abs() <= SERIES_BELOW {
+            let v = series().map(|c| c.iter().rev().fold(0.0, |acc, &cn| acc * t + cn));
+            return Basis {
+                t,
+                s1: v[0],
+                c1: v[1],
+                int_s: v[2],
+                int_c: v[3],
+                int_ss: v[4],
+                int_sc: v[5],
+                int_cc: v[6],
+            };
+        }
+        let k = t.abs().sqrt();
+        let (k2, k3, k4) = (k * k, k * k * k, k * k * k * k);
+        if t > 0.0 {
+            let (sh, ch, sh2) = (k.sinh(), k.cosh(), (2.0 * k).sinh());
+            Basis {
+                t,
+                s1: sh / k,
+                c1: (ch - 1.0) / k2,
+                int_s: (ch - 1.0) / k2,
+                int_c: (sh - k) / k3,
+                int_ss: (sh2 / (4.0 * k) - 0.5) / k2,
+                int_sc: (sh * sh / (2.0 * k) - (ch - 1.0) / k) / k3,
+                int_cc: (1.5 + sh2 / (4.0 * k) - 2.0 * sh / k) / k4,
+            }
         } else {
-            2.0
-        };
-        s += w * th * th;
+            let (sn, cs, sn2) = (k.sin(), k.cos(), (2.0 * k).sin());
+            Basis {
+                t,
+                s1: sn / k,
+                c1: (1.0 - cs) / k2,
+                int_s: (1.0 - cs) / k2,
+                int_c: (k - sn) / k3,
+                int_ss: (0.5 - sn2 / (4.0 * k)) / k2,
+                int_sc: ((1.0 - cs) / k - sn * sn / (2.0 * k)) / k3,
+                int_cc: (1.5 - 2.0 * sn / k + sn2 / (4.0 * k)) / k4,
+            }
+        }
     }
-    0.5 * s * h / 3.0
+
+    /// (a3, a5) meeting y(1) = y, θ(1) = th, and the model's mismatch ½∫θ² − deficit.
+    fn fit(&self, y: f64, th: f64, deficit: f64) -> Option<(f64, f64, f64)> {
+        // [∫S  −∫C] [a3]   [y ]
+        // [S1  −C1] [a5] = [th]
+        let det = -self.int_s * self.c1 + self.int_c * self.s1;
+        if !(det.is_finite() && det.abs() > 1e-300) {
+            return None;
+        }
+        let a3 = (-y * self.c1 + self.int_c * th) / det;
+        let a5 = (self.int_s * th - self.s1 * y) / det;
+        let half =
+            0.5 * (a3 * a3 * self.int_ss - 2.0 * a3 * a5 * self.int_sc + a5 * a5 * self.int_cc);
+        let g = half - deficit;
+        (g.is_finite() && a3.is_finite() && a5.is_finite()).then_some((a3, a5, g))
+    }
 }
 
-/// Deficit mismatch g(k) = ½∫θ² − (1 − x) for the model at k, and the start it gives.
-fn mismatch(k: f64, tension: bool, y: f64, th: f64, deficit: f64) -> Option<(f64, PlanarParams)> {
-    let (c, a3) = coefficients(k, tension, y, th)?;
-    let g = half_energy(k, tension, c, a3) - deficit;
-    let t = if tension { k * k } else { -k * k };
-    let a = PlanarParams::new(a3, t, c * t);
-    (g.is_finite() && a.iter().all(|v| v.is_finite())).then_some((g, a))
+/// Smallest |T| of the log-spaced grid on each side of T = 0 (which is a grid point itself).
+const T_SMALL: f64 = 1e-3;
+/// Most compression: just below the clamped–clamped Euler load 4π² (beyond it the straight
+/// rod is unstable, and the 2×2 system turns singular at (2π)²).
+const T_COMPRESSION: f64 = -(0.999 * std::f64::consts::TAU) * (0.999 * std::f64::consts::TAU);
+/// Most tension: k = 100 (boundary layers of width 0.01; beyond, the strong-tension starts of
+/// [`super::fronts`] take over).
+const T_TENSION: f64 = 1e4;
+/// Grid points per decade of |T|.
+const PER_DECADE: f64 = 6.0;
+
+/// The scan grid, most compressed first, with its coefficients (target-independent: once).
+fn grid() -> &'static [Basis] {
+    static GRID: OnceLock<Vec<Basis>> = OnceLock::new();
+    GRID.get_or_init(|| {
+        let side = |hi: f64| -> Vec<f64> {
+            let n = ((hi / T_SMALL).log10() * PER_DECADE).ceil() as usize;
+            (0..=n)
+                .map(|i| T_SMALL * (hi / T_SMALL).powf(i as f64 / n as f64))
+                .collect()
+        };
+        let mut ts: Vec<f64> = side(-T_COMPRESSION).into_iter().rev().map(|t| -t).collect();
+        ts.push(0.0);
+        ts.extend(side(T_TENSION));
+        ts.into_iter().map(Basis::at).collect()
+    })
 }
 
-/// Up to `max` starts for a target near full extension (distance > 0.9, small tip angle), in
-/// the order found (compression branch first, then tension by increasing T).
+/// Regula falsi (Illinois) for the mismatch's root between two grid points of opposite sign.
+fn root(lo: (f64, f64), hi: (f64, f64), y: f64, th: f64, deficit: f64) -> Option<PlanarParams> {
+    let ((mut t0, mut g0), (mut t1, mut g1)) = (lo, hi);
+    let mut best = None;
+    let mut side = 0;
+    for _ in 0..60 {
+        let t = (t0 * g1 - t1 * g0) / (g1 - g0);
+        let t = if t.is_finite() && t > t0.min(t1) && t < t0.max(t1) {
+            t
+        } else {
+            0.5 * (t0 + t1)
+        };
+        let (a3, a5, g) = Basis::at(t).fit(y, th, deficit)?;
+        best = Some(PlanarParams::new(a3, t, a5));
+        if g == 0.0 || (t1 - t0).abs() <= 1e-12 * (1.0 + t.abs()) || g.abs() <= 1e-12 * deficit {
+            break;
+        }
+        if (g < 0.0) == (g0 < 0.0) {
+            t0 = t;
+            g0 = g;
+            if side == -1 {
+                g1 *= 0.5;
+            }
+            side = -1;
+        } else {
+            t1 = t;
+            g1 = g;
+            if side == 1 {
+                g0 *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    best.filter(|a| a.iter().all(|v| v.is_finite()))
+}
+
+/// Up to `max` starts for a target near full extension (distance in (0.9, 1), x > 0, tip angle
+/// below 1.2 rad), smallest |a4| first (the gently bent rod before the tensioned or compressed
+/// ones).
 pub(crate) fn starts(target: &PlanarPose, max: usize) -> Vec<PlanarParams> {
-    let mut out = Vec::new();
     let r = target.x.hypot(target.y);
     let th = wrap_angle(target.theta);
     if !(r > 0.9 && r < 1.0 && target.x > 0.0 && th.abs() < 1.2) {
-        return out;
+        return Vec::new();
     }
     let (y, deficit) = (target.y, 1.0 - target.x);
-    // Compression: k ∈ [0.05, 2π·0.999] (beyond, the straight rod is past its first
-    // clamped–clamped Euler load); tension: k ∈ [0.05, 100], log-spaced.
-    for tension in [false, true] {
-        let (k_lo, k_hi): (f64, f64) = if tension {
-            (0.05, 100.0)
-        } else {
-            (0.05, 0.999 * std::f64::consts::TAU)
+    let mut out = Vec::new();
+    let mut prev: Option<(f64, f64)> = None;
+    for b in grid() {
+        let Some((_, _, g)) = b.fit(y, th, deficit) else {
+            prev = None;
+            continue;
         };
-        const M: usize = 48;
-        let ratio = (k_hi / k_lo).ln() / M as f64;
-        let mut prev: Option<(f64, f64)> = None;
-        for i in 0..=M {
-            let k = k_lo * (ratio * i as f64).exp();
-            let Some((g, _)) = mismatch(k, tension, y, th, deficit) else {
-                prev = None;
-                continue;
-            };
-            if let Some((k0, g0)) = prev {
-                if (g0 <= 0.0) != (g <= 0.0) {
-                    // Bisection in log k.
-                    let (mut lo, mut hi, mut glo) = (k0.ln(), k.ln(), g0);
-                    for _ in 0..30 {
-                        let mid = 0.5 * (lo + hi);
-                        match mismatch(mid.exp(), tension, y, th, deficit) {
-                            Some((gm, _)) if (gm <= 0.0) == (glo <= 0.0) => {
-                                lo = mid;
-                                glo = gm;
-                            }
-                            Some(_) => hi = mid,
-                            None => break,
-                        }
-                    }
-                    if let Some((_, a)) = mismatch((0.5 * (lo + hi)).exp(), tension, y, th, deficit)
-                    {
-                        out.push(a);
-                        if out.len() >= max {
-                            return out;
-                        }
-                    }
-                }
+        if let Some((t0, g0)) = prev {
+            if (g0 <= 0.0) != (g <= 0.0) {
+                out.extend(root((t0, g0), (b.t, g), y, th, deficit));
             }
-            prev = Some((k, g));
         }
+        prev = Some((b.t, g));
     }
+    out.sort_by(|p, q| p[1].abs().total_cmp(&q[1].abs()));
+    out.truncate(max);
     out
 }
 
@@ -146,6 +240,63 @@ mod tests {
             assert!(
                 s.iter().any(|g| (g - a).norm() < 0.25 * a.norm()),
                 "{a:?}: {s:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn series_and_closed_forms_agree_where_they_meet() {
+        // At |T| = SERIES_BELOW the two evaluations of every coefficient agree to ~1e-13
+        // relative (the closed forms' cancellation at k = 2 costs ~1.5 digits of 1e-16).
+        for t in [SERIES_BELOW, -SERIES_BELOW] {
+            let s = Basis::at(t);
+            let c = Basis::at(t * (1.0 + f64::EPSILON));
+            let pairs = [
+                (s.s1, c.s1),
+                (s.c1, c.c1),
+                (s.int_s, c.int_s),
+                (s.int_c, c.int_c),
+                (s.int_ss, c.int_ss),
+                (s.int_sc, c.int_sc),
+                (s.int_cc, c.int_cc),
+            ];
+            for (i, (u, v)) in pairs.into_iter().enumerate() {
+                assert!(
+                    (u - v).abs() <= 1e-12 * u.abs(),
+                    "T = {t}, coefficient {i}: {u} vs {v}"
+                );
+            }
+        }
+        // T = 0: S = t, C = t²/2.
+        let z = Basis::at(0.0);
+        let expected = [1.0, 0.5, 0.5, 1.0 / 6.0, 1.0 / 3.0, 0.125, 0.05];
+        let got = [z.s1, z.c1, z.int_s, z.int_c, z.int_ss, z.int_sc, z.int_cc];
+        for (e, g) in expected.into_iter().zip(got) {
+            assert!((e - g).abs() < 1e-16, "{e} vs {g}");
+        }
+    }
+
+    #[test]
+    fn gently_bent_rods_through_zero_force() {
+        // Little or no force, either sign (the force-free rod is inside the scan, not at its
+        // edge): the first start is the rod itself to the model's accuracy (it drops terms
+        // O(θ) relative to those it keeps: 1.5 % in (a3, a5) at θ ≈ 0.05, the last rod), so
+        // |Δa4| is small in absolute terms and (a3, a5) match to a few θ relative.
+        for a in [
+            PlanarParams::new(-1.07e-4, 2.8e-8, 1.2e-9),
+            PlanarParams::new(1e-3, -1.5e-3, -4e-3),
+            PlanarParams::new(2e-3, 0.0, 0.0),
+            PlanarParams::new(0.0, 0.0, 1e-2),
+            PlanarParams::new(0.05, 0.3, -0.02),
+        ] {
+            let b = crate::planar::tip(&a).unwrap();
+            let s = starts(&b, 4);
+            let g = s.first().unwrap_or_else(|| panic!("{a:?}: no start"));
+            assert!((g[1] - a[1]).abs() < 0.05, "{a:?}: {g:?}");
+            let bend = a[0].abs() + a[2].abs();
+            assert!(
+                (g[0] - a[0]).abs() + (g[2] - a[2]).abs() < (1e-3 + 0.5 * bend) * bend,
+                "{a:?}: {g:?}"
             );
         }
     }

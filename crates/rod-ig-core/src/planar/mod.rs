@@ -25,8 +25,10 @@ use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport}
 use taylor::{DualF64x2, Gradient, TaylorRod};
 
 /// Rods with ρ = max(|a3|, √‖(a4, a5)‖) up to this value are evaluated by the Taylor series
-/// (one step from 0 to 1 whose truncation estimate certifies full accuracy: the terms behave
-/// like ρᵏ/k!, 2³⁰/30! ≈ 4e-24). This is the regime of nearly straight, gently bent and tiny
+/// (a few steps whose truncation estimate certifies full accuracy: one from 0 to 1 for small ρ,
+/// two to five for ρ ∈ [0.3, 2], where the series' radius of convergence — the distance to the
+/// pendulum solution's complex singularities, ~ln(1/amplitude)/ρ — falls below ~3 and the
+/// derivative parts' terms decay only geometrically). This is the regime of nearly straight, gently bent and tiny
 /// rods, where the closed form is built from O(1) elliptic quantities whose differences are the
 /// answer (cancellation). Above it, the closed form is used unless its own a-priori error
 /// estimate (`Closed::needs_reference`) says it loses accuracy.

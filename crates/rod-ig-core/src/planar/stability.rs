@@ -35,10 +35,7 @@ const CLOSED_J_ABS: f64 = 64.0 * f64::EPSILON;
 /// det J and a first-order bound on its error: Σ e_ij |C_ij| over the entries' errors
 /// e_ij = rel·|J_ij| + abs and the cofactors C_ij, plus the rounding of the expansion.
 fn det_and_error(j: &[[f64; 3]; 3], rel: f64, abs: f64) -> (f64, f64) {
-    let m0 = j[1][1] * j[2][2] - j[1][2] * j[2][1];
-    let m1 = j[1][0] * j[2][2] - j[1][2] * j[2][0];
-    let m2 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
-    let det = j[0][0] * m0 - j[0][1] * m1 + j[0][2] * m2;
+    let det = det3(j);
     let mut err = 0.0;
     let mut size = 0.0;
     for r in 0..3 {
@@ -53,6 +50,15 @@ fn det_and_error(j: &[[f64; 3]; 3], rel: f64, abs: f64) -> (f64, f64) {
         }
     }
     (det, err + 8.0 * f64::EPSILON * size)
+}
+
+/// det J by expansion along the x row.
+#[inline]
+fn det3(j: &[[f64; 3]; 3]) -> f64 {
+    let m0 = j[1][1] * j[2][2] - j[1][2] * j[2][1];
+    let m1 = j[1][0] * j[2][2] - j[1][2] * j[2][0];
+    let m2 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
+    j[0][0] * m0 - j[0][1] * m1 + j[0][2] * m2
 }
 
 /// The FINDINGS §5 normalisation t⁹ (a3²/8640 + a5² t²/33600).
@@ -78,20 +84,44 @@ fn normalised_det(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64) -> (f64, f64) {
 /// by σ = max(|a3|, |a5|) (det scales by 1/σ², the normalisation is taken with a/σ): both are
 /// O(σ²) for a nearly straight rod, and the scaled quantities are O(1).
 fn normalised_det_series<T: Gradient>(rod: &TaylorRod<T>, a3: f64, a5: f64, t: f64) -> (f64, f64) {
-    let sigma = a3.abs().max(a5.abs());
-    let Some(p) = rod.pose(t) else {
+    let Some(j) = scaled_series_jacobian(rod, a3, a5, t) else {
         return (f64::NAN, f64::INFINITY);
     };
-    let mut j = p.map(|v| v.gradient());
+    let (det, err) = det_and_error(&j, SERIES_ENTRY_REL, 0.0);
+    let n = normalisation_scaled(a3, a5, t);
+    (det / n, err / n)
+}
+
+/// g(t) alone (the scan's samples; the error bound is needed at the margin's t only).
+fn normalised_det_series_value<T: Gradient>(rod: &TaylorRod<T>, a3: f64, a5: f64, t: f64) -> f64 {
+    let Some(j) = scaled_series_jacobian(rod, a3, a5, t) else {
+        return f64::NAN;
+    };
+    det3(&j) / normalisation_scaled(a3, a5, t)
+}
+
+/// J(t) from the series with the x row and the a4 column divided by σ = max(|a3|, |a5|).
+fn scaled_series_jacobian<T: Gradient>(
+    rod: &TaylorRod<T>,
+    a3: f64,
+    a5: f64,
+    t: f64,
+) -> Option<[[f64; 3]; 3]> {
+    let sigma = a3.abs().max(a5.abs());
+    let mut j = rod.pose(t)?.map(|v| v.gradient());
     for v in j[0].iter_mut() {
         *v /= sigma;
     }
     for r in j.iter_mut() {
         r[1] /= sigma;
     }
-    let (det, err) = det_and_error(&j, SERIES_ENTRY_REL, 0.0);
-    let n = normalisation(a3 / sigma, a5 / sigma, t);
-    (det / n, err / n)
+    Some(j)
+}
+
+/// The normalisation taken with a/σ (see [`normalised_det_series`]).
+fn normalisation_scaled(a3: f64, a5: f64, t: f64) -> f64 {
+    let sigma = a3.abs().max(a5.abs());
+    normalisation(a3 / sigma, a5 / sigma, t)
 }
 
 /// The straight rod a3 = a5 = 0: J's x row vanishes (∂x/∂a ≡ 0: an inextensible straight rod
@@ -159,9 +189,14 @@ fn scan_series<T: Gradient>(
     a5: f64,
     spacing: f64,
 ) -> Result<StabilityReport, RodError> {
-    let g = |t: f64| normalised_det_series(rod, a3, a5, t);
-    let s = scan(&|t| g(t).0, SERIES_T_MIN, spacing, a3, a5)?;
-    Ok(verdict(s, g(s.t_margin).1))
+    let s = scan(
+        &|t| normalised_det_series_value(rod, a3, a5, t),
+        SERIES_T_MIN,
+        spacing,
+        a3,
+        a5,
+    )?;
+    Ok(verdict(s, normalised_det_series(rod, a3, a5, s.t_margin).1))
 }
 
 /// Stability on the closed form (FINDINGS §5), with the series where the closed form's own

@@ -20,14 +20,16 @@
 //! the last two terms of every series — value and each derivative — at the step h are below
 //! `Measured::TAIL_TOL` times that series' largest term; for an entire function this is the standard
 //! a-posteriori truncation estimate (Jorba & Zou 2005, §3.2). A gently bent rod is covered by one
-//! step from 0 to 1; otherwise h shrinks until the estimate holds at [`MAX_ORDER`].
+//! step from 0 to 1; otherwise h shrinks until the estimate holds at [`MAX_ORDER`]. The scale of
+//! every series is kept up to date term by term, so each order's test reads two terms only.
 
 use crate::eft::{two_prod, two_sum};
 use crate::scalar::Dual3;
 use crate::RodError;
 
-/// Highest Taylor order per step. For ρ = max(|a3|, √‖(a4, a5)‖) ≤ 2 one step to t = 1 needs
-/// ≲ 30 terms (terms behave like ρᵏ/k!, and 2³⁰/30! ≈ 4e-24); more terms only cost time.
+/// Highest Taylor order per step. The terms decay like (h/R)ᵏ with R the radius of convergence
+/// (≳ 3 for gently bent rods: one step to t = 1 in ≲ 32 terms); where R is smaller, shorter
+/// steps at this order cost less than more terms (work per step grows like the order squared).
 pub(crate) const MAX_ORDER: usize = 32;
 const LEN: usize = MAX_ORDER + 1;
 /// Lowest order at which convergence is tested: the series of an odd or even function has
@@ -63,6 +65,12 @@ pub(crate) trait Measured:
     fn div_n(self, n: f64) -> Self;
     /// self · h for an f64 step.
     fn mul_f(self, h: f64) -> Self;
+    /// The product of the values only, derivatives dropped: the energy series, whose
+    /// derivatives nothing reads (a third of the Cauchy products' work in dual numbers).
+    #[inline]
+    fn mul_values(self, o: Self) -> Self {
+        self * o
+    }
 }
 
 impl Measured for f64 {
@@ -106,6 +114,10 @@ impl Measured for Dual3 {
     #[inline]
     fn mul_f(self, h: f64) -> Self {
         self * h
+    }
+    #[inline]
+    fn mul_values(self, o: Self) -> Self {
+        Dual3::constant(self.v * o.v)
     }
 }
 
@@ -298,6 +310,13 @@ impl Measured for DualF64x2 {
             g: [self.g[0].mul_f(h), self.g[1].mul_f(h), self.g[2].mul_f(h)],
         }
     }
+    #[inline]
+    fn mul_values(self, o: Self) -> Self {
+        Self {
+            v: self.v * o.v,
+            g: [DoubleF64::default(); 3],
+        }
+    }
 }
 
 /// Value and gradient of a dual-number series scalar, rounded to f64.
@@ -349,6 +368,15 @@ pub(crate) struct Segment<T> {
 }
 
 impl<T: Measured> Segment<T> {
+    fn empty() -> Self {
+        Self {
+            t0: 0.0,
+            h: 0.0,
+            order: 0,
+            coef: [[T::constant(0.0); LEN]; SERIES],
+        }
+    }
+
     #[inline]
     fn horner(&self, series: usize, dt: f64) -> T {
         let c = &self.coef[series];
@@ -384,9 +412,10 @@ impl<T: Measured> Segment<T> {
 /// The rod on [0, 1] as a chain of Taylor steps.
 #[derive(Clone, Debug)]
 pub(crate) struct TaylorRod<T> {
-    /// The first step, inline: a near-relaxed rod is one step, and the solvers evaluate
-    /// thousands of them, so no heap allocation for it.
-    first: Option<Segment<T>>,
+    /// The first step (a near-relaxed rod is one step), boxed: a segment of dual numbers is
+    /// 7 KB, and moving it by value through the constructors and results cost more than the
+    /// allocation (memmove was 7 % of a forward evaluation).
+    first: Option<Box<Segment<T>>>,
     /// Later steps (multi-step rods only).
     rest: Vec<Segment<T>>,
     end: [T; SERIES],
@@ -402,10 +431,16 @@ impl<T: Measured> TaylorRod<T> {
         state[K] = a3;
         state[C] = T::constant(1.0);
         let mut t0 = 0.0f64;
-        let mut first = None;
+        let mut first: Option<Box<Segment<T>>> = None;
         let mut rest = Vec::new();
+        // Without dense output one segment is reused by every step, filled in place.
+        let mut scratch: Option<Box<Segment<T>>> = None;
         for _ in 0..max_steps {
-            let seg = step(&state, a4, a5, t0, 1.0 - t0)?;
+            let mut seg = match scratch.take() {
+                Some(s) => s,
+                None => Box::new(Segment::empty()),
+            };
+            step(&mut seg, &state, a4, a5, t0, 1.0 - t0)?;
             state = seg.state_at_end();
             if !state
                 .iter()
@@ -414,12 +449,12 @@ impl<T: Measured> TaylorRod<T> {
                 return Err(overflow());
             }
             t0 = if seg.h >= 1.0 - t0 { 1.0 } else { t0 + seg.h };
-            if dense {
-                if first.is_none() {
-                    first = Some(seg);
-                } else {
-                    rest.push(seg);
-                }
+            if !dense {
+                scratch = Some(seg);
+            } else if first.is_none() {
+                first = Some(seg);
+            } else {
+                rest.push(*seg);
             }
             if t0 >= 1.0 {
                 return Ok(Self {
@@ -439,13 +474,14 @@ impl<T: Measured> TaylorRod<T> {
         [self.end[X], self.end[Y], self.end[TH]]
     }
 
-    /// Elastic energy ½∫₀¹κ², integrated along (no cancellation).
+    /// Elastic energy ½∫₀¹κ², integrated along (no cancellation). Value only: in dual numbers
+    /// its derivatives are not computed (zero).
     pub fn energy(&self) -> T {
         self.end[E]
     }
 
     fn segment(&self, t: f64) -> Option<&Segment<T>> {
-        let first = self.first.as_ref()?;
+        let first = self.first.as_deref()?;
         if t <= first.t0 + first.h || self.rest.is_empty() {
             return Some(first);
         }
@@ -473,33 +509,38 @@ fn overflow() -> RodError {
     )
 }
 
-/// Builds the Taylor coefficients from `state` at t0 and chooses the step (≤ `remaining`).
+/// Builds the Taylor coefficients from `state` at t0 into `seg` (in place: no 7 KB moves) and
+/// chooses the step (≤ `remaining`).
 fn step<T: Measured>(
+    seg: &mut Segment<T>,
     state: &[T; SERIES],
     a4: T,
     a5: T,
     t0: f64,
     remaining: f64,
-) -> Result<Segment<T>, RodError> {
+) -> Result<(), RodError> {
     let zero = T::constant(0.0);
-    let mut seg = Segment {
-        t0,
-        h: remaining,
-        order: 0,
-        coef: [[zero; LEN]; SERIES],
-    };
+    seg.t0 = t0;
+    seg.h = remaining;
+    seg.order = 0;
+    // Only coefficients 0..=order are ever read, and each is written before it is read.
     for (i, v) in state.iter().enumerate() {
         seg.coef[i][0] = *v;
     }
+    // Running scale (largest |term| so far) of every series and measured part at h =
+    // `remaining`, so that the order loop's truncation test costs O(1) per order instead of a
+    // pass over every term (it was a quarter of a series' cost).
+    let mut tails = Tails::<T>::new(remaining);
+    tails.add(seg, 0);
     for k in 0..MAX_ORDER {
         let c = &mut seg.coef;
-        // Cauchy products (s κ)_k, (c κ)_k, (κ κ)_k.
+        // Cauchy products (s κ)_k, (c κ)_k, (κ κ)_k (the last for the energy: values only).
         let (mut sk, mut ck, mut kk) = (zero, zero, zero);
         for j in 0..=k {
             let kap = c[K][k - j];
             sk += c[S][j] * kap;
             ck += c[C][j] * kap;
-            kk += c[K][j] * kap;
+            kk += c[K][j].mul_values(kap);
         }
         let n = (k + 1) as f64;
         c[K][k + 1] = (a4 * c[S][k] - a5 * c[C][k]).div_n(n);
@@ -510,20 +551,21 @@ fn step<T: Measured>(
         c[Y][k + 1] = c[S][k].div_n(n);
         c[E][k + 1] = kk.div_n(2.0 * n);
         seg.order = k + 1;
-        // The test is cheap only when rare: check every other order once a few terms exist
-        // (two consecutive zero terms of an even/odd series cannot fake convergence then,
-        // since the check also needs the scale's terms to have been reached).
-        if k + 1 >= MIN_ORDER && (k + 1) % 2 == 0 && converged(&seg, remaining) {
-            return Ok(seg);
+        tails.add(seg, k + 1);
+        // Tested at even orders once a few terms exist (two consecutive zero terms of an
+        // even/odd series cannot fake convergence then, since the check also needs the scale's
+        // terms to have been reached).
+        if k + 1 >= MIN_ORDER && (k + 1) % 2 == 0 && tails.converged(seg) {
+            return Ok(());
         }
     }
     // Not converged at the full remaining length: shrink h until the tail estimate holds.
     let mut h = remaining;
     while h > MIN_STEP {
         h *= STEP_SHRINK;
-        if converged(&seg, h) {
+        if converged(seg, h) {
             seg.h = h;
-            return Ok(seg);
+            return Ok(());
         }
     }
     if seg.coef.iter().flatten().all(|v| v.part(0).is_finite()) {
@@ -532,6 +574,63 @@ fn step<T: Measured>(
         )))
     } else {
         Err(overflow())
+    }
+}
+
+/// The truncation test of [`converged`] at a fixed h, kept up to date term by term.
+struct Tails<T> {
+    h: f64,
+    /// h^k for the next term k.
+    hp: f64,
+    /// h^k of the last two terms added (k − 1, k).
+    last_hp: [f64; 2],
+    /// Largest |term| so far per series and measured part (at most 4 parts).
+    scale: [[f64; 4]; SERIES],
+    /// A term was not finite.
+    overflow: bool,
+    _t: std::marker::PhantomData<T>,
+}
+
+impl<T: Measured> Tails<T> {
+    fn new(h: f64) -> Self {
+        Self {
+            h,
+            hp: 1.0,
+            last_hp: [0.0; 2],
+            scale: [[0.0; 4]; SERIES],
+            overflow: false,
+            _t: std::marker::PhantomData,
+        }
+    }
+
+    /// Takes term `k` (the next one) of every series into the scales.
+    #[inline]
+    fn add(&mut self, seg: &Segment<T>, k: usize) {
+        for (series, scale) in seg.coef.iter().zip(self.scale.iter_mut()) {
+            for (part, s) in scale.iter_mut().enumerate().take(T::PARTS) {
+                let term = series[k].part(part) * self.hp;
+                self.overflow |= !term.is_finite();
+                *s = s.max(term);
+            }
+        }
+        self.last_hp = [self.last_hp[1], self.hp];
+        self.hp *= self.h;
+    }
+
+    /// [`converged`] at this h for a segment whose terms 0..=order were all added: the same
+    /// verdict, from the last two terms only.
+    fn converged(&self, seg: &Segment<T>) -> bool {
+        if self.overflow {
+            return false;
+        }
+        let n = seg.order;
+        let [hn1, hn] = self.last_hp;
+        seg.coef.iter().zip(&self.scale).all(|(series, scale)| {
+            (0..T::PARTS).all(|part| {
+                let last = series[n - 1].part(part) * hn1 + series[n].part(part) * hn;
+                last <= T::TAIL_TOL * scale[part]
+            })
+        })
     }
 }
 
