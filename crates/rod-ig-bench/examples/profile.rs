@@ -10,6 +10,25 @@ use std::time::Instant;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if args.get(1).map(String::as_str) == Some("one") {
+        // `one a3 a4 a5`: the forward evaluation of one rod, timed over 20,000 calls.
+        let v: Vec<f64> = args[2..5].iter().filter_map(|s| s.parse().ok()).collect();
+        let a = rod_ig_core::PlanarParams::new(v[0], v[1], v[2]);
+        let t0 = Instant::now();
+        for _ in 0..20_000 {
+            let _ = black_box(planar::evaluate(black_box(&a)));
+        }
+        let tip = Instant::now();
+        for _ in 0..20_000 {
+            let _ = black_box(planar::tip_and_jacobian(black_box(&a)));
+        }
+        println!(
+            "evaluate {:.2} µs, tip_and_jacobian {:.2} µs",
+            (tip - t0).as_secs_f64() * 50.0,
+            tip.elapsed().as_secs_f64() * 50.0
+        );
+        return;
+    }
     let what = args.get(1).map_or("forward", String::as_str);
     let index: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1);
     let rounds: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(20);
@@ -26,7 +45,7 @@ fn main() {
         .filter(|a| (lo..hi).contains(&a[0].abs().max(a[1].hypot(a[2]).sqrt())))
         .copied()
         .collect();
-    let targets: Vec<_> = if what != "solve" {
+    let targets: Vec<_> = if what != "solve" && what != "slowest" {
         Vec::new()
     } else {
         inputs
@@ -80,6 +99,29 @@ fn main() {
                     t / *n as f64
                 );
             }
+        }
+    }
+    if what == "slowest" {
+        // The five slowest solves of the sample's targets, with their work.
+        let mut rows: Vec<(f64, String)> = targets
+            .iter()
+            .map(|b| {
+                let t = Instant::now();
+                let r = ig::solve(b, &opts);
+                let us = t.elapsed().as_secs_f64() * 1e6;
+                let what = match r {
+                    Ok(s) => format!(
+                        "a {:?} iterations {} starts {}",
+                        s.a, s.iterations, s.starts
+                    ),
+                    Err(f) => format!("failed: {}", f.reason),
+                };
+                (us, format!("{b:?}: {what}"))
+            })
+            .collect();
+        rows.sort_by(|p, q| q.0.total_cmp(&p.0));
+        for (us, row) in rows.iter().take(5) {
+            println!("{us:8.1} µs  {row}");
         }
     }
     let us = t0.elapsed().as_secs_f64() * 1e6 / calls as f64;

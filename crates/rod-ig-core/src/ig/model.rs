@@ -46,6 +46,12 @@ pub(crate) fn tip_and_jacobian_precise(
     backend::tip_and_jacobian(a)
 }
 
+/// Υ(a), J(1, a), energy and the stability test at full accuracy from one precomputation.
+#[inline]
+pub(crate) fn evaluate_precise(a: &PlanarParams) -> Result<crate::planar::Evaluation, RodError> {
+    backend::evaluate(a)
+}
+
 /// The stability verdict of FINDINGS §5 (det J(t, a) > 0 on (0, 1]).
 #[inline]
 pub(crate) fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
@@ -82,5 +88,9 @@ mod backend {
     #[inline]
     pub(super) fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
         crate::planar::stability(a)
+    }
+    #[inline]
+    pub(super) fn evaluate(a: &PlanarParams) -> Result<crate::planar::Evaluation, RodError> {
+        crate::planar::evaluate(a)
     }
 }

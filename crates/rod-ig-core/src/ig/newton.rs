@@ -52,6 +52,20 @@ pub(crate) fn verify(a: &PlanarParams, target: &PlanarPose, tolerance: f64) -> O
     (e.pos_err <= tolerance && e.ang_err <= tolerance).then_some(e)
 }
 
+/// [`verify`] and the stability test of the verified point from one evaluation
+/// (`planar::evaluate`: one closed form or one dense series serves the tip, J and the scan of
+/// det J(t), where separate calls built it twice). None when the re-evaluated point misses the
+/// tolerance or cannot be evaluated.
+pub(crate) fn verify_with_stability(
+    a: &PlanarParams,
+    target: &PlanarPose,
+    tolerance: f64,
+) -> Option<(Eval, crate::StabilityReport)> {
+    let ev = model::evaluate_precise(a).ok()?;
+    let e = eval_from((ev.tip, ev.jacobian), target)?;
+    (e.pos_err <= tolerance && e.ang_err <= tolerance).then_some((e, ev.stability))
+}
+
 fn eval_from((tip, jac): (PlanarPose, PlanarJacobian), target: &PlanarPose) -> Option<Eval> {
     let f = model::residual(&tip, target);
     if !(f.iter().all(|v| v.is_finite()) && jac.iter().all(|v| v.is_finite())) {

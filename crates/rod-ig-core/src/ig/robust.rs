@@ -101,8 +101,7 @@ fn try_start(
         counts.best = (r.residual, Some(r.last_a));
     }
     let (a, _) = r.found?;
-    let e = newton::verify(&a, target, options.tolerance)?;
-    let st = model::stability(&a).ok()?;
+    let (e, st) = newton::verify_with_stability(&a, target, options.tolerance)?;
     if !st.stable {
         return None;
     }
@@ -125,7 +124,7 @@ struct Starts<'t> {
     /// 0: short list not yet loaded; r ≥ 1: neighbourhood radius loaded.
     stage: usize,
     served: Vec<u32>,
-    /// Model-based starts ([`model_starts`]): before the atlas, after the short list, and at
+    /// Model-based starts ([`ModelStarts`]): before the atlas, after the short list, and at
     /// the end.
     model: ModelStarts,
 }
@@ -133,7 +132,7 @@ struct Starts<'t> {
 /// Most small-angle starts ([`straight`]) and strong-tension starts ([`fronts`]) per solve.
 const MODEL_STARTS: usize = 4;
 
-/// The model-based starts for `target`, each list in the order it is served by `pop`:
+/// The model-based starts for `target`, in the order they are served:
 /// - `first`: small-angle starts ([`straight`]) with cheap f64 iterations, served before any
 ///   atlas seed: near full extension the atlas (a grid over the paper's box) has few seeds in
 ///   Newton's basin, and the model's start for a gently bent rod converges in a few steps;
@@ -143,21 +142,61 @@ const MODEL_STARTS: usize = 4;
 ///   come from targets so close to full extension that the small-angle model has roots up to
 ///   a4 = 1e4; iterated precisely, they would spend the deadline that the atlas seeds after
 ///   them need (seen: 5 % of log-scale targets near full extension lost to the deadline).
+///
+/// Each is computed when first needed: most solves end at the first small-angle start or
+/// before.
 struct ModelStarts {
-    first: Vec<PlanarParams>,
-    early: Vec<PlanarParams>,
-    late: Vec<PlanarParams>,
+    straight: straight::Roots,
+    /// Small-angle starts served so far (at most [`MODEL_STARTS`] in all).
+    served_straight: usize,
+    early: Option<Vec<PlanarParams>>,
+    /// Small-angle starts that need precise iterations, in the order found.
+    late: std::collections::VecDeque<PlanarParams>,
 }
 
-fn model_starts(target: &PlanarPose) -> ModelStarts {
-    let (mut late, mut first): (Vec<_>, Vec<_>) = straight::starts(target, MODEL_STARTS)
-        .into_iter()
-        .partition(crate::planar::needs_precise_iterations);
-    let mut early = fronts::starts(target, MODEL_STARTS);
-    first.reverse();
-    early.reverse();
-    late.reverse();
-    ModelStarts { first, early, late }
+impl ModelStarts {
+    fn new(target: &PlanarPose) -> Self {
+        ModelStarts {
+            straight: straight::roots(target),
+            served_straight: 0,
+            early: None,
+            late: Default::default(),
+        }
+    }
+
+    /// The next small-angle start iterated in f64 (those needing precise iterations are put
+    /// aside for [`Self::late`]).
+    fn first(&mut self) -> Option<PlanarParams> {
+        while self.served_straight < MODEL_STARTS {
+            let a = self.straight.next()?;
+            self.served_straight += 1;
+            if crate::planar::needs_precise_iterations(&a) {
+                self.late.push_back(a);
+            } else {
+                return Some(a);
+            }
+        }
+        None
+    }
+
+    fn early(&mut self, target: &PlanarPose) -> Option<PlanarParams> {
+        self.early
+            .get_or_insert_with(|| {
+                let mut e = fronts::starts(target, MODEL_STARTS);
+                e.reverse();
+                e
+            })
+            .pop()
+    }
+
+    fn late(&mut self) -> Option<PlanarParams> {
+        while self.served_straight < MODEL_STARTS {
+            let Some(a) = self.straight.next() else { break };
+            self.served_straight += 1;
+            self.late.push_back(a);
+        }
+        self.late.pop_front()
+    }
 }
 
 impl<'t> Starts<'t> {
@@ -198,7 +237,7 @@ impl<'t> Starts<'t> {
             pos: 0,
             stage: 0,
             served: Vec::new(),
-            model: model_starts(target),
+            model: ModelStarts::new(target),
         };
         if guess.is_some() {
             let atlas = atlas::get();
@@ -231,7 +270,7 @@ impl<'t> Starts<'t> {
             }
         }
         let as_model_start = |a| Some((atlas::Start { a, predicted: None }, false));
-        if let Some(a) = self.model.first.pop() {
+        if let Some(a) = self.model.first() {
             return as_model_start(a);
         }
         let atlas = atlas::get();
@@ -250,11 +289,11 @@ impl<'t> Starts<'t> {
                 return Some(as_start(g));
             }
             if self.stage >= 1 {
-                if let Some(a) = self.model.early.pop() {
+                if let Some(a) = self.model.early(self.target) {
                     return as_model_start(a);
                 }
                 if self.stage >= 3 {
-                    return self.model.late.pop().and_then(as_model_start);
+                    return self.model.late().and_then(as_model_start);
                 }
             }
             self.buf.clear();
@@ -369,14 +408,15 @@ pub(crate) fn solve_all(
     let mut idx = Vec::new();
     atlas.candidates(target, 1, &mut idx);
     list.extend(idx.iter().take(200).map(|&(_, k)| atlas.start(k, target)));
-    let model = model_starts(target);
+    let mut model = ModelStarts::new(target);
+    let firsts: Vec<_> = std::iter::from_fn(|| model.first()).collect();
+    let earlies: Vec<_> = std::iter::from_fn(|| model.early(target)).collect();
+    let lates: Vec<_> = std::iter::from_fn(|| model.late()).collect();
     list.extend(
-        model
-            .first
+        firsts
             .into_iter()
-            .rev()
-            .chain(model.early.into_iter().rev())
-            .chain(model.late.into_iter().rev())
+            .chain(earlies)
+            .chain(lates)
             .map(|a| atlas::Start { a, predicted: None }),
     );
     let mut solutions: Vec<Solution> = Vec::new();
@@ -394,10 +434,7 @@ pub(crate) fn solve_all(
         if solutions.iter().any(|s| !distinct(&s.a, &a)) {
             continue;
         }
-        let Some(e) = newton::verify(&a, target, options.tolerance) else {
-            continue;
-        };
-        let Ok(st) = model::stability(&a) else {
+        let Some((e, st)) = newton::verify_with_stability(&a, target, options.tolerance) else {
             continue;
         };
         if st.stable {

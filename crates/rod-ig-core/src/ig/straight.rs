@@ -18,10 +18,14 @@
 use crate::{wrap_angle, PlanarParams, PlanarPose};
 use std::sync::OnceLock;
 
-/// The T-dependent coefficients of the model: values at t = 1 and integrals over [0, 1].
+/// The T-dependent coefficients of the model: values at t = 1 and integrals over [0, 1]; under
+/// tension beyond [`SERIES_BELOW`], k = √T and e^{−k} for the bounded exponential form (see
+/// [`Basis::fit`]).
 #[derive(Clone, Copy, Debug)]
 struct Basis {
     t: f64,
+    /// (k, e^{−k}) where the fit uses the bounded exponentials (tension, T > SERIES_BELOW).
+    exponential: Option<(f64, f64)>,
     s1: f64,
     c1: f64,
     int_s: f64,
@@ -73,6 +77,7 @@ impl Basis {
             let v = series().map(|c| c.iter().rev().fold(0.0, |acc, &cn| acc * t + cn));
             return Basis {
                 t,
+                exponential: None,
                 s1: v[0],
                 c1: v[1],
                 int_s: v[2],
@@ -85,21 +90,24 @@ impl Basis {
         let k = t.abs().sqrt();
         let (k2, k3, k4) = (k * k, k * k * k, k * k * k * k);
         if t > 0.0 {
-            let (sh, ch, sh2) = (k.sinh(), k.cosh(), (2.0 * k).sinh());
+            // sinh and cosh grow like e^k while the answer is O(1): the fit works in bounded
+            // exponentials instead, and these coefficients are not used.
             Basis {
                 t,
-                s1: sh / k,
-                c1: (ch - 1.0) / k2,
-                int_s: (ch - 1.0) / k2,
-                int_c: (sh - k) / k3,
-                int_ss: (sh2 / (4.0 * k) - 0.5) / k2,
-                int_sc: (sh * sh / (2.0 * k) - (ch - 1.0) / k) / k3,
-                int_cc: (1.5 + sh2 / (4.0 * k) - 2.0 * sh / k) / k4,
+                exponential: Some((k, (-k).exp())),
+                s1: f64::NAN,
+                c1: f64::NAN,
+                int_s: f64::NAN,
+                int_c: f64::NAN,
+                int_ss: f64::NAN,
+                int_sc: f64::NAN,
+                int_cc: f64::NAN,
             }
         } else {
             let (sn, cs, sn2) = (k.sin(), k.cos(), (2.0 * k).sin());
             Basis {
                 t,
+                exponential: None,
                 s1: sn / k,
                 c1: (1.0 - cs) / k2,
                 int_s: (1.0 - cs) / k2,
@@ -113,6 +121,9 @@ impl Basis {
 
     /// (a3, a5) meeting y(1) = y, θ(1) = th, and the model's mismatch ½∫θ² − deficit.
     fn fit(&self, y: f64, th: f64, deficit: f64) -> Option<(f64, f64, f64)> {
+        if let Some((k, e)) = self.exponential {
+            return Self::fit_exponential(self.t, k, e, y, th, deficit);
+        }
         // [∫S  −∫C] [a3]   [y ]
         // [S1  −C1] [a5] = [th]
         let det = -self.int_s * self.c1 + self.int_c * self.s1;
@@ -123,6 +134,37 @@ impl Basis {
         let a5 = (self.int_s * th - self.s1 * y) / det;
         let half =
             0.5 * (a3 * a3 * self.int_ss - 2.0 * a3 * a5 * self.int_sc + a5 * a5 * self.int_cc);
+        let g = half - deficit;
+        (g.is_finite() && a3.is_finite() && a5.is_finite()).then_some((a3, a5, g))
+    }
+}
+
+impl Basis {
+    /// [`Basis::fit`] under tension T = k² in the bounded form θ = c + P e^{k(t−1)} + Q e^{−kt}
+    /// (c = a5/T): the conditions θ(0) = 0, θ(1) = th, ∫θ = y are a well-conditioned 3×3 system
+    /// for every k ≥ 2, where the sinh/cosh form cancels terms of size e^{2k} down to O(1)
+    /// (spurious roots from rounding were found at k ≈ 18-38 before). Then a3 = θ'(0) and
+    /// ½∫θ² = ½[c² + 2c(P + Q)(1 − e)/k + (P² + Q²)(1 − e²)/(2k) + 2PQ e], e = e^{−k}.
+    fn fit_exponential(
+        t: f64,
+        k: f64,
+        e: f64,
+        y: f64,
+        th: f64,
+        deficit: f64,
+    ) -> Option<(f64, f64, f64)> {
+        let w = (1.0 - e) / k; // ∫e^{k(t−1)} = ∫e^{−kt}
+                               // Rows: θ(0) = 0, θ(1) = th, ∫θ = y; unknowns (c, P, Q).
+        let m = nalgebra::Matrix3::new(1.0, e, 1.0, 1.0, 1.0, e, 1.0, w, w);
+        let sol = m.lu().solve(&nalgebra::Vector3::new(0.0, th, y))?;
+        let (c, p, q) = (sol[0], sol[1], sol[2]);
+        let a3 = k * (p * e - q);
+        let a5 = c * t;
+        let half = 0.5
+            * (c * c
+                + 2.0 * c * (p + q) * w
+                + (p * p + q * q) * (1.0 - e * e) / (2.0 * k)
+                + 2.0 * p * q * e);
         let g = half - deficit;
         (g.is_finite() && a3.is_finite() && a5.is_finite()).then_some((a3, a5, g))
     }
@@ -156,6 +198,12 @@ fn grid() -> &'static [Basis] {
     })
 }
 
+/// The root's accuracy: far below the model's own error (it drops terms O(θ²) relative to the
+/// shortening), so Newton from the start needs no more steps than from the exact model root.
+const ROOT_G_TOL: f64 = 1e-9;
+/// The root's accuracy in T (relative to 1 + |T|).
+const ROOT_T_TOL: f64 = 1e-9;
+
 /// Regula falsi (Illinois) for the mismatch's root between two grid points of opposite sign.
 fn root(lo: (f64, f64), hi: (f64, f64), y: f64, th: f64, deficit: f64) -> Option<PlanarParams> {
     let ((mut t0, mut g0), (mut t1, mut g1)) = (lo, hi);
@@ -170,7 +218,10 @@ fn root(lo: (f64, f64), hi: (f64, f64), y: f64, th: f64, deficit: f64) -> Option
         };
         let (a3, a5, g) = Basis::at(t).fit(y, th, deficit)?;
         best = Some(PlanarParams::new(a3, t, a5));
-        if g == 0.0 || (t1 - t0).abs() <= 1e-12 * (1.0 + t.abs()) || g.abs() <= 1e-12 * deficit {
+        if g == 0.0
+            || (t1 - t0).abs() <= ROOT_T_TOL * (1.0 + t.abs())
+            || g.abs() <= ROOT_G_TOL * deficit
+        {
             break;
         }
         if (g < 0.0) == (g0 < 0.0) {
@@ -192,17 +243,46 @@ fn root(lo: (f64, f64), hi: (f64, f64), y: f64, th: f64, deficit: f64) -> Option
     best.filter(|a| a.iter().all(|v| v.is_finite()))
 }
 
-/// Up to `max` starts for a target near full extension (distance in (0.9, 1), x > 0, tip angle
-/// below 1.2 rad), smallest |a4| first (the gently bent rod before the tensioned or compressed
-/// ones).
-pub(crate) fn starts(target: &PlanarPose, max: usize) -> Vec<PlanarParams> {
+/// The small-angle starts of a target, computed one at a time (each root costs a regula falsi,
+/// and most solves need only the first).
+pub(crate) struct Roots {
+    y: f64,
+    th: f64,
+    deficit: f64,
+    /// Sign-change brackets on the grid, nearest T = 0 last (served by `pop`).
+    brackets: Vec<((f64, f64), (f64, f64))>,
+}
+
+impl Iterator for Roots {
+    type Item = PlanarParams;
+    fn next(&mut self) -> Option<PlanarParams> {
+        while let Some((lo, hi)) = self.brackets.pop() {
+            if let Some(a) = root(lo, hi, self.y, self.th, self.deficit) {
+                return Some(a);
+            }
+        }
+        None
+    }
+}
+
+/// The starts for a target near full extension (distance in (0.9, 1), x > 0, tip angle below
+/// 1.2 rad), smallest |a4| first (the gently bent rod before the tensioned or compressed ones);
+/// none elsewhere.
+pub(crate) fn roots(target: &PlanarPose) -> Roots {
     let r = target.x.hypot(target.y);
     let th = wrap_angle(target.theta);
-    if !(r > 0.9 && r < 1.0 && target.x > 0.0 && th.abs() < 1.2) {
-        return Vec::new();
-    }
     let (y, deficit) = (target.y, 1.0 - target.x);
-    let mut out = Vec::new();
+    let mut roots = Roots {
+        y,
+        th,
+        deficit,
+        brackets: Vec::new(),
+    };
+    if !(r > 0.9 && r < 1.0 && target.x > 0.0 && th.abs() < 1.2) {
+        return roots;
+    }
+    // Brackets of the mismatch's sign changes on the grid (cheap: the grid's coefficients are
+    // precomputed).
     let mut prev: Option<(f64, f64)> = None;
     for b in grid() {
         let Some((_, _, g)) = b.fit(y, th, deficit) else {
@@ -211,14 +291,28 @@ pub(crate) fn starts(target: &PlanarPose, max: usize) -> Vec<PlanarParams> {
         };
         if let Some((t0, g0)) = prev {
             if (g0 <= 0.0) != (g <= 0.0) {
-                out.extend(root((t0, g0), (b.t, g), y, th, deficit));
+                roots.brackets.push(((t0, g0), (b.t, g)));
             }
         }
         prev = Some((b.t, g));
     }
-    out.sort_by(|p, q| p[1].abs().total_cmp(&q[1].abs()));
-    out.truncate(max);
-    out
+    let nearest_zero = |((t0, _), (t1, _)): &((f64, f64), (f64, f64))| {
+        if t0 * t1 <= 0.0 {
+            0.0
+        } else {
+            t0.abs().min(t1.abs())
+        }
+    };
+    roots
+        .brackets
+        .sort_by(|p, q| nearest_zero(q).total_cmp(&nearest_zero(p)));
+    roots
+}
+
+/// Up to `max` of [`roots`].
+#[cfg(test)]
+pub(crate) fn starts(target: &PlanarPose, max: usize) -> Vec<PlanarParams> {
+    roots(target).take(max).collect()
 }
 
 #[cfg(test)]
@@ -246,9 +340,9 @@ mod tests {
 
     #[test]
     fn series_and_closed_forms_agree_where_they_meet() {
-        // At |T| = SERIES_BELOW the two evaluations of every coefficient agree to ~1e-13
+        // At T = −SERIES_BELOW the two evaluations of every coefficient agree to ~1e-13
         // relative (the closed forms' cancellation at k = 2 costs ~1.5 digits of 1e-16).
-        for t in [SERIES_BELOW, -SERIES_BELOW] {
+        for t in [-SERIES_BELOW] {
             let s = Basis::at(t);
             let c = Basis::at(t * (1.0 + f64::EPSILON));
             let pairs = [
@@ -267,12 +361,43 @@ mod tests {
                 );
             }
         }
+        // At T = +SERIES_BELOW the series and the bounded exponential form give the same fit.
+        for (y, th, deficit) in [(0.01, 0.02, 1e-4), (-0.3, 0.5, 0.1), (1e-6, -3e-6, 1e-12)] {
+            let s = Basis::at(SERIES_BELOW).fit(y, th, deficit).unwrap();
+            let e = Basis::at(SERIES_BELOW * (1.0 + f64::EPSILON))
+                .fit(y, th, deficit)
+                .unwrap();
+            let half = |f: (f64, f64, f64)| f.2 + deficit;
+            assert!((s.0 - e.0).abs() <= 1e-12 * s.0.abs(), "a3 {s:?} vs {e:?}");
+            assert!((s.1 - e.1).abs() <= 1e-12 * s.1.abs(), "a5 {s:?} vs {e:?}");
+            assert!(
+                (half(s) - half(e)).abs() <= 1e-12 * half(s),
+                "½∫θ² {s:?} vs {e:?}"
+            );
+        }
         // T = 0: S = t, C = t²/2.
         let z = Basis::at(0.0);
         let expected = [1.0, 0.5, 0.5, 1.0 / 6.0, 1.0 / 3.0, 0.125, 0.05];
         let got = [z.s1, z.c1, z.int_s, z.int_c, z.int_ss, z.int_sc, z.int_cc];
         for (e, g) in expected.into_iter().zip(got) {
             assert!((e - g).abs() < 1e-16, "{e} vs {g}");
+        }
+    }
+
+    #[test]
+    fn no_spurious_roots_under_strong_tension() {
+        // The sinh/cosh form of the fit cancelled terms of size e^{2k} and produced sign
+        // changes from rounding at k ≈ 18-38 (three bogus starts per gently bent target).
+        // The shortening of the model grows with T at fixed (y, θ) there: no root.
+        for a in [
+            PlanarParams::new(-1.07e-4, 2.8e-8, 1.2e-9),
+            PlanarParams::new(1e-3, -1.5e-3, -4e-3),
+            PlanarParams::new(0.05, 0.3, -0.02),
+            PlanarParams::new(0.1, -5.0, 0.1),
+        ] {
+            let b = crate::planar::tip(&a).unwrap();
+            let s = starts(&b, 8);
+            assert!(s.iter().all(|g| g[1] < 100.0), "{a:?}: {s:?}");
         }
     }
 
