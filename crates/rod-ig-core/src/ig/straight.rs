@@ -13,7 +13,9 @@
 //! end-shortening 1 − x(1) ≈ ½∫θ² is a quadratic form in (a3, a5) whose coefficients depend on
 //! T only; T is chosen so that it matches the target's 1 − x (a scan over a fixed grid of T,
 //! whose coefficients are computed once, then regula falsi). Each root gives a start
-//! a = (a3, T, a5) that Newton refines.
+//! a = (a3, T, a5) that Newton refines. Under tension beyond T = 4 the fit is made in the
+//! bounded exponentials e^{k(t−1)}, e^{−kt} (`Basis::fit_exponential`): sinh and cosh would
+//! cancel terms of size e^{2k}.
 
 use crate::{wrap_angle, PlanarParams, PlanarPose};
 use std::sync::OnceLock;
