@@ -27,6 +27,32 @@ pub struct ModelEvaluation<const N: usize, X> {
     pub full_accuracy: bool,
 }
 
+/// A full-accuracy planar evaluation (closed form or series).
+impl From<crate::planar::Evaluation> for ModelEvaluation<3, PlanarPose> {
+    fn from(e: crate::planar::Evaluation) -> Self {
+        Self {
+            tip: e.tip,
+            jacobian: e.jacobian,
+            energy: e.energy,
+            stability: e.stability,
+            full_accuracy: true,
+        }
+    }
+}
+
+/// A full-accuracy 3-D evaluation (at the model's rtol).
+impl From<crate::spatial::Evaluation3d> for ModelEvaluation<6, SpatialPose> {
+    fn from(e: crate::spatial::Evaluation3d) -> Self {
+        Self {
+            tip: e.tip,
+            jacobian: e.jacobian,
+            energy: e.energy,
+            stability: e.stability,
+            full_accuracy: true,
+        }
+    }
+}
+
 /// A rod model: a ∈ ℝᴺ ↦ tip pose, with everything the inverse-geometry strategies need.
 pub trait RodModel<const N: usize> {
     /// The tip pose type.
@@ -222,14 +248,7 @@ impl RodModel<3> for PlanarClosedForm {
     }
 
     fn evaluate(&self, a: &Vector3<f64>) -> Result<ModelEvaluation<3, PlanarPose>, RodError> {
-        let e = crate::planar::evaluate(a)?;
-        Ok(ModelEvaluation {
-            tip: e.tip,
-            jacobian: e.jacobian,
-            energy: e.energy,
-            stability: e.stability,
-            full_accuracy: true,
-        })
+        crate::planar::evaluate(a).map(ModelEvaluation::from)
     }
 
     fn evaluate_iterate(
@@ -337,14 +356,7 @@ impl RodModel<6> for Spatial {
             rtol: self.rtol,
             ..crate::spatial::StabilityOptions::production()
         };
-        let e = crate::spatial::evaluate(a, &self.stiffness, &options)?;
-        Ok(ModelEvaluation {
-            tip: e.tip,
-            jacobian: e.jacobian,
-            energy: e.energy,
-            stability: e.stability,
-            full_accuracy: true,
-        })
+        crate::spatial::evaluate(a, &self.stiffness, &options).map(ModelEvaluation::from)
     }
 
     fn energy(&self, a: &SVector<f64, 6>) -> Result<f64, RodError> {
