@@ -22,11 +22,22 @@ fn main() {
         for _ in 0..20_000 {
             let _ = black_box(planar::tip_and_jacobian(black_box(&a)));
         }
+        let t_stab = Instant::now();
+        for _ in 0..20_000 {
+            let _ = black_box(planar::stability(black_box(&a)));
+        }
+        let t_energy = Instant::now();
+        for _ in 0..20_000 {
+            let _ = black_box(planar::energy(black_box(&a)));
+        }
         println!(
-            "evaluate {:.2} µs, tip_and_jacobian {:.2} µs",
+            "evaluate {:.2} µs, tip_and_jacobian {:.2} µs, stability {:.2} µs, energy {:.2} µs",
             (tip - t0).as_secs_f64() * 50.0,
-            tip.elapsed().as_secs_f64() * 50.0
+            (t_stab - tip).as_secs_f64() * 50.0,
+            (t_energy - t_stab).as_secs_f64() * 50.0,
+            t_energy.elapsed().as_secs_f64() * 50.0
         );
+        println!("{:?}", planar::evaluate(&a));
         return;
     }
     let what = args.get(1).map_or("forward", String::as_str);
@@ -99,6 +110,25 @@ fn main() {
                     t / *n as f64
                 );
             }
+        }
+    }
+    if what == "slowest-forward" {
+        // The ten slowest forward evaluations of the sample, with their curvature scale.
+        let mut rows: Vec<(f64, String)> = inputs
+            .iter()
+            .map(|a| {
+                let t = Instant::now();
+                for _ in 0..20 {
+                    let _ = black_box(planar::evaluate(black_box(a)));
+                }
+                let us = t.elapsed().as_secs_f64() * 1e6 / 20.0;
+                let rho = a[0].abs().max(a[1].hypot(a[2]).sqrt());
+                (us, format!("{:?} rho {rho:.3}", a.as_slice()))
+            })
+            .collect();
+        rows.sort_by(|p, q| q.0.total_cmp(&p.0));
+        for (us, row) in rows.iter().take(10) {
+            println!("{us:8.1} µs  {row}");
         }
     }
     if what == "slowest" {

@@ -16,6 +16,7 @@ const TIP_TOL: f64 = 1e-9;
 const JAC_REL_TOL: f64 = 1e-6;
 const REFERENCE_RTOL: f64 = 1e-12;
 const CLEAR_MARGIN: f64 = 1e-3;
+const ENERGY_REL_TOL: f64 = 1e-8;
 
 fn p(a3: f64, a4: f64, a5: f64) -> PlanarParams {
     PlanarParams::new(a3, a4, a5)
@@ -80,6 +81,28 @@ proptest! {
         }
     }
 
+    /// The energy every entry point reports (`evaluate`, `energy`, `PlanarRod::energy`)
+    /// within 1e-8 relative of the reference's ½∫κ² (a quadrature state of the same
+    /// integration), bending ≥ 1e-6 so that the energy (≳ 1e-13) stays far above the
+    /// reference's absolute tolerance. The closed form's identity λ2/2 − a4 x − a5 y cancels on
+    /// nearly straight rods under force; it was off by up to 2e-8 there.
+    #[test]
+    fn energy_matches_reference_on_log_scale(
+        a3 in log_scale(-6.0, 0.7),
+        a4 in log_scale(-9.0, 1.5),
+        a5 in log_scale(-6.0, 1.5),
+    ) {
+        let a = p(a3, a4, a5);
+        prop_assume!(a3.abs().max(a5.abs()) >= 1e-6);
+        let reference = planar_reference::energy(&a, 1e-13).unwrap();
+        let e = planar::evaluate(&a).unwrap().energy;
+        prop_assert!((e - reference).abs() <= ENERGY_REL_TOL * reference,
+            "{a:?}: evaluate {e:e} vs reference {reference:e}");
+        let free = planar::energy(&a).unwrap();
+        prop_assert!((free - reference).abs() <= ENERGY_REL_TOL * reference,
+            "{a:?}: energy() {free:e} vs reference {reference:e}");
+    }
+
     /// g depends on (a3, a5) only through their ratio up to O(σ²) (the map is odd in
     /// (a3, a5)): the margin of a tiny rod equals the margin on the same ray at σ = 1e-6.
     #[test]
@@ -122,6 +145,57 @@ fn gentle_arcs_are_stable_with_a_margin_near_one() {
             (s.margin - r.margin).abs() < 0.02,
             "{a:?}: {s:?} vs reference {r:?}"
         );
+    }
+}
+
+/// Found while extending the closed form below ρ = 2: a near-circle under a tiny force whose
+/// det J(t) at t = 0.05 the closed form cannot resolve (its cancellation grows like 1/(ρt)³);
+/// its error bound claimed it could, and the rod was reported clearly unstable (margin −1.1).
+/// The reference gives a margin of 0.97.
+#[test]
+fn near_circle_under_a_tiny_force_is_stable() {
+    let a = p(-0.5591892386186595, 5e-324, -1.6952053074303805e-5);
+    let s = planar::stability(&a).unwrap();
+    let r = planar_reference::stability(&a).unwrap();
+    assert!(s.stable && !s.uncertain, "{s:?} vs reference {r:?}");
+    assert!(
+        (s.margin - r.margin).abs() < 0.02,
+        "{s:?} vs reference {r:?}"
+    );
+}
+
+/// Found with the energy property test: nearly straight rods under a moderate tension, where
+/// λ2/2 − a4 x − a5 y cancels (energy ~1e-6 against a4 ~ 5): was off by 2.1e-8 relative.
+#[test]
+fn energy_of_nearly_straight_rods_under_tension() {
+    for a in [
+        p(
+            0.00024342400656406497,
+            5.237979469205642,
+            0.004036346542497472,
+        ),
+        p(
+            0.00124300475321155,
+            4.085403463747335,
+            0.0038640067329324397,
+        ),
+        p(
+            -8.087132396235233e-8,
+            1.0085971305615415,
+            -0.0008657072852274446,
+        ),
+    ] {
+        let reference = planar_reference::energy(&a, 1e-13).unwrap();
+        for e in [
+            planar::evaluate(&a).unwrap().energy,
+            planar::energy(&a).unwrap(),
+            planar::PlanarRod::new(&a).unwrap().energy(),
+        ] {
+            assert!(
+                (e - reference).abs() <= 1e-10 * reference,
+                "{a:?}: {e:e} vs reference {reference:e}"
+            );
+        }
     }
 }
 

@@ -39,6 +39,8 @@ pub(crate) struct Eval {
     pub pos_err: f64,
     pub ang_err: f64,
     pub norm: f64,
+    /// ½∫κ² when the evaluation computed it (`verify_with_stability`).
+    pub energy: Option<f64>,
 }
 
 pub(crate) fn eval(a: &PlanarParams, target: &PlanarPose, precision: Precision) -> Option<Eval> {
@@ -62,7 +64,8 @@ pub(crate) fn verify_with_stability(
     tolerance: f64,
 ) -> Option<(Eval, crate::StabilityReport)> {
     let ev = model::evaluate_precise(a).ok()?;
-    let e = eval_from((ev.tip, ev.jacobian), target)?;
+    let mut e = eval_from((ev.tip, ev.jacobian), target)?;
+    e.energy = Some(ev.energy);
     (e.pos_err <= tolerance && e.ang_err <= tolerance).then_some((e, ev.stability))
 }
 
@@ -80,6 +83,7 @@ fn eval_from((tip, jac): (PlanarPose, PlanarJacobian), target: &PlanarPose) -> O
         pos_err,
         ang_err,
         norm: f.norm(),
+        energy: None,
     })
 }
 
@@ -99,7 +103,12 @@ pub(crate) fn make_solution(
         position_error: e.pos_err,
         orientation_error: e.ang_err,
         residual: e.norm,
-        energy: model::energy_from_tip(a, &e.tip),
+        // The identity cancels on nearly straight rods under force: the evaluation's energy
+        // (integrated where needed) when there is one.
+        energy: e
+            .energy
+            .or_else(|| crate::planar::energy(a).ok())
+            .unwrap_or_else(|| model::energy_from_tip(a, &e.tip)),
         evaluations: iterations + 1,
         starts: 1,
         elapsed_us: 0.0,

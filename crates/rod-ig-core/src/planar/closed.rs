@@ -56,7 +56,7 @@ pub(crate) struct Closed<T: Real> {
     /// √m (case I), or 1 − δ/2 (case III).
     sqm: T,
     /// m (cases I, II) ; δ = 1 − m_I (case III; value 0, carries the derivative).
-    m: T,
+    pub(crate) m: T,
     /// Coefficient of t in ∫β1: m1 − m q (I), −q (II).
     lin: T,
     /// m1 = 1 − m (cases I, II), as computed from λ4.
@@ -234,6 +234,22 @@ pub(crate) enum SeriesNeed {
 /// 8.2e-11 relative over 2000 box cases, rounded up).
 pub(crate) const CLOSED_J_REL: f64 = 1e-10;
 
+/// Largest estimated relative error of J ([`Closed::jacobian_rel_error`], cancellation part)
+/// for which the closed form is used; beyond, the Taylor series (exact to ~1e-14). 100× inside
+/// the 1e-6 that issue 9 asks of J, so that det J and Newton steps built on it keep their
+/// digits.
+pub(crate) const CLOSED_J_TOLERANCE: f64 = 1e-8;
+
+/// Growth of the J cancellation loss on gently bent rods, ε·(1/m + 1/m1)·K/ρ³: measured against
+/// the Taylor series on 400,000 log-scale rods with ρ ∈ [0.03, 4] (issue 9 sample), the worst
+/// ratio error/(ε·(1/m + 1/m1)/ρ³) is 170–330 in every ρ bucket; K is that, ×3.
+pub(crate) const CANCELLATION_RHO3: f64 = 1000.0;
+
+/// Pose error of the closed form in ulps: measured ≤ 7·ε·(1 + 1/m + 1/m1) for ρ ≥ 0.5 and
+/// ≤ 6·ε·(1 + 1/m + 1/m1)/ρ below (same sample, against the Taylor series and, where the f64
+/// series is itself ill-conditioned, the double-double one); ×2.
+pub(crate) const CLOSED_POSE_ULPS: f64 = 16.0;
+
 /// Largest phase |Γ| = r + |φ| of the Jacobi functions the closed form accepts: their
 /// argument carries an absolute rounding error ~ε|Γ|, which at 1e9 is ~1e-7 rad, the edge of
 /// the 1e-6 accuracy the solvers need; beyond, the rod is left to the fallbacks.
@@ -252,20 +268,62 @@ struct Invariants<T> {
 }
 
 impl<T: Real> Closed<T> {
-    /// A-priori estimate of the relative error of the J entries: the base accuracy
-    /// [`CLOSED_J_REL`], or the cancellation losses ≈ ε/m1 near the separatrix and ≈ ε/m at small
-    /// m (see [`SEPARATRIX_M1`], [`SMALL_M`]) when larger.
-    pub fn jacobian_rel_error(&self) -> f64 {
-        let loss = match self.case {
-            Case::I | Case::II => 1.0 / self.m1 + 1.0 / self.m.re(),
-            _ => 1.0,
+    /// A-priori estimate of the relative error (Frobenius) of J(t, a): the base accuracy
+    /// [`CLOSED_J_REL`], or, when larger, the cancellation loss ε·(1/m + 1/m1)·s(ρ) of cases I
+    /// and II (near the separatrix 1/m1, at small m 1/m: see [`SEPARATRIX_M1`], [`SMALL_M`]),
+    /// with s(ρ) = max(1, [`CANCELLATION_RHO3`]/ρ³) the growth of that loss on gently bent rods
+    /// of curvature scale ρ; [`Case::SmallForce`] adds its truncation O(m). At t < 1: the part [0, t] of the rod is a rod of length
+    /// t, i.e. a unit rod of curvature scale ρt with the same m and m1, so s(ρ) becomes s(ρt)
+    /// (J(t) of a strongly bent rod is as hard near t = 0 as J(1) of a gently bent one).
+    pub fn jacobian_rel_error_at(&self, t: f64) -> f64 {
+        let e = match self.case {
+            Case::I | Case::II => self.cancellation_loss(t) * f64::EPSILON,
+            Case::SmallForce => self.rho_spread(t) * f64::EPSILON + self.m.re(),
+            _ => 0.0,
         };
-        let e = f64::EPSILON * loss;
         if e.is_finite() {
             e.max(CLOSED_J_REL)
         } else {
             f64::INFINITY
         }
+    }
+
+    /// (1/m + 1/m1)·s(ρt) for cases I and II, s(ρt) alone otherwise (in units of ε).
+    fn cancellation_loss(&self, t: f64) -> f64 {
+        let loss = match self.case {
+            Case::I | Case::II => 1.0 / self.m1 + 1.0 / self.m.re(),
+            _ => 1.0,
+        };
+        loss * self.rho_spread(t)
+    }
+
+    /// s(ρt) = max(1, [`CANCELLATION_RHO3`]/(ρt)³), ρ = max(|a3|, √F): the closed form's
+    /// quantities are O(1) in the rod's own scale, while the entries of J of a gently bent rod
+    /// are O(ρ)..O(ρ³) smaller than the terms they are differences of.
+    fn rho_spread(&self, t: f64) -> f64 {
+        let rho = self
+            .a3
+            .re()
+            .abs()
+            .max(self.a4.re().hypot(self.a5.re()).sqrt())
+            * t;
+        (CANCELLATION_RHO3 / (rho * rho * rho)).max(1.0)
+    }
+
+    /// A-priori bound on the absolute error of the pose (x, y, θ) at any t ∈ [0, 1]:
+    /// [`CLOSED_POSE_ULPS`]·ε·(1 + (1/m + 1/m1))·max(1, 1/ρ) (cases I and II; the other cases
+    /// without the m terms).
+    pub fn pose_abs_error(&self) -> f64 {
+        let rho = self
+            .a3
+            .re()
+            .abs()
+            .max(self.a4.re().hypot(self.a5.re()).sqrt());
+        let loss = match self.case {
+            Case::I | Case::II => 1.0 / self.m1 + 1.0 / self.m.re(),
+            _ => 0.0,
+        };
+        CLOSED_POSE_ULPS * f64::EPSILON * (1.0 + loss) * rho.recip().max(1.0)
     }
 
     /// True when J (and det J) from this closed form may be off by more than ≈ 1e-9 relative:
@@ -308,7 +366,12 @@ impl<T: Real> Closed<T> {
             return false;
         }
         match self.case {
-            Case::I | Case::II => self.m1 < SEPARATRIX_M1 || self.m.re() < SMALL_M,
+            Case::I | Case::II => {
+                self.m1 < SEPARATRIX_M1
+                    || self.m.re() < SMALL_M
+                    || self.cancellation_loss(1.0) * f64::EPSILON > CLOSED_J_TOLERANCE
+            }
+            Case::SmallForce => self.rho_spread(1.0) * f64::EPSILON > CLOSED_J_TOLERANCE,
             Case::III => {
                 let (p, r) = (self.phi.re(), self.r.re());
                 p.abs().max((p + r).abs()) > SEPARATRIX_GAMMA
@@ -479,6 +542,9 @@ impl<T: Real> Closed<T> {
         let m = f * 4.0 / alpha3;
         if m.re() < SMALL_FORCE_M {
             self.case = Case::SmallForce;
+            // Not used by the small-force formulas: kept for the error estimate (J is exact
+            // to O(m) there).
+            self.m = m;
             return Some(());
         }
         let m1 = -lambda4 * 4.0 / (alpha3 * alpha3);

@@ -25,14 +25,13 @@ use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport}
 use taylor::{DualF64x2, Gradient, TaylorRod};
 
 /// Rods with ρ = max(|a3|, √‖(a4, a5)‖) up to this value are evaluated by the Taylor series
-/// (a few steps whose truncation estimate certifies full accuracy: one from 0 to 1 for small ρ,
-/// two to five for ρ ∈ [0.3, 2], where the series' radius of convergence — the distance to the
-/// pendulum solution's complex singularities, ~ln(1/amplitude)/ρ — falls below ~3 and the
-/// derivative parts' terms decay only geometrically). This is the regime of nearly straight, gently bent and tiny
-/// rods, where the closed form is built from O(1) elliptic quantities whose differences are the
-/// answer (cancellation). Above it, the closed form is used unless its own a-priori error
-/// estimate (`Closed::needs_reference`) says it loses accuracy.
-const SERIES_RHO: f64 = 2.0;
+/// without trying the closed form: one step from 0 to 1 (a few µs), and the closed form's own
+/// error estimate ([`Closed::jacobian_rel_error`], which grows like 1/ρ³ on gently bent rods)
+/// would reject nearly all of them. Above, the closed form is used wherever that estimate
+/// allows (J within `CLOSED_J_TOLERANCE`), the series elsewhere: near the separatrix, at small
+/// m (near-circles under a tiny force, nearly straight rods under compression) and on gently
+/// bent rods whose entries of J are far smaller than the elliptic quantities they come from.
+const SERIES_RHO: f64 = 0.25;
 /// Step budget of the f64 Taylor series (bounded time: ≈ 3 µs per step in dual numbers, so
 /// ≲ 6 ms; a rod that needs more steps is beyond what the fallback resolves quickly).
 const SERIES_MAX_STEPS: usize = 2_000;
@@ -318,11 +317,12 @@ impl PlanarRod {
         }
     }
 
-    /// Elastic energy ½∫₀¹κ² = λ2/2 − a4 x(1) − a5 y(1), λ2 = a3² + 2a4 (FINDINGS §1).
+    /// Elastic energy ½∫₀¹κ² = λ2/2 − a4 x(1) − a5 y(1), λ2 = a3² + 2a4 (FINDINGS §1), or
+    /// integrated along the series where that identity cancels (see `closed_energy`).
     /// May be +∞ when a3² overflows (the free function [`energy`] reports that as an error).
     pub fn energy(&self) -> f64 {
         match &self.backend {
-            Backend::Closed(_) => energy_from_tip(&self.a, &self.tip),
+            Backend::Closed(c) => closed_energy(c, &self.a, &self.tip).unwrap_or(f64::INFINITY),
             // ½∫κ² integrated along: the identity cancels for a nearly straight rod under force.
             Backend::Series(r) => r.energy(),
         }
@@ -332,6 +332,39 @@ impl PlanarRod {
 fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
     let (a3, a4, a5) = (a[0], a[1], a[2]);
     0.5 * a3 * a3 + a4 - a4 * tip.x - a5 * tip.y
+}
+
+/// Relative accuracy asked of the energy: issue 9 asks 1e-8; 10× inside, with a bound that
+/// is itself ≥ 2× the measured error.
+const ENERGY_REL_TOLERANCE: f64 = 1e-9;
+
+/// The energy of a rod whose tip came from the closed form `c`: the identity of FINDINGS §1
+/// (free) where its error bound allows, else ½∫κ² integrated along the f64 Taylor series. The
+/// identity subtracts a4·x + a5·y from λ2/2, both ≈ ‖F‖ on a nearly straight rod under force,
+/// whose energy is orders of magnitude smaller: its error is (|a4| + |a5|) times the pose
+/// error ([`Closed::pose_abs_error`]) plus the rounding of the sum.
+fn closed_energy<T: crate::scalar::Real>(
+    c: &Closed<T>,
+    a: &PlanarParams,
+    tip: &PlanarPose,
+) -> Result<f64, RodError> {
+    let (a3, a4, a5) = (a[0], a[1], a[2]);
+    let e = energy_from_tip(a, tip);
+    let rounding =
+        4.0 * f64::EPSILON * (0.5 * a3 * a3 + a4.abs() + (a4 * tip.x).abs() + (a5 * tip.y).abs());
+    let bound = (a4.abs() + a5.abs()) * c.pose_abs_error() + rounding;
+    if !e.is_finite() {
+        return Err(overflow());
+    }
+    if bound <= ENERGY_REL_TOLERANCE * e.abs() {
+        return Ok(e);
+    }
+    let e = series_f64(a, false)?.energy();
+    if e.is_finite() {
+        Ok(e)
+    } else {
+        Err(overflow())
+    }
 }
 
 fn finite_tip([x, y, th]: [f64; 3]) -> Result<PlanarPose, RodError> {
@@ -396,14 +429,6 @@ pub fn pose_and_jacobian(
 /// from it are noise (strong-tension rods, a4 ~ 1e3, were left unsolved).
 const ITERATION_F64_MAX_ERROR: f64 = 1e-6;
 
-/// Smallest curvature scale ρ at which a solver's iterations take the closed form inside the
-/// series' domain (ρ ≤ [`SERIES_RHO`]) when its error estimate holds. Below, the series is one
-/// short step (cheap) and the closed form's cancellation grows like 1/ρ²; above, the two agree
-/// to ~1e-13 in the tip and ≤ 3.3e-7 relative in J (near-circles under a tiny force; test
-/// `iteration_closed_form_agrees_with_the_series`), inside what a Newton step needs, and every
-/// answer is re-evaluated by the series.
-const ITERATION_CLOSED_RHO: f64 = 0.25;
-
 /// Whether iterations near `a` need the double-double series near the separatrix
 /// (ε·e^{√‖F‖} > [`ITERATION_F64_MAX_ERROR`]). Solvers decide this once per start, from the
 /// start: a start in the strong-tension regime iterates precisely (a few ms per evaluation),
@@ -423,21 +448,6 @@ pub(crate) fn tip_and_jacobian_for_iteration(
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     check_params(a)?;
     if series_first(a) {
-        if curvature_scale(a) >= ITERATION_CLOSED_RHO {
-            // The closed form where its own error estimate holds: the series costs 10-20 µs
-            // here (several steps of order 32 in dual numbers), the closed form < 1 µs.
-            let closed = with_seeded(
-                a,
-                |c| match c.needs_series() {
-                    SeriesNeed::None => pose_jac_from(c.pose(1.0)).map(Some),
-                    _ => Ok(None),
-                },
-                || Ok(None),
-            );
-            if let Ok(Some(tip_and_jac)) = closed {
-                return Ok(tip_and_jac);
-            }
-        }
         return series_pose_and_jac(a, 1.0);
     }
     with_seeded(
@@ -531,10 +541,7 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
                 });
             }
             let (tip, jacobian) = pose_and_jac_of(c, a, 1.0)?;
-            let energy = energy_from_tip(a, &tip);
-            if !energy.is_finite() {
-                return Err(overflow());
-            }
+            let energy = closed_energy(c, a, &tip)?;
             let stability = stability::stability_of(c, a)?;
             Ok(Evaluation {
                 tip,
@@ -552,13 +559,15 @@ mod tests {
     use super::*;
     use crate::rng::SplitMix64;
 
-    /// Where solver iterations take the closed form inside the series' domain, it agrees with
-    /// the series (the accurate formulation there) far below what a Newton step needs: tip
-    /// within 1e-10 absolute (measured 9e-14), J within 1e-6 relative (Frobenius; measured
-    /// 3.3e-7, on near-circles under a force of ~1e-7: a Newton step with that J error still
-    /// contracts by ~1e-7 · cond J per iteration). Log-scale magnitudes, random signs.
+    /// Where the closed form is chosen on the rods the series used to take (ρ ∈ [0.25, 4],
+    /// log-scale magnitudes, random signs), its a-priori estimates bound its actual errors
+    /// against the Taylor series (accurate to ~1e-14 there: e^{√F} ≤ e² amplification): J
+    /// within `jacobian_rel_error` (relative, Frobenius), every pose component within
+    /// `pose_abs_error`, and the energy `evaluate` reports within 1e-9 relative (its own
+    /// bound is 1e-10: the identity where it holds, the series elsewhere). Measured worst
+    /// ratios: J 0.38 of its estimate, pose 0.43; energy 2.6e-12.
     #[test]
-    fn iteration_closed_form_agrees_with_the_series() {
+    fn closed_form_where_chosen_meets_its_error_estimates() {
         let mut r = SplitMix64::new(17);
         let mut signed = |lo: f64, hi: f64| {
             let v = 10f64.powf(r.range(lo, hi));
@@ -568,32 +577,48 @@ mod tests {
                 v
             }
         };
-        let (mut closed_used, mut worst_tip, mut worst_j) = (0, 0.0f64, 0.0f64);
-        for _ in 0..20_000 {
-            let a = PlanarParams::new(signed(-8.0, 0.4), signed(-9.0, 0.7), signed(-9.0, 0.7));
-            let rho = curvature_scale(&a);
-            if !(ITERATION_CLOSED_RHO..=SERIES_RHO).contains(&rho) {
+        let (mut closed_used, mut in_domain) = (0usize, 0usize);
+        let (mut worst_j, mut worst_tip, mut worst_e) = (0.0f64, 0.0f64, 0.0f64);
+        for _ in 0..40_000 {
+            let a = PlanarParams::new(signed(-8.0, 0.7), signed(-9.0, 1.2), signed(-9.0, 1.2));
+            if !(SERIES_RHO..=4.0).contains(&curvature_scale(&a)) {
                 continue;
             }
-            let (tip, j) = tip_and_jacobian_for_iteration(&a, false).unwrap();
-            let (tip_s, j_s) = series_pose_and_jac(&a, 1.0).unwrap();
-            if tip == tip_s && j == j_s {
-                continue; // the series itself was used
-            }
+            in_domain += 1;
+            let seeded = Closed::new(
+                Dual3::variable(a[0], 0),
+                Dual3::variable(a[1], 1),
+                Dual3::variable(a[2], 2),
+            );
+            let Some(c) = seeded.filter(|c| c.needs_series() == SeriesNeed::None) else {
+                continue;
+            };
             closed_used += 1;
+            let (tip, j) = pose_jac_from(c.pose(1.0)).unwrap();
+            let rod = series_dual(&a, false).unwrap();
+            let (tip_s, j_s) = pose_jac_from(rod.tip()).unwrap();
             let dtip = (tip.x - tip_s.x)
                 .abs()
                 .max((tip.y - tip_s.y).abs())
                 .max((tip.theta - tip_s.theta).abs());
-            worst_tip = worst_tip.max(dtip);
-            worst_j = worst_j.max((j - j_s).norm() / j_s.norm());
+            worst_tip = worst_tip.max(dtip / c.pose_abs_error());
+            worst_j = worst_j.max((j - j_s).norm() / j_s.norm() / c.jacobian_rel_error_at(1.0));
+            let e = evaluate(&a).unwrap().energy;
+            worst_e = worst_e.max((e - rod.energy().v).abs() / rod.energy().v);
         }
-        eprintln!("closed form used on {closed_used} rods: tip {worst_tip:e}, J {worst_j:e}");
-        assert!(
-            closed_used > 1000,
-            "only {closed_used} rods took the closed form"
+        eprintln!(
+            "closed form on {closed_used} of {in_domain} rods: J error / estimate {worst_j:.2}, \
+             pose error / estimate {worst_tip:.2}, energy {worst_e:.1e} relative"
         );
-        assert!(worst_tip <= 1e-10, "tip differs by {worst_tip:e}");
-        assert!(worst_j <= 1e-6, "J differs by {worst_j:e} relative");
+        assert!(
+            closed_used * 2 > in_domain,
+            "the closed form took only {closed_used} of {in_domain} rods"
+        );
+        assert!(worst_j <= 1.0, "J error {worst_j} times its estimate");
+        assert!(
+            worst_tip <= 1.0,
+            "pose error {worst_tip} times its estimate"
+        );
+        assert!(worst_e <= 1e-9, "energy off by {worst_e:e} relative");
     }
 }

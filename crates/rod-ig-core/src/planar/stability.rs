@@ -75,7 +75,7 @@ fn rows(p: &[Dual3; 3]) -> [[f64; 3]; 3] {
 /// g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (FINDINGS §5) and its error bound, from the
 /// dual-number closed form.
 fn normalised_det(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64) -> (f64, f64) {
-    let (det, err) = det_and_error(&rows(&c.pose(t)), c.jacobian_rel_error(), CLOSED_J_ABS);
+    let (det, err) = det_and_error(&rows(&c.pose(t)), c.jacobian_rel_error_at(t), CLOSED_J_ABS);
     let n = normalisation(a3, a5, t);
     (det / n, err / n)
 }
@@ -218,7 +218,17 @@ pub(crate) fn stability_of(
         SeriesNeed::None => {}
     }
     let (a3, a5) = (a[0], a[2]);
-    let g = |t: f64| normalised_det(c, a3, a5, t);
+    // At small t the entries of J(t) are O(t)..O(t³) and the closed form's absolute error
+    // floor swamps det J ∝ t⁹: there g comes from a short Taylor series from the base,
+    // which is accurate relative to itself (one low-order step for t ≲ 0.2).
+    let start = ShortSeries::new(a);
+    let g = |t: f64| {
+        let (v, e) = normalised_det(c, a3, a5, t);
+        if e <= CLOSED_G_ERROR {
+            return (v, e);
+        }
+        start.normalised_det(t).unwrap_or((v, e))
+    };
     let wl = c.wavelength();
     // No conjugate point comes before a fraction of the half-wavelength, and there the
     // closed-form det J (≈ t⁹) is swamped by rounding: start the scan at t0.
@@ -231,6 +241,64 @@ pub(crate) fn stability_of(
         return stability_of_series(a, None, Some(wl), false);
     }
     Ok(report)
+}
+
+/// Largest error bound of the closed form's g(t) for which the scan takes its value (g is
+/// scale-free, ≈ 1 on a gently bent rod: a thousandth of that cannot decide a sign or the
+/// margin's verdict; near a root of g the bound is small and the closed form is kept).
+const CLOSED_G_ERROR: f64 = 1e-3;
+/// Step budget of the short series (≈ 3 µs per step): beyond, the rod is too strongly bent
+/// for a short start and the closed form's value stands (an uncertain verdict then goes to
+/// the full series, as without the short series).
+const SHORT_SERIES_MAX_STEPS: usize = 24;
+
+/// The rod's Taylor series from the base to some t_end ≤ 1, built on first use and extended
+/// (rebuilt to 2t) when asked beyond its end.
+struct ShortSeries {
+    a: PlanarParams,
+    /// (t_end, the series; None when it could not be built within its budget).
+    rod: std::cell::RefCell<Option<(f64, Option<TaylorRod<Dual3>>)>>,
+}
+
+impl ShortSeries {
+    fn new(a: &PlanarParams) -> Self {
+        Self {
+            a: *a,
+            rod: std::cell::RefCell::new(None),
+        }
+    }
+
+    /// g(t) and its error bound from the series; None where the series cannot be built (the
+    /// caller keeps the closed form's value) or the bending is too small to scale (σ < 1e-60,
+    /// where `stability_of_series` works on a ray).
+    fn normalised_det(&self, t: f64) -> Option<(f64, f64)> {
+        let (a3, a5) = (self.a[0], self.a[2]);
+        if a3.abs().max(a5.abs()) < SIGMA_RAY {
+            return None;
+        }
+        let mut slot = self.rod.borrow_mut();
+        if let Some((_, None)) = slot.as_ref() {
+            return None;
+        }
+        if slot.as_ref().is_none_or(|(end, _)| *end < t) {
+            let end = (2.0 * t).clamp(0.2, 1.0);
+            let rod = TaylorRod::new_to(
+                Dual3::variable(a3, 0),
+                Dual3::variable(self.a[1], 1),
+                Dual3::variable(a5, 2),
+                end,
+                SHORT_SERIES_MAX_STEPS,
+                true,
+            )
+            .ok();
+            *slot = Some((end, rod));
+        }
+        let (_, Some(rod)) = slot.as_ref()? else {
+            return None;
+        };
+        let (v, e) = normalised_det_series(rod, a3, a5, t);
+        v.is_finite().then_some((v, e))
+    }
 }
 
 /// What a scan of g found.

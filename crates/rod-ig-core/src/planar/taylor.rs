@@ -426,6 +426,19 @@ impl<T: Measured> TaylorRod<T> {
     /// `dense` keeps every step's polynomials (for [`Self::pose`] at interior t); otherwise
     /// only the end state is kept.
     pub fn new(a3: T, a4: T, a5: T, max_steps: usize, dense: bool) -> Result<Self, RodError> {
+        Self::new_to(a3, a4, a5, 1.0, max_steps, dense)
+    }
+
+    /// [`Self::new`] on [0, `t_end`] only (t_end ≤ 1): the first part of a rod, e.g. where the
+    /// closed form cannot resolve det J(t) at small t. `tip` and `energy` are then at t_end.
+    pub fn new_to(
+        a3: T,
+        a4: T,
+        a5: T,
+        t_end: f64,
+        max_steps: usize,
+        dense: bool,
+    ) -> Result<Self, RodError> {
         let zero = T::constant(0.0);
         let mut state = [zero; SERIES];
         state[K] = a3;
@@ -440,7 +453,7 @@ impl<T: Measured> TaylorRod<T> {
                 Some(s) => s,
                 None => Box::new(Segment::empty()),
             };
-            step(&mut seg, &state, a4, a5, t0, 1.0 - t0)?;
+            step(&mut seg, &state, a4, a5, t0, t_end - t0)?;
             state = seg.state_at_end();
             if !state
                 .iter()
@@ -448,7 +461,11 @@ impl<T: Measured> TaylorRod<T> {
             {
                 return Err(overflow());
             }
-            t0 = if seg.h >= 1.0 - t0 { 1.0 } else { t0 + seg.h };
+            t0 = if seg.h >= t_end - t0 {
+                t_end
+            } else {
+                t0 + seg.h
+            };
             if !dense {
                 scratch = Some(seg);
             } else if first.is_none() {
@@ -456,7 +473,7 @@ impl<T: Measured> TaylorRod<T> {
             } else {
                 rest.push(*seg);
             }
-            if t0 >= 1.0 {
+            if t0 >= t_end {
                 return Ok(Self {
                     first,
                     rest,
