@@ -404,8 +404,8 @@ pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
 
 /// Pose q(t, a) and J(t, a) = ∂q(t)/∂a (rows x, y, θ; columns a3, a4, a5), exact up to
 /// rounding: the closed form evaluated in forward-mode dual numbers, or, for nearly straight,
-/// gently bent and tiny rods (ρ ≤ 2) and in the thin regimes where the closed form's error
-/// estimate fails (1 − m < 1e-7 near the separatrix, m < 1e-6, see `Closed::needs_series`),
+/// gently bent and tiny rods (ρ ≤ 0.25) and wherever the closed form's error estimate fails
+/// (near the separatrix, at small m, gently bent rods: see `Closed::needs_series`),
 /// the Taylor series in dual numbers (double-double where rounding grows like e^{√‖F‖}).
 /// FINDINGS §4 asks for such a fallback.
 pub fn pose_and_jacobian(
