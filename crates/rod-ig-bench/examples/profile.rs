@@ -14,28 +14,20 @@ fn main() {
         // `one a3 a4 a5`: the forward evaluation of one rod, timed over 20,000 calls.
         let v: Vec<f64> = args[2..5].iter().filter_map(|s| s.parse().ok()).collect();
         let a = rod_ig_core::PlanarParams::new(v[0], v[1], v[2]);
-        let t0 = Instant::now();
-        for _ in 0..20_000 {
-            let _ = black_box(planar::evaluate(black_box(&a)));
-        }
-        let tip = Instant::now();
-        for _ in 0..20_000 {
-            let _ = black_box(planar::tip_and_jacobian(black_box(&a)));
-        }
-        let t_stab = Instant::now();
-        for _ in 0..20_000 {
-            let _ = black_box(planar::stability(black_box(&a)));
-        }
-        let t_energy = Instant::now();
-        for _ in 0..20_000 {
-            let _ = black_box(planar::energy(black_box(&a)));
+        // µs per call, over 20,000 calls.
+        fn per_call<R>(f: impl Fn() -> R) -> f64 {
+            let t = Instant::now();
+            for _ in 0..20_000 {
+                let _ = black_box(f());
+            }
+            t.elapsed().as_secs_f64() * 50.0
         }
         println!(
             "evaluate {:.2} µs, tip_and_jacobian {:.2} µs, stability {:.2} µs, energy {:.2} µs",
-            (tip - t0).as_secs_f64() * 50.0,
-            (t_stab - tip).as_secs_f64() * 50.0,
-            (t_energy - t_stab).as_secs_f64() * 50.0,
-            t_energy.elapsed().as_secs_f64() * 50.0
+            per_call(|| planar::evaluate(black_box(&a))),
+            per_call(|| planar::tip_and_jacobian(black_box(&a))),
+            per_call(|| planar::stability(black_box(&a))),
+            per_call(|| planar::energy(black_box(&a))),
         );
         println!("{:?}", planar::evaluate(&a));
         return;

@@ -301,24 +301,23 @@ impl<T: Real> Closed<T> {
     /// quantities are O(1) in the rod's own scale, while the entries of J of a gently bent rod
     /// are O(ρ)..O(ρ³) smaller than the terms they are differences of.
     fn rho_spread(&self, t: f64) -> f64 {
-        let rho = self
-            .a3
+        let rho = self.curvature_scale() * t;
+        (CANCELLATION_RHO3 / (rho * rho * rho)).max(1.0)
+    }
+
+    /// ρ = max(|a3|, √F), the rod's curvature scale.
+    fn curvature_scale(&self) -> f64 {
+        self.a3
             .re()
             .abs()
             .max(self.a4.re().hypot(self.a5.re()).sqrt())
-            * t;
-        (CANCELLATION_RHO3 / (rho * rho * rho)).max(1.0)
     }
 
     /// A-priori bound on the absolute error of the pose (x, y, θ) at any t ∈ [0, 1]:
     /// [`CLOSED_POSE_ULPS`]·ε·(1 + (1/m + 1/m1))·max(1, 1/ρ) (cases I and II; the other cases
     /// without the m terms).
     pub fn pose_abs_error(&self) -> f64 {
-        let rho = self
-            .a3
-            .re()
-            .abs()
-            .max(self.a4.re().hypot(self.a5.re()).sqrt());
+        let rho = self.curvature_scale();
         let loss = match self.case {
             Case::I | Case::II => 1.0 / self.m1 + 1.0 / self.m.re(),
             _ => 0.0,
