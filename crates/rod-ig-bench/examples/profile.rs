@@ -11,16 +11,20 @@ use std::time::Instant;
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.get(1).map(String::as_str) == Some("one") {
-        // `one a3 a4 a5`: the forward evaluation of one rod, timed over 20,000 calls.
+        // `one a3 a4 a5`: the forward evaluation of one rod, each call timed over ~0.2 s.
         let v: Vec<f64> = args[2..5].iter().filter_map(|s| s.parse().ok()).collect();
         let a = rod_ig_core::PlanarParams::new(v[0], v[1], v[2]);
-        // µs per call, over 20,000 calls.
+        // µs per call: one call sizes the loop so that a slow rod does not take minutes.
         fn per_call<R>(f: impl Fn() -> R) -> f64 {
             let t = Instant::now();
-            for _ in 0..20_000 {
+            let _ = black_box(f());
+            let first = t.elapsed().as_secs_f64();
+            let calls = (0.2 / first.max(1e-9)).clamp(1.0, 20_000.0) as u32;
+            let t = Instant::now();
+            for _ in 0..calls {
                 let _ = black_box(f());
             }
-            t.elapsed().as_secs_f64() * 50.0
+            t.elapsed().as_secs_f64() * 1e6 / f64::from(calls)
         }
         println!(
             "evaluate {:.2} µs, tip_and_jacobian {:.2} µs, stability {:.2} µs, energy {:.2} µs",
@@ -35,7 +39,12 @@ fn main() {
     let what = args.get(1).map_or("forward", String::as_str);
     let index: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1);
     let rounds: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(20);
-    let sets = samples(1000);
+    let sets = samples(
+        std::env::var("PROFILE_N")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(1000),
+    );
     let (name, inputs) = &sets[index.min(sets.len() - 1)];
     // Optional ρ window: only rods with lo ≤ ρ < hi.
     let lo: f64 = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(0.0);

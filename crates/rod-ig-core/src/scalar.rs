@@ -35,6 +35,9 @@ pub trait Real:
     fn from_f64(v: f64) -> Self;
     /// The f64 value (the real part of a dual number).
     fn re(self) -> f64;
+    /// The same number with its value replaced by `v` (derivatives kept): for a value computed
+    /// more accurately than the arithmetic that produced the derivatives.
+    fn with_re(self, v: f64) -> Self;
     /// Square root. For a dual number at value 0 the derivative is set to 0 (not ∞).
     fn sqrt(self) -> Self;
     /// Sine.
@@ -87,6 +90,10 @@ impl Real for f64 {
     #[inline]
     fn re(self) -> f64 {
         self
+    }
+    #[inline]
+    fn with_re(self, v: f64) -> Self {
+        v
     }
     #[inline]
     fn sqrt(self) -> Self {
@@ -384,6 +391,10 @@ impl Real for Dual3 {
     #[inline]
     fn re(self) -> f64 {
         self.v
+    }
+    #[inline]
+    fn with_re(self, v: f64) -> Self {
+        Dual3 { v, g: self.g }
     }
     #[inline]
     fn sqrt(self) -> Self {

@@ -61,6 +61,9 @@ pub(crate) struct Closed<T: Real> {
     lin: T,
     /// m1 = 1 − m (cases I, II), as computed from λ4.
     pub m1: f64,
+    /// (a5² + a3²|a3²/4 + a4|)/|λ4| ≥ 1: how much the terms of λ4 cancel (≈ 1 for a rod with
+    /// little bending near the separatrix, ~1/m1 for O(1) parameters tuned onto it).
+    lambda4_spread: f64,
     landen: Duplication<T>,
     /// Jacobi values at Γ0 = φ (cases I, II).
     j0: JacobiValues<T>,
@@ -87,6 +90,49 @@ fn near_one<T: Real>(u: T, delta: T) -> (T, T, T, T) {
     let dn = se + q * th * (sh + u * se);
     let e = th + delta * 0.5 * (u - th * 0.5 - u * se * se * 0.5);
     (sn, cn, dn, e)
+}
+
+/// λ4 = a5² − a3²(a3²/4 + a4) (FINDINGS §2) to about ε relative to itself: the two terms cancel
+/// near the separatrix (λ4 = 0), and m1 ∝ λ4 sets every log-singular piece of the closed form
+/// there (a = (2, 3, 4 + 1e-8): λ4 = 8e-8 from terms of 16, so f64 leaves it 4e-8 off and J(t)
+/// 1.5e-6 off). Products by Dekker's exact two_prod, the sums in double-double; falls back to
+/// f64 where the splitting would overflow (|a| ≳ 1e150: λ4 is then not near a cancellation
+/// anyway, or the rod is beyond the fallbacks).
+fn lambda4_value(a3: f64, a4: f64, a5: f64) -> f64 {
+    use crate::eft::{two_prod, two_sum};
+    let plain = a5 * a5 - a3 * a3 * (a3 * a3 * 0.25 + a4);
+    if !(a3.abs().max(a5.abs()) < 1e150 && a4.abs() < 1e300) {
+        return plain;
+    }
+    let (p, pe) = two_prod(a5, a5);
+    let (s, se) = two_prod(a3, a3);
+    // a3²/4 + a4 (a3²/4 exact: a power-of-two scaling)
+    let (i, ie) = two_sum(s * 0.25, a4);
+    let i_lo = ie + se * 0.25;
+    let (q, qe) = two_prod(s, i);
+    let q_lo = qe + s * i_lo + se * i;
+    let (d, de) = two_sum(p, -q);
+    let v = d + (de + pe - q_lo);
+    if v.is_finite() {
+        v
+    } else {
+        plain
+    }
+}
+
+/// m near 1 (m1 < 1/2) as 1 − m1. Both formulas for m are exact, but m's derivatives from
+/// its own formula (α3/(4F) in case I, 4F/α3 in case II) are differences of O(1/F) terms
+/// that cancel to O(m1): their rounding, ε/F, is then amplified by the ~1/m1 sensitivity of
+/// K, E and the phase near the separatrix (the ∂/∂a4 column of J was lost, e.g. 1.49 for
+/// 3.8e-5 at m1 = 9e-26). 1 − m1 carries m1's derivatives, which come from λ4 without
+/// cancellation.
+#[inline]
+fn complement_near_one<T: Real>(m: T, m1: T) -> T {
+    if m1.re() < 0.5 {
+        T::from_f64(1.0) - m1
+    } else {
+        m
+    }
 }
 
 /// Integrals S1 = ∫₀ᵗ C, S2 = ∫₀ᵗ S1, S3 = ∫₀ᵗ S2 of the linearised straight rod
@@ -200,10 +246,34 @@ fn circle_force_terms<T: Real>(c: T, t: f64) -> [T; 6] {
     }
 }
 
-/// Below this m1 the dual-number derivatives lose ≈ 1e-16/m1 (relative) to cancellation
-/// between the log-singular pieces of the Landen form (K, E/K, Z and the phase all behave like
-/// ln m1 while J is analytic across the separatrix).
+/// Below this m1 (near the separatrix) the closed form's J error is estimated by
+/// [`SEPARATRIX_J_ULPS`]/√m1 instead of 1/m1: with m's derivatives taken from m1's (see
+/// `complement_near_one`) the remaining loss grows like 1/√m1 — the rod lingers by the
+/// hyperbolic straight equilibrium over a phase ≈ K(m) ≈ ln(4/√m1), where its J entries are
+/// e^{−K} ≈ √m1 times the O(1) elliptic pieces they are differences of.
 pub(crate) const SEPARATRIX_M1: f64 = 1e-7;
+/// Near the separatrix (m1 < [`SEPARATRIX_M1`]) the relative J error of the closed form is
+/// estimated as ε·s(ρ)·(1/m + this/√m1). Measured against the rigorous 320-bit reference
+/// (scripts/gen_separatrix_truth.py, 940 rods with m1 from 1e-30 to 1e-7 and ρ from 0.1 to
+/// 100) and the double-double series (18,000 rods, ρ ≤ 12): error·√m1/(ε·s(ρ)) ≤ 0.42 (ρ ≤ 12)
+/// and ≤ 0.71 (ρ ≥ 28); this is that, ×3.
+pub(crate) const SEPARATRIX_J_ULPS: f64 = 2.0;
+/// Largest (a5² + a3²|a3²/4 + a4|)/(F α3) (the terms of m1 before they cancel) for which the
+/// separatrix estimates apply: the rigorous-reference samples (little bending under a force)
+/// reach 8.3e-7.
+pub(crate) const SEPARATRIX_TERMS_MAX: f64 = 1e-6;
+/// Near the separatrix the pose error is estimated with this in place of 1/m1 (measured ≤ 226 ε
+/// for ρ ≥ 1 and ≤ 374 ε/ρ below, same samples: 16·(1 + 40) covers both ×2.9).
+const SEPARATRIX_POSE_LOSS: f64 = 40.0;
+/// Largest J error estimate accepted from the closed form near the separatrix when no
+/// certified fallback exists (√‖F‖ beyond what the double-double series certifies): ten times
+/// inside the 1e-6 that issue 9 asks of J, instead of [`CLOSED_J_TOLERANCE`]'s hundred.
+pub(crate) const CLOSED_J_LAST_RESORT: f64 = 1e-7;
+/// Largest √‖F‖ for which the double-double series is certified: rounding and truncation
+/// (≤ 1e-22 per step) made near the hyperbolic straight equilibrium grow by up to e^{√‖F‖},
+/// ≤ 5e-11 here. Beyond (measured: tips off by 0.25 and J by 100 % at √‖F‖ ≈ 50–100 and
+/// m1 < 1e-19), only the closed form answers, or a clear error.
+pub(crate) const SERIES_DD_MAX_ROOT_F: f64 = 27.0;
 /// Below this m (cases I and II, above the [`Case::SmallForce`] switch) the dual-number
 /// derivatives lose ≈ 1e-16/m to cancellation in ∂(a4/F, a5/F, √α3)/∂a (near-straight rods
 /// under compression, near-circles); det J, whose x-row is then O(√m), cannot be trusted.
@@ -269,12 +339,14 @@ struct Invariants<T> {
 
 impl<T: Real> Closed<T> {
     /// A-priori estimate of the relative error (Frobenius) of J(t, a): the base accuracy
-    /// [`CLOSED_J_REL`], or, when larger, the cancellation loss ε·(1/m + 1/m1)·s(ρ) of cases I
-    /// and II (near the separatrix 1/m1, at small m 1/m: see [`SEPARATRIX_M1`], [`SMALL_M`]),
-    /// with s(ρ) = max(1, [`CANCELLATION_RHO3`]/ρ³) the growth of that loss on gently bent rods
-    /// of curvature scale ρ; [`Case::SmallForce`] adds its truncation O(m). At t < 1: the part [0, t] of the rod is a rod of length
-    /// t, i.e. a unit rod of curvature scale ρt with the same m and m1, so s(ρ) becomes s(ρt)
-    /// (J(t) of a strongly bent rod is as hard near t = 0 as J(1) of a gently bent one).
+    /// [`CLOSED_J_REL`], or, when larger, the cancellation loss ε·(1/m + L(m1))·s(ρ) of cases I
+    /// and II, with L = 1/m1, or [`SEPARATRIX_J_ULPS`]/√m1 near the separatrix (m1 <
+    /// [`SEPARATRIX_M1`]); 1/m is the loss at small m ([`SMALL_M`]) and s(ρ) = max(1,
+    /// [`CANCELLATION_RHO3`]/ρ³) the growth of that loss on gently bent rods of curvature scale
+    /// ρ; [`Case::SmallForce`] adds its truncation O(m). At t < 1: the part [0, t] of the rod
+    /// is a rod of length t, i.e. a unit rod of curvature scale ρt with the same m and m1, so
+    /// s(ρ) becomes s(ρt) (J(t) of a strongly bent rod is as hard near t = 0 as J(1) of a
+    /// gently bent one).
     pub fn jacobian_rel_error_at(&self, t: f64) -> f64 {
         let e = match self.case {
             Case::I | Case::II => self.cancellation_loss(t) * f64::EPSILON,
@@ -288,13 +360,41 @@ impl<T: Real> Closed<T> {
         }
     }
 
-    /// (1/m + 1/m1)·s(ρt) for cases I and II, s(ρt) alone otherwise (in units of ε).
+    /// (1/m + L(m1))·s(ρt) for cases I and II, s(ρt) alone otherwise (in units of ε).
     fn cancellation_loss(&self, t: f64) -> f64 {
         let loss = match self.case {
-            Case::I | Case::II => 1.0 / self.m1 + 1.0 / self.m.re(),
+            Case::I | Case::II => self.m1_loss_j() + 1.0 / self.m.re(),
             _ => 1.0,
         };
         loss * self.rho_spread(t)
+    }
+
+    /// Near the separatrix with little bending: m1 < [`SEPARATRIX_M1`] and the terms of λ4
+    /// small too (c·m1 ≤ [`SEPARATRIX_TERMS_MAX`], c = `lambda4_spread`), the regime where the
+    /// separatrix estimates were measured. O(1) parameters tuned onto the separatrix (a = (2, 3,
+    /// 4 + 1e-8): terms of λ4 ~ 16, c·m1 = 0.16) keep the 1/m1 estimate, hence the series.
+    fn near_separatrix_weakly_bent(&self) -> bool {
+        self.m1 < SEPARATRIX_M1 && self.lambda4_spread * self.m1 <= SEPARATRIX_TERMS_MAX
+    }
+
+    /// The m1 part of J's cancellation loss: 1/m1, or near the separatrix with little bending
+    /// [`SEPARATRIX_J_ULPS`]/√m1.
+    fn m1_loss_j(&self) -> f64 {
+        if self.near_separatrix_weakly_bent() {
+            SEPARATRIX_J_ULPS / self.m1.sqrt()
+        } else {
+            1.0 / self.m1
+        }
+    }
+
+    /// The m1 part of the pose's loss: 1/m1, or near the separatrix with little bending
+    /// [`SEPARATRIX_POSE_LOSS`].
+    fn m1_loss_pose(&self) -> f64 {
+        if self.near_separatrix_weakly_bent() {
+            SEPARATRIX_POSE_LOSS
+        } else {
+            1.0 / self.m1
+        }
     }
 
     /// s(ρt) = max(1, [`CANCELLATION_RHO3`]/(ρt)³), ρ = max(|a3|, √F): the closed form's
@@ -319,7 +419,7 @@ impl<T: Real> Closed<T> {
     pub fn pose_abs_error(&self) -> f64 {
         let rho = self.curvature_scale();
         let loss = match self.case {
-            Case::I | Case::II => 1.0 / self.m1 + 1.0 / self.m.re(),
+            Case::I | Case::II => self.m1_loss_pose() + 1.0 / self.m.re(),
             _ => 0.0,
         };
         CLOSED_POSE_ULPS * f64::EPSILON * (1.0 + loss) * rho.recip().max(1.0)
@@ -339,16 +439,33 @@ impl<T: Real> Closed<T> {
     /// rod lingers by the hyperbolic straight equilibrium, where rounding grows exponentially
     /// (ill-conditioned: double-double series); at small m the loss is plain cancellation in the
     /// closed form (f64 series).
+    ///
+    /// Near the separatrix under a force beyond what the double-double series certifies
+    /// (√‖F‖ > [`SERIES_DD_MAX_ROOT_F`]) the closed form is kept while its estimate is within
+    /// [`CLOSED_J_LAST_RESORT`]; beyond, `IllConditioned` leads to the series' clear error.
     pub fn needs_series(&self) -> SeriesNeed {
         if !self.needs_reference_by_estimate() {
             SeriesNeed::None
-        } else if (self.case == Case::III || self.m1 < SEPARATRIX_M1)
-            && self.rounding_amplification() * f64::EPSILON > SERIES_F64_ERROR
-        {
-            SeriesNeed::IllConditioned
+        } else if self.needs_precise_series() {
+            let root_f = self.a4.re().hypot(self.a5.re()).sqrt();
+            if root_f > SERIES_DD_MAX_ROOT_F
+                && matches!(self.case, Case::I | Case::II)
+                && self.cancellation_loss(1.0) * f64::EPSILON <= CLOSED_J_LAST_RESORT
+            {
+                SeriesNeed::None
+            } else {
+                SeriesNeed::IllConditioned
+            }
         } else {
             SeriesNeed::Cancellation
         }
+    }
+
+    /// Whether a series standing in for this closed form must be the double-double one: near
+    /// the separatrix, where f64 rounding grows like e^{√‖F‖} beyond [`SERIES_F64_ERROR`].
+    pub fn needs_precise_series(&self) -> bool {
+        (self.case == Case::III || self.m1 < SEPARATRIX_M1)
+            && self.rounding_amplification() * f64::EPSILON > SERIES_F64_ERROR
     }
 
     /// Growth of a rounding error made along the rod near the separatrix: the linearisation
@@ -366,8 +483,7 @@ impl<T: Real> Closed<T> {
         }
         match self.case {
             Case::I | Case::II => {
-                self.m1 < SEPARATRIX_M1
-                    || self.m.re() < SMALL_M
+                self.m.re() < SMALL_M
                     || self.cancellation_loss(1.0) * f64::EPSILON > CLOSED_J_TOLERANCE
             }
             Case::SmallForce => self.rho_spread(1.0) * f64::EPSILON > CLOSED_J_TOLERANCE,
@@ -413,6 +529,7 @@ impl<T: Real> Closed<T> {
             m: zero,
             lin: zero,
             m1: 1.0,
+            lambda4_spread: 1.0,
             landen: dummy_landen,
             j0: dummy_j,
             th0: zero,
@@ -440,11 +557,13 @@ impl<T: Real> Closed<T> {
         };
         let a3s = a3 * a3;
         let alpha3 = a3s + fp * 2.0;
-        let lambda4 = a5 * a5 - a3s * (a3s * 0.25 + a4);
+        let lambda4 = (a5 * a5 - a3s * (a3s * 0.25 + a4)).with_re(lambda4_value(a3r, a4r, a5r));
         s.chat = a4 / f;
         s.shat = a5 / f;
         s.sqa3 = alpha3.sqrt();
         let l4 = lambda4.re();
+        s.lambda4_spread =
+            ((a5r * a5r + a3r * a3r * (a3r * a3r * 0.25 + a4r).abs()) / l4.abs()).max(1.0);
         if !(f.re().is_finite() && alpha3.re().is_finite() && l4.is_finite()) {
             return None;
         }
@@ -493,8 +612,8 @@ impl<T: Real> Closed<T> {
         } = *inv;
         let zero = T::from_f64(0.0);
         self.case = Case::I;
-        let m = alpha3 / (f * 4.0);
         let m1 = lambda4 / (f * alpha3);
+        let m = complement_near_one(alpha3 / (f * 4.0), m1);
         let landen = Duplication::new(m, m1);
         if !landen.converged() {
             return None;
@@ -547,6 +666,7 @@ impl<T: Real> Closed<T> {
             return Some(());
         }
         let m1 = -lambda4 * 4.0 / (alpha3 * alpha3);
+        let m = complement_near_one(m, m1);
         let landen = Duplication::new(m, m1);
         if !landen.converged() {
             return None;

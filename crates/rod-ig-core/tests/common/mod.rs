@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 /// `shared/` holding `oracle/` found walking up from this crate (in CI and in a fresh clone it
 /// sits beside the repository). Panics with a clear message when absent: tests against the
 /// oracle must fail, not pass vacuously, when their reference data is missing.
+#[allow(dead_code)] // not every test binary that includes this module reads the oracle
 pub fn shared_dir() -> PathBuf {
     if let Ok(p) = std::env::var("ROD_IG_SHARED") {
         let p = PathBuf::from(p);
