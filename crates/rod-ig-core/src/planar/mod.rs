@@ -22,7 +22,7 @@ use closed::{Closed, SeriesNeed};
 
 use crate::scalar::Dual3;
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
-use closed::{CLOSED_J_TOLERANCE, SERIES_DD_MAX_ROOT_F};
+use closed::{CLOSED_J_TOLERANCE, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F};
 use taylor::{DualF64x2, Gradient, TaylorRod};
 
 /// Rods with ρ = max(|a3|, √‖(a4, a5)‖) up to this value are evaluated by the Taylor series
@@ -368,11 +368,13 @@ const ENERGY_REL_TOLERANCE: f64 = 1e-9;
 /// identity subtracts a4·x + a5·y from λ2/2, both ≈ ‖F‖ on a nearly straight rod under force,
 /// whose energy is orders of magnitude smaller: its error is (|a4| + |a5|) times the pose
 /// error ([`Closed::pose_abs_error`]) plus the rounding of the sum.
-fn closed_energy<T: crate::scalar::Real>(
+/// The energy by the identity λ2/2 − a4 x − a5 y where its error bound allows (see
+/// [`closed_energy`]), else None.
+fn energy_by_identity<T: crate::scalar::Real>(
     c: &Closed<T>,
     a: &PlanarParams,
     tip: &PlanarPose,
-) -> Result<f64, RodError> {
+) -> Result<Option<f64>, RodError> {
     let (a3, a4, a5) = (a[0], a[1], a[2]);
     let e = energy_from_tip(a, tip);
     let rounding =
@@ -381,7 +383,15 @@ fn closed_energy<T: crate::scalar::Real>(
     if !e.is_finite() {
         return Err(overflow());
     }
-    if bound <= ENERGY_REL_TOLERANCE * e.abs() {
+    Ok((bound <= ENERGY_REL_TOLERANCE * e.abs()).then_some(e))
+}
+
+fn closed_energy<T: crate::scalar::Real>(
+    c: &Closed<T>,
+    a: &PlanarParams,
+    tip: &PlanarPose,
+) -> Result<f64, RodError> {
+    if let Some(e) = energy_by_identity(c, a, tip)? {
         return Ok(e);
     }
     // Near the separatrix under a strong force the f64 series' rounding grows like e^{√‖F‖}.
@@ -571,6 +581,22 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
                 });
             }
             let (tip, jacobian) = pose_and_jac_of(c, a, 1.0)?;
+            if c.m1 < SEPARATRIX_M1
+                && !c.needs_precise_series()
+                && energy_by_identity(c, a, &tip)?.is_none()
+            {
+                // A nearly straight rod under a force near the separatrix: its energy and
+                // det J(t) both need the series (the identity cancels, the x row of J is below
+                // the closed form's error floor); one dense series serves both. The tip and J
+                // stay the closed form's, identical to `tip_and_jacobian`'s.
+                let rod = series_dual(a, true)?;
+                return Ok(Evaluation {
+                    tip,
+                    jacobian,
+                    energy: rod.energy().v,
+                    stability: stability::stability_of_series(a, Some(&rod), None, false)?,
+                });
+            }
             let energy = closed_energy(c, a, &tip)?;
             let stability = stability::stability_of(c, a)?;
             Ok(Evaluation {
