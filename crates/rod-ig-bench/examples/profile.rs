@@ -154,6 +154,11 @@ fn main() {
         for (us, row) in rows.iter().take(5) {
             println!("{us:8.1} µs  {row}");
         }
+        let failed: Vec<_> = rows.iter().filter(|r| r.1.contains("failed")).collect();
+        println!("{} of {} targets solved", rows.len() - failed.len(), rows.len());
+        for (us, row) in failed {
+            println!("{us:8.1} µs  {row}");
+        }
     }
     let us = t0.elapsed().as_secs_f64() * 1e6 / calls as f64;
     println!("{what} on {name}: {calls} calls, {us:.2} µs per call");
