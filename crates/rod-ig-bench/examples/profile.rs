@@ -155,7 +155,11 @@ fn main() {
             println!("{us:8.1} µs  {row}");
         }
         let failed: Vec<_> = rows.iter().filter(|r| r.1.contains("failed")).collect();
-        println!("{} of {} targets solved", rows.len() - failed.len(), rows.len());
+        println!(
+            "{} of {} targets solved",
+            rows.len() - failed.len(),
+            rows.len()
+        );
         for (us, row) in failed {
             println!("{us:8.1} µs  {row}");
         }

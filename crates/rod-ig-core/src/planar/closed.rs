@@ -272,7 +272,8 @@ pub(crate) const CLOSED_J_LAST_RESORT: f64 = 1e-7;
 /// Largest √‖F‖ for which the double-double series is certified: rounding and truncation
 /// (≤ 1e-22 per step) made near the hyperbolic straight equilibrium grow by up to e^{√‖F‖},
 /// ≤ 5e-11 here. Beyond (measured: tips off by 0.25 and J by 100 % at √‖F‖ ≈ 50–100 and
-/// m1 < 1e-19), only the closed form answers, or a clear error.
+/// m1 < 1e-19), the closed form answers where its estimate holds, or where it agrees with a
+/// tighter double-double series (`planar::cross_checked_tip`), else a clear error.
 pub(crate) const SERIES_DD_MAX_ROOT_F: f64 = 27.0;
 /// Below this m (cases I and II, above the [`Case::SmallForce`] switch) the dual-number
 /// derivatives lose ≈ 1e-16/m to cancellation in ∂(a4/F, a5/F, √α3)/∂a (near-straight rods
@@ -425,12 +426,13 @@ impl<T: Real> Closed<T> {
         CLOSED_POSE_ULPS * f64::EPSILON * (1.0 + loss) * rho.recip().max(1.0)
     }
 
-    /// True when J (and det J) from this closed form may be off by more than ≈ 1e-9 relative:
-    /// near the separatrix (0 < m1 < 1e-7, including near-straight rods under tension), small
-    /// m (1e-6 > m, near-straight rods under compression, near-circles above the small-force
-    /// switch) and case III with |Γ| > 8 somewhere on [0, 1]. Callers then take the pose, J and
-    /// the stability test from the Taylor series (FINDINGS §4: "fall back to an ODE"), unless
-    /// max(a3², |a4|, |a5|) > 1e6; see `needs_series` for which one.
+    /// True when J (and det J) from this closed form may be off by more than
+    /// [`CLOSED_J_TOLERANCE`]: where its cancellation estimate (`jacobian_rel_error_at`)
+    /// exceeds it (near the separatrix by 2/√m1, at small m by 1/m, on gently bent rods by
+    /// 1/ρ³), at small m (1e-6 > m: near-straight rods under compression, near-circles above
+    /// the small-force switch) and in case III with |Γ| > 8 somewhere on [0, 1]. Callers then
+    /// take the pose, J and the stability test from the Taylor series (FINDINGS §4: "fall back
+    /// to an ODE"), unless max(a3², |a4|, |a5|) > 1e6; see `needs_series` for which one.
     pub fn needs_reference(&self) -> bool {
         self.needs_series() != SeriesNeed::None
     }
@@ -442,7 +444,8 @@ impl<T: Real> Closed<T> {
     ///
     /// Near the separatrix under a force beyond what the double-double series certifies
     /// (√‖F‖ > [`SERIES_DD_MAX_ROOT_F`]) the closed form is kept while its estimate is within
-    /// [`CLOSED_J_LAST_RESORT`]; beyond, `IllConditioned` leads to the series' clear error.
+    /// [`CLOSED_J_LAST_RESORT`]; beyond, `IllConditioned` leads to a cross-check of the closed
+    /// form against a tighter double-double series, which answers or refuses clearly.
     pub fn needs_series(&self) -> SeriesNeed {
         if !self.needs_reference_by_estimate() {
             SeriesNeed::None

@@ -175,7 +175,7 @@ pub(crate) fn stability_of_series(
     let b = PlanarParams::new(a3, a4, a5);
     let spacing = wavelength.map_or(SERIES_SPACING, |w| (0.25 * w).clamp(1e-3, SERIES_SPACING));
     if precise {
-        let rod = super::series_dd(&b, true, super::STABILITY_DD_MAX_ROOT_F)?;
+        let rod = super::series_dd::<false>(&b, true, super::STABILITY_DD_MAX_ROOT_F)?;
         return scan_series(&rod, a3, a5, spacing);
     }
     match rod {
