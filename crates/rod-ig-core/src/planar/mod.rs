@@ -680,6 +680,30 @@ mod tests {
     use super::*;
     use crate::rng::SplitMix64;
 
+    /// ±10^U(lo, hi), random sign.
+    fn signed_pow10(r: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
+        let v = 10f64.powf(r.range(lo, hi));
+        if r.range(0.0, 1.0) < 0.5 {
+            -v
+        } else {
+            v
+        }
+    }
+
+    /// The closed form's errors against a reference tip and J, each divided by its a-priori
+    /// estimate: (pose, J).
+    fn error_ratios(c: &Closed<Dual3>, tip_ref: &PlanarPose, j_ref: &PlanarJacobian) -> (f64, f64) {
+        let (tip, j) = pose_jac_from(c.pose(1.0)).unwrap();
+        let dtip = (tip.x - tip_ref.x)
+            .abs()
+            .max((tip.y - tip_ref.y).abs())
+            .max((tip.theta - tip_ref.theta).abs());
+        (
+            dtip / c.pose_abs_error(),
+            (j - j_ref).norm() / j_ref.norm() / c.jacobian_rel_error_at(1.0),
+        )
+    }
+
     /// Where the closed form is chosen on the rods the series used to take (ρ ∈ [0.25, 4],
     /// log-scale magnitudes, random signs), its a-priori estimates bound its actual errors
     /// against the Taylor series (accurate to ~1e-14 there: e^{√F} ≤ e² amplification): J
@@ -690,14 +714,7 @@ mod tests {
     #[test]
     fn closed_form_where_chosen_meets_its_error_estimates() {
         let mut r = SplitMix64::new(17);
-        let mut signed = |lo: f64, hi: f64| {
-            let v = 10f64.powf(r.range(lo, hi));
-            if r.range(0.0, 1.0) < 0.5 {
-                -v
-            } else {
-                v
-            }
-        };
+        let mut signed = |lo: f64, hi: f64| signed_pow10(&mut r, lo, hi);
         let (mut closed_used, mut in_domain) = (0usize, 0usize);
         let (mut worst_j, mut worst_tip, mut worst_e) = (0.0f64, 0.0f64, 0.0f64);
         for _ in 0..40_000 {
@@ -715,15 +732,11 @@ mod tests {
                 continue;
             };
             closed_used += 1;
-            let (tip, j) = pose_jac_from(c.pose(1.0)).unwrap();
             let rod = series_dual(&a, false).unwrap();
             let (tip_s, j_s) = pose_jac_from(rod.tip()).unwrap();
-            let dtip = (tip.x - tip_s.x)
-                .abs()
-                .max((tip.y - tip_s.y).abs())
-                .max((tip.theta - tip_s.theta).abs());
-            worst_tip = worst_tip.max(dtip / c.pose_abs_error());
-            worst_j = worst_j.max((j - j_s).norm() / j_s.norm() / c.jacobian_rel_error_at(1.0));
+            let (tip_ratio, j_ratio) = error_ratios(&c, &tip_s, &j_s);
+            worst_tip = worst_tip.max(tip_ratio);
+            worst_j = worst_j.max(j_ratio);
             let e = evaluate(&a).unwrap().energy;
             worst_e = worst_e.max((e - rod.energy().v).abs() / rod.energy().v);
         }
@@ -752,14 +765,7 @@ mod tests {
     #[test]
     fn closed_form_near_the_separatrix_meets_its_error_estimates() {
         let mut r = SplitMix64::new(23);
-        let mut signed = |lo: f64, hi: f64| {
-            let v = 10f64.powf(r.range(lo, hi));
-            if r.range(0.0, 1.0) < 0.5 {
-                -v
-            } else {
-                v
-            }
-        };
+        let mut signed = |lo: f64, hi: f64| signed_pow10(&mut r, lo, hi);
         let (mut closed_used, mut in_domain) = (0usize, 0usize);
         let (mut worst_j, mut worst_tip) = (0.0f64, 0.0f64);
         while in_domain < 1500 {
@@ -781,14 +787,10 @@ mod tests {
                 continue;
             }
             closed_used += 1;
-            let (tip, j) = pose_jac_from(c.pose(1.0)).unwrap();
             let (tip_s, j_s, _) = ill_conditioned_tip(&a).unwrap();
-            let dtip = (tip.x - tip_s.x)
-                .abs()
-                .max((tip.y - tip_s.y).abs())
-                .max((tip.theta - tip_s.theta).abs());
-            worst_tip = worst_tip.max(dtip / c.pose_abs_error());
-            worst_j = worst_j.max((j - j_s).norm() / j_s.norm() / c.jacobian_rel_error_at(1.0));
+            let (tip_ratio, j_ratio) = error_ratios(&c, &tip_s, &j_s);
+            worst_tip = worst_tip.max(tip_ratio);
+            worst_j = worst_j.max(j_ratio);
         }
         eprintln!(
             "closed form on {closed_used} of {in_domain} rods near the separatrix: J error / \
