@@ -74,8 +74,18 @@ fn rows(p: &[Dual3; 3]) -> [[f64; 3]; 3] {
 
 /// g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (FINDINGS §5) and its error bound, from the
 /// dual-number closed form.
-fn normalised_det(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64) -> (f64, f64) {
-    let (det, err) = det_and_error(&rows(&c.pose(t)), c.jacobian_rel_error_at(t), CLOSED_J_ABS);
+/// With `norm_wise`, every entry's error is bounded by rel·‖J(t)‖ (the Frobenius estimate
+/// itself) instead of rel·|entry|: near the separatrix an entry far below ‖J‖ (the x row while
+/// the rod lingers by the straight equilibrium) can be off by that much.
+fn normalised_det(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64, norm_wise: bool) -> (f64, f64) {
+    let j = rows(&c.pose(t));
+    let rel = c.jacobian_rel_error_at(t);
+    let abs = if norm_wise {
+        CLOSED_J_ABS.max(rel * j.iter().flatten().map(|v| v * v).sum::<f64>().sqrt())
+    } else {
+        CLOSED_J_ABS
+    };
+    let (det, err) = det_and_error(&j, rel, abs);
     let n = normalisation(a3, a5, t);
     (det / n, err / n)
 }
@@ -209,11 +219,18 @@ pub(crate) fn stability_of(
     if c.case == Case::Straight {
         return Ok(straight_report());
     }
-    // Near the separatrix under a strong force the scan runs on the double-double series even
-    // where the closed form's tip and J(1) are accurate: its J(t) entries far below ‖J‖ (the x
-    // row while the rod lingers by the straight equilibrium) are not, and two verdicts in 720
-    // were wrong on the rigorous reference (scripts/gen_separatrix_truth.py), none on the series.
+    // Near the separatrix under a strong force the closed form's J(t) entries far below ‖J‖
+    // (the x row while the rod lingers by the straight equilibrium) are not accurate relative
+    // to themselves: with entry-wise error bounds two verdicts in 720 were wrong on the
+    // rigorous reference (scripts/gen_separatrix_truth.py). The scan there bounds every entry
+    // norm-wise and hands what it cannot decide to the double-double series.
     if c.needs_precise_series() {
+        if c.needs_series() == SeriesNeed::None {
+            let report = closed_scan(c, a, true)?;
+            if !report.uncertain {
+                return Ok(report);
+            }
+        }
         return stability_of_series(a, None, Some(c.wavelength()), true);
     }
     match c.needs_series() {
@@ -225,13 +242,29 @@ pub(crate) fn stability_of(
         }
         SeriesNeed::None => {}
     }
+    let report = closed_scan(c, a, false)?;
+    if report.uncertain {
+        // The closed form cannot decide: its error bound covers the margin. The series'
+        // entries are accurate relative to themselves; ask it.
+        return stability_of_series(a, None, Some(c.wavelength()), false);
+    }
+    Ok(report)
+}
+
+/// The scan of g on the closed form (a short series near the base); the report, uncertain
+/// where the error bound covers the margin (`norm_wise`: see [`normalised_det`]).
+fn closed_scan(
+    c: &Closed<Dual3>,
+    a: &PlanarParams,
+    norm_wise: bool,
+) -> Result<StabilityReport, RodError> {
     let (a3, a5) = (a[0], a[2]);
     // At small t the entries of J(t) are O(t)..O(t³) and the closed form's absolute error
     // floor swamps det J ∝ t⁹: there g comes from a short Taylor series from the base,
     // which is accurate relative to itself (one low-order step for t ≲ 0.2).
     let start = ShortSeries::new(a);
     let g = |t: f64| {
-        let (v, e) = normalised_det(c, a3, a5, t);
+        let (v, e) = normalised_det(c, a3, a5, t, norm_wise);
         if e <= CLOSED_G_ERROR {
             return (v, e);
         }
@@ -242,13 +275,7 @@ pub(crate) fn stability_of(
     // closed-form det J (≈ t⁹) is swamped by rounding: start the scan at t0.
     let t0 = (0.1 * wl).clamp(T_MIN, T_MARGIN);
     let s = scan(&|t| g(t).0, t0, (0.25 * wl).clamp(0.01, 0.1), a3, a5)?;
-    let report = verdict(s, g(s.t_margin).1);
-    if report.uncertain {
-        // The closed form cannot decide: its error bound covers the margin. The series'
-        // entries are accurate relative to themselves; ask it.
-        return stability_of_series(a, None, Some(wl), false);
-    }
-    Ok(report)
+    Ok(verdict(s, g(s.t_margin).1))
 }
 
 /// Largest error bound of the closed form's g(t) for which the scan takes its value (g is
