@@ -18,11 +18,10 @@ mod stability;
 mod taylor;
 
 pub use closed::Case;
-use closed::{Closed, SeriesNeed};
+use closed::{Closed, SeriesNeed, CLOSED_J_TOLERANCE, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F};
 
 use crate::scalar::Dual3;
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
-use closed::{CLOSED_J_TOLERANCE, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F};
 use taylor::{DualF64x2, Gradient, TaylorRod};
 
 /// Rods with ρ = max(|a3|, √‖(a4, a5)‖) up to this value are evaluated by the Taylor series
@@ -426,13 +425,10 @@ fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
 /// is itself ≥ 2× the measured error.
 const ENERGY_REL_TOLERANCE: f64 = 1e-9;
 
-/// The energy of a rod whose tip came from the closed form `c`: the identity of FINDINGS §1
-/// (free) where its error bound allows, else ½∫κ² integrated along the f64 Taylor series. The
-/// identity subtracts a4·x + a5·y from λ2/2, both ≈ ‖F‖ on a nearly straight rod under force,
-/// whose energy is orders of magnitude smaller: its error is (|a4| + |a5|) times the pose
-/// error ([`Closed::pose_abs_error`]) plus the rounding of the sum.
-/// The energy by the identity λ2/2 − a4 x − a5 y where its error bound allows (see
-/// [`closed_energy`]), else None.
+/// The energy by the identity λ2/2 − a4 x − a5 y of FINDINGS §1 where its error bound allows,
+/// else None. The identity subtracts a4·x + a5·y from λ2/2, both ≈ ‖F‖ on a nearly straight
+/// rod under force, whose energy is orders of magnitude smaller: its error is (|a4| + |a5|)
+/// times the pose error ([`Closed::pose_abs_error`]) plus the rounding of the sum.
 fn energy_by_identity<T: crate::scalar::Real>(
     c: &Closed<T>,
     a: &PlanarParams,
@@ -449,6 +445,9 @@ fn energy_by_identity<T: crate::scalar::Real>(
     Ok((bound <= ENERGY_REL_TOLERANCE * e.abs()).then_some(e))
 }
 
+/// The energy of a rod whose tip came from the closed form `c`: the identity (free) where its
+/// error bound allows ([`energy_by_identity`]), else ½∫κ² integrated along the Taylor series
+/// (double-double near the separatrix under a strong force).
 fn closed_energy<T: crate::scalar::Real>(
     c: &Closed<T>,
     a: &PlanarParams,
