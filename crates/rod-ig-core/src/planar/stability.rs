@@ -14,9 +14,10 @@ const T_MARGIN: f64 = 0.05;
 /// themselves, so det J ≈ t⁹·(…) is resolved down to small t (the cofactor terms are O(t⁸) and
 /// cancel to O(t⁹): a 1/t loss, 100× here).
 const SERIES_T_MIN: f64 = 0.01;
-/// Scan spacing on the series for a rod with no wavelength below it (gently bent rods: g is a
-/// smooth function of t, and local minima are refined by parabolic steps).
-const SERIES_SPACING: f64 = 0.05;
+/// Largest scan spacing on the series (gently bent rods: g is a smooth function of t, varying
+/// on 2π/ρ ≥ 25 for the series' rods, ρ ≤ 0.25, and local minima are refined by parabolic
+/// steps); the closed-form scan's largest spacing too.
+const SERIES_SPACING: f64 = 0.1;
 /// Relative accuracy of the Taylor series' J entries (truncation below one unit roundoff plus
 /// the rounding of ≲ 33 terms of products: measured ≤ 2e-15 against the reference, ×5).
 const SERIES_ENTRY_REL: f64 = 1e-14;
@@ -183,7 +184,11 @@ pub(crate) fn stability_of_series(
         a5 *= l;
     }
     let b = PlanarParams::new(a3, a4, a5);
-    let spacing = wavelength.map_or(SERIES_SPACING, |w| (0.25 * w).clamp(1e-3, SERIES_SPACING));
+    // Without the closed form's wavelength, the rod's own scale: κ varies on 1/ρ, so g on
+    // about 2π/ρ (the same quarter-wavelength rule as the closed-form scan).
+    let wavelength =
+        wavelength.unwrap_or_else(|| std::f64::consts::TAU / super::curvature_scale(a));
+    let spacing = (0.25 * wavelength).clamp(1e-3, SERIES_SPACING);
     if precise {
         let rod = super::series_dd::<false>(&b, true, super::STABILITY_DD_MAX_ROOT_F)?;
         return scan_series(&rod, a3, a5, spacing);
@@ -291,8 +296,9 @@ const SHORT_SERIES_MAX_STEPS: usize = 24;
 /// (rebuilt to 2t) when asked beyond its end.
 struct ShortSeries {
     a: PlanarParams,
-    /// (t_end, the series; None when it could not be built within its budget).
-    rod: std::cell::RefCell<Option<(f64, Option<TaylorRod<Dual3>>)>>,
+    /// (the series, steps left of its budget); Some(None) when it could not be built or
+    /// extended within the budget.
+    rod: std::cell::RefCell<Option<Option<(TaylorRod<Dual3>, usize)>>>,
 }
 
 impl ShortSeries {
@@ -312,23 +318,33 @@ impl ShortSeries {
             return None;
         }
         let mut slot = self.rod.borrow_mut();
-        if let Some((_, None)) = slot.as_ref() {
-            return None;
+        let end = (2.0 * t).clamp(0.2, 1.0);
+        match slot.as_mut() {
+            Some(None) => return None,
+            // Grown, not rebuilt: the steps to the old end are kept.
+            Some(Some((rod, left))) if rod.t_end() < t => match rod.extend_to(end, *left) {
+                Ok(steps) => *left -= steps,
+                Err(_) => *slot = Some(None),
+            },
+            Some(Some(_)) => {}
+            None => {
+                let rod = TaylorRod::new_to(
+                    Dual3::variable(a3, 0),
+                    Dual3::variable(self.a[1], 1),
+                    Dual3::variable(a5, 2),
+                    0.0,
+                    0,
+                    true,
+                )
+                .and_then(|mut rod| {
+                    let steps = rod.extend_to(end, SHORT_SERIES_MAX_STEPS)?;
+                    Ok((rod, SHORT_SERIES_MAX_STEPS - steps))
+                })
+                .ok();
+                *slot = Some(rod);
+            }
         }
-        if slot.as_ref().is_none_or(|(end, _)| *end < t) {
-            let end = (2.0 * t).clamp(0.2, 1.0);
-            let rod = TaylorRod::new_to(
-                Dual3::variable(a3, 0),
-                Dual3::variable(self.a[1], 1),
-                Dual3::variable(a5, 2),
-                end,
-                SHORT_SERIES_MAX_STEPS,
-                true,
-            )
-            .ok();
-            *slot = Some((end, rod));
-        }
-        let (_, Some(rod)) = slot.as_ref()? else {
+        let Some(Some((rod, _))) = slot.as_ref() else {
             return None;
         };
         let (v, e) = normalised_det_series(rod, a3, a5, t);

@@ -430,7 +430,15 @@ pub(crate) struct TaylorRod<T> {
     first: Option<Box<Segment<T>>>,
     /// Later steps (multi-step rods only).
     rest: Vec<Segment<T>>,
+    /// The state at `t_end`.
     end: [T; SERIES],
+    /// Where the integration has reached.
+    t_end: f64,
+    /// The base force (the right-hand side's parameters), kept for [`Self::extend_to`].
+    a4: T,
+    a5: T,
+    /// Whether every step's polynomials are kept.
+    dense: bool,
 }
 
 impl<T: Measured> TaylorRod<T> {
@@ -452,45 +460,65 @@ impl<T: Measured> TaylorRod<T> {
         dense: bool,
     ) -> Result<Self, RodError> {
         let zero = T::constant(0.0);
-        let mut state = [zero; SERIES];
-        state[K] = a3;
-        state[C] = T::constant(1.0);
-        let mut t0 = 0.0f64;
-        let mut first: Option<Box<Segment<T>>> = None;
-        let mut rest = Vec::new();
+        let mut end = [zero; SERIES];
+        end[K] = a3;
+        end[C] = T::constant(1.0);
+        let mut rod = Self {
+            first: None,
+            rest: Vec::new(),
+            end,
+            t_end: 0.0,
+            a4,
+            a5,
+            dense,
+        };
+        rod.extend_to(t_end, max_steps)?;
+        Ok(rod)
+    }
+
+    /// Where the integration has reached (the t of [`Self::tip`]).
+    pub fn t_end(&self) -> f64 {
+        self.t_end
+    }
+
+    /// Continues the integration from [`Self::t_end`] to `t_end` in at most `max_steps` steps
+    /// (the steps already taken are kept, not redone); returns the number of steps taken.
+    pub fn extend_to(&mut self, t_end: f64, max_steps: usize) -> Result<usize, RodError> {
+        let mut t0 = self.t_end;
+        if t0 >= t_end {
+            return Ok(0);
+        }
         // Without dense output one segment is reused by every step, filled in place.
         let mut scratch: Option<Box<Segment<T>>> = None;
-        for _ in 0..max_steps {
+        for steps in 1..=max_steps {
             let mut seg = match scratch.take() {
                 Some(s) => s,
                 None => Box::new(Segment::empty()),
             };
-            step(&mut seg, &state, a4, a5, t0, t_end - t0)?;
-            state = seg.state_at_end();
+            step(&mut seg, &self.end, self.a4, self.a5, t0, t_end - t0)?;
+            let state = seg.state_at_end();
             if !state
                 .iter()
                 .all(|v| (0..T::PARTS).all(|i| v.part(i).is_finite()))
             {
                 return Err(overflow());
             }
+            self.end = state;
             t0 = if seg.h >= t_end - t0 {
                 t_end
             } else {
                 t0 + seg.h
             };
-            if !dense {
+            self.t_end = t0;
+            if !self.dense {
                 scratch = Some(seg);
-            } else if first.is_none() {
-                first = Some(seg);
+            } else if self.first.is_none() {
+                self.first = Some(seg);
             } else {
-                rest.push(*seg);
+                self.rest.push(*seg);
             }
             if t0 >= t_end {
-                return Ok(Self {
-                    first,
-                    rest,
-                    end: state,
-                });
+                return Ok(steps);
             }
         }
         Err(RodError::Integration(format!(
