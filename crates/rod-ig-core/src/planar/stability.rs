@@ -296,16 +296,25 @@ const SHORT_SERIES_MAX_STEPS: usize = 24;
 /// (rebuilt to 2t) when asked beyond its end.
 struct ShortSeries {
     a: PlanarParams,
-    /// (the series, steps left of its budget); Some(None) when it could not be built or
-    /// extended within the budget.
-    rod: std::cell::RefCell<Option<Option<(TaylorRod<Dual3>, usize)>>>,
+    rod: std::cell::RefCell<Start>,
+}
+
+/// The state of a [`ShortSeries`].
+enum Start {
+    NotBuilt,
+    /// It could not be built or extended within its step budget.
+    Failed,
+    Built {
+        rod: Box<TaylorRod<Dual3>>,
+        steps_left: usize,
+    },
 }
 
 impl ShortSeries {
     fn new(a: &PlanarParams) -> Self {
         Self {
             a: *a,
-            rod: std::cell::RefCell::new(None),
+            rod: std::cell::RefCell::new(Start::NotBuilt),
         }
     }
 
@@ -319,32 +328,34 @@ impl ShortSeries {
         }
         let mut slot = self.rod.borrow_mut();
         let end = (2.0 * t).clamp(0.2, 1.0);
-        match slot.as_mut() {
-            Some(None) => return None,
+        match &mut *slot {
+            Start::Failed => return None,
             // Grown, not rebuilt: the steps to the old end are kept.
-            Some(Some((rod, left))) if rod.t_end() < t => match rod.extend_to(end, *left) {
-                Ok(steps) => *left -= steps,
-                Err(_) => *slot = Some(None),
-            },
-            Some(Some(_)) => {}
-            None => {
-                let rod = TaylorRod::new_to(
+            Start::Built { rod, steps_left } if rod.t_end() < t => {
+                match rod.extend_to(end, *steps_left) {
+                    Ok(steps) => *steps_left -= steps,
+                    Err(_) => *slot = Start::Failed,
+                }
+            }
+            Start::Built { .. } => {}
+            Start::NotBuilt => {
+                *slot = match TaylorRod::new_to(
                     Dual3::variable(a3, 0),
                     Dual3::variable(self.a[1], 1),
                     Dual3::variable(a5, 2),
-                    0.0,
-                    0,
+                    end,
+                    SHORT_SERIES_MAX_STEPS,
                     true,
-                )
-                .and_then(|mut rod| {
-                    let steps = rod.extend_to(end, SHORT_SERIES_MAX_STEPS)?;
-                    Ok((rod, SHORT_SERIES_MAX_STEPS - steps))
-                })
-                .ok();
-                *slot = Some(rod);
+                ) {
+                    Ok(rod) => Start::Built {
+                        steps_left: SHORT_SERIES_MAX_STEPS - rod.steps(),
+                        rod: Box::new(rod),
+                    },
+                    Err(_) => Start::Failed,
+                };
             }
         }
-        let Some(Some((rod, _))) = slot.as_ref() else {
+        let Start::Built { rod, .. } = &*slot else {
             return None;
         };
         let (v, e) = normalised_det_series(rod, a3, a5, t);

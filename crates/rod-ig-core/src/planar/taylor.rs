@@ -481,6 +481,11 @@ impl<T: Measured> TaylorRod<T> {
         self.t_end
     }
 
+    /// Number of steps kept (dense rods; 0 otherwise).
+    pub fn steps(&self) -> usize {
+        self.first.as_ref().map_or(0, |_| 1 + self.rest.len())
+    }
+
     /// Continues the integration from [`Self::t_end`] to `t_end` in at most `max_steps` steps
     /// (the steps already taken are kept, not redone); returns the number of steps taken.
     pub fn extend_to(&mut self, t_end: f64, max_steps: usize) -> Result<usize, RodError> {
