@@ -144,11 +144,7 @@ fn cross_checked_tip(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian, f6
     };
     let rod = series_dd::<true>(a, false, STABILITY_DD_MAX_ROOT_F)?;
     let (tip_s, j_s) = pose_jac_from(rod.tip())?;
-    let Some(c) = Closed::new(
-        Dual3::variable(a[0], 0),
-        Dual3::variable(a[1], 1),
-        Dual3::variable(a[2], 2),
-    ) else {
+    let Some(c) = seeded_closed(a) else {
         return Err(refuse("the closed form overflows".into()));
     };
     let (tip, j) = pose_jac_from(c.pose(1.0))?;
@@ -208,6 +204,16 @@ fn overflow() -> RodError {
     RodError::Overflow("closed form of the planar rod: parameters too large for f64".into())
 }
 
+/// The closed form in dual numbers seeded with the identity on a (so that it carries J); None
+/// where an intermediate quantity overflows.
+fn seeded_closed(a: &PlanarParams) -> Option<Closed<Dual3>> {
+    Closed::new(
+        Dual3::variable(a[0], 0),
+        Dual3::variable(a[1], 1),
+        Dual3::variable(a[2], 2),
+    )
+}
+
 /// Runs `f` on the dual-number closed form seeded with the identity on a. The closed form
 /// (≈ 1 KB of dual numbers) is borrowed where it was built, never moved through an
 /// `Option`/`Result` (each move was a memcpy).
@@ -217,11 +223,7 @@ fn with_seeded<R>(
     series: impl FnOnce() -> Result<R, RodError>,
 ) -> Result<R, RodError> {
     check_params(a)?;
-    let closed = Closed::new(
-        Dual3::variable(a[0], 0),
-        Dual3::variable(a[1], 1),
-        Dual3::variable(a[2], 2),
-    );
+    let closed = seeded_closed(a);
     match &closed {
         Some(c) => f(c),
         // The closed form's intermediate ratios overflowed (e.g. a tiny moment against a
@@ -722,11 +724,7 @@ mod tests {
                 continue;
             }
             in_domain += 1;
-            let seeded = Closed::new(
-                Dual3::variable(a[0], 0),
-                Dual3::variable(a[1], 1),
-                Dual3::variable(a[2], 2),
-            );
+            let seeded = seeded_closed(&a);
             let Some(c) = seeded.filter(|c| c.needs_series() == SeriesNeed::None) else {
                 continue;
             };
@@ -769,11 +767,7 @@ mod tests {
         let (mut worst_j, mut worst_tip) = (0.0f64, 0.0f64);
         while in_domain < 1500 {
             let a = PlanarParams::new(signed(-14.0, 1.0), signed(-1.5, 2.2), signed(-14.0, 1.0));
-            let Some(c) = Closed::new(
-                Dual3::variable(a[0], 0),
-                Dual3::variable(a[1], 1),
-                Dual3::variable(a[2], 2),
-            ) else {
+            let Some(c) = seeded_closed(&a) else {
                 continue;
             };
             let rho = curvature_scale(&a);
