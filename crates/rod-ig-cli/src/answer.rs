@@ -31,6 +31,8 @@ pub struct SolveAnswer<A, T> {
     termination: &'static str,
     /// Starts tried (multi-start strategies; 1 for Newton).
     starts: u32,
+    /// Wall time of the request (ms), from its parsed options to its answer.
+    elapsed_ms: f64,
     /// Every distinct stable solution found (`"all": true`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub solutions: Option<Vec<SolveAnswer<A, T>>>,
@@ -57,6 +59,7 @@ impl<A, T> SolveAnswer<A, T> {
             reason: None,
             termination: solver::Termination::Converged.as_str(),
             starts: s.starts,
+            elapsed_ms: s.elapsed_us / 1e3,
             solutions: None,
         }
     }
@@ -82,8 +85,17 @@ impl<A, T> SolveAnswer<A, T> {
             reason: Some(reason),
             termination: termination.as_str(),
             starts: 0,
+            elapsed_ms: 0.0,
             solutions: None,
         }
+    }
+}
+
+impl<A, T> SolveAnswer<A, T> {
+    /// The answer with its wall time set from the solver's measure (µs).
+    pub fn with_elapsed_us(mut self, us: f64) -> Self {
+        self.elapsed_ms = us / 1e3;
+        self
     }
 }
 
@@ -102,6 +114,7 @@ pub fn answer<const N: usize, M, A, T>(
 where
     M: InverseGeometry<N>,
 {
+    let t0 = std::time::Instant::now();
     let run = || {
         let first = solver::solve(model, target, options);
         let solutions = all.then(|| solver::solve_all(model, target, options));
@@ -125,6 +138,7 @@ where
             f.termination(),
         ),
     };
+    answer.elapsed_ms = t0.elapsed().as_secs_f64() * 1e3;
     if let Some(solutions) = solutions {
         if solutions.is_empty() && answer.success {
             // solve_all includes the first-found answer, so this is unreachable in practice;

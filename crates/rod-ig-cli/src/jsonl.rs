@@ -65,13 +65,26 @@ pub fn check_alpha(alpha: f64) -> Result<f64, String> {
     }
 }
 
-/// Checks a solver tolerance (positive, finite).
+/// Checks a solver tolerance against the solver's documented range.
 pub fn check_tolerance(tolerance: f64) -> Result<f64, String> {
-    if tolerance.is_finite() && tolerance > 0.0 {
+    use rod_ig_core::solver::{MAX_TOLERANCE, MIN_TOLERANCE};
+    if (MIN_TOLERANCE..=MAX_TOLERANCE).contains(&tolerance) {
         Ok(tolerance)
     } else {
         Err(format!(
-            "tolerance must be positive and finite, got {tolerance}"
+            "tolerance must be in [{MIN_TOLERANCE:e}, {MAX_TOLERANCE:e}], got {tolerance}"
+        ))
+    }
+}
+
+/// Checks an iteration budget (per start, [`rod_ig_core::solver::SolveOptions`]).
+pub fn check_max_iterations(n: u32) -> Result<u32, String> {
+    use rod_ig_core::solver::MAX_ITERATIONS_LIMIT;
+    if (1..=MAX_ITERATIONS_LIMIT).contains(&n) {
+        Ok(n)
+    } else {
+        Err(format!(
+            "max_iterations must be in [1, {MAX_ITERATIONS_LIMIT}] (per start), got {n}"
         ))
     }
 }
@@ -86,7 +99,7 @@ pub fn apply_newton_knobs(
         *into.0 = check_alpha(a)?;
     }
     if let Some(n) = max_iterations {
-        *into.1 = n;
+        *into.1 = check_max_iterations(n)?;
     }
     if let Some(t) = tolerance {
         *into.2 = check_tolerance(t)?;
@@ -210,6 +223,9 @@ mod tests {
         );
         assert_eq!(check_tolerance(1e-9), Ok(1e-9));
         assert!(check_tolerance(-1.0).is_err() && check_tolerance(f64::INFINITY).is_err());
+        assert!(check_tolerance(1e308).is_err() && check_tolerance(1e-20).is_err());
+        assert_eq!(check_max_iterations(1), Ok(1));
+        assert!(check_max_iterations(0).is_err() && check_max_iterations(100_001).is_err());
     }
 
     #[test]

@@ -102,7 +102,8 @@ impl Tracking {
                 f.residual,
                 f.reason.to_string(),
                 f.termination(),
-            ),
+            )
+            .with_elapsed_us(f.elapsed_us),
         };
         let mut answer = TrackAnswer {
             solve,

@@ -7,6 +7,7 @@ use rod_ig_core::solver::PlanarClosedForm;
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
+use std::io::Write;
 
 /// One `rod-ig forward` request.
 #[derive(Deserialize)]
@@ -97,20 +98,54 @@ pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
 /// or path message; larger requests are a mistake (issue 9: 1e12 aborted, 2⁶⁴ − 1 panicked).
 pub const MAX_SHAPE_SAMPLES: usize = 1_000_000;
 
+/// Checks a `--samples` value (2 to [`MAX_SHAPE_SAMPLES`]).
+pub fn check_samples(samples: usize) -> Result<(), String> {
+    if (2..=MAX_SHAPE_SAMPLES).contains(&samples) {
+        Ok(())
+    } else {
+        Err(format!(
+            "--samples must be between 2 and {MAX_SHAPE_SAMPLES}, got {samples}"
+        ))
+    }
+}
+
 /// Samples the rod `a` at `samples` points from the base to the tip.
 pub fn sample_shape(a: [f64; 3], samples: usize) -> Result<Vec<PlanarPose>, String> {
-    if !(2..=MAX_SHAPE_SAMPLES).contains(&samples) {
-        return Err(format!(
-            "--samples must be between 2 and {MAX_SHAPE_SAMPLES}, got {samples}"
-        ));
-    }
+    check_samples(samples)?;
     let rod = planar::PlanarRod::new(&PlanarParams::from(a)).map_err(|e| e.to_string())?;
     Ok(rod.shape(samples))
+}
+
+/// Writes the rod `a` as one JSON line {"a": [..], "poses": [{"x", "y", "theta"}, ..]} with
+/// `samples` poses from the base to the tip, each written as it is computed (the same poses
+/// as [`planar::PlanarRod::shape`], in memory independent of `samples`).
+pub fn write_shape_line(out: &mut impl Write, a: [f64; 3], samples: usize) -> Result<(), String> {
+    check_samples(samples)?;
+    let rod = planar::PlanarRod::new(&PlanarParams::from(a)).map_err(|e| e.to_string())?;
+    let io = |e: std::io::Error| e.to_string();
+    write!(out, "{{\"a\":").map_err(io)?;
+    serde_json::to_writer(&mut *out, &a).map_err(|e| e.to_string())?;
+    write!(out, ",\"poses\":[").map_err(io)?;
+    let last = samples - 1;
+    for i in 0..samples {
+        let pose = if i == last {
+            rod.tip()
+        } else {
+            rod.pose(i as f64 / last as f64)
+        };
+        if i > 0 {
+            out.write_all(b",").map_err(io)?;
+        }
+        serde_json::to_writer(&mut *out, &pose).map_err(|e| e.to_string())?;
+    }
+    out.write_all(b"]}\n").map_err(io)
 }
 
 /// Every distinct stable solution found for the target (x, y, θ), least energy first.
 pub fn all_stable_solutions(x: f64, y: f64, theta: f64) -> Result<Vec<[f64; 3]>, String> {
     let target = PlanarPose::new(x, y, theta);
+    // A one-shot drawing: build the atlas first rather than charge it to the search's deadline.
+    ig::warm_up();
     let found = ig::solve_all(&target, &SolveOptions::default());
     if found.is_empty() {
         // Say why: the first-found search's own reason.

@@ -181,16 +181,14 @@ fn requests_are_bounded_with_clear_reasons() {
         ),
     );
     assert_eq!(out.len(), 5);
+    // Options out of range: an error line (the CLI checks the solver's documented bounds).
     assert!(
-        out[0]["reason"]
-            .as_str()
-            .unwrap()
-            .contains("max_iterations"),
+        out[0]["error"].as_str().unwrap().contains("max_iterations"),
         "{}",
         out[0]
     );
     assert!(
-        out[1]["reason"].as_str().unwrap().contains("tolerance"),
+        out[1]["error"].as_str().unwrap().contains("tolerance"),
         "{}",
         out[1]
     );

@@ -46,6 +46,10 @@ pub const BODY_SAMPLES: usize = 48;
 pub const DEFAULT_PLAN_DEADLINE: Duration = Duration::from_millis(500);
 /// Samples between two polls of the deadline along an edge (~1 ms of stability tests).
 const DEADLINE_POLL: usize = 32;
+/// Largest obstacle coordinate and disc radius accepted, in rod lengths. The rod lies within
+/// the unit disc, so 1e6 already covers "everything"; the bound keeps every product of the
+/// geometry (≤ 4e12) far from overflow (issue 24: a 1e200 triangle was silently ignored).
+pub const MAX_OBSTACLE_COORDINATE: f64 = 1e6;
 /// Goal tolerance: the last rod's tip is within this of the goal pose.
 pub const GOAL_TOLERANCE: f64 = 1e-7;
 
@@ -151,17 +155,22 @@ impl Planner {
         Self::default()
     }
 
-    fn ensure_roadmap(&mut self) {
+    /// Builds the roadmap from the atlas if needed; false when the deadline in force passed
+    /// before the atlas was ready.
+    fn ensure_roadmap(&mut self) -> bool {
         if !self.nodes.is_empty() {
-            return;
+            return true;
         }
-        let atlas = ig::atlas::get();
+        let Some(atlas) = ig::atlas::get() else {
+            return false;
+        };
         let n = atlas.len();
         let stride = (n / ROADMAP_NODES).max(1);
         self.nodes = (0..n)
             .step_by(stride)
             .map(|k| atlas.seed_params(k))
             .collect();
+        true
     }
 
     /// Number of roadmap nodes (0 before the first query).
@@ -173,9 +182,13 @@ impl Planner {
     /// `request.goal` (module docs).
     pub fn plan(&mut self, request: &PlanRequest) -> Result<Plan, PlanError> {
         check_request(request)?;
-        // Built once per planner (the atlas, ~0.5 s once per process): not charged to a query.
-        self.ensure_roadmap();
         let t0 = Instant::now();
+        // The roadmap comes from the atlas, built once per process in steps charged to the
+        // deadline of the query that needs it.
+        let _deadline = ig::deadline::scope(request.deadline);
+        if !self.ensure_roadmap() {
+            return Err(PlanError::Deadline { edges_checked: 0 });
+        }
         let start = request.start;
         let margin = margin_of(&start);
         if margin < MIN_MARGIN {
@@ -220,19 +233,34 @@ fn check_request(request: &PlanRequest) -> Result<(), PlanError> {
             crate::ig::MAX_DEADLINE
         )));
     }
-    for o in &request.obstacles {
-        match o {
-            Obstacle::Disc { center, radius } => {
-                if !(center.iter().all(|v| v.is_finite()) && radius.is_finite() && *radius > 0.0) {
-                    return Err(PlanError::Invalid(format!("bad disc {o:?}")));
-                }
+    request.obstacles.iter().try_for_each(check_obstacle)
+}
+
+/// Checks an obstacle: coordinates within ±[`MAX_OBSTACLE_COORDINATE`], disc radius in
+/// (0, [`MAX_OBSTACLE_COORDINATE`]], polygons with at least 3 vertices.
+fn check_obstacle(o: &Obstacle) -> Result<(), PlanError> {
+    let in_range = |v: &f64| v.abs() <= MAX_OBSTACLE_COORDINATE;
+    match o {
+        Obstacle::Disc { center, radius } => {
+            if !(center.iter().all(in_range) && *radius > 0.0 && in_range(radius)) {
+                return Err(PlanError::Invalid(format!(
+                    "disc {center:?} radius {radius}: the centre's coordinates must be within \
+                     ±{MAX_OBSTACLE_COORDINATE:e} and the radius in (0, {MAX_OBSTACLE_COORDINATE:e}] \
+                     (rod lengths)"
+                )));
             }
-            Obstacle::Polygon { points } => {
-                if points.len() < 3 || points.iter().flatten().any(|v| !v.is_finite()) {
-                    return Err(PlanError::Invalid(
-                        "a polygon needs at least 3 finite vertices".into(),
-                    ));
-                }
+        }
+        Obstacle::Polygon { points } => {
+            if points.len() < 3 {
+                return Err(PlanError::Invalid(
+                    "a polygon needs at least 3 vertices".into(),
+                ));
+            }
+            if let Some(p) = points.iter().find(|p| !p.iter().all(in_range)) {
+                return Err(PlanError::Invalid(format!(
+                    "polygon vertex {p:?}: coordinates must be finite and within \
+                     ±{MAX_OBSTACLE_COORDINATE:e} (rod lengths)"
+                )));
             }
         }
     }
@@ -290,10 +318,20 @@ fn cross(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
 }
 
+/// True when the closed segments [p, q] and [a, b] meet (touching and collinear overlap
+/// included: an obstacle's edge along the rod counts as a contact). Compares the signs of the
+/// orientations, never their products, which underflow to 0 for tiny obstacles.
 fn segments_intersect(p: [f64; 2], q: [f64; 2], a: [f64; 2], b: [f64; 2]) -> bool {
+    let opposite = |u: f64, v: f64| (u <= 0.0 && v >= 0.0) || (u >= 0.0 && v <= 0.0);
     let (d1, d2) = (cross(a, b, p), cross(a, b, q));
     let (d3, d4) = (cross(p, q, a), cross(p, q, b));
-    d1 * d2 <= 0.0 && d3 * d4 <= 0.0
+    if d1 == 0.0 && d2 == 0.0 && d3 == 0.0 && d4 == 0.0 {
+        // Collinear: they meet iff their extents overlap on both axes.
+        let overlap =
+            |i: usize| p[i].min(q[i]) <= a[i].max(b[i]) && a[i].min(b[i]) <= p[i].max(q[i]);
+        return overlap(0) && overlap(1);
+    }
+    opposite(d1, d2) && opposite(d3, d4)
 }
 
 /// Even–odd rule.
@@ -576,4 +614,116 @@ impl<'p> Query<'p> {
 
 fn key(u: NodeId, v: NodeId) -> (NodeId, NodeId) {
     (u.min(v), u.max(v))
+}
+
+#[cfg(test)]
+mod tests {
+    //! The obstacle geometry on polygons and discs from 1e-300 to the coordinate bound, and
+    //! degenerate ones (issue 24: products of huge coordinates overflowed, tiny ones underflow).
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A rod drawn from the stable, moderately bent set (the shapes the planner sees).
+    fn rod() -> impl Strategy<Value = PlanarParams> {
+        (-6.0..6.0f64, -30.0..30.0f64, -30.0..30.0f64)
+            .prop_map(|(a, b, c)| PlanarParams::new(a, b, c))
+    }
+
+    /// A log-uniform scale in [1e-300, MAX_OBSTACLE_COORDINATE / 2] (the triangles below
+    /// reach 2× their scale).
+    fn scale() -> impl Strategy<Value = f64> {
+        (-300.0..(MAX_OBSTACLE_COORDINATE / 2.0).log10()).prop_map(|e: f64| 10f64.powf(e))
+    }
+
+    fn triangle(c: [f64; 2], s: f64) -> Obstacle {
+        Obstacle::Polygon {
+            points: vec![
+                [c[0] + s, c[1] + s],
+                [c[0] - s, c[1] + s],
+                [c[0], c[1] - 2.0 * s],
+            ],
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// Every obstacle containing the base point (0, 0), which every rod passes through,
+        /// touches every rod: tiny triangles and discs around the base, and triangles as large
+        /// as the bound allows.
+        #[test]
+        fn obstacles_around_the_base_touch_every_rod(a in rod(), s in scale()) {
+            prop_assume!(PlanarRod::new(&a).is_ok());
+            prop_assert!(collides(&a, &[triangle([0.0, 0.0], s)]), "triangle of scale {s:e}");
+            let disc = Obstacle::Disc { center: [s / 2.0, 0.0], radius: s };
+            prop_assert!(collides(&a, &[disc]), "disc of radius {s:e}");
+            prop_assert!(check_obstacle(&triangle([0.0, 0.0], s)).is_ok());
+        }
+
+        /// Obstacles beyond the unit disc (where no rod reaches) touch none, whatever their
+        /// size, down to 1e-300.
+        #[test]
+        fn obstacles_out_of_reach_touch_no_rod(a in rod(), s in scale(), angle in 0.0..std::f64::consts::TAU) {
+            prop_assume!(PlanarRod::new(&a).is_ok());
+            let s = s.min(0.4);
+            let c = [1.5 * angle.cos(), 1.5 * angle.sin()];
+            prop_assert!(!collides(&a, &[triangle(c, s / 2.0)]), "triangle at {c:?} of scale {s:e}");
+            let disc = Obstacle::Disc { center: c, radius: s };
+            prop_assert!(!collides(&a, &[disc]));
+        }
+
+        /// A degenerate polygon (three collinear points: a wall of zero area) across the
+        /// rod's chord is touched: the body runs from x = 0 to the tip's x, so it crosses
+        /// x = tip.x / 2 somewhere within |y| ≤ 1.
+        #[test]
+        fn a_zero_area_wall_across_the_rod_is_touched(a in rod(), h in 1.0..MAX_OBSTACLE_COORDINATE) {
+            let Ok(r) = PlanarRod::new(&a) else { return Ok(()) };
+            let tip = r.tip();
+            prop_assume!(tip.x.abs() > 0.05);
+            let x = tip.x / 2.0;
+            let wall = Obstacle::Polygon { points: vec![[x, -h], [x, 0.0], [x, h]] };
+            prop_assert!(collides(&a, &[wall]), "wall at x = {x}, tip {tip:?}");
+        }
+
+        /// Coordinates beyond the bound, or not finite, are refused with the bound named.
+        #[test]
+        fn coordinates_beyond_the_bound_are_refused(e in 6.01..308.0f64, sign in prop::bool::ANY) {
+            let v = if sign { 10f64.powf(e) } else { -(10f64.powf(e)) };
+            let p = Obstacle::Polygon { points: vec![[0.0, 0.0], [v, 0.0], [0.0, 1.0]] };
+            match check_obstacle(&p) {
+                Err(PlanError::Invalid(why)) => prop_assert!(why.contains("1e6")),
+                other => prop_assert!(false, "{v:e} accepted: {other:?}"),
+            }
+            let d = Obstacle::Disc { center: [v, 0.0], radius: 1.0 };
+            prop_assert!(check_obstacle(&d).is_err());
+        }
+    }
+
+    #[test]
+    fn collinear_segments_meet_only_where_they_overlap() {
+        assert!(segments_intersect(
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [0.5, 0.0],
+            [2.0, 0.0]
+        ));
+        assert!(!segments_intersect(
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.5, 0.0],
+            [2.0, 0.0]
+        ));
+        assert!(segments_intersect(
+            [0.0, 0.0],
+            [1.0, 1.0],
+            [1e-300, 1e-300],
+            [2e-300, 2e-300]
+        ));
+        for bad in [f64::NAN, f64::INFINITY, 1e200] {
+            let p = Obstacle::Polygon {
+                points: vec![[0.0, 0.0], [bad, 0.0], [0.0, 1.0]],
+            };
+            assert!(check_obstacle(&p).is_err());
+        }
+    }
 }

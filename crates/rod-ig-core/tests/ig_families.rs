@@ -177,11 +177,15 @@ fn run(objective: Objective, per_family: usize, seed: u64) {
 
 #[test]
 fn robust_solve_every_family_default_objective() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     run(Objective::FirstFound, 400, 91);
 }
 
 #[test]
 fn robust_solve_every_family_least_energy() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     run(Objective::LeastEnergy, 150, 92);
 }
 
@@ -191,6 +195,8 @@ fn robust_solve_every_family_least_energy() {
 /// iterations on average for the log-scale targets within 1e-4 of full extension).
 #[test]
 fn near_full_extension_solves_from_the_small_angle_start() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     let opts = SolveOptions::default();
     for (name, family) in &FAMILIES[..3] {
         let ts: Vec<PlanarPose> = targets(*family, 93, 400)

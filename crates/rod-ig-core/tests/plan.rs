@@ -75,6 +75,8 @@ fn verify(plan: &rod_ig_core::plan::Plan, request: &PlanRequest, reference: bool
 
 #[test]
 fn plans_between_random_stable_rods_are_stable_all_the_way() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     let mut rng = SplitMix64::new(2026);
     let mut planner = Planner::new();
     let (mut solved, mut times) = (0, Vec::new());
@@ -111,6 +113,8 @@ fn plans_between_random_stable_rods_are_stable_all_the_way() {
 
 #[test]
 fn plans_avoid_obstacles_and_failures_say_why() {
+    // The atlas, once per process, outside the deadlines under test.
+    rod_ig_core::ig::warm_up();
     let mut planner = Planner::new();
     let start = PlanarParams::new(1.0, 2.0, -1.0);
     let goal = PlanarPose::new(0.3, 0.6, 2.5);

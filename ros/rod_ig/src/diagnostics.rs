@@ -235,6 +235,8 @@ mod tests {
         use rod_ig_core::ig::{self, SolveOptions};
         use rod_ig_core::solver::observe;
         use rod_ig_core::PlanarPose;
+        // The atlas, once per process (the node builds it at start-up).
+        ig::warm_up();
         let mut s = SolveStats::default();
         for target in [
             PlanarPose::new(0.5, 0.3, 0.8),

@@ -347,9 +347,12 @@ impl Params {
             "path_samples" => self.path_samples = integer(name, value, 2, 100_000)? as usize,
             "tolerance" => {
                 let v = double(name, value)?;
-                let min = rod_ig_core::ig::MIN_TOLERANCE;
-                check(name, v.is_finite() && v >= min && v < 1.0, || {
-                    format!("must be in [{min:e}, 1), got {v}")
+                let (min, max) = (
+                    rod_ig_core::ig::MIN_TOLERANCE,
+                    rod_ig_core::ig::MAX_TOLERANCE,
+                );
+                check(name, (min..=max).contains(&v), || {
+                    format!("must be in [{min:e}, {max:e}], got {v}")
                 })?;
                 self.tolerance = v;
             }
@@ -483,8 +486,8 @@ impl Params {
                 "rod_length" => ("Physical length L of the rod (m); outputs are scaled by it", "> 0".into(), Unbounded),
                 "base_frame" => ("frame_id used when a target's frame_id is empty (the base gripper's frame)", String::new(), Unbounded),
                 "path_samples" => ("Poses per published nav_msgs/Path", String::new(), Integer(2, 100_000)),
-                "tolerance" => ("Solver convergence tolerance on the tip pose (normalised by rod length)", format!("[{:e}, 1)", rod_ig_core::ig::MIN_TOLERANCE), Unbounded),
-                "max_iterations" => ("Solver iteration limit per solve", String::new(), Integer(1, 100_000)),
+                "tolerance" => ("Solver convergence tolerance on the tip pose (normalised by rod length)", format!("[{:e}, {:e}]", rod_ig_core::ig::MIN_TOLERANCE, rod_ig_core::ig::MAX_TOLERANCE), Double(rod_ig_core::ig::MIN_TOLERANCE, rod_ig_core::ig::MAX_TOLERANCE)),
+                "max_iterations" => ("Solver iteration limit per start of the search (Newton: of the run)", String::new(), Integer(1, 100_000)),
                 "method" => ("Solver: robust (stable, default) or newton (the paper's iteration)", "robust or newton".into(), Unbounded),
                 "bending_stiffness" => ("Bending stiffness EI (N m^2) for the wrench and energy in joules; 0 = unknown", ">= 0".into(), Unbounded),
                 "planar_tolerance" => ("Largest |z| (m) and tilt out of the plane (rad) accepted as planar", String::new(), Double(0.0, 0.5)),

@@ -55,16 +55,24 @@ impl Overrides {
             o.initial_guess = Some(PlanarParams::new(g[0], g[1], g[2]));
         }
         if req.tolerance != 0.0 {
-            if !(req.tolerance.is_finite() && req.tolerance > 0.0 && req.tolerance < 1.0) {
+            use rod_ig_core::ig::{MAX_TOLERANCE, MIN_TOLERANCE};
+            if !(MIN_TOLERANCE..=MAX_TOLERANCE).contains(&req.tolerance) {
                 return Err(format!(
-                    "tolerance must be in (0, 1), got {}",
+                    "tolerance must be in [{MIN_TOLERANCE:e}, {MAX_TOLERANCE:e}], got {}",
                     req.tolerance
                 ));
             }
             o.tolerance = Some(req.tolerance);
         }
         if req.max_iterations != 0 {
-            o.max_iterations = Some(req.max_iterations.min(100_000));
+            let limit = rod_ig_core::ig::MAX_ITERATIONS_LIMIT;
+            if req.max_iterations > limit {
+                return Err(format!(
+                    "max_iterations must be in [1, {limit}] (per start), got {}",
+                    req.max_iterations
+                ));
+            }
+            o.max_iterations = Some(req.max_iterations);
         }
         if req.path_samples != 0 {
             if !(2..=100_000).contains(&req.path_samples) {

@@ -1,7 +1,7 @@
 //! A coarse atlas of stable rods indexed by their tip, to start the robust solver near a
 //! solution.
 //!
-//! Built once per process (lazily, [`std::sync::OnceLock`]) from rays of the weighted scaling
+//! Built once per process, lazily and in deadline-bounded steps ([`get`]), from rays of the weighted scaling
 //! a(s) = (s a3, s² a4, s² a5): the rod a restricted to [0, s] and rescaled to unit length is
 //! the rod a(s), so its tip is (x(s)/s, y(s)/s, θ(s)) and it is stable iff det J(τ, a) > 0 for
 //! τ ≤ s (FINDINGS §5). One RK4 integration of a ray end-point with its variational equations
@@ -15,8 +15,10 @@
 use super::scan;
 use crate::{wrap_angle, PlanarParams, PlanarPose};
 use nalgebra::{Matrix3, Vector3};
+use std::collections::BTreeMap;
 use std::f64::consts::{PI, TAU};
-use std::sync::OnceLock;
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::{Duration, Instant};
 
 /// Cells per unit of x and y (x, y ∈ [−1, 1]).
 const NXY: usize = 40;
@@ -65,11 +67,6 @@ pub(crate) struct Atlas {
 }
 
 static ATLAS: OnceLock<Atlas> = OnceLock::new();
-
-/// The atlas, built on first use.
-pub(crate) fn get() -> &'static Atlas {
-    ATLAS.get_or_init(build)
-}
 
 #[inline]
 fn cell_of(x: f64, y: f64, th: f64) -> Option<(usize, usize, usize)> {
@@ -146,109 +143,361 @@ fn halton(mut i: u64, b: u64) -> f64 {
     r
 }
 
-fn build() -> Atlas {
-    let ncells = NXY * NXY * NT;
-    let mut cells: Vec<Vec<(Seed, f64)>> = vec![Vec::new(); ncells];
-    let mut buf: Vec<(f64, f64, f64, f64, Matrix3<f64>)> = Vec::with_capacity(STEPS);
-    for i in 0..(RAYS + SEPARATRIX_RAYS) as u64 {
-        let a = if (i as usize) < RAYS {
-            PlanarParams::new(
-                (2.0 * halton(i + 1, 2) - 1.0) * A3_MAX,
-                (2.0 * halton(i + 1, 3) - 1.0) * A45_MAX,
-                (2.0 * halton(i + 1, 5) - 1.0) * A45_MAX,
-            )
-        } else {
-            match separatrix_endpoint(i + 1) {
-                Some(a) => a,
-                None => continue,
+/// Rays integrated per chunk of the build (≈ 0.5 ms of work: the granularity at which a
+/// request's deadline is polled while the atlas is being built).
+const RAYS_PER_CHUNK: usize = 32;
+/// Chunks of rays.
+const CHUNKS: usize = (RAYS + SEPARATRIX_RAYS).div_ceil(RAYS_PER_CHUNK);
+/// A piece of work still missing this long after it was handed out is handed out again.
+const LOST_WORK: Duration = Duration::from_millis(200);
+
+/// The atlas under construction, in two phases of small pieces: chunks of rays integrated into
+/// seeds, then the cells' short lists by x slab. The request that triggers the build is
+/// charged only the pieces its deadline allows (issue 24: no request answers later than its
+/// deadline) and the next request resumes; threads that need the atlas build it together,
+/// each computing the pieces it claims outside the lock. Seeds are filed in ray order whatever
+/// thread computed them, so the atlas is the same on every run.
+struct Builder {
+    cells: Vec<Vec<(Seed, f64)>>,
+    /// Pieces handed out so far: chunks 0..CHUNKS, then slabs.
+    handed_out: usize,
+    /// When each piece was (last) handed out.
+    handed_at: Vec<Instant>,
+    /// Chunks computed but not yet filed (waiting for an earlier one).
+    pending: BTreeMap<usize, Vec<Seed>>,
+    /// Chunks filed, in order.
+    filed: usize,
+    /// The seeds and cell offsets once every chunk is filed (short lists still empty).
+    seeded: Option<Arc<Atlas>>,
+    /// Short lists per slab, as they are computed.
+    slabs: Vec<Option<SlabLists>>,
+}
+
+/// The short lists of one x slab: per cell (in index order) its length, and the seed indices.
+struct SlabLists {
+    lengths: Vec<u32>,
+    near: Vec<u32>,
+}
+
+static BUILDER: Mutex<Option<Builder>> = Mutex::new(None);
+
+/// What a thread does next for the build.
+enum Work {
+    Chunk(usize),
+    Slab(usize, Arc<Atlas>),
+    /// Another thread computes the pieces still missing.
+    Wait,
+    Done(Atlas),
+}
+
+/// The atlas, built on first use within the current deadline ([`super::deadline`]) on every
+/// core: `None` when the deadline passes first. The work done is kept and resumed by the next
+/// call; threads calling it together share the build (each polls the deadline between pieces
+/// of ≈ 0.5 ms).
+pub(crate) fn get() -> Option<&'static Atlas> {
+    if let Some(atlas) = ATLAS.get() {
+        return Some(atlas);
+    }
+    let end = super::deadline::current();
+    let helpers = std::thread::available_parallelism().map_or(1, |n| n.get()) - 1;
+    std::thread::scope(|scope| {
+        for _ in 0..helpers {
+            scope.spawn(move || {
+                let _deadline = super::deadline::until(end);
+                build()
+            });
+        }
+        build()
+    })
+}
+
+/// Builds pieces of the atlas until it is complete or the deadline passes.
+fn build() -> Option<&'static Atlas> {
+    loop {
+        if let Some(atlas) = ATLAS.get() {
+            return Some(atlas);
+        }
+        if super::deadline::expired() {
+            return None;
+        }
+        let work = {
+            let mut guard = lock_builder();
+            if ATLAS.get().is_some() {
+                continue;
             }
+            let work = guard.get_or_insert_with(Builder::new).next_work();
+            if matches!(work, Work::Done(_)) {
+                *guard = None;
+            }
+            work
         };
-        buf.clear();
-        let mut t1 = f64::INFINITY;
-        let ok = scan::integrate(&a, STEPS, |t, x, y, th, j, det| {
-            if t >= crate::STABILITY_T_MIN && det <= 0.0 {
-                t1 = t;
-                return false;
+        match work {
+            Work::Chunk(c) => {
+                let seeds = chunk_seeds(c);
+                if let Some(b) = lock_builder().as_mut() {
+                    b.file_chunk(c, seeds);
+                }
             }
-            buf.push((t, x, y, th, *j));
-            true
+            Work::Slab(ix, seeded) => {
+                let lists = seeded.short_lists(ix);
+                if let Some(b) = lock_builder().as_mut() {
+                    b.slabs[ix].get_or_insert(lists);
+                }
+            }
+            Work::Wait => std::thread::sleep(Duration::from_micros(50)),
+            Work::Done(atlas) => {
+                let _ = ATLAS.set(atlas);
+            }
+        }
+    }
+}
+
+/// The builder's lock. A panic in another thread leaves a consistent state (a piece handed
+/// out and never delivered is handed out again, [`Builder::next_work`]).
+fn lock_builder() -> std::sync::MutexGuard<'static, Option<Builder>> {
+    BUILDER.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// The atlas, built now if needed whatever the time it takes (no deadline applies).
+pub(crate) fn get_blocking() -> &'static Atlas {
+    let _unbounded = super::deadline::unbounded();
+    loop {
+        if let Some(atlas) = get() {
+            return atlas;
+        }
+    }
+}
+
+impl Builder {
+    fn new() -> Self {
+        Self {
+            cells: vec![Vec::new(); NXY * NXY * NT],
+            handed_out: 0,
+            handed_at: Vec::with_capacity(CHUNKS + NXY),
+            pending: BTreeMap::new(),
+            filed: 0,
+            seeded: None,
+            slabs: (0..NXY).map(|_| None).collect(),
+        }
+    }
+
+    /// The next piece of work.
+    fn next_work(&mut self) -> Work {
+        let now = Instant::now();
+        if self.handed_out < CHUNKS {
+            return self.hand_out(now);
+        }
+        if self.filed < CHUNKS {
+            return self.missing(self.filed, now, Work::Chunk(self.filed));
+        }
+        let Some(seeded) = self.seeded.clone() else {
+            return Work::Wait;
+        };
+        if self.handed_out < CHUNKS + NXY {
+            let ix = self.handed_out - CHUNKS;
+            self.hand_out(now);
+            return Work::Slab(ix, seeded);
+        }
+        if let Some(ix) = self.slabs.iter().position(Option::is_none) {
+            return self.missing(CHUNKS + ix, now, Work::Slab(ix, seeded));
+        }
+        Work::Done(self.assemble(seeded))
+    }
+
+    fn hand_out(&mut self, now: Instant) -> Work {
+        self.handed_at.push(now);
+        self.handed_out += 1;
+        Work::Chunk(self.handed_out - 1)
+    }
+
+    /// Piece `id` is handed out but not delivered: `again` if its thread seems to have died
+    /// (a piece takes ~0.5 ms), else wait for it.
+    fn missing(&mut self, id: usize, now: Instant, again: Work) -> Work {
+        if now.duration_since(self.handed_at[id]) > LOST_WORK {
+            self.handed_at[id] = now;
+            again
+        } else {
+            Work::Wait
+        }
+    }
+
+    /// Files chunk `c` (and every pending chunk after it that is now in order).
+    fn file_chunk(&mut self, c: usize, seeds: Vec<Seed>) {
+        if c >= self.filed {
+            // A chunk computed twice (handed out again) is filed once.
+            self.pending.entry(c).or_insert(seeds);
+        }
+        while let Some(seeds) = self.pending.remove(&self.filed) {
+            for seed in seeds {
+                file_seed(&mut self.cells, seed);
+            }
+            self.filed += 1;
+        }
+        if self.filed == CHUNKS && self.seeded.is_none() {
+            self.seeded = Some(Arc::new(self.seeds()));
+        }
+    }
+
+    /// The seeds of every cell, in cell order (short lists still empty).
+    fn seeds(&mut self) -> Atlas {
+        let ncells = NXY * NXY * NT;
+        let mut offsets = Vec::with_capacity(ncells + 1);
+        let mut seeds = Vec::new();
+        for c in std::mem::take(&mut self.cells) {
+            offsets.push(seeds.len() as u32);
+            seeds.extend(c.into_iter().map(|(s, _)| s));
+        }
+        offsets.push(seeds.len() as u32);
+        Atlas {
+            offsets,
+            seeds,
+            near_offsets: Vec::new(),
+            near: Vec::new(),
+        }
+    }
+
+    /// The complete atlas: the seeds with every slab's short lists in cell order.
+    fn assemble(&mut self, seeded: Arc<Atlas>) -> Atlas {
+        self.seeded = None;
+        let mut atlas = Arc::try_unwrap(seeded).unwrap_or_else(|shared| Atlas {
+            offsets: shared.offsets.clone(),
+            seeds: shared.seeds.clone(),
+            near_offsets: Vec::new(),
+            near: Vec::new(),
         });
-        if ok.is_none() {
+        atlas.near_offsets.reserve(NXY * NXY * NT + 1);
+        for slab in self.slabs.iter_mut().filter_map(Option::take) {
+            let mut start = atlas.near.len() as u32;
+            for len in slab.lengths {
+                atlas.near_offsets.push(start);
+                start += len;
+            }
+            atlas.near.extend(slab.near);
+        }
+        atlas.near_offsets.push(atlas.near.len() as u32);
+        atlas
+    }
+}
+
+/// The candidate seeds of chunk `c`'s rays, in ray order.
+fn chunk_seeds(c: usize) -> Vec<Seed> {
+    let mut out = Vec::new();
+    let mut buf = Vec::with_capacity(STEPS);
+    let end = ((c + 1) * RAYS_PER_CHUNK).min(RAYS + SEPARATRIX_RAYS);
+    for i in c * RAYS_PER_CHUNK..end {
+        ray_seeds(i as u64, &mut buf, &mut out);
+    }
+    out
+}
+
+/// Integrates ray `i` and appends its stable rods as seeds.
+fn ray_seeds(i: u64, buf: &mut Vec<(f64, f64, f64, f64, Matrix3<f64>)>, out: &mut Vec<Seed>) {
+    let a = if (i as usize) < RAYS {
+        PlanarParams::new(
+            (2.0 * halton(i + 1, 2) - 1.0) * A3_MAX,
+            (2.0 * halton(i + 1, 3) - 1.0) * A45_MAX,
+            (2.0 * halton(i + 1, 5) - 1.0) * A45_MAX,
+        )
+    } else {
+        match separatrix_endpoint(i + 1) {
+            Some(a) => a,
+            None => return,
+        }
+    };
+    buf.clear();
+    let mut t1 = f64::INFINITY;
+    let ok = scan::integrate(&a, STEPS, |t, x, y, th, j, det| {
+        if t >= crate::STABILITY_T_MIN && det <= 0.0 {
+            t1 = t;
+            return false;
+        }
+        buf.push((t, x, y, th, *j));
+        true
+    });
+    if ok.is_none() {
+        return;
+    }
+    for &(t, x, y, th, j) in buf.iter() {
+        // Keep a margin from the first conjugate point (seeds deep inside A_stable).
+        if t < 0.05 || t > 0.985 * t1 {
             continue;
         }
-        for &(t, x, y, th, j) in buf.iter() {
-            // Keep a margin from the first conjugate point (seeds deep inside A_stable).
-            if t < 0.05 || t > 0.985 * t1 {
-                continue;
-            }
-            let tip = [x / t, y / t, wrap_angle(th)];
-            let Some((ix, iy, it)) = cell_of(tip[0], tip[1], tip[2]) else {
-                continue;
-            };
-            // J of the scaled rod a(t) = (t a3, t² a4, t² a5) at its tip: positions scale by
-            // 1/t, and ∂/∂a(t) = ∂/∂a · diag(1/t, 1/t², 1/t²).
-            let d = Matrix3::from_diagonal(&Vector3::new(1.0 / t, 1.0 / t, 1.0));
-            let s = Matrix3::from_diagonal(&Vector3::new(1.0 / t, 1.0 / (t * t), 1.0 / (t * t)));
-            let Some(jinv) = (d * j * s).try_inverse() else {
-                continue;
-            };
-            if !jinv.iter().all(|v| v.is_finite()) {
-                continue;
-            }
-            let seed = Seed {
-                a: [t * a[0], t * t * a[1], t * t * a[2]],
-                tip,
-                jinv,
-            };
-            let d = tip_distance2(&tip, &centre(ix, iy, it));
-            let cell = &mut cells[index(ix, iy, it)];
-            if let Some(slot) = cell.iter_mut().find(|(s, _)| same_branch(&s.a, &seed.a)) {
-                if d < slot.1 {
-                    *slot = (seed, d);
-                }
-            } else if cell.len() < K {
-                cell.push((seed, d));
-            } else if let Some(worst) = cell
-                .iter_mut()
-                .max_by(|p, q| p.1.total_cmp(&q.1))
-                .filter(|w| d < w.1)
-            {
-                *worst = (seed, d);
-            }
-        }
+        out.extend(scaled_seed(&a, t, x, y, th, &j));
     }
-    let mut offsets = Vec::with_capacity(ncells + 1);
-    let mut seeds = Vec::new();
-    for c in cells {
-        offsets.push(seeds.len() as u32);
-        seeds.extend(c.into_iter().map(|(s, _)| s));
-    }
-    offsets.push(seeds.len() as u32);
-    let mut atlas = Atlas {
-        offsets,
-        seeds,
-        near_offsets: Vec::with_capacity(ncells + 1),
-        near: Vec::new(),
+}
+
+/// The rod a(t) = (t a3, t² a4, t² a5) of ray `a` at `t` as a seed, with J⁻¹ at its tip:
+/// positions scale by 1/t, and ∂/∂a(t) = ∂/∂a · diag(1/t, 1/t², 1/t²).
+fn scaled_seed(
+    a: &PlanarParams,
+    t: f64,
+    x: f64,
+    y: f64,
+    th: f64,
+    j: &Matrix3<f64>,
+) -> Option<Seed> {
+    let tip = [x / t, y / t, wrap_angle(th)];
+    let d = Matrix3::from_diagonal(&Vector3::new(1.0 / t, 1.0 / t, 1.0));
+    let s = Matrix3::from_diagonal(&Vector3::new(1.0 / t, 1.0 / (t * t), 1.0 / (t * t)));
+    let jinv = (d * j * s).try_inverse()?;
+    jinv.iter().all(|v| v.is_finite()).then_some(Seed {
+        a: [t * a[0], t * t * a[1], t * t * a[2]],
+        tip,
+        jinv,
+    })
+}
+
+/// Files `seed` into its cell: one seed per branch, the one nearest the cell centre, at most
+/// [`K`] branches (the farthest replaced).
+fn file_seed(cells: &mut [Vec<(Seed, f64)>], seed: Seed) {
+    let Some((ix, iy, it)) = cell_of(seed.tip[0], seed.tip[1], seed.tip[2]) else {
+        return;
     };
-    // Per cell, the NEAR seeds of its 3×3×3 neighbourhood nearest the cell centre.
-    let mut tmp = Vec::new();
-    for ix in 0..NXY {
-        for iy in 0..NXY {
-            for it in 0..NT {
-                atlas.near_offsets.push(atlas.near.len() as u32);
-                tmp.clear();
-                let c = centre(ix, iy, it);
-                atlas.collect(ix, iy, it, 1, &c, &mut tmp);
-                tmp.sort_by(|p, q| p.0.total_cmp(&q.0));
-                atlas.near.extend(tmp.iter().take(NEAR).map(|p| p.1));
-            }
+    let d = tip_distance2(&seed.tip, &centre(ix, iy, it));
+    let cell = &mut cells[index(ix, iy, it)];
+    if let Some(slot) = cell.iter_mut().find(|(s, _)| same_branch(&s.a, &seed.a)) {
+        if d < slot.1 {
+            *slot = (seed, d);
         }
+    } else if cell.len() < K {
+        cell.push((seed, d));
+    } else if let Some(worst) = cell
+        .iter_mut()
+        .max_by(|p, q| p.1.total_cmp(&q.1))
+        .filter(|w| d < w.1)
+    {
+        *worst = (seed, d);
     }
-    atlas.near_offsets.push(atlas.near.len() as u32);
-    atlas
 }
 
 impl Atlas {
+    /// Per cell of the x slab `ix` (in index order), the NEAR seeds of its 3×3×3
+    /// neighbourhood nearest the cell centre.
+    fn short_lists(&self, ix: usize) -> SlabLists {
+        let mut lists = SlabLists {
+            lengths: Vec::with_capacity(NXY * NT),
+            near: Vec::with_capacity(NXY * NT * NEAR),
+        };
+        let mut tmp = Vec::new();
+        // By distance then index: a total order, so the lists do not depend on the order of
+        // collection.
+        let order = |p: &(f64, u32), q: &(f64, u32)| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1));
+        for iy in 0..NXY {
+            for it in 0..NT {
+                tmp.clear();
+                self.collect(ix, iy, it, 1, &centre(ix, iy, it), &mut tmp);
+                if tmp.len() > NEAR {
+                    tmp.select_nth_unstable_by(NEAR, order);
+                    tmp.truncate(NEAR);
+                }
+                tmp.sort_unstable_by(order);
+                lists.lengths.push(tmp.len() as u32);
+                lists.near.extend(tmp.iter().map(|p| p.1));
+            }
+        }
+        lists
+    }
+
     /// Number of seeds.
     pub(crate) fn len(&self) -> usize {
         self.seeds.len()
@@ -353,8 +602,9 @@ impl Atlas {
 }
 
 /// The atlas seed nearest `target` in tip space (searching up to 3 cells away).
+/// `None` too when the deadline passes before the atlas is built.
 pub(crate) fn nearest(target: &PlanarPose) -> Option<PlanarParams> {
-    let atlas = get();
+    let atlas = get()?;
     let mut v = Vec::new();
     atlas.near_list(target, &mut v);
     for r in 1..=3 {

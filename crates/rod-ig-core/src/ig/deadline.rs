@@ -35,6 +35,21 @@ pub(crate) fn scope(budget: Duration) -> Guard {
     })
 }
 
+/// The deadline in force on this thread.
+pub(crate) fn current() -> Option<Instant> {
+    END.with(|e| e.get())
+}
+
+/// Puts `end` in force on this thread until dropped (a helper thread working for a call).
+pub(crate) fn until(end: Option<Instant>) -> Guard {
+    END.with(|e| Guard(e.replace(end)))
+}
+
+/// Lifts the deadline until dropped (work that must complete, such as an explicit warm-up).
+pub(crate) fn unbounded() -> Guard {
+    END.with(|e| Guard(e.replace(None)))
+}
+
 /// True once the current deadline has passed.
 #[inline]
 pub(crate) fn expired() -> bool {

@@ -15,8 +15,9 @@
 //!   solution before it is returned. The caller's initial guess goes first when its residual is
 //!   no larger than the nearest seed's (it then selects the solution branch).
 //!
-//! The atlas (~80 k seeds, ~10 MB) is built once per process on first use, in about half a
-//! second; call [`warm_up`] at start-up to take that cost out of the first solve.
+//! The atlas (~80 k seeds, ~10 MB) is built once per process on first use, in about a quarter
+//! of a second, in steps charged to the deadline of the call that needs it; call [`warm_up`]
+//! at start-up to take that cost out of the first solves.
 //!
 //! [`solve_all`] lists the distinct stable solutions found; [`Objective::LeastEnergy`] returns the
 //! least elastic energy among them. [`Tracker`] follows a stream of nearby targets.
@@ -41,7 +42,7 @@ pub use tracker::Tracker;
 pub use crate::solver::IgError;
 pub use crate::solver::{
     Method, Objective, Termination, DEFAULT_DEADLINE, MAX_DEADLINE, MAX_ITERATIONS_LIMIT,
-    MIN_TOLERANCE,
+    MAX_TOLERANCE, MIN_TOLERANCE,
 };
 
 /// Options of the planar [`solve`], [`solve_all`] and [`Tracker`].
@@ -132,11 +133,6 @@ impl InverseGeometry<3> for PlanarClosedForm {
     fn default_start(&self, target: &PlanarPose) -> Option<PlanarParams> {
         atlas::nearest(target)
     }
-
-    fn prepare(&self) {
-        // The atlas is built once per process (≈ 0.5 s): not part of any request's budget.
-        let _ = atlas::get();
-    }
 }
 
 /// The closed-form answer polished by the reference integrator: the paper's Newton (α = 1) on
@@ -190,15 +186,15 @@ impl InverseGeometry<3> for PlanarReference {
     fn default_start(&self, target: &PlanarPose) -> Option<PlanarParams> {
         atlas::nearest(target)
     }
-
-    fn prepare(&self) {
-        let _ = atlas::get();
-    }
 }
 
-/// Builds the solver's atlas of stable rods now (it is otherwise built lazily, once per process,
-/// on the first robust solve; this takes a few tens of milliseconds). Returns its number of
-/// entries.
+/// Builds the solver's atlas of stable rods now, whatever the time it takes (≈ 0.25 s on one
+/// core). Returns its number of entries.
+///
+/// Without it the atlas is built on the first robust solve, in steps of ≈ 0.5 ms charged to
+/// that call's deadline: a first call with a short deadline returns
+/// [`Termination::Deadline`] and the next calls resume the build. A process that serves
+/// requests calls this at start-up (or on a background thread: requests share the build).
 pub fn warm_up() -> usize {
-    atlas::get().len()
+    atlas::get_blocking().len()
 }

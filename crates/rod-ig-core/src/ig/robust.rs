@@ -14,7 +14,7 @@ use crate::{PlanarParams, PlanarPose};
 const MAX_STARTS: usize = 48;
 /// The polishing stage runs when the best residual is below this.
 const POLISH_BELOW: f64 = 0.05;
-/// Iteration budget of the polishing stage.
+/// Iteration budget of the polishing stage (at most the caller's `max_iterations`).
 const POLISH_BUDGET: u32 = 300;
 /// Iteration budget for the caller's initial guess, which may be far from the target: beyond
 /// it, the atlas starts (a few iterations each) are the better bet.
@@ -117,6 +117,7 @@ fn try_start(
 /// solution branch); a far guess (larger residual) is tried after the short list.
 struct Starts<'t> {
     target: &'t PlanarPose,
+    atlas: &'static atlas::Atlas,
     guess: Option<PlanarParams>,
     guess_first: bool,
     buf: Vec<(f64, u32)>,
@@ -200,7 +201,7 @@ impl ModelStarts {
 }
 
 impl<'t> Starts<'t> {
-    fn new(target: &'t PlanarPose, options: &SolveOptions) -> Self {
+    fn new(target: &'t PlanarPose, atlas: &'static atlas::Atlas, options: &SolveOptions) -> Self {
         // The guess: used as is when det J(1, a0) > 0 (the local solver's requirement; an
         // unstable guess of even index is caught by the final stability test), else brought into
         // the stable set by weighted scaling.
@@ -231,6 +232,7 @@ impl<'t> Starts<'t> {
         }
         let mut s = Self {
             target,
+            atlas,
             guess,
             guess_first: true,
             buf: Vec::new(),
@@ -240,7 +242,6 @@ impl<'t> Starts<'t> {
             model: ModelStarts::new(target),
         };
         if guess.is_some() {
-            let atlas = atlas::get();
             atlas.near_list(target, &mut s.buf);
             s.stage = 1;
             let seed_residual = s
@@ -273,7 +274,7 @@ impl<'t> Starts<'t> {
         if let Some(a) = self.model.first() {
             return as_model_start(a);
         }
-        let atlas = atlas::get();
+        let atlas = self.atlas;
         loop {
             while self.pos < self.buf.len() {
                 let k = self.buf[self.pos].1;
@@ -308,22 +309,31 @@ impl<'t> Starts<'t> {
     }
 }
 
+/// The failure of a solve whose deadline passed, with the work done so far.
+fn deadline_failure(counts: &Counts) -> Failure {
+    Failure {
+        reason: IgError::Deadline {
+            iteration: counts.iterations,
+        },
+        iterations: counts.iterations,
+        residual: counts.best.0,
+        last_a: counts.best.1,
+        elapsed_us: 0.0,
+    }
+}
+
 pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Failure> {
     let mut counts = Counts::default();
-    let mut starts = Starts::new(target, options);
+    // The atlas is built on first use, in steps charged to this call's deadline.
+    let Some(atlas) = atlas::get() else {
+        return Err(deadline_failure(&counts));
+    };
+    let mut starts = Starts::new(target, atlas, options);
     let budget = per_start_budget(options);
     let mut n = 0;
     while n < MAX_STARTS {
         if super::deadline::expired() {
-            return Err(Failure {
-                reason: IgError::Deadline {
-                    iteration: counts.iterations,
-                },
-                iterations: counts.iterations,
-                residual: counts.best.0,
-                last_a: counts.best.1,
-                elapsed_us: 0.0,
-            });
+            return Err(deadline_failure(&counts));
         }
         let Some((start, is_guess)) = starts.next() else {
             break;
@@ -347,7 +357,8 @@ pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solut
     if let (r, Some(a)) = counts.best {
         if r < POLISH_BELOW {
             let start = atlas::Start { a, predicted: None };
-            if let Some(mut s) = try_start(target, &start, options, POLISH_BUDGET, &mut counts) {
+            let budget = POLISH_BUDGET.min(options.max_iterations);
+            if let Some(mut s) = try_start(target, &start, options, budget, &mut counts) {
                 s.iterations = counts.iterations;
                 s.evaluations = counts.evaluations;
                 s.starts = n as u32 + 1;
@@ -394,7 +405,14 @@ pub(crate) fn solve_all(
 ) -> All {
     let mut counts = Counts::default();
     let budget = per_start_budget(options);
-    let atlas = atlas::get();
+    let Some(atlas) = atlas::get() else {
+        return All {
+            solutions: Vec::new(),
+            iterations: 0,
+            evaluations: 0,
+            starts: 0,
+        };
+    };
     let mut list: Vec<atlas::Start> = Vec::new();
     if let Some(g) = options
         .initial_guess

@@ -91,13 +91,14 @@ impl Tracker {
     /// J(1, a) (slower, ~1 ms, but the branch then tracks well).
     pub fn solve(&mut self, target: &PlanarPose) -> Result<Solution, Failure> {
         let t0 = std::time::Instant::now();
-        let _ = super::warm_up();
         let _deadline = super::deadline::scope(self.options.deadline);
         if let Err(e) = super::check_target(target) {
             let mut f = Failure::early(e);
             f.elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
             return Err(f);
         }
+        // The angle reduced exactly (as every entry point does, `RodModel::canonical_target`).
+        let target = &PlanarPose::new(target.x, target.y, wrap_angle(target.theta));
         let warm = self.last.map(|l| l.0).or(self.options.initial_guess);
         let predicted = self.predict(target);
         let mut iterations = 0;

@@ -202,7 +202,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                 event: BranchEvent::None,
             };
         }
-        self.model.prepare();
+        let target = &self.model.canonical_target(target);
         let _deadline = crate::ig::deadline::scope(self.options.deadline);
         let mut work = Work::default();
         let mut current = held;

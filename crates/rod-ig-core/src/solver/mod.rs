@@ -17,7 +17,8 @@
 //! use rod_ig_core::spatial::SpatialPose;
 //! use rod_ig_core::PlanarPose;
 //!
-//! // Planar: the closed forms.
+//! // Planar: the closed forms (the atlas of stable rods built first, outside the deadline).
+//! rod_ig_core::ig::warm_up();
 //! let s = solver::solve(&PlanarClosedForm, &PlanarPose::new(0.5, 0.4, 1.0), &SolveOptions::default())
 //!     .expect("a reachable target");
 //! assert!(s.stable && s.position_error <= 1e-6);
@@ -47,7 +48,7 @@ pub use observer::{observe, Counters, Event, IterationLog, Observer};
 pub(crate) use options::check_options;
 pub use options::{
     Method, Objective, SolveOptions, DEFAULT_DEADLINE, DEFAULT_DEADLINE_3D, DEFAULT_MAX_ITERATIONS,
-    DEFAULT_TOLERANCE, MAX_DEADLINE, MAX_ITERATIONS_LIMIT, MIN_TOLERANCE,
+    DEFAULT_TOLERANCE, MAX_DEADLINE, MAX_ITERATIONS_LIMIT, MAX_TOLERANCE, MIN_TOLERANCE,
 };
 pub use outcome::{Failure, IgError, Solution, Termination};
 
@@ -92,10 +93,6 @@ pub trait InverseGeometry<const N: usize>: RodModel<N> {
 
     /// The start of the paper's Newton when the caller gives none.
     fn default_start(&self, target: &Self::Pose) -> Option<SVector<f64, N>>;
-
-    /// One-time preparation (tables built once per process) run before a call's deadline
-    /// starts, so that it is not charged to the first request.
-    fn prepare(&self) {}
 }
 
 fn check<const N: usize, M: InverseGeometry<N> + ?Sized>(
@@ -125,9 +122,8 @@ pub fn solve<const N: usize, M: InverseGeometry<N> + ?Sized>(
     let result = match check(model, target, options) {
         Err(e) => Err(Failure::early(e)),
         Ok(()) => {
-            model.prepare();
             let _deadline = crate::ig::deadline::scope(options.deadline);
-            dispatch(model, target, options)
+            dispatch(model, &model.canonical_target(target), options)
         }
     };
     let elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
@@ -164,9 +160,15 @@ fn dispatch<const N: usize, M: InverseGeometry<N> + ?Sized>(
                 .initial_guess
                 .or_else(|| model.default_start(target))
             else {
-                let reason = IgError::NoStableSolution {
-                    starts: 0,
-                    last: None,
+                // No default start: the model's tables were not ready within the deadline, or
+                // it has none for this target.
+                let reason = if crate::ig::deadline::expired() {
+                    IgError::Deadline { iteration: 0 }
+                } else {
+                    IgError::NoStableSolution {
+                        starts: 0,
+                        last: None,
+                    }
                 };
                 return Err(Failure::early(reason));
             };
@@ -212,9 +214,9 @@ pub fn solve_all<const N: usize, M: InverseGeometry<N> + ?Sized>(
     if check(model, target, options).is_err() {
         return Vec::new();
     }
-    model.prepare();
     let t0 = std::time::Instant::now();
     let _deadline = crate::ig::deadline::scope(options.deadline);
+    let target = &model.canonical_target(target);
     let found = model.robust_all(target, options);
     let mut solutions = found.solutions;
     let mut iterations = found.iterations;

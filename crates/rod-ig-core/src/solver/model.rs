@@ -107,6 +107,13 @@ pub trait RodModel<const N: usize> {
     /// Checks that `target` is finite and within reach.
     fn check_target(&self, target: &Self::Pose) -> Result<(), IgError>;
 
+    /// The target as every solver sees it, reported errors included: planar angles reduced
+    /// exactly to (−π, π] ([`crate::wrap_angle`]), so that θ = 3.7e11 solves exactly as its
+    /// reduction does (a residual θ_tip − θ_target would round away the low bits first).
+    fn canonical_target(&self, target: &Self::Pose) -> Self::Pose {
+        *target
+    }
+
     /// det J(1, a): its sign changes exactly where a branch of equilibria folds (and where
     /// stability can be lost along it, FINDINGS §5).
     fn jacobian_det(&self, jacobian: &SMatrix<f64, N, N>) -> f64;
@@ -224,6 +231,10 @@ macro_rules! planar_geometry {
 
         fn check_target(&self, target: &PlanarPose) -> Result<(), IgError> {
             planar_check_target(target)
+        }
+
+        fn canonical_target(&self, target: &PlanarPose) -> PlanarPose {
+            PlanarPose::new(target.x, target.y, wrap_angle(target.theta))
         }
 
         fn interpolate(&self, from: &PlanarPose, to: &PlanarPose, s: f64) -> PlanarPose {

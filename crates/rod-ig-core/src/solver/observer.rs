@@ -6,6 +6,7 @@
 //! use rod_ig_core::solver::{self, observe, Event, IterationLog, PlanarClosedForm};
 //! use rod_ig_core::PlanarPose;
 //!
+//! rod_ig_core::ig::warm_up(); // the atlas, outside the solve's deadline
 //! let target = PlanarPose::new(0.6, 0.3, 0.5);
 //! let options = solver::SolveOptions::default();
 //! let (result, log) = observe(IterationLog::default(), || {

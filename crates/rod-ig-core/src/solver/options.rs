@@ -34,10 +34,12 @@ pub struct SolveOptions<P> {
     /// Newton step length α ∈ (0, 1] (paper §3.1). The robust solver starts its backtracking
     /// from this value.
     pub alpha: f64,
-    /// Iteration budget (Newton: total; robust: per start). At most [`MAX_ITERATIONS_LIMIT`].
+    /// Iteration budget of one run from one start: Newton, the run; the robust search, each of
+    /// its starts (the final polish of the best iterate included), so a robust solve makes at
+    /// most `max_iterations` × its starts iterations in all. In [1, [`MAX_ITERATIONS_LIMIT`]].
     pub max_iterations: u32,
-    /// Tolerance on the position error and on the orientation error (rod lengths, rad). At
-    /// least [`MIN_TOLERANCE`].
+    /// Tolerance on the position error and on the orientation error (rod lengths, rad). In
+    /// [[`MIN_TOLERANCE`], [`MAX_TOLERANCE`]].
     pub tolerance: f64,
     /// Initial guess a0. Required by [`Method::Newton`] (without one, it starts from the
     /// model's default start); the robust solver tries it first.
@@ -66,6 +68,9 @@ pub const MAX_ITERATIONS_LIMIT: u32 = 100_000;
 /// Smallest accepted tolerance: positions of the unit rod carry rounding errors of a few 1e-16
 /// (and J-conditioned amplification), so a tolerance below 1e-14 cannot be met reliably.
 pub const MIN_TOLERANCE: f64 = 1e-14;
+/// Largest accepted tolerance: 1e-2 of the rod length (1 cm on a 1 m cable) and 10 mrad.
+/// Beyond it "converged" would call a rod a solution whose tip visibly misses the target.
+pub const MAX_TOLERANCE: f64 = 1e-2;
 /// Default tolerance: 1e-6 of the rod length (1 µm on a 1 m cable) and 1 µrad.
 pub const DEFAULT_TOLERANCE: f64 = 1e-6;
 /// Default iteration budget: the paper's protocol (FINDINGS §8).
@@ -108,15 +113,15 @@ pub(crate) fn check_options<const N: usize>(
             options.alpha
         )));
     }
-    if !(options.tolerance >= MIN_TOLERANCE && options.tolerance.is_finite()) {
+    if !(options.tolerance >= MIN_TOLERANCE && options.tolerance <= MAX_TOLERANCE) {
         return Err(IgError::InvalidOptions(format!(
-            "tolerance = {:e} is not a finite number >= {MIN_TOLERANCE:e} (rounding bound)",
+            "tolerance = {:e} is not in [{MIN_TOLERANCE:e} (rounding bound), {MAX_TOLERANCE:e}]",
             options.tolerance
         )));
     }
-    if options.max_iterations > MAX_ITERATIONS_LIMIT {
+    if !(1..=MAX_ITERATIONS_LIMIT).contains(&options.max_iterations) {
         return Err(IgError::InvalidOptions(format!(
-            "max_iterations = {} exceeds the limit {MAX_ITERATIONS_LIMIT}",
+            "max_iterations = {} is not in [1, {MAX_ITERATIONS_LIMIT}]",
             options.max_iterations
         )));
     }

@@ -74,6 +74,13 @@ impl Default for Stiffness {
     }
 }
 
+/// Smallest accepted stiffness coefficient. The unit rod's equilibria depend only on the
+/// ratios c_i / c_j; ratios beyond 1e12 make the Hamiltonian system so stiff that no answer
+/// could be certified, so each coefficient is kept within [1e-6, 1e6].
+pub const MIN_STIFFNESS: f64 = 1e-6;
+/// Largest accepted stiffness coefficient ([`MIN_STIFFNESS`]).
+pub const MAX_STIFFNESS: f64 = 1e6;
+
 impl Stiffness {
     /// Checks that c1, c2, c3 are finite and > 0.
     pub fn validate(&self) -> Result<(), RodError> {
@@ -85,9 +92,9 @@ impl Stiffness {
                     value: c,
                 });
             }
-            if c <= 0.0 {
+            if !(MIN_STIFFNESS..=MAX_STIFFNESS).contains(&c) {
                 return Err(RodError::OutOfDomain(format!(
-                    "stiffness c{} must be > 0 (got {c})",
+                    "stiffness c{} must be in [{MIN_STIFFNESS:e}, {MAX_STIFFNESS:e}] (got {c})",
                     i + 1
                 )));
             }
