@@ -7,7 +7,9 @@
 #      `RUSTDOCFLAGS="-D warnings" cargo doc --no-deps`;
 #   4. `cargo test --workspace` (unit, integration and doc-tests, the seeded CLI fuzz) and the
 #      pytest suite in tests/ (real rclpy client, node as a subprocess on random ROS domains,
-#      loopback only).
+#      loopback only);
+#   5. the Python package: `pip install ./python` into its own venv, its pytest suite and
+#      `mypy --strict`.
 # Prints cargo's and pytest's summary lines; exits non-zero if anything fails.
 #
 # Environment: ROD_IG_VENV, ROD_IG_BUILD, PYTHON (see setup-env.sh); CARGO_TARGET_DIR;
@@ -57,7 +59,28 @@ python -m pytest "$REPO/tests" -q -p no:cacheprovider -W ignore::DeprecationWarn
 pytest_rc=${PIPESTATUS[0]}
 [ "$pytest_rc" = 0 ] || { echo "pytest FAILED (full log: $LOGS/pytest.log; node logs in $LOGS)"; status=1; }
 
+echo "== Python package rod_ig: pip install ./python, pytest python/tests, mypy --strict"
+# Its own venv (numpy 2, dask, matplotlib): the ROS venv's wheels pin their own numpy.
+PYVENV="${ROD_IG_BUILD:-$REPO/build}/py-venv"
+[ -x "$PYVENV/bin/python" ] || python3 -m venv "$PYVENV"
+py_ok=1
+"$PYVENV/bin/python" -m pip install --quiet --disable-pip-version-check \
+    pytest hypothesis mypy "dask[array]" matplotlib numpy >"$LOGS/py-deps.log" 2>&1 || py_ok=0
+# Same target dir as the package's own builds (python/target), so that reruns are incremental.
+"$PYVENV/bin/python" -m pip install --quiet --disable-pip-version-check --force-reinstall \
+    --no-deps ./python >"$LOGS/py-build.log" 2>&1 || py_ok=0
+if [ "$py_ok" = 1 ]; then
+    (cd "$LOGS" && ROD_IG_CLI="$TARGET/release/rod-ig" "$PYVENV/bin/python" -m pytest \
+        "$REPO/python/tests" -q -p no:cacheprovider 2>&1) | tee "$LOGS/py-test.log" | tail -n 5
+    [ "${PIPESTATUS[0]}" = 0 ] || { echo "python package tests FAILED (see $LOGS/py-test.log)"; status=1; }
+    "$PYVENV/bin/python" -m mypy --strict "$REPO/python/rod_ig" >"$LOGS/mypy.log" 2>&1 \
+        || { echo "mypy --strict FAILED (see $LOGS/mypy.log)"; status=1; }
+else
+    echo "python package build FAILED (see $LOGS/py-deps.log, $LOGS/py-build.log)"; status=1
+fi
+
 echo "== summary"
 grep -E '^test result:' "$LOGS/cargo-test.log" | awk '{p+=$4; f+=$6} END {printf "cargo: %d passed, %d failed\n", p, f}'
 tail -n 1 "$LOGS/pytest.log"
+[ -f "$LOGS/py-test.log" ] && echo "python package: $(tail -n 1 "$LOGS/py-test.log")"
 exit $status

@@ -45,9 +45,8 @@ pub use model::{
 };
 pub(crate) use observer::emit;
 pub use observer::{observe, Counters, Event, IterationLog, Observer};
-pub(crate) use options::check_options;
 pub use options::{
-    Method, Objective, SolveOptions, DEFAULT_DEADLINE, DEFAULT_DEADLINE_3D, DEFAULT_MAX_ITERATIONS,
+    check_options, Method, Objective, SolveOptions, DEFAULT_DEADLINE, DEFAULT_DEADLINE_3D, DEFAULT_MAX_ITERATIONS,
     DEFAULT_TOLERANCE, MAX_DEADLINE, MAX_ITERATIONS_LIMIT, MAX_TOLERANCE, MIN_TOLERANCE,
 };
 pub use outcome::{Failure, IgError, Solution, Termination};

@@ -103,8 +103,9 @@ impl Default for SolveOptions<nalgebra::Vector6<f64>> {
     }
 }
 
-/// Checks the options against their documented limits.
-pub(crate) fn check_options<const N: usize>(
+/// Checks the options against their documented limits (every solve does this first; a front
+/// end may call it to refuse a request before any work).
+pub fn check_options<const N: usize>(
     options: &SolveOptions<nalgebra::SVector<f64, N>>,
 ) -> Result<(), IgError> {
     if !(options.alpha > 0.0 && options.alpha <= 1.0) {

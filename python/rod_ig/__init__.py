@@ -1,0 +1,379 @@
+"""rod-ig: equilibria, stability and inverse geometry of an elastic rod held by two grippers.
+
+The rod has unit length and unit bending stiffness; its base gripper is the identity frame
+(REP 103: x forward along the base tangent, y left, angles in radians, counter-clockwise).
+A planar equilibrium is parametrised by a = (a3, a4, a5), the base moment and force (paper
+Roussel, Renaud, Taix 2015); a 3-D one by a in R^6. Scale lengths by your rod's length L,
+forces by EI/L^2 and moments by EI/L.
+
+Every batch function takes float64 arrays with any leading batch shape ``(...)``, runs on all
+cores by default (``threads=1`` for one), releases the GIL while it works and can be
+interrupted with Ctrl-C. A target that cannot be solved is data (``success`` False and a
+``termination`` string), never an exception; bad input (wrong shape, dtype, NaN) raises
+``ValueError`` / ``TypeError`` naming the argument.
+
+>>> import rod_ig
+>>> r = rod_ig.forward([[2.0, -10.0, 5.0]])
+>>> bool(r.stable[0])
+True
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from . import _rod_ig
+
+__version__: str = _rod_ig.__version__
+
+__all__ = [
+    "__version__",
+    "forward",
+    "shape",
+    "solve",
+    "forward3d",
+    "solve3d",
+    "warm_up",
+    "Tracker",
+    "Planner",
+    "ForwardResult",
+    "Forward3dResult",
+    "SolveResult",
+    "MoveResult",
+    "PlanResult",
+]
+
+FloatArray = npt.NDArray[np.float64]
+BoolArray = npt.NDArray[np.bool_]
+
+
+def _batch(name: str, value: npt.ArrayLike, width: int) -> tuple[FloatArray, tuple[int, ...]]:
+    """``value`` as a C-contiguous float64 array of shape (..., width), checked."""
+    arr = np.asarray(value)
+    if arr.dtype.kind not in "fiu":
+        raise TypeError(f"{name} must hold real numbers (float64), got dtype {arr.dtype}")
+    if arr.ndim == 0 or arr.shape[-1] != width:
+        raise ValueError(f"{name} must have shape (..., {width}), got {arr.shape}")
+    arr = np.ascontiguousarray(arr, dtype=np.float64)
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        index = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise ValueError(f"{name} is not finite at index {index}: {arr[index]}")
+    return arr, arr.shape[:-1]
+
+
+def _broadcast(*arrays: FloatArray) -> tuple[list[FloatArray], tuple[int, ...]]:
+    """Broadcasts the leading (batch) dimensions of arrays of shape (..., w_i)."""
+    try:
+        shape = np.broadcast_shapes(*(a.shape[:-1] for a in arrays))
+    except ValueError as e:
+        raise ValueError(f"batch shapes do not broadcast: {e}") from None
+    out = [
+        np.ascontiguousarray(np.broadcast_to(a, shape + a.shape[-1:])).reshape(-1) for a in arrays
+    ]
+    return out, shape
+
+
+@dataclass(frozen=True)
+class ForwardResult:
+    """Planar forward map of a batch of rods (shape ``(...)``)."""
+
+    tip: FloatArray
+    """(..., 3): tip pose (x, y, theta) in the base frame, theta unwrapped (the integral of the
+    curvature), in rod lengths and radians."""
+    jacobian: FloatArray
+    """(..., 3, 3): J(1, a), rows x, y, theta; columns a3, a4, a5."""
+    stable: BoolArray
+    """(...): the rod is a stable equilibrium (FINDINGS section 5 test)."""
+    margin: FloatArray
+    """(...): normalised stability margin g_min (about 1 for a gently bent rod, < 0 unstable)."""
+    uncertain: BoolArray
+    """(...): the margin is within its rounding-error bound (``stable`` is then False)."""
+    energy: FloatArray
+    """(...): elastic energy (unit stiffness)."""
+
+
+@dataclass(frozen=True)
+class Forward3dResult:
+    """3-D forward map of a batch of rods (shape ``(...)``)."""
+
+    position: FloatArray
+    """(..., 3): tip position in the base frame (rod lengths)."""
+    quaternion: FloatArray
+    """(..., 4): tip orientation (x, y, z, w)."""
+    jacobian: FloatArray
+    """(..., 6, 6): J(1, a) as body twists, rows omega1 omega2 omega3 v1 v2 v3."""
+    stable: BoolArray
+    margin: FloatArray
+    energy: FloatArray
+
+
+@dataclass(frozen=True)
+class SolveResult:
+    """Inverse geometry of a batch of targets (shape ``(...)``)."""
+
+    success: BoolArray
+    a: FloatArray
+    """(..., 3) or (..., 6): the stable rod found (NaN where it failed)."""
+    termination: npt.NDArray[np.str_]
+    """(...): "converged", "deadline", "no_stable_solution", "unreachable", ... (the CLI's)."""
+    iterations: npt.NDArray[np.uint32]
+    margin: FloatArray
+    energy: FloatArray
+    position_error: FloatArray
+    orientation_error: FloatArray
+    solutions: npt.NDArray[np.object_] | None = None
+    """With ``all=True``: (...) object array, each entry an (k, 3) or (k, 6) array of every
+    distinct stable solution found, least energy first."""
+
+
+def _solve_result(
+    d: dict[str, Any], shape: tuple[int, ...], dim: int, all: bool
+) -> SolveResult:
+    solutions = None
+    if all:
+        solutions = np.empty(len(d["solutions"]), dtype=object)
+        for i, s in enumerate(d["solutions"]):
+            solutions[i] = s.reshape(-1, dim)
+        solutions = solutions.reshape(shape)
+    return SolveResult(
+        success=d["success"].reshape(shape),
+        a=d["a"].reshape(shape + (dim,)),
+        termination=np.array(d["termination"], dtype=str).reshape(shape),
+        iterations=d["iterations"].reshape(shape),
+        margin=d["margin"].reshape(shape),
+        energy=d["energy"].reshape(shape),
+        position_error=d["position_error"].reshape(shape),
+        orientation_error=d["orientation_error"].reshape(shape),
+        solutions=solutions,
+    )
+
+
+def forward(a: npt.ArrayLike, threads: int | None = None) -> ForwardResult:
+    """Planar forward map of rods ``a`` of shape (..., 3) = (a3, a4, a5): tip pose, J(1, a),
+    stability verdict and margin, energy (closed forms, paper section 2). A rod that cannot be
+    evaluated (beyond the certified domain) gets NaN, ``stable`` False, ``uncertain`` True."""
+    arr, shape = _batch("a", a, 3)
+    d = _rod_ig.forward(arr.reshape(-1), threads=threads)
+    return ForwardResult(
+        tip=d["tip"].reshape(shape + (3,)),
+        jacobian=d["jacobian"].reshape(shape + (3, 3)),
+        stable=d["stable"].reshape(shape),
+        margin=d["margin"].reshape(shape),
+        uncertain=d["uncertain"].reshape(shape),
+        energy=d["energy"].reshape(shape),
+    )
+
+
+def shape(a: npt.ArrayLike, samples: int = 100, threads: int | None = None) -> FloatArray:
+    """Poses (x, y, theta) of rods ``a`` (..., 3) at ``samples`` points from the base (the
+    identity) to the tip: shape (..., samples, 3)."""
+    if not 2 <= int(samples) <= 1_000_000:
+        raise ValueError(f"samples must be in [2, 1000000], got {samples}")
+    arr, batch = _batch("a", a, 3)
+    out = _rod_ig.shape(arr.reshape(-1), int(samples), threads=threads)
+    return out.reshape(batch + (int(samples), 3))
+
+
+def solve(
+    targets: npt.ArrayLike,
+    a0: npt.ArrayLike | None = None,
+    objective: str = "first",
+    method: str = "robust",
+    deadline_ms: float = 250.0,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    alpha: float | None = None,
+    all: bool = False,
+    threads: int | None = None,
+) -> SolveResult:
+    """Planar inverse geometry: for each target (x, y, theta) of shape (..., 3), a stable rod
+    whose tip is there. ``a0`` (broadcast against the targets) starts the search and selects
+    the branch; ``objective`` "first" | "least_energy"; ``method`` "robust" | "newton" (the
+    paper's alpha-Newton from ``a0``); ``deadline_ms`` per target; ``tolerance`` on the
+    position (rod lengths) and angle (rad) errors, in [1e-14, 1e-2]; ``max_iterations`` per
+    start; ``all=True`` also lists every distinct stable solution found."""
+    t, _ = _batch("targets", targets, 3)
+    arrays = [t]
+    if a0 is not None:
+        arrays.append(_batch("a0", a0, 3)[0])
+    flat, batch = _broadcast(*arrays)
+    d = _rod_ig.solve(
+        flat[0],
+        a0=flat[1] if a0 is not None else None,
+        objective=objective,
+        method=method,
+        deadline_ms=deadline_ms,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        alpha=alpha,
+        all=all,
+        threads=threads,
+    )
+    return _solve_result(d, batch, 3, all)
+
+
+def forward3d(
+    a: npt.ArrayLike,
+    stiffness: tuple[float, float, float] = (1.0, 1.0, 1.0),
+    threads: int | None = None,
+) -> Forward3dResult:
+    """3-D forward map of rods ``a`` (..., 6) by numerical integration (FINDINGS3D), with
+    stiffness (c1 torsion, c2, c3 bending) each in [1e-6, 1e6]."""
+    arr, batch = _batch("a", a, 6)
+    d = _rod_ig.forward3d(arr.reshape(-1), stiffness=tuple(stiffness), threads=threads)
+    return Forward3dResult(
+        position=d["position"].reshape(batch + (3,)),
+        quaternion=d["quaternion"].reshape(batch + (4,)),
+        jacobian=d["jacobian"].reshape(batch + (6, 6)),
+        stable=d["stable"].reshape(batch),
+        margin=d["margin"].reshape(batch),
+        energy=d["energy"].reshape(batch),
+    )
+
+
+def solve3d(
+    position: npt.ArrayLike,
+    quaternion: npt.ArrayLike,
+    a0: npt.ArrayLike | None = None,
+    objective: str = "first",
+    method: str = "robust",
+    deadline_ms: float = 1000.0,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    alpha: float | None = None,
+    stiffness: tuple[float, float, float] = (1.0, 1.0, 1.0),
+    all: bool = False,
+    threads: int | None = None,
+) -> SolveResult:
+    """3-D inverse geometry: targets given by ``position`` (..., 3) and ``quaternion``
+    (..., 4) as (x, y, z, w), broadcast together; the options of :func:`solve`."""
+    arrays = [_batch("position", position, 3)[0], _batch("quaternion", quaternion, 4)[0]]
+    if a0 is not None:
+        arrays.append(_batch("a0", a0, 6)[0])
+    flat, batch = _broadcast(*arrays)
+    d = _rod_ig.solve3d(
+        flat[0],
+        flat[1],
+        a0=flat[2] if a0 is not None else None,
+        objective=objective,
+        method=method,
+        deadline_ms=deadline_ms,
+        tolerance=tolerance,
+        max_iterations=max_iterations,
+        alpha=alpha,
+        stiffness=tuple(stiffness),
+        all=all,
+        threads=threads,
+    )
+    return _solve_result(d, batch, 6, all)
+
+
+def warm_up() -> int:
+    """Builds the planar solver's atlas of stable rods now (about 0.15 s on two cores; done
+    otherwise by the first solve). Returns its number of seeds."""
+    return _rod_ig.warm_up()
+
+
+@dataclass(frozen=True)
+class MoveResult:
+    """One move of a :class:`Tracker`: the fields of :class:`SolveResult` for one target, and
+    the branch event."""
+
+    success: bool
+    a: FloatArray
+    termination: str
+    iterations: int
+    margin: float
+    energy: float
+    position_error: float
+    orientation_error: float
+    event: str
+    """"none", "snap" (the branch folded: the rod jumped to another equilibrium) or "lost"."""
+    critical: FloatArray | None = None
+    """After a snap: the gripper pose (x, y, theta) where the branch folded."""
+    critical_a: FloatArray | None = None
+    energy_released: float | None = None
+    reason: str | None = None
+
+
+class Tracker:
+    """Quasi-static motion: the rod follows its equilibrium branch as the tip gripper moves,
+    and snaps where the branch folds.
+
+    >>> t = Tracker()
+    >>> t.move([0.6, 0.2, 0.4]).event
+    'none'
+    """
+
+    def __init__(
+        self,
+        a0: Sequence[float] | None = None,
+        deadline_ms: float = 250.0,
+        tolerance: float | None = None,
+    ) -> None:
+        start = None if a0 is None else [float(v) for v in _batch("a0", a0, 3)[0].reshape(3)]
+        self._inner = _rod_ig.Tracker(a0=start, deadline_ms=deadline_ms, tolerance=tolerance)
+
+    def move(self, target: npt.ArrayLike) -> MoveResult:
+        """Moves the tip gripper to ``target`` (x, y, theta) and returns the rod it holds."""
+        t = [float(v) for v in _batch("target", target, 3)[0].reshape(3)]
+        return MoveResult(**self._inner.move(t))
+
+    @property
+    def rod(self) -> FloatArray | None:
+        """The rod held now (a3, a4, a5), None before the first move or after a loss."""
+        r = self._inner.rod
+        return None if r is None else np.array(r)
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """A plan: stable rods from the start to a rod whose tip is the goal."""
+
+    success: bool
+    rods: FloatArray
+    """(n, 3): rods, consecutive ones within 0.1 (1 + |a|)."""
+    gripper: FloatArray
+    """(n, 3): the tip gripper's poses (x, y, theta)."""
+    min_margin: float
+    reason: str
+
+
+class Planner:
+    """Plans stable, collision-free gripper paths for the planar rod over a roadmap of stable
+    rods, kept across calls. Obstacles are dicts ``{"type": "disc", "center": [x, y],
+    "radius": r}`` or ``{"type": "polygon", "points": [[x, y], ...]}`` in rod lengths, within
+    +-1e6."""
+
+    def __init__(self) -> None:
+        self._inner = _rod_ig.Planner()
+
+    def plan(
+        self,
+        start: Sequence[float],
+        goal: Sequence[float],
+        obstacles: Sequence[dict[str, Any]] = (),
+        deadline_ms: float = 500.0,
+    ) -> PlanResult:
+        """Plans from the rod ``start`` (a3, a4, a5) to a rod whose tip is ``goal`` (x, y,
+        theta)."""
+        s = [float(v) for v in _batch("start", start, 3)[0]]
+        g = [float(v) for v in _batch("goal", goal, 3)[0]]
+        d = self._inner.plan(s, g, obstacles=list(obstacles), deadline_ms=deadline_ms)
+        return PlanResult(
+            success=d["success"],
+            rods=d["rods"].reshape(-1, 3),
+            gripper=d["gripper"].reshape(-1, 3),
+            min_margin=d["min_margin"],
+            reason=d["reason"],
+        )
+
+    @property
+    def roadmap_size(self) -> int:
+        """Roadmap nodes (0 before the first plan)."""
+        return self._inner.roadmap_size

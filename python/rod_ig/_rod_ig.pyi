@@ -1,0 +1,70 @@
+"""Type stubs of the native module (Rust, PyO3). Arrays are flat float64; ``rod_ig`` checks
+shapes and reshapes."""
+
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+def forward(a: npt.NDArray[np.float64], threads: int | None = None) -> dict[str, Any]: ...
+def shape(
+    a: npt.NDArray[np.float64], samples: int, threads: int | None = None
+) -> npt.NDArray[np.float64]: ...
+def solve(
+    targets: npt.NDArray[np.float64],
+    a0: npt.NDArray[np.float64] | None = None,
+    objective: str = "first",
+    method: str = "robust",
+    deadline_ms: float | None = None,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    alpha: float | None = None,
+    all: bool = False,
+    threads: int | None = None,
+) -> dict[str, Any]: ...
+def forward3d(
+    a: npt.NDArray[np.float64],
+    stiffness: tuple[float, ...] = (1.0, 1.0, 1.0),
+    threads: int | None = None,
+) -> dict[str, Any]: ...
+def solve3d(
+    position: npt.NDArray[np.float64],
+    quaternion: npt.NDArray[np.float64],
+    a0: npt.NDArray[np.float64] | None = None,
+    objective: str = "first",
+    method: str = "robust",
+    deadline_ms: float | None = None,
+    tolerance: float | None = None,
+    max_iterations: int | None = None,
+    alpha: float | None = None,
+    stiffness: tuple[float, ...] = (1.0, 1.0, 1.0),
+    all: bool = False,
+    threads: int | None = None,
+) -> dict[str, Any]: ...
+def warm_up() -> int: ...
+
+class Tracker:
+    def __init__(
+        self,
+        a0: list[float] | None = None,
+        deadline_ms: float | None = None,
+        tolerance: float | None = None,
+    ) -> None: ...
+    def move(self, target: list[float]) -> dict[str, Any]: ...
+    @property
+    def rod(self) -> list[float] | None: ...
+
+class Planner:
+    def __init__(self) -> None: ...
+    def plan(
+        self,
+        start: list[float],
+        goal: list[float],
+        obstacles: list[dict[str, Any]] = ...,
+        deadline_ms: float = 500.0,
+    ) -> dict[str, Any]: ...
+    @property
+    def roadmap_size(self) -> int: ...
+def _time_evaluate(a: npt.NDArray[np.float64]) -> float: ...

@@ -1,0 +1,717 @@
+//! The native half of the `rod_ig` Python package: batch loops over `rod_ig_core` on all cores
+//! with the GIL released. Arrays come in C-contiguous and float64 with the batch flattened
+//! (the Python half, `rod_ig/__init__.py`, checks shapes and dtypes, broadcasts and reshapes);
+//! every output is allocated once and handed to numpy without a copy.
+
+use nalgebra::{Vector3, Vector6};
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use rod_ig_core::plan::{Obstacle, PlanRequest, Planner as CorePlanner};
+use rod_ig_core::solver::{
+    self, BranchEvent, BranchFollower, Method, Objective, PlanarClosedForm, SolveOptions, Spatial,
+};
+use rod_ig_core::spatial::{self, SpatialPose, StabilityOptions, Stiffness};
+use rod_ig_core::{planar, PlanarParams, PlanarPose};
+use std::time::Duration;
+
+/// Rods per block between two checks for Ctrl-C (the GIL is taken back for each check).
+const FORWARD_BLOCK: usize = 1 << 14;
+
+/// Runs `work(i)` for i in 0..n on `threads` threads in blocks, writing each result through
+/// `write(i, result)` on the calling side of each block; Ctrl-C between blocks raises
+/// KeyboardInterrupt. `work` runs with the GIL released.
+fn batch<R: Send>(
+    py: Python<'_>,
+    n: usize,
+    threads: usize,
+    block: usize,
+    work: impl Fn(usize) -> R + Sync,
+    mut write: impl FnMut(usize, R),
+) -> PyResult<()> {
+    let threads = threads.max(1);
+    let mut start = 0;
+    while start < n {
+        let end = (start + block.max(threads)).min(n);
+        let results: Vec<R> = py.detach(|| {
+            let len = end - start;
+            let per = len.div_ceil(threads);
+            std::thread::scope(|s| {
+                let handles: Vec<_> = (0..threads)
+                    .map(|t| {
+                        let lo = start + t * per;
+                        let hi = (lo + per).min(end);
+                        let work = &work;
+                        s.spawn(move || (lo..hi).map(work).collect::<Vec<R>>())
+                    })
+                    .collect();
+                handles
+                    .into_iter()
+                    .flat_map(|h| h.join().unwrap_or_default())
+                    .collect()
+            })
+        });
+        for (k, r) in results.into_iter().enumerate() {
+            write(start + k, r);
+        }
+        py.check_signals()?;
+        start = end;
+    }
+    Ok(())
+}
+
+/// The number of threads to use: `threads` if given (≥ 1), else every core.
+fn thread_count(threads: Option<usize>) -> PyResult<usize> {
+    match threads {
+        Some(0) => Err(PyValueError::new_err("threads must be >= 1")),
+        Some(t) => Ok(t),
+        None => Ok(std::thread::available_parallelism().map_or(1, |n| n.get())),
+    }
+}
+
+fn f64_out<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
+    v.into_pyarray(py)
+}
+
+/// Planar forward map of n rods `a` (flattened (n, 3)): tip (x, y, θ unwrapped), J (rows x, y,
+/// θ; columns a3, a4, a5), stable, margin, uncertain, energy. A rod that cannot be evaluated
+/// gets NaN, stable False, uncertain True.
+#[pyfunction]
+#[pyo3(signature = (a, threads=None))]
+fn forward<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let a = a.as_slice()?;
+    let n = a.len() / 3;
+    let threads = thread_count(threads)?;
+    let mut tip = vec![f64::NAN; 3 * n];
+    let mut jac = vec![f64::NAN; 9 * n];
+    let mut stable = vec![false; n];
+    let mut margin = vec![f64::NAN; n];
+    let mut uncertain = vec![true; n];
+    let mut energy = vec![f64::NAN; n];
+    batch(
+        py,
+        n,
+        threads,
+        FORWARD_BLOCK,
+        |i| planar::evaluate(&PlanarParams::new(a[3 * i], a[3 * i + 1], a[3 * i + 2])).ok(),
+        |i, e| {
+            if let Some(e) = e {
+                tip[3 * i..3 * i + 3].copy_from_slice(&[e.tip.x, e.tip.y, e.tip.theta]);
+                for r in 0..3 {
+                    for c in 0..3 {
+                        jac[9 * i + 3 * r + c] = e.jacobian[(r, c)];
+                    }
+                }
+                stable[i] = e.stability.stable;
+                margin[i] = e.stability.margin;
+                uncertain[i] = e.stability.uncertain;
+                energy[i] = e.energy;
+            }
+        },
+    )?;
+    let d = PyDict::new(py);
+    d.set_item("tip", f64_out(py, tip))?;
+    d.set_item("jacobian", f64_out(py, jac))?;
+    d.set_item("stable", stable.into_pyarray(py))?;
+    d.set_item("margin", f64_out(py, margin))?;
+    d.set_item("uncertain", uncertain.into_pyarray(py))?;
+    d.set_item("energy", f64_out(py, energy))?;
+    Ok(d)
+}
+
+/// Shapes of n rods: `samples` poses (x, y, θ) each from the base to the tip (NaN for a rod
+/// that cannot be evaluated).
+#[pyfunction]
+#[pyo3(signature = (a, samples, threads=None))]
+fn shape<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    samples: usize,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let a = a.as_slice()?;
+    let n = a.len() / 3;
+    let threads = thread_count(threads)?;
+    let mut out = vec![f64::NAN; 3 * samples * n];
+    batch(
+        py,
+        n,
+        threads,
+        (FORWARD_BLOCK / samples.max(1)).max(1),
+        |i| {
+            planar::PlanarRod::new(&PlanarParams::new(a[3 * i], a[3 * i + 1], a[3 * i + 2]))
+                .ok()
+                .map(|rod| rod.shape(samples))
+        },
+        |i, poses| {
+            for (k, p) in poses.into_iter().flatten().enumerate() {
+                let o = 3 * (samples * i + k);
+                out[o..o + 3].copy_from_slice(&[p.x, p.y, p.theta]);
+            }
+        },
+    )?;
+    Ok(f64_out(py, out))
+}
+
+/// Solver options from the keyword arguments of `solve`/`solve3d` (defaults: the model's).
+fn options<const N: usize>(
+    defaults: SolveOptions<nalgebra::SVector<f64, N>>,
+    method: &str,
+    objective: &str,
+    deadline_ms: Option<f64>,
+    tolerance: Option<f64>,
+    max_iterations: Option<u32>,
+    alpha: Option<f64>,
+) -> PyResult<SolveOptions<nalgebra::SVector<f64, N>>> {
+    let mut o = defaults;
+    o.method = match method {
+        "robust" => Method::Robust,
+        "newton" => Method::Newton,
+        m => {
+            return Err(PyValueError::new_err(format!(
+                "method must be 'robust' or 'newton', got {m:?}"
+            )))
+        }
+    };
+    o.objective = match objective {
+        "first" => Objective::FirstFound,
+        "least_energy" => Objective::LeastEnergy,
+        m => {
+            return Err(PyValueError::new_err(format!(
+                "objective must be 'first' or 'least_energy', got {m:?}"
+            )))
+        }
+    };
+    if let Some(ms) = deadline_ms {
+        if !(ms.is_finite() && ms > 0.0 && ms <= solver::MAX_DEADLINE.as_secs_f64() * 1e3) {
+            return Err(PyValueError::new_err(format!(
+                "deadline_ms must be in (0, {}], got {ms}",
+                solver::MAX_DEADLINE.as_millis()
+            )));
+        }
+        o.deadline = Duration::from_secs_f64(ms / 1e3);
+    }
+    if let Some(t) = tolerance {
+        o.tolerance = t;
+    }
+    if let Some(m) = max_iterations {
+        o.max_iterations = m;
+    }
+    if let Some(a) = alpha {
+        o.alpha = a;
+    }
+    // The solver's own check, with its message, before any work.
+    solver::check_options(&o).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(o)
+}
+
+/// The per-target outputs of a batch solve.
+struct SolveOut {
+    success: Vec<bool>,
+    a: Vec<f64>,
+    termination: Vec<&'static str>,
+    iterations: Vec<u32>,
+    margin: Vec<f64>,
+    energy: Vec<f64>,
+    position_error: Vec<f64>,
+    orientation_error: Vec<f64>,
+    solutions: Vec<Vec<f64>>,
+}
+
+impl SolveOut {
+    fn new(n: usize, dim: usize) -> Self {
+        SolveOut {
+            success: vec![false; n],
+            a: vec![f64::NAN; dim * n],
+            termination: vec![""; n],
+            iterations: vec![0; n],
+            margin: vec![f64::NAN; n],
+            energy: vec![f64::NAN; n],
+            position_error: vec![f64::NAN; n],
+            orientation_error: vec![f64::NAN; n],
+            solutions: Vec::new(),
+        }
+    }
+
+    fn write<P: AsRef<[f64]>, X>(
+        &mut self,
+        i: usize,
+        r: &Result<solver::Solution<P, X>, solver::Failure<P>>,
+    ) {
+        match r {
+            Ok(s) => {
+                let a = s.a.as_ref();
+                let dim = a.len();
+                self.success[i] = true;
+                self.a[dim * i..dim * (i + 1)].copy_from_slice(a);
+                self.termination[i] = solver::Termination::Converged.as_str();
+                self.iterations[i] = s.iterations;
+                self.margin[i] = s.stability_margin;
+                self.energy[i] = s.energy;
+                self.position_error[i] = s.position_error;
+                self.orientation_error[i] = s.orientation_error;
+            }
+            Err(f) => {
+                self.termination[i] = f.termination().as_str();
+                self.iterations[i] = f.iterations;
+            }
+        }
+    }
+
+    fn into_dict(self, py: Python<'_>, all: bool) -> PyResult<Bound<'_, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("success", self.success.into_pyarray(py))?;
+        d.set_item("a", f64_out(py, self.a))?;
+        d.set_item("termination", PyList::new(py, self.termination)?)?;
+        d.set_item("iterations", self.iterations.into_pyarray(py))?;
+        d.set_item("margin", f64_out(py, self.margin))?;
+        d.set_item("energy", f64_out(py, self.energy))?;
+        d.set_item("position_error", f64_out(py, self.position_error))?;
+        d.set_item("orientation_error", f64_out(py, self.orientation_error))?;
+        if all {
+            let list = PyList::empty(py);
+            for s in self.solutions {
+                list.append(f64_out(py, s))?;
+            }
+            d.set_item("solutions", list)?;
+        }
+        Ok(d)
+    }
+}
+
+/// Targets per block of a batch solve between two checks for Ctrl-C (a solve takes µs to ms).
+const SOLVE_BLOCK: usize = 256;
+
+/// Planar inverse geometry of n targets (x, y, θ) (flattened), optional starts `a0`.
+#[pyfunction]
+#[pyo3(signature = (targets, a0=None, objective="first", method="robust", deadline_ms=None,
+                    tolerance=None, max_iterations=None, alpha=None, all=false, threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn solve<'py>(
+    py: Python<'py>,
+    targets: PyReadonlyArray1<'py, f64>,
+    a0: Option<PyReadonlyArray1<'py, f64>>,
+    objective: &str,
+    method: &str,
+    deadline_ms: Option<f64>,
+    tolerance: Option<f64>,
+    max_iterations: Option<u32>,
+    alpha: Option<f64>,
+    all: bool,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let t = targets.as_slice()?;
+    let n = t.len() / 3;
+    let a0 = match &a0 {
+        Some(a) => Some(a.as_slice()?),
+        None => None,
+    };
+    let base = options(
+        SolveOptions::default(),
+        method,
+        objective,
+        deadline_ms,
+        tolerance,
+        max_iterations,
+        alpha,
+    )?;
+    if base.method == Method::Newton && a0.is_none() {
+        return Err(PyValueError::new_err("method 'newton' needs a0"));
+    }
+    rod_ig_core::ig::warm_up();
+    let threads = thread_count(threads)?;
+    let mut out = SolveOut::new(n, 3);
+    batch(
+        py,
+        n,
+        threads,
+        SOLVE_BLOCK,
+        |i| {
+            let target = PlanarPose::new(t[3 * i], t[3 * i + 1], t[3 * i + 2]);
+            let mut o = base;
+            o.initial_guess = a0.map(|g| PlanarParams::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]));
+            let first = solver::solve(&PlanarClosedForm, &target, &o);
+            let every = all.then(|| solver::solve_all(&PlanarClosedForm, &target, &o));
+            (first, every)
+        },
+        |i, (first, every)| {
+            out.write(i, &first);
+            if let Some(every) = every {
+                out.solutions
+                    .push(every.iter().flat_map(|s| s.a.iter().copied()).collect());
+            }
+        },
+    )?;
+    out.into_dict(py, all)
+}
+
+fn stiffness_of(c: (f64, f64, f64)) -> PyResult<Stiffness> {
+    let k = Stiffness {
+        c1: c.0,
+        c2: c.1,
+        c3: c.2,
+    };
+    k.validate()
+        .map_err(|e| PyValueError::new_err(format!("stiffness: {e}")))?;
+    Ok(k)
+}
+
+/// 3-D forward map of n rods `a` (flattened (n, 6)): position, quaternion (x, y, z, w),
+/// J (6×6, body twists, rows ω1 ω2 ω3 v1 v2 v3), stable, margin, energy.
+#[pyfunction]
+#[pyo3(signature = (a, stiffness=(1.0, 1.0, 1.0), threads=None))]
+fn forward3d<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    stiffness: (f64, f64, f64),
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let a = a.as_slice()?;
+    let n = a.len() / 6;
+    let k = stiffness_of(stiffness)?;
+    let threads = thread_count(threads)?;
+    let opts = StabilityOptions::production();
+    let mut position = vec![f64::NAN; 3 * n];
+    let mut quaternion = vec![f64::NAN; 4 * n];
+    let mut jac = vec![f64::NAN; 36 * n];
+    let mut stable = vec![false; n];
+    let mut margin = vec![f64::NAN; n];
+    let mut energy = vec![f64::NAN; n];
+    batch(
+        py,
+        n,
+        threads,
+        SOLVE_BLOCK,
+        |i| spatial::evaluate(&Vector6::from_column_slice(&a[6 * i..6 * i + 6]), &k, &opts).ok(),
+        |i, e| {
+            if let Some(e) = e {
+                let p = e.tip.position;
+                position[3 * i..3 * i + 3].copy_from_slice(&[p.x, p.y, p.z]);
+                quaternion[4 * i..4 * i + 4].copy_from_slice(&e.tip.quaternion_xyzw());
+                for r in 0..6 {
+                    for c in 0..6 {
+                        jac[36 * i + 6 * r + c] = e.jacobian[(r, c)];
+                    }
+                }
+                stable[i] = e.stability.stable;
+                margin[i] = e.stability.margin;
+                energy[i] = e.energy;
+            }
+        },
+    )?;
+    let d = PyDict::new(py);
+    d.set_item("position", f64_out(py, position))?;
+    d.set_item("quaternion", f64_out(py, quaternion))?;
+    d.set_item("jacobian", f64_out(py, jac))?;
+    d.set_item("stable", stable.into_pyarray(py))?;
+    d.set_item("margin", f64_out(py, margin))?;
+    d.set_item("energy", f64_out(py, energy))?;
+    Ok(d)
+}
+
+/// 3-D inverse geometry of n targets (positions (n, 3), quaternions (n, 4) x, y, z, w).
+#[pyfunction]
+#[pyo3(signature = (position, quaternion, a0=None, objective="first", method="robust",
+                    deadline_ms=None, tolerance=None, max_iterations=None, alpha=None,
+                    stiffness=(1.0, 1.0, 1.0), all=false, threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn solve3d<'py>(
+    py: Python<'py>,
+    position: PyReadonlyArray1<'py, f64>,
+    quaternion: PyReadonlyArray1<'py, f64>,
+    a0: Option<PyReadonlyArray1<'py, f64>>,
+    objective: &str,
+    method: &str,
+    deadline_ms: Option<f64>,
+    tolerance: Option<f64>,
+    max_iterations: Option<u32>,
+    alpha: Option<f64>,
+    stiffness: (f64, f64, f64),
+    all: bool,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let p = position.as_slice()?;
+    let q = quaternion.as_slice()?;
+    let n = p.len() / 3;
+    let a0 = match &a0 {
+        Some(a) => Some(a.as_slice()?),
+        None => None,
+    };
+    let model = Spatial::with_stiffness(stiffness_of(stiffness)?);
+    let base = options(
+        SolveOptions::default(),
+        method,
+        objective,
+        deadline_ms,
+        tolerance,
+        max_iterations,
+        alpha,
+    )?;
+    if base.method == Method::Newton && a0.is_none() {
+        return Err(PyValueError::new_err("method 'newton' needs a0"));
+    }
+    let threads = thread_count(threads)?;
+    let mut out = SolveOut::new(n, 6);
+    batch(
+        py,
+        n,
+        threads,
+        SOLVE_BLOCK,
+        |i| {
+            let pose = SpatialPose::from_xyzw(
+                Vector3::new(p[3 * i], p[3 * i + 1], p[3 * i + 2]),
+                [q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]],
+            );
+            let mut o = base;
+            o.initial_guess = a0.map(|g| Vector6::from_column_slice(&g[6 * i..6 * i + 6]));
+            match pose {
+                Ok(target) => {
+                    let first = solver::solve(&model, &target, &o);
+                    let every = all.then(|| solver::solve_all(&model, &target, &o));
+                    (first, every)
+                }
+                Err(e) => (
+                    Err(solver::Failure::early(solver::IgError::InvalidOptions(
+                        e.to_string(),
+                    ))),
+                    all.then(Vec::new),
+                ),
+            }
+        },
+        |i, (first, every)| {
+            out.write(i, &first);
+            if let Some(every) = every {
+                out.solutions
+                    .push(every.iter().flat_map(|s| s.a.iter().copied()).collect());
+            }
+        },
+    )?;
+    out.into_dict(py, all)
+}
+
+/// Quasi-static motion of the planar rod: the rod follows its equilibrium branch as the tip
+/// gripper moves, and snaps where the branch folds.
+#[pyclass(module = "rod_ig._rod_ig")]
+struct Tracker {
+    follower: BranchFollower<3, PlanarClosedForm>,
+}
+
+#[pymethods]
+impl Tracker {
+    #[new]
+    #[pyo3(signature = (a0=None, deadline_ms=None, tolerance=None))]
+    fn new(
+        a0: Option<[f64; 3]>,
+        deadline_ms: Option<f64>,
+        tolerance: Option<f64>,
+    ) -> PyResult<Self> {
+        let o = options(
+            SolveOptions::default(),
+            "robust",
+            "first",
+            deadline_ms,
+            tolerance,
+            None,
+            None,
+        )?;
+        rod_ig_core::ig::warm_up();
+        let follower = match a0 {
+            Some(a) => BranchFollower::holding(PlanarClosedForm, o, PlanarParams::from(a))
+                .map_err(|e| PyValueError::new_err(format!("a0 cannot be held: {e}")))?,
+            None => BranchFollower::new(PlanarClosedForm, o),
+        };
+        Ok(Tracker { follower })
+    }
+
+    /// Moves the gripper to `target` (x, y, θ); returns the solve's fields plus `event`.
+    #[pyo3(name = "move")]
+    fn move_to<'py>(&mut self, py: Python<'py>, target: [f64; 3]) -> PyResult<Bound<'py, PyDict>> {
+        let pose = PlanarPose::new(target[0], target[1], target[2]);
+        let follower = &mut self.follower;
+        let m = py.detach(|| follower.follow(&pose));
+        let mut out = SolveOut::new(1, 3);
+        out.write(0, &m.result);
+        let d = PyDict::new(py);
+        d.set_item("success", out.success[0])?;
+        d.set_item("a", f64_out(py, out.a))?;
+        d.set_item("termination", out.termination[0])?;
+        d.set_item("iterations", out.iterations[0])?;
+        d.set_item("margin", out.margin[0])?;
+        d.set_item("energy", out.energy[0])?;
+        d.set_item("position_error", out.position_error[0])?;
+        d.set_item("orientation_error", out.orientation_error[0])?;
+        d.set_item("event", m.event.as_str())?;
+        if let BranchEvent::Snap {
+            critical,
+            critical_a,
+            energy_released,
+            ..
+        } = m.event
+        {
+            d.set_item(
+                "critical",
+                f64_out(py, vec![critical.x, critical.y, critical.theta]),
+            )?;
+            d.set_item(
+                "critical_a",
+                f64_out(py, critical_a.iter().copied().collect()),
+            )?;
+            d.set_item("energy_released", energy_released)?;
+        }
+        if let Err(f) = &m.result {
+            d.set_item("reason", f.reason.to_string())?;
+        }
+        Ok(d)
+    }
+
+    /// The rod held now (a3, a4, a5), or None.
+    #[getter]
+    fn rod(&self) -> Option<[f64; 3]> {
+        self.follower.rod().map(|a| [a[0], a[1], a[2]])
+    }
+}
+
+/// Stable gripper paths for the planar rod: a roadmap over stable rods, kept across calls.
+#[pyclass(module = "rod_ig._rod_ig")]
+struct Planner {
+    planner: CorePlanner,
+}
+
+#[pymethods]
+impl Planner {
+    #[new]
+    fn new() -> Self {
+        Planner {
+            planner: CorePlanner::new(),
+        }
+    }
+
+    /// Plans from the rod `start` to a rod whose tip is `goal` (x, y, θ) around `obstacles`
+    /// (dicts {"type": "disc", "center": [x, y], "radius": r} or {"type": "polygon",
+    /// "points": [[x, y], ...]}).
+    #[pyo3(signature = (start, goal, obstacles=Vec::new(), deadline_ms=500.0))]
+    fn plan<'py>(
+        &mut self,
+        py: Python<'py>,
+        start: [f64; 3],
+        goal: [f64; 3],
+        obstacles: Vec<Bound<'py, PyDict>>,
+        deadline_ms: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let obstacles = obstacles
+            .iter()
+            .map(obstacle_of)
+            .collect::<PyResult<Vec<_>>>()?;
+        if !(deadline_ms.is_finite() && deadline_ms > 0.0 && deadline_ms <= 10_000.0) {
+            return Err(PyValueError::new_err(format!(
+                "deadline_ms must be in (0, 10000], got {deadline_ms}"
+            )));
+        }
+        let request = PlanRequest {
+            start: PlanarParams::from(start),
+            goal: PlanarPose::new(goal[0], goal[1], goal[2]),
+            obstacles,
+            deadline: Duration::from_secs_f64(deadline_ms / 1e3),
+        };
+        let planner = &mut self.planner;
+        let r = py.detach(|| {
+            rod_ig_core::ig::warm_up();
+            planner.plan(&request)
+        });
+        let d = PyDict::new(py);
+        match r {
+            Ok(p) => {
+                d.set_item("success", true)?;
+                let rods: Vec<f64> = p.rods.iter().flat_map(|a| a.iter().copied()).collect();
+                let gripper: Vec<f64> =
+                    p.gripper.iter().flat_map(|g| [g.x, g.y, g.theta]).collect();
+                d.set_item("rods", f64_out(py, rods))?;
+                d.set_item("gripper", f64_out(py, gripper))?;
+                d.set_item("min_margin", p.min_margin)?;
+                d.set_item("reason", "")?;
+            }
+            Err(e) => {
+                d.set_item("success", false)?;
+                d.set_item("rods", f64_out(py, Vec::new()))?;
+                d.set_item("gripper", f64_out(py, Vec::new()))?;
+                d.set_item("min_margin", f64::NAN)?;
+                d.set_item("reason", e.to_string())?;
+            }
+        }
+        Ok(d)
+    }
+
+    /// Roadmap nodes (0 before the first plan).
+    #[getter]
+    fn roadmap_size(&self) -> usize {
+        self.planner.roadmap_size()
+    }
+}
+
+fn obstacle_of(d: &Bound<'_, PyDict>) -> PyResult<Obstacle> {
+    let kind: String = d
+        .get_item("type")?
+        .ok_or_else(|| PyValueError::new_err("obstacle needs a 'type'"))?
+        .extract()?;
+    match kind.as_str() {
+        "disc" => Ok(Obstacle::Disc {
+            center: d
+                .get_item("center")?
+                .ok_or_else(|| PyValueError::new_err("disc needs 'center'"))?
+                .extract()?,
+            radius: d
+                .get_item("radius")?
+                .ok_or_else(|| PyValueError::new_err("disc needs 'radius'"))?
+                .extract()?,
+        }),
+        "polygon" => Ok(Obstacle::Polygon {
+            points: d
+                .get_item("points")?
+                .ok_or_else(|| PyValueError::new_err("polygon needs 'points'"))?
+                .extract()?,
+        }),
+        other => Err(PyValueError::new_err(format!(
+            "obstacle type must be 'disc' or 'polygon', got {other:?}"
+        ))),
+    }
+}
+
+/// Seconds the plain Rust loop of `planar::evaluate` takes over the rods `a` (no Python, no
+/// output arrays): the baseline of the package's benchmark (`python/bench.py`).
+#[pyfunction]
+fn _time_evaluate(py: Python<'_>, a: PyReadonlyArray1<'_, f64>) -> PyResult<f64> {
+    let a = a.as_slice()?;
+    Ok(py.detach(|| {
+        let t0 = std::time::Instant::now();
+        for r in a.chunks_exact(3) {
+            std::hint::black_box(planar::evaluate(&PlanarParams::new(r[0], r[1], r[2])).ok());
+        }
+        t0.elapsed().as_secs_f64()
+    }))
+}
+
+/// Builds the planar solver's atlas now (≈ 0.15 s on two cores); returns its size.
+#[pyfunction]
+fn warm_up(py: Python<'_>) -> usize {
+    py.detach(rod_ig_core::ig::warm_up)
+}
+
+#[pymodule]
+fn _rod_ig(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(forward, m)?)?;
+    m.add_function(wrap_pyfunction!(shape, m)?)?;
+    m.add_function(wrap_pyfunction!(solve, m)?)?;
+    m.add_function(wrap_pyfunction!(forward3d, m)?)?;
+    m.add_function(wrap_pyfunction!(solve3d, m)?)?;
+    m.add_function(wrap_pyfunction!(warm_up, m)?)?;
+    m.add_function(wrap_pyfunction!(_time_evaluate, m)?)?;
+    m.add_class::<Tracker>()?;
+    m.add_class::<Planner>()?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

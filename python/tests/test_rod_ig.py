@@ -1,0 +1,311 @@
+"""Tests of the rod_ig Python package: against the reference data, against the CLI, batch
+shapes and broadcasting, every error path, the GIL released, Ctrl-C, the Dask recipe."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import rod_ig
+
+HERE = Path(__file__).parent
+REPO = HERE.parents[1]
+
+
+def oracle() -> list[dict]:
+    lines = (HERE / "data" / "oracle_cases_200.jsonl").read_text().splitlines()
+    return [json.loads(line) for line in lines]
+
+
+def cli() -> str:
+    path = os.environ.get("ROD_IG_CLI", str(REPO / "target" / "release" / "rod-ig"))
+    if not Path(path).exists():
+        subprocess.run(
+            ["cargo", "build", "--release", "-p", "rod-ig-cli"], cwd=REPO, check=True
+        )
+    return path
+
+
+def run_cli(command: str, requests: list[dict]) -> list[dict]:
+    text = "".join(json.dumps(r) + "\n" for r in requests)
+    out = subprocess.run([cli(), command], input=text, capture_output=True, text=True, check=True)
+    return [json.loads(line) for line in out.stdout.splitlines()]
+
+
+# --- the reference data ----------------------------------------------------------------------
+
+
+def test_forward_matches_the_oracle() -> None:
+    """Tolerances of the oracle's README: tip 1e-11, J 1e-8 relative, identical verdicts."""
+    cases = oracle()
+    a = np.array([c["a"] for c in cases])
+    r = rod_ig.forward(a)
+    for i, c in enumerate(cases):
+        theta, x, y = c["tip"]
+        assert np.allclose(r.tip[i], [x, y, theta], rtol=0, atol=1e-11)
+        jac = np.array(c["jac"])[[1, 2, 0]]  # oracle rows θ, x, y -> ours x, y, θ
+        scale = np.abs(jac).max()
+        assert np.abs(r.jacobian[i] - jac).max() <= 1e-8 * scale
+        assert bool(r.stable[i]) == c["stable"]
+        assert abs(r.energy[i] - c["energy"]) <= 1e-9 * max(1.0, c["energy"])
+
+
+def test_results_equal_the_cli_on_the_same_inputs() -> None:
+    a = np.array([c["a"] for c in oracle()[:40]] + [[0.0, 0.0, 0.0], [1e-30, 5.0, -0.0]])
+    r = rod_ig.forward(a, threads=2)
+    answers = run_cli("forward", [{"a": list(map(float, row))} for row in a])
+    for i, ans in enumerate(answers):
+        tip = ans["tip"]
+        assert list(r.tip[i]) == [tip["x"], tip["y"], tip["theta"]]
+        assert r.jacobian[i].tolist() == ans["jacobian"]
+        assert bool(r.stable[i]) == ans["stable"]
+        assert r.energy[i] == ans["energy"]
+        assert bool(r.uncertain[i]) == ans["stability_uncertain"]
+    targets = np.array([[0.5, 0.2, 1.0], [0.6, 0.3, 370000000000.123], [0.3, -0.5, -2.0]])
+    s = rod_ig.solve(targets, threads=1)
+    answers = run_cli("solve", [{"target": dict(zip("x y theta".split(), map(float, t)))} for t in targets])
+    for i, ans in enumerate(answers):
+        assert bool(s.success[i]) == ans["success"]
+        assert s.termination[i] == ans["termination"]
+        assert s.a[i].tolist() == ans["a"]
+        assert s.position_error[i] == ans["position_error"]
+
+
+def test_solve_inverts_the_forward_map_of_stable_rods() -> None:
+    cases = [c for c in oracle() if c["stable"]][:30]
+    tips = rod_ig.forward(np.array([c["a"] for c in cases])).tip
+    s = rod_ig.solve(tips)
+    assert s.success.all(), s.termination
+    back = rod_ig.forward(s.a)
+    assert back.stable.all()
+    assert np.abs(back.tip[:, :2] - tips[:, :2]).max() <= 1e-6
+    dtheta = np.angle(np.exp(1j * (back.tip[:, 2] - tips[:, 2])))
+    assert np.abs(dtheta).max() <= 1e-6
+    assert (s.position_error <= 1e-6).all() and (s.orientation_error <= 1e-6).all()
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.floats(-3, 3),
+    st.floats(-4, 2),
+    st.floats(-4, 2),
+    st.sampled_from([-1.0, 0.0, 1.0]),
+)
+def test_forward_is_consistent_with_shape_on_log_scale_rods(
+    a3: float, log_a4: float, log_a5: float, sign: float
+) -> None:
+    """Log-scale magnitudes, exact zeros and signs: the last shape pose is the tip."""
+    a = np.array([a3, sign * 10.0**log_a4, -(10.0**log_a5)])
+    r = rod_ig.forward(a)
+    poses = rod_ig.shape(a, samples=5)
+    assert poses.shape == (5, 3)
+    if np.isfinite(r.tip).all():
+        assert np.allclose(poses[-1], r.tip, atol=1e-12)
+        assert np.allclose(poses[0], 0.0)
+
+
+def test_3d_forward_and_solve_roundtrip() -> None:
+    rng = np.random.default_rng(3)
+    a = rng.uniform(-3, 3, size=(8, 6))
+    f = rod_ig.forward3d(a)
+    assert f.position.shape == (8, 3) and f.quaternion.shape == (8, 4) and f.jacobian.shape == (8, 6, 6)
+    assert np.allclose(np.linalg.norm(f.quaternion, axis=-1), 1.0)
+    ok = f.stable
+    s = rod_ig.solve3d(f.position[ok], f.quaternion[ok])
+    assert s.success.all(), s.termination
+    back = rod_ig.forward3d(s.a)
+    assert np.abs(back.position - f.position[ok]).max() <= 1e-6
+    answers = run_cli("forward3d", [{"a": list(map(float, row))} for row in a[:3]])
+    for i, ans in enumerate(answers):
+        assert f.position[i].tolist() == ans["tip"]["position"]
+
+
+# --- shapes, broadcasting, errors --------------------------------------------------------------
+
+
+def test_batch_shapes_and_broadcasting() -> None:
+    a = np.zeros((2, 3, 3))
+    a[..., 0] = 1.0
+    r = rod_ig.forward(a)
+    assert r.tip.shape == (2, 3, 3) and r.jacobian.shape == (2, 3, 3, 3) and r.stable.shape == (2, 3)
+    assert rod_ig.forward([1.0, 2.0, 3.0]).tip.shape == (3,)
+    assert rod_ig.shape(a, samples=7).shape == (2, 3, 7, 3)
+    assert rod_ig.forward(np.zeros((0, 3))).tip.shape == (0, 3)
+    # One start broadcast against many targets, integer input accepted.
+    targets = np.array([[[0.5, 0.2, 1.0]], [[0.4, 0.1, 0.5]]])  # (2, 1, 3)
+    s = rod_ig.solve(targets, a0=np.array([[-7.4, -36.0, -15.4]] * 4))  # (4, 3) -> (2, 4)
+    assert s.a.shape == (2, 4, 3) and s.success.shape == (2, 4) and s.termination.shape == (2, 4)
+    assert rod_ig.forward(np.array([[1, 2, 3]], dtype=np.int32)).tip.shape == (1, 3)
+    s = rod_ig.solve([0.5, 0.2, 1.0], all=True, objective="least_energy")
+    assert s.solutions is not None and s.solutions.shape == ()
+    sols = s.solutions[()]
+    assert sols.ndim == 2 and sols.shape[1] == 3 and len(sols) >= 1
+    assert np.isclose(rod_ig.forward(sols[0]).energy, s.energy)
+
+
+def test_errors_name_the_argument() -> None:
+    with pytest.raises(ValueError, match=r"a must have shape \(\.\.\., 3\)"):
+        rod_ig.forward(np.zeros((4, 2)))
+    with pytest.raises(TypeError, match="a must hold real numbers"):
+        rod_ig.forward([["x", "y", "z"]])
+    with pytest.raises(TypeError, match="a must hold real numbers"):
+        rod_ig.forward(np.ones((2, 3), dtype=complex))
+    bad = np.zeros((5, 3))
+    bad[3, 1] = np.nan
+    with pytest.raises(ValueError, match=r"a is not finite at index \(3, 1\)"):
+        rod_ig.forward(bad)
+    with pytest.raises(ValueError, match="targets is not finite"):
+        rod_ig.solve([0.5, np.inf, 0.0])
+    with pytest.raises(ValueError, match="quaternion must have shape"):
+        rod_ig.solve3d([0.5, 0.2, 0.1], [0.0, 0.0, 1.0])
+    with pytest.raises(ValueError, match="do not broadcast"):
+        rod_ig.solve(np.zeros((3, 3)), a0=np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="tolerance"):
+        rod_ig.solve([0.5, 0.2, 1.0], tolerance=1e308)
+    with pytest.raises(ValueError, match="max_iterations"):
+        rod_ig.solve([0.5, 0.2, 1.0], max_iterations=0)
+    with pytest.raises(ValueError, match="method"):
+        rod_ig.solve([0.5, 0.2, 1.0], method="magic")
+    with pytest.raises(ValueError, match="newton"):
+        rod_ig.solve([0.5, 0.2, 1.0], method="newton")
+    with pytest.raises(ValueError, match="deadline_ms"):
+        rod_ig.solve([0.5, 0.2, 1.0], deadline_ms=-1)
+    with pytest.raises(ValueError, match="stiffness"):
+        rod_ig.forward3d(np.zeros(6), stiffness=(0.0, 1.0, 1.0))
+    with pytest.raises(ValueError, match="samples"):
+        rod_ig.shape([1, 2, 3], samples=1)
+    with pytest.raises(ValueError, match="threads"):
+        rod_ig.forward([1, 2, 3], threads=0)
+    r = rod_ig.Planner().plan(
+        [0.5, 0.1, 0.1], [0.8, 0.3, 0.5], [{"type": "disc", "center": [1e200, 0.0], "radius": 1.0}]
+    )
+    assert not r.success and "1e6" in r.reason
+    with pytest.raises(ValueError, match="obstacle type"):
+        rod_ig.Planner().plan([0.5, 0.1, 0.1], [0.8, 0.3, 0.5], [{"type": "cube"}])
+
+
+def test_unsolvable_targets_are_data_not_exceptions() -> None:
+    s = rod_ig.solve([[2.0, 0.0, 0.0], [0.5, 0.2, 1.0], [0.9, 0.1, 3.0]], deadline_ms=5)
+    assert s.success.tolist()[:2] == [False, True]
+    assert s.termination[0] == "unreachable"
+    assert np.isnan(s.a[0]).all()
+    assert s.termination[2] in ("converged", "deadline", "no_stable_solution")
+
+
+# --- motion and planning -----------------------------------------------------------------------
+
+
+def test_tracker_follows_and_snaps() -> None:
+    """The buckled rod (grippers 0.8 apart) whose tip gripper turns snaps through."""
+    s = rod_ig.solve([0.8, 0.0, 0.0], all=True)
+    sols = s.solutions[()]
+    mid = rod_ig.shape(sols, samples=3)[:, 1, 1]
+    energy = rod_ig.forward(sols).energy
+    up = sols[np.argmin(np.where(mid > 0, energy, np.inf))]
+    t = rod_ig.Tracker(a0=up)
+    moves = [t.move([0.8, 0.0, th]) for th in np.arange(1, 31) * 0.05]
+    assert all(m.success for m in moves)
+    snaps = [m for m in moves if m.event == "snap"]
+    assert len(snaps) == 1 and snaps[0].energy_released > 0
+    assert snaps[0].critical is not None and abs(snaps[0].critical[0] - 0.8) < 1e-6
+    assert t.rod is not None and t.rod.shape == (3,)
+    m = t.move([0.8, 0.0, 1.5])
+    assert m.event == "none" and m.success
+
+
+def test_planner_plans_around_a_disc() -> None:
+    p = rod_ig.Planner()
+    r = p.plan([0.5, 0.1, 0.1], [0.6, 0.4, 1.0], [{"type": "disc", "center": [0.3, 0.6], "radius": 0.08}])
+    assert r.success, r.reason
+    assert r.rods.shape[1] == 3 and r.gripper.shape == r.rods.shape
+    assert r.min_margin > 0 and p.roadmap_size > 0
+    assert np.allclose(r.gripper[-1][:2], [0.6, 0.4], atol=1e-6)
+
+
+# --- concurrency and interruption --------------------------------------------------------------
+
+
+def test_the_gil_is_released_while_a_batch_runs() -> None:
+    """While one thread runs a long one-thread batch, the main thread keeps running Python:
+    if the GIL were held, the counter could not move during the call."""
+    a = np.tile([[2.0, -10.0, 5.0]], (150_000, 1))
+    done = threading.Event()
+
+    def work() -> None:
+        rod_ig.forward(a, threads=1)
+        done.set()
+
+    worker = threading.Thread(target=work)
+    count = 0
+    worker.start()
+    time.sleep(0.005)
+    while not done.is_set():
+        count += 1
+    worker.join()
+    assert count > 1000
+
+
+def test_two_threads_compute_the_same_as_one() -> None:
+    a = np.random.default_rng(1).uniform([-10, -100, -100], [10, 100, 100], size=(2000, 3))
+    one = rod_ig.forward(a, threads=1)
+    results: list[rod_ig.ForwardResult] = []
+    threads = [threading.Thread(target=lambda: results.append(rod_ig.forward(a, threads=1))) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results + [rod_ig.forward(a, threads=3)]:
+        assert np.array_equal(r.tip, one.tip, equal_nan=True)
+        assert np.array_equal(r.stable, one.stable)
+
+
+def test_ctrl_c_interrupts_a_long_batch() -> None:
+    script = (
+        "import numpy as np, rod_ig, sys\n"
+        "a = np.tile([[2.0, -10.0, 5.0]], (20_000_000, 1))\n"
+        "print('started', flush=True)\n"
+        "rod_ig.forward(a, threads=1)\n"
+        "print('finished', flush=True)\n"
+    )
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert p.stdout is not None
+    assert p.stdout.readline().strip() == "started"
+    time.sleep(0.3)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=10)
+    assert "finished" not in out
+    assert "KeyboardInterrupt" in err
+
+
+# --- beyond one machine: the Dask recipe -------------------------------------------------------
+
+
+def test_dask_recipe_maps_the_batch_api_over_chunks() -> None:
+    import dask.array as da
+
+    from rod_ig.dask import forward_blocks
+
+    rng = np.random.default_rng(7)
+    a = rng.uniform([-10, -100, -100], [10, 100, 100], size=(20_000, 3))
+    rods = da.from_array(a, chunks=(4_000, 3))
+    tip, stable, margin = forward_blocks(rods)
+    tip, stable, margin = (x.compute(scheduler="threads") for x in (tip, stable, margin))
+    direct = rod_ig.forward(a)
+    assert np.array_equal(tip, direct.tip, equal_nan=True)
+    assert np.array_equal(stable, direct.stable)
+    assert np.array_equal(margin, direct.margin, equal_nan=True)
+
+
+def test_version() -> None:
+    assert isinstance(rod_ig.__version__, str) and rod_ig.__version__.count(".") == 2
