@@ -46,8 +46,9 @@ pub use model::{
 pub(crate) use observer::emit;
 pub use observer::{observe, Counters, Event, IterationLog, Observer};
 pub use options::{
-    check_options, Method, Objective, SolveOptions, DEFAULT_DEADLINE, DEFAULT_DEADLINE_3D, DEFAULT_MAX_ITERATIONS,
-    DEFAULT_TOLERANCE, MAX_DEADLINE, MAX_ITERATIONS_LIMIT, MAX_TOLERANCE, MIN_TOLERANCE,
+    check_options, Method, Objective, SolveOptions, DEFAULT_DEADLINE, DEFAULT_DEADLINE_3D,
+    DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, MAX_DEADLINE, MAX_ITERATIONS_LIMIT, MAX_TOLERANCE,
+    MIN_TOLERANCE,
 };
 pub use outcome::{Failure, IgError, Solution, Termination};
 
