@@ -159,6 +159,7 @@ fn shape<'py>(
 }
 
 /// Solver options from the keyword arguments of `solve`/`solve3d` (defaults: the model's).
+#[allow(clippy::too_many_arguments)]
 fn options<const N: usize>(
     defaults: SolveOptions<nalgebra::SVector<f64, N>>,
     method: &str,
@@ -167,6 +168,7 @@ fn options<const N: usize>(
     tolerance: Option<f64>,
     max_iterations: Option<u32>,
     alpha: Option<f64>,
+    has_a0: bool,
 ) -> PyResult<SolveOptions<nalgebra::SVector<f64, N>>> {
     let mut o = defaults;
     o.method = match method {
@@ -207,6 +209,9 @@ fn options<const N: usize>(
     }
     // The solver's own check, with its message, before any work.
     solver::check_options(&o).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    if o.method == Method::Newton && !has_a0 {
+        return Err(PyValueError::new_err("method 'newton' needs a0"));
+    }
     Ok(o)
 }
 
@@ -306,11 +311,7 @@ fn solve<'py>(
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let t = targets.as_slice()?;
-    let n = t.len() / 3;
-    let a0 = match &a0 {
-        Some(a) => Some(a.as_slice()?),
-        None => None,
-    };
+    let a0 = a0.as_ref().map(|a| a.as_slice()).transpose()?;
     let base = options(
         SolveOptions::default(),
         method,
@@ -319,25 +320,62 @@ fn solve<'py>(
         tolerance,
         max_iterations,
         alpha,
+        a0.is_some(),
     )?;
-    if base.method == Method::Newton && a0.is_none() {
-        return Err(PyValueError::new_err("method 'newton' needs a0"));
-    }
     rod_ig_core::ig::warm_up();
+    let target_of = |i: usize| Ok(PlanarPose::new(t[3 * i], t[3 * i + 1], t[3 * i + 2]));
+    solve_batch(
+        py,
+        &PlanarClosedForm,
+        t.len() / 3,
+        a0,
+        base,
+        all,
+        threads,
+        target_of,
+    )
+}
+
+/// Solves the n targets `target_of(i)` on `model` (a start from row i of `a0`, if given, and
+/// with `all` every distinct stable solution) and collects the outputs: the loop shared by
+/// `solve` and `solve3d`. A target that cannot be formed is an invalid-input failure.
+#[allow(clippy::too_many_arguments)]
+fn solve_batch<'py, const N: usize, M>(
+    py: Python<'py>,
+    model: &M,
+    n: usize,
+    a0: Option<&[f64]>,
+    base: SolveOptions<nalgebra::SVector<f64, N>>,
+    all: bool,
+    threads: Option<usize>,
+    target_of: impl Fn(usize) -> Result<M::Pose, String> + Sync,
+) -> PyResult<Bound<'py, PyDict>>
+where
+    M: solver::InverseGeometry<N> + Sync,
+    M::Pose: Send,
+{
     let threads = thread_count(threads)?;
-    let mut out = SolveOut::new(n, 3);
+    let mut out = SolveOut::new(n, N);
     batch(
         py,
         n,
         threads,
         SOLVE_BLOCK,
         |i| {
-            let target = PlanarPose::new(t[3 * i], t[3 * i + 1], t[3 * i + 2]);
             let mut o = base;
-            o.initial_guess = a0.map(|g| PlanarParams::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]));
-            let first = solver::solve(&PlanarClosedForm, &target, &o);
-            let every = all.then(|| solver::solve_all(&PlanarClosedForm, &target, &o));
-            (first, every)
+            o.initial_guess =
+                a0.map(|g| nalgebra::SVector::from_column_slice(&g[N * i..N * (i + 1)]));
+            match target_of(i) {
+                Ok(target) => {
+                    let first = solver::solve(model, &target, &o);
+                    let every = all.then(|| solver::solve_all(model, &target, &o));
+                    (first, every)
+                }
+                Err(e) => (
+                    Err(solver::Failure::early(solver::IgError::InvalidOptions(e))),
+                    all.then(Vec::new),
+                ),
+            }
         },
         |i, (first, every)| {
             out.write(i, &first);
@@ -437,11 +475,7 @@ fn solve3d<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = position.as_slice()?;
     let q = quaternion.as_slice()?;
-    let n = p.len() / 3;
-    let a0 = match &a0 {
-        Some(a) => Some(a.as_slice()?),
-        None => None,
-    };
+    let a0 = a0.as_ref().map(|a| a.as_slice()).transpose()?;
     let model = Spatial::with_stiffness(stiffness_of(stiffness)?);
     let base = options(
         SolveOptions::default(),
@@ -451,47 +485,16 @@ fn solve3d<'py>(
         tolerance,
         max_iterations,
         alpha,
+        a0.is_some(),
     )?;
-    if base.method == Method::Newton && a0.is_none() {
-        return Err(PyValueError::new_err("method 'newton' needs a0"));
-    }
-    let threads = thread_count(threads)?;
-    let mut out = SolveOut::new(n, 6);
-    batch(
-        py,
-        n,
-        threads,
-        SOLVE_BLOCK,
-        |i| {
-            let pose = SpatialPose::from_xyzw(
-                Vector3::new(p[3 * i], p[3 * i + 1], p[3 * i + 2]),
-                [q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]],
-            );
-            let mut o = base;
-            o.initial_guess = a0.map(|g| Vector6::from_column_slice(&g[6 * i..6 * i + 6]));
-            match pose {
-                Ok(target) => {
-                    let first = solver::solve(&model, &target, &o);
-                    let every = all.then(|| solver::solve_all(&model, &target, &o));
-                    (first, every)
-                }
-                Err(e) => (
-                    Err(solver::Failure::early(solver::IgError::InvalidOptions(
-                        e.to_string(),
-                    ))),
-                    all.then(Vec::new),
-                ),
-            }
-        },
-        |i, (first, every)| {
-            out.write(i, &first);
-            if let Some(every) = every {
-                out.solutions
-                    .push(every.iter().flat_map(|s| s.a.iter().copied()).collect());
-            }
-        },
-    )?;
-    out.into_dict(py, all)
+    let target_of = |i: usize| {
+        SpatialPose::from_xyzw(
+            Vector3::new(p[3 * i], p[3 * i + 1], p[3 * i + 2]),
+            [q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]],
+        )
+        .map_err(|e| e.to_string())
+    };
+    solve_batch(py, &model, p.len() / 3, a0, base, all, threads, target_of)
 }
 
 /// Quasi-static motion of the planar rod: the rod follows its equilibrium branch as the tip
@@ -518,6 +521,7 @@ impl Tracker {
             tolerance,
             None,
             None,
+            false,
         )?;
         rod_ig_core::ig::warm_up();
         let follower = match a0 {

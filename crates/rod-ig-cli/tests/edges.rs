@@ -3,32 +3,12 @@
 //! bounded, `shape` streamed in bounded memory.
 
 use serde_json::Value;
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufRead, BufReader, Read};
 use std::process::{Command, Stdio};
 
-/// Runs `rod-ig args` with `stdin`; its JSON answer lines.
-fn run(args: &[&str], stdin: &str) -> Vec<Value> {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("rod-ig starts");
-    child
-        .stdin
-        .take()
-        .expect("stdin")
-        .write_all(stdin.as_bytes())
-        .expect("write stdin");
-    let out = child.wait_with_output().expect("rod-ig exits");
-    assert!(out.status.success(), "exit status {:?}", out.status);
-    String::from_utf8(out.stdout)
-        .expect("UTF-8")
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("JSON line"))
-        .collect()
-}
+mod common;
+
+use common::{run, run_with_stderr};
 
 /// The documented slack of a request past its deadline.
 const SLACK_MS: f64 = 10.0;
@@ -114,22 +94,11 @@ fn numeric_options_out_of_range_are_refused() {
 
 #[test]
 fn max_iterations_holds_per_start() {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
-        .args(["solve", "--verbose"])
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("rod-ig starts");
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(b"{\"target\":{\"x\":0.6,\"y\":0.3,\"theta\":0.5},\"max_iterations\":1}\n")
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
-    let events: Vec<Value> = String::from_utf8(out.stderr)
-        .unwrap()
+    let (_, stderr) = run_with_stderr(
+        &["solve", "--verbose"],
+        "{\"target\":{\"x\":0.6,\"y\":0.3,\"theta\":0.5},\"max_iterations\":1}\n",
+    );
+    let events: Vec<Value> = stderr
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
