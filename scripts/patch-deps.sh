@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
 # Applies the project's own patches (patches/<crate>-<version>-*.patch) to the crates.io
-# releases of two dependencies, at build time, into build/patched/<crate>-<version>, which
-# Cargo.toml's [patch.crates-io] points at. The repository holds only the patches (each with
-# its rationale in its header), never a copy of the crates' sources.
+# releases of two dependencies of the ROS node, at build time, into
+# build/patched/<crate>-<version>, which ros/rod_ig/Cargo.toml's [patch.crates-io] points at
+# (the node is a Cargo workspace of its own: the math crate and the CLI never need this). The
+# repository holds only the patches (each with its rationale in its header), never a copy of
+# the crates' sources.
 #
 # Every entry point (scripts/run-node.sh, scripts/test-all.sh, .ci/run) runs this before cargo;
-# run it once by hand before a bare `cargo build` in a fresh clone. Idempotent and fast when
-# done (a stamp holds the patches' checksums). Needs curl (or the crate in cargo's cache),
+# run it once by hand before building the node with a bare cargo command. Idempotent and fast
+# when done (a stamp holds the patches' checksums). Needs curl (or the crate in cargo's cache),
 # sha256sum, tar, and patch or git.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -14,7 +14,7 @@ if [ "${ROD_IG_SETUP_CLIENT:-0}" = 1 ]; then
     bash "$REPO/scripts/setup-env.sh"
 fi
 bash "$REPO/scripts/patch-deps.sh"
-cargo build --release -p rod_ig --bin rod_ig_node >&2
+cargo build --release --manifest-path "$REPO/ros/rod_ig/Cargo.toml" --bins >&2
 BIN="${CARGO_TARGET_DIR:-$REPO/target}/release/rod_ig_node"
 export ROS_DISTRO="${ROS_DISTRO:-kilted}"
 export RUST_LOG="${RUST_LOG:-info,rustdds=error,rustdds::network::udp_listener=off,ros2_client=warn}"

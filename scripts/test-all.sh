@@ -2,12 +2,12 @@
 # Everything from scratch on a fresh Debian 12 machine with Rust and CPython 3.11, idempotent:
 #   1. Python headers if missing (apt: python3-dev), the venv with ROS 2 Kilted wheels, and the
 #      interface package rod_ig_msgs (scripts/setup-env.sh);
-#   2. the Cargo workspace (release: the integration tests run the release node);
-#   3. lint: `cargo fmt --check`, `cargo clippy --workspace --all-targets -- -D warnings`,
-#      `RUSTDOCFLAGS="-D warnings" cargo doc --no-deps`;
-#   4. `cargo test --workspace` (unit, integration and doc-tests, the seeded CLI fuzz) and the
-#      pytest suite in tests/ (real rclpy client, node as a subprocess on random ROS domains,
-#      loopback only);
+#   2. lint of the three Cargo workspaces (crates, ros/rod_ig, python): `cargo fmt --check`,
+#      `cargo clippy --all-targets -- -D warnings`, `RUSTDOCFLAGS="-D warnings" cargo doc`;
+#   3. `cargo test` of the crates and of the node (unit, integration and doc-tests, the seeded
+#      CLI fuzz), then the release CLI and node as scripts/run-node.sh builds them;
+#   4. the pytest suite in tests/ (real rclpy client, node as a subprocess on random ROS
+#      domains, loopback only);
 #   5. the Python package: `pip install ./python` into its own venv, its pytest suite and
 #      `mypy --strict`.
 # Prints cargo's and pytest's summary lines; exits non-zero if anything fails.
@@ -31,26 +31,40 @@ bash "$REPO/scripts/setup-env.sh" || { echo "setup-env.sh failed"; exit 1; }
 source "$REPO/scripts/env.sh"
 export ROS_DISTRO="${ROS_DISTRO:-kilted}"
 
-echo "== lint: cargo fmt --check, clippy -D warnings, rustdoc -D warnings"
-cargo fmt --all -- --check >"$LOGS/fmt.log" 2>&1 || { echo "cargo fmt --check FAILED (see $LOGS/fmt.log)"; status=1; }
-cargo clippy --workspace --all-targets --release -- -D warnings >"$LOGS/clippy.log" 2>&1 \
-    || { echo "clippy FAILED (see $LOGS/clippy.log)"; grep -E '^(error|warning)' "$LOGS/clippy.log" | head; status=1; }
-RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --workspace >"$LOGS/doc.log" 2>&1 \
-    || { echo "cargo doc FAILED (see $LOGS/doc.log)"; status=1; }
+# Three Cargo workspaces: the crates (root), the node (its own, with the patched DDS crates)
+# and the Python package; one target directory (.cargo/config.toml).
+NODE=(--manifest-path "$REPO/ros/rod_ig/Cargo.toml")
+PYPKG=(--manifest-path "$REPO/python/Cargo.toml")
 
-echo "== cargo build --release --workspace"
-cargo build --release --workspace 2>&1 | tail -n 3
+echo "== lint: cargo fmt --check, clippy -D warnings, rustdoc -D warnings (crates, node, python)"
+lint() { # name [--manifest-path M]
+    local name=$1; shift
+    cargo fmt --all "$@" -- --check >>"$LOGS/fmt.log" 2>&1 \
+        || { echo "cargo fmt --check FAILED: $name (see $LOGS/fmt.log)"; status=1; }
+    cargo clippy "$@" --workspace --all-targets --release -- -D warnings >>"$LOGS/clippy.log" 2>&1 \
+        || { echo "clippy FAILED: $name"; grep -E '^(error|warning)' "$LOGS/clippy.log" | head; status=1; }
+    [ "$name" = python ] && return
+    RUSTDOCFLAGS="-D warnings" cargo doc "$@" --no-deps --workspace >>"$LOGS/doc.log" 2>&1 \
+        || { echo "cargo doc FAILED: $name (see $LOGS/doc.log)"; status=1; }
+}
+: >"$LOGS/fmt.log"; : >"$LOGS/clippy.log"; : >"$LOGS/doc.log"
+lint crates
+lint node "${NODE[@]}"
+lint python "${PYPKG[@]}"
+
+echo "== cargo test: the crates, then the node (release profile: shares the build with the node under test)"
+{ cargo test --release --workspace --no-fail-fast 2>&1; cargo test --release "${NODE[@]}" --no-fail-fast 2>&1; } \
+    | tee "$LOGS/cargo-test.log" \
+    | grep -E '^(test result:|error(\[|:)|failures:|    [a-zA-Z_:]+$|test .* FAILED)'
+grep -qE '^test result: FAILED|^error(\[|:)' "$LOGS/cargo-test.log" \
+    && { echo "cargo test FAILED (full log: $LOGS/cargo-test.log)"; status=1; }
+
+echo "== cargo build --release: the CLI and the node as ./scripts/run-node.sh builds them (no rebuild after this)"
+{ cargo build --release -p rod-ig-cli && cargo build --release "${NODE[@]}" --bins; } 2>&1 | tail -n 3
 [ "${PIPESTATUS[0]}" = 0 ] || { echo "cargo build failed"; exit 1; }
 
-echo "== cargo test --workspace (release profile: shares the build with the node under test)"
-cargo test --release --workspace --no-fail-fast 2>&1 | tee "$LOGS/cargo-test.log" \
-    | grep -E '^(test result:|error(\[|:)|failures:|    [a-zA-Z_:]+$|test .* FAILED)' 
-cargo_rc=${PIPESTATUS[0]}
-[ "$cargo_rc" = 0 ] || { echo "cargo test FAILED (full log: $LOGS/cargo-test.log)"; status=1; }
-
 echo "== pytest tests/"
-# The binaries built above (rodig_harness.py would otherwise run its own `cargo build -p
-# rod_ig`, whose feature set differs from the workspace build's and relinks everything).
+# The binaries built above (rodig_harness.py would otherwise build them itself).
 TARGET="${CARGO_TARGET_DIR:-$REPO/target}"
 export ROD_IG_NODE_BIN="$TARGET/release/rod_ig_node" ROD_IG_ECHO_BIN="$TARGET/release/rod_ig_echo"
 # shellcheck disable=SC2086

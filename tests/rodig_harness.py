@@ -48,7 +48,7 @@ _built = False
 
 
 def binary(name: str) -> Path:
-    """Path of a release binary of the root package. Unless ROD_IG_NODE_BIN / ROD_IG_ECHO_BIN
+    """Path of a release binary of the node package (ros/rod_ig). Unless ROD_IG_NODE_BIN / ROD_IG_ECHO_BIN
     name one, `cargo build --release` runs once per test session (a no-op when up to date)."""
     global _built
     override = os.environ.get(f"ROD_IG_{name.upper().removeprefix('ROD_IG_')}_BIN")
@@ -56,7 +56,8 @@ def binary(name: str) -> Path:
         return Path(override)
     if not _built:
         subprocess.run(["bash", str(REPO / "scripts" / "patch-deps.sh")], check=True)
-        subprocess.run(["cargo", "build", "--release", "-p", "rod_ig", "--bins"], cwd=REPO, check=True)
+        subprocess.run(["cargo", "build", "--release", "--manifest-path",
+                        str(REPO / "ros" / "rod_ig" / "Cargo.toml"), "--bins"], cwd=REPO, check=True)
         _built = True
     target_dir = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
     return target_dir / "release" / name

@@ -24,7 +24,7 @@ REPO = HERE.parents[1]
 
 
 def oracle() -> list[dict]:
-    lines = (HERE / "data" / "oracle_cases_200.jsonl").read_text().splitlines()
+    lines = (REPO / "data" / "oracle" / "cases_public.jsonl").read_text().splitlines()[:200]
     return [json.loads(line) for line in lines]
 
 

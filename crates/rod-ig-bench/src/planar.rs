@@ -9,7 +9,7 @@ use rod_ig_core::{planar, wrap_angle, PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-/// One inverse-geometry case, as in `shared/oracle/ig_public.jsonl`.
+/// One inverse-geometry case, as in `data/oracle/ig_public.jsonl`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct IgCase {
     /// A stable rod whose tip is the target.

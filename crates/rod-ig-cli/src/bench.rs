@@ -109,7 +109,7 @@ const FINDINGS_TABLE1: [(f64, f64); 6] = [
     (60.9, 65.2),
 ];
 
-/// Reads inverse-geometry cases (`shared/oracle/ig_public.jsonl` format).
+/// Reads inverse-geometry cases (`data/oracle/ig_public.jsonl` format).
 pub fn read_cases(path: &Path) -> Result<Vec<IgCase>, String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     text.lines()

@@ -107,8 +107,9 @@ enum Command {
         /// Fewer rounds and samples (a smoke run, not for quoting).
         #[arg(long)]
         quick: bool,
-        /// Inverse-geometry cases for the Table 1 protocol (JSON lines, as in the oracle).
-        #[arg(long, default_value = "../shared/oracle/ig_public.jsonl")]
+        /// Inverse-geometry cases for the Table 1 protocol (JSON lines, as in the oracle; default:
+        /// the repository's data/oracle/ig_public.jsonl).
+        #[arg(long, default_value = concat!(env!("CARGO_MANIFEST_DIR"), "/../../data/oracle/ig_public.jsonl"))]
         ig_cases: PathBuf,
         /// Which parts to run.
         #[arg(long, value_enum, default_value = "all")]

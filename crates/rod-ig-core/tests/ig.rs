@@ -1,9 +1,7 @@
 //! Acceptance tests of the planar inverse geometry (issue #3).
 //!
-//! Reference data: `shared/oracle/ig_public.jsonl` (30 targets × 15 stable initial guesses) and
-//! the figures of `shared/paper/FINDINGS.md` §8. The shared directory is found from the
-//! environment variable `ROD_IG_SHARED`, else by walking up from this crate's directory to the
-//! first ancestor holding `shared/oracle`.
+//! Reference data: `data/oracle/ig_public.jsonl` (30 targets × 15 stable initial guesses) and
+//! the figures of FINDINGS.md §8 (the project's paper notes, cited, not copied).
 
 mod workloads;
 use rod_ig_core::ig::{self, IgError, Method, Objective, SolveOptions, Tracker};
@@ -11,10 +9,10 @@ use rod_ig_core::{wrap_angle, PlanarParams, PlanarPose};
 use workloads::planar::{self as bench, IgCase, ParamBox};
 
 mod common;
-use common::shared_dir;
+use common::oracle_file;
 
 fn ig_cases() -> Vec<IgCase> {
-    let path = shared_dir().join("oracle").join("ig_public.jsonl");
+    let path = oracle_file("ig_public.jsonl");
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     text.lines()

@@ -3,7 +3,7 @@
 //! axial force, and the paper's box — for the default and the least-energy objective, and
 //! every success is a verified stable rod.
 //!
-//! Families as in `shared/oracle/relaxed_public.jsonl`'s README, drawn with our own seeds.
+//! Families as in `data/oracle/relaxed_public.jsonl`'s README, drawn with our own seeds.
 //! Targets: tips of rods our stability test calls stable with a clear verdict, ‖(x, y)‖ < 1.
 //! The deadline is raised to 5 s so that the outcome depends on the iteration budgets, not on
 //! the machine's speed (the 250 ms default cuts ≈ 0.2 % of strong-force solves, whose

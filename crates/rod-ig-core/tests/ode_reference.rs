@@ -6,7 +6,7 @@ use rod_ig_core::ode::{self, planar_reference as pr, OdeError, OdeOptions};
 use std::ops::ControlFlow;
 
 mod common;
-use common::shared_dir;
+use common::oracle_file;
 
 struct Case {
     a: Vector3<f64>,
@@ -18,7 +18,7 @@ struct Case {
 }
 
 fn load_cases() -> Vec<Case> {
-    let path = shared_dir().join("oracle/cases_public.jsonl");
+    let path = oracle_file("cases_public.jsonl");
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     text.lines()

@@ -1,20 +1,19 @@
-//! The closed form against the independent oracle `shared/oracle/cases_public.jsonl`
+//! The closed form against the independent oracle `data/oracle/cases_public.jsonl`
 //! (2,000 cases, DOP853 at rtol 1e-12 with variational equations).
 //!
-//! Acceptance (shared/oracle/README.md): tip ≤ 1e-11 abs, J ≤ 1e-8 relative (‖ΔJ‖_F/‖J‖_F),
+//! Acceptance (data/oracle/README.md): tip ≤ 1e-11 abs, J ≤ 1e-8 relative (‖ΔJ‖_F/‖J‖_F),
 //! stability verdict identical on every line, energy ≤ 1e-9 abs.
-//! The shared directory is found through `ROD_IG_SHARED` or by walking up from the crate.
-//! If it cannot be found the test FAILS.
+//! The data is part of the repository: if it cannot be read the test FAILS.
 
 use rod_ig_core::planar;
 use rod_ig_core::{PlanarJacobian, PlanarParams};
 
 mod common;
-use common::{numbers as arr, shared_dir};
+use common::{numbers as arr, oracle_file};
 
 #[test]
 fn closed_form_matches_oracle_on_all_public_cases() {
-    let path = shared_dir().join("oracle").join("cases_public.jsonl");
+    let path = oracle_file("cases_public.jsonl");
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     let (mut e_tip, mut e_jac, mut e_en, mut e_margin) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);

@@ -1,7 +1,7 @@
-//! Forward map, J, energy and stability against `shared/oracle/relaxed_public.jsonl`: 800 rods
+//! Forward map, J, energy and stability against `data/oracle/relaxed_public.jsonl`: 800 rods
 //! in the regime a cable lives in (gently bent, nearly straight, tiny, strong axial force),
 //! integrated independently with a pure relative tolerance (scipy DOP853, rtol 1e-12,
-//! atol 1e-30; see shared/oracle/README.md).
+//! atol 1e-30; see data/oracle/README.md).
 //!
 //! Acceptance (issue 9): tip within 1e-9, J within 1e-6 relative (Frobenius), energy within
 //! 1e-8 relative, and the stability verdict equal to the oracle's wherever its normalised
@@ -13,9 +13,9 @@ use rod_ig_core::planar;
 use rod_ig_core::{PlanarJacobian, PlanarParams};
 
 mod common;
-use common::{numbers as arr, shared_dir};
+use common::{numbers as arr, oracle_file};
 
-/// Blocks of the file (shared/oracle/README.md).
+/// Blocks of the file (data/oracle/README.md).
 const BLOCKS: [(&str, usize, usize); 5] = [
     ("log-scale", 0, 300),
     ("moment, tiny force", 300, 450),
@@ -67,7 +67,7 @@ fn truth() -> std::collections::HashMap<usize, serde_json::Value> {
 #[test]
 fn relaxed_families_match_the_oracle() {
     let truth = truth();
-    let path = shared_dir().join("oracle").join("relaxed_public.jsonl");
+    let path = oracle_file("relaxed_public.jsonl");
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();

@@ -135,7 +135,7 @@ pub fn tip_and_jacobian(
 }
 
 /// Tip pose q(1) and J(1, a) with a pure relative tolerance (atol = 1e-300), as the oracle's
-/// reference integration (shared/oracle/README.md): tiny a give tiny entries of J (O(|a|²)),
+/// reference integration (data/oracle/README.md): tiny a give tiny entries of J (O(|a|²)),
 /// which an absolute tolerance would not resolve.
 pub fn tip_and_jacobian_relative(
     a: &PlanarParams,

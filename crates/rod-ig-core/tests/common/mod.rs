@@ -2,33 +2,13 @@
 
 use std::path::{Path, PathBuf};
 
-/// The project's `shared/` directory (paper, oracle): `$ROD_IG_SHARED` if set, else the first
-/// `shared/` holding `oracle/` found walking up from this crate (in CI and in a fresh clone it
-/// sits beside the repository). Panics with a clear message when absent: tests against the
-/// oracle must fail, not pass vacuously, when their reference data is missing.
+/// The public reference sets (`data/oracle/` of the repository: cases, inverse geometry,
+/// near-relaxed rods; see its README), by file name.
 #[allow(dead_code)] // not every test binary that includes this module reads the oracle
-pub fn shared_dir() -> PathBuf {
-    if let Ok(p) = std::env::var("ROD_IG_SHARED") {
-        let p = PathBuf::from(p);
-        assert!(
-            p.join("oracle").is_dir(),
-            "ROD_IG_SHARED={} has no oracle/ directory",
-            p.display()
-        );
-        return p;
-    }
-    let start = Path::new(env!("CARGO_MANIFEST_DIR"));
-    start
-        .ancestors()
-        .map(|dir| dir.join("shared"))
-        .find(|cand| cand.join("oracle").is_dir())
-        .unwrap_or_else(|| {
-            panic!(
-                "shared oracle directory not found: set ROD_IG_SHARED or place `shared/oracle` \
-                 beside the repository (searched upwards from {})",
-                start.display()
-            )
-        })
+pub fn oracle_file(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data/oracle")
+        .join(name)
 }
 
 /// The numbers of a JSON array (panics with a clear message on anything else: test data).
