@@ -9,11 +9,13 @@
 //! - [`solver`]: the only module that calls `rod_ig_core`.
 //! - [`pipeline`]: one target in, the messages to publish out (no DDS).
 //! - [`diagnostics`]: the solve statistics reported on `/diagnostics`.
+//! - [`graph`]: the node's name and its topic and service names.
 //! - [`node`]: DDS context, topics, service, parameters and tasks.
 #![warn(missing_docs)]
 
 pub mod convert;
 pub mod diagnostics;
+pub mod graph;
 pub mod messages;
 pub mod node;
 pub mod params;

@@ -37,8 +37,7 @@ use crate::params::{Params, Startup};
 use crate::pipeline::{Outcome, Overrides, Processor};
 use crate::ros_args::NodeIdentity;
 
-/// The node's name.
-pub const NODE_NAME: &str = "rod_ig_node";
+pub use crate::graph::{names, NODE_NAME};
 
 /// Errors that stop the node from starting.
 #[derive(Debug, Error)]
@@ -235,26 +234,6 @@ fn create_context(mw: &MiddlewareConfig) -> Result<Context, NodeError> {
     }
     let participant = builder.build().map_err(create_err("DDS participant"))?;
     Context::from_domain_participant(participant).map_err(create_err("ROS context"))
-}
-
-/// The node's relative topic and service names (resolved through [`NodeIdentity`]).
-pub mod names {
-    /// Targets in (geometry_msgs/PoseStamped).
-    pub const TARGET: &str = "rod/target";
-    /// Rod shape out (nav_msgs/Path).
-    pub const PATH: &str = "rod/path";
-    /// Solution out (rod_ig_msgs/RodSolution).
-    pub const SOLUTION: &str = "rod/solution";
-    /// RViz marker out (visualization_msgs/Marker).
-    pub const MARKER: &str = "rod/marker";
-    /// The service (rod_ig_msgs/srv/SolveRod).
-    pub const SOLVE: &str = "rod/solve";
-    /// The planning service (rod_ig_msgs/srv/PlanRod).
-    pub const PLAN: &str = "rod/plan";
-    /// The planned rods (visualization_msgs/Marker, LINE_LIST).
-    pub const PLAN_RODS: &str = "rod/plan_rods";
-    /// Diagnostics out (diagnostic_msgs/DiagnosticArray): absolute, as diagnostic_updater's.
-    pub const DIAGNOSTICS: &str = "/diagnostics";
 }
 
 /// `identity.resolve_split(name)` as a ros2-client [`Name`].

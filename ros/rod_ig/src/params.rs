@@ -120,25 +120,31 @@ impl Default for TargetQos {
 pub const QOS_POLICIES: [&str; 4] = ["reliability", "durability", "history", "depth"];
 
 impl Default for Params {
+    /// The defaults of [`TABLE`].
     fn default() -> Self {
-        Self {
+        let mut p = Self {
             rod_length: 1.0,
-            base_frame: "rod_base".into(),
-            path_samples: 100,
-            tolerance: 1e-6,
-            max_iterations: 100,
+            base_frame: String::new(),
+            path_samples: 0,
+            tolerance: 0.0,
+            max_iterations: 0,
             method: Method::Robust,
             bending_stiffness: 0.0,
-            planar_tolerance: 1e-4,
-            publish_marker: true,
-            marker_width: 0.01,
+            planar_tolerance: 0.0,
+            publish_marker: false,
+            marker_width: 0.0,
             solve_3d: false,
-            follow_branch: true,
-            deadline_ms: rod_ig_core::ig::DEFAULT_DEADLINE.as_secs_f64() * 1e3,
+            follow_branch: false,
+            deadline_ms: 0.0,
             use_sim_time: false,
             target_qos: TargetQos::default(),
             target_topic: "/rod/target".into(),
+        };
+        for spec in &TABLE {
+            // The table's defaults are within its ranges (tested: `defaults`).
+            let _ = (spec.set)(&mut p, &spec.default.value());
         }
+        p
     }
 }
 
@@ -146,7 +152,7 @@ impl Default for Params {
 #[derive(Debug, Error, PartialEq)]
 pub enum ParamError {
     /// No such parameter.
-    #[error("unknown parameter '{0}' (known: {known})", known = NAMES.join(", "))]
+    #[error("unknown parameter '{0}' (known: {known})", known = names().collect::<Vec<_>>().join(", "))]
     Unknown(String),
     /// Wrong ROS type.
     #[error("parameter '{name}' must be {expected}, got {got}")]
@@ -179,23 +185,376 @@ pub enum ParamError {
     },
 }
 
-/// The names of all parameters, in declaration order.
-pub const NAMES: [&str; 14] = [
-    "rod_length",
-    "base_frame",
-    "path_samples",
-    "tolerance",
-    "max_iterations",
-    "method",
-    "bending_stiffness",
-    "planar_tolerance",
-    "publish_marker",
-    "marker_width",
-    "solve_3d",
-    "follow_branch",
-    "deadline_ms",
-    "use_sim_time",
+/// A parameter's ROS type and the values it accepts.
+#[derive(Clone, Copy, Debug)]
+enum Kind {
+    /// A finite double in [lo, hi] (hi may be infinite); `lo_open`: lo itself excluded.
+    Double { lo: f64, hi: f64, lo_open: bool },
+    /// An integer in [lo, hi].
+    Integer { lo: i64, hi: i64 },
+    /// A bool.
+    Bool,
+    /// A string, checked by the row's `set`.
+    Str,
+}
+
+/// A parameter's default, as written in the table.
+#[derive(Clone, Copy, Debug)]
+enum DefaultValue {
+    Double(f64),
+    Integer(i64),
+    Bool(bool),
+    Str(&'static str),
+}
+
+/// One row of the parameter table: everything about one parameter, written once. The
+/// descriptors (`ros2 param describe`), get, set, the params-file reader and `--help` all
+/// come from [`TABLE`].
+struct Spec {
+    name: &'static str,
+    kind: Kind,
+    default: DefaultValue,
+    /// Meaning and unit, as `ros2 param describe` shows it.
+    description: &'static str,
+    /// What a range cannot express (the allowed strings), or "".
+    constraints: &'static str,
+    /// The current value.
+    get: fn(&Params) -> ParameterValue,
+    /// How it applies: stores a value that passed `kind`'s check into [`Params`], which every
+    /// request reads (strings are parsed and checked here).
+    set: fn(&mut Params, &ParameterValue) -> Result<(), String>,
+}
+
+fn f64_of(v: &ParameterValue) -> f64 {
+    match v {
+        ParameterValue::Double(d) => *d,
+        ParameterValue::Integer(i) => *i as f64,
+        _ => f64::NAN,
+    }
+}
+
+fn i64_of(v: &ParameterValue) -> i64 {
+    match v {
+        ParameterValue::Integer(i) => *i,
+        _ => 0,
+    }
+}
+
+fn bool_of(v: &ParameterValue) -> bool {
+    matches!(v, ParameterValue::Boolean(true))
+}
+
+fn str_of(v: &ParameterValue) -> &str {
+    match v {
+        ParameterValue::String(s) => s,
+        _ => "",
+    }
+}
+
+const MAX_DEADLINE_MS: f64 = rod_ig_core::ig::MAX_DEADLINE.as_secs_f64() * 1e3;
+/// Most poses per published path: a nav_msgs/Path of 100,000 poses is ~6 MB.
+const MAX_PATH_SAMPLES: i64 = 100_000;
+
+/// Every parameter of `rod_ig_node` (beside the `qos_overrides` ones), in declaration order.
+const TABLE: [Spec; 14] = [
+    Spec {
+        name: "rod_length",
+        kind: Kind::Double {
+            lo: 0.0,
+            hi: f64::INFINITY,
+            lo_open: true,
+        },
+        default: DefaultValue::Double(1.0),
+        description: "Physical length L of the rod (m); outputs are scaled by it",
+        constraints: "",
+        get: |p| ParameterValue::Double(p.rod_length),
+        set: |p, v| {
+            p.rod_length = f64_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "base_frame",
+        kind: Kind::Str,
+        default: DefaultValue::Str("rod_base"),
+        description: "frame_id used when a target's frame_id is empty (the base gripper's frame)",
+        constraints: "a TF frame id: letters, digits, '_', '-', '.', '/' (not leading)",
+        get: |p| ParameterValue::String(p.base_frame.clone()),
+        set: |p, v| {
+            p.base_frame = check_frame_id(str_of(v))?.to_string();
+            Ok(())
+        },
+    },
+    Spec {
+        name: "path_samples",
+        kind: Kind::Integer {
+            lo: 2,
+            hi: MAX_PATH_SAMPLES,
+        },
+        default: DefaultValue::Integer(100),
+        description: "Poses per published nav_msgs/Path",
+        constraints: "",
+        get: |p| ParameterValue::Integer(p.path_samples as i64),
+        set: |p, v| {
+            p.path_samples = i64_of(v) as usize;
+            Ok(())
+        },
+    },
+    Spec {
+        name: "tolerance",
+        kind: Kind::Double {
+            lo: rod_ig_core::ig::MIN_TOLERANCE,
+            hi: rod_ig_core::ig::MAX_TOLERANCE,
+            lo_open: false,
+        },
+        default: DefaultValue::Double(rod_ig_core::solver::DEFAULT_TOLERANCE),
+        description: "Solver convergence tolerance on the tip pose (normalised by rod length)",
+        constraints: "",
+        get: |p| ParameterValue::Double(p.tolerance),
+        set: |p, v| {
+            p.tolerance = f64_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "max_iterations",
+        kind: Kind::Integer {
+            lo: 1,
+            hi: rod_ig_core::ig::MAX_ITERATIONS_LIMIT as i64,
+        },
+        default: DefaultValue::Integer(rod_ig_core::solver::DEFAULT_MAX_ITERATIONS as i64),
+        description: "Solver iteration limit per start of the search (Newton: of the run)",
+        constraints: "",
+        get: |p| ParameterValue::Integer(i64::from(p.max_iterations)),
+        set: |p, v| {
+            p.max_iterations = i64_of(v) as u32;
+            Ok(())
+        },
+    },
+    Spec {
+        name: "method",
+        kind: Kind::Str,
+        default: DefaultValue::Str("robust"),
+        description: "Solver: robust (stable, default) or newton (the paper's iteration)",
+        constraints: "robust or newton",
+        get: |p| ParameterValue::String(p.method.as_str().into()),
+        set: |p, v| {
+            p.method = Method::parse(str_of(v)).map_err(|e| e.to_string())?;
+            Ok(())
+        },
+    },
+    Spec {
+        name: "bending_stiffness",
+        kind: Kind::Double {
+            lo: 0.0,
+            hi: f64::INFINITY,
+            lo_open: false,
+        },
+        default: DefaultValue::Double(0.0),
+        description:
+            "Bending stiffness EI (N m^2) for the wrench and energy in joules; 0 = unknown",
+        constraints: "",
+        get: |p| ParameterValue::Double(p.bending_stiffness),
+        set: |p, v| {
+            p.bending_stiffness = f64_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "planar_tolerance",
+        kind: Kind::Double {
+            lo: 0.0,
+            hi: 0.5,
+            lo_open: false,
+        },
+        default: DefaultValue::Double(1e-4),
+        description: "Largest |z| (m) and tilt out of the plane (rad) accepted as planar",
+        constraints: "",
+        get: |p| ParameterValue::Double(p.planar_tolerance),
+        set: |p, v| {
+            p.planar_tolerance = f64_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "publish_marker",
+        kind: Kind::Bool,
+        default: DefaultValue::Bool(true),
+        description: "Publish the RViz line strip on rod/marker",
+        constraints: "",
+        get: |p| ParameterValue::Boolean(p.publish_marker),
+        set: |p, v| {
+            p.publish_marker = bool_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "marker_width",
+        kind: Kind::Double {
+            lo: 0.0,
+            hi: f64::INFINITY,
+            lo_open: true,
+        },
+        default: DefaultValue::Double(0.01),
+        description: "Line width of the marker (m)",
+        constraints: "",
+        get: |p| ParameterValue::Double(p.marker_width),
+        set: |p, v| {
+            p.marker_width = f64_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "solve_3d",
+        kind: Kind::Bool,
+        default: DefaultValue::Bool(false),
+        description: "Answer non-planar targets with the 3-D solver instead of rejecting them",
+        constraints: "",
+        get: |p| ParameterValue::Boolean(p.solve_3d),
+        set: |p, v| {
+            p.solve_3d = bool_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "follow_branch",
+        kind: Kind::Bool,
+        default: DefaultValue::Bool(true),
+        description: "rod/target moves the gripper: the rod follows its branch and snaps where it \
+                      folds (event in RodSolution); false: independent solves",
+        constraints: "",
+        get: |p| ParameterValue::Boolean(p.follow_branch),
+        set: |p, v| {
+            p.follow_branch = bool_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "deadline_ms",
+        kind: Kind::Double {
+            lo: 0.0,
+            hi: MAX_DEADLINE_MS,
+            lo_open: true,
+        },
+        default: DefaultValue::Double(rod_ig_core::ig::DEFAULT_DEADLINE.as_secs_f64() * 1e3),
+        description: "Wall-time budget of one solve (ms); a solve that runs out answers \
+                      'deadline reached'",
+        constraints: "",
+        get: |p| ParameterValue::Double(p.deadline_ms),
+        set: |p, v| {
+            p.deadline_ms = f64_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "use_sim_time",
+        kind: Kind::Bool,
+        default: DefaultValue::Bool(false),
+        description: "Use /clock (rosgraph_msgs/Clock) as the node's time",
+        constraints: "",
+        get: |p| ParameterValue::Boolean(p.use_sim_time),
+        set: |p, v| {
+            p.use_sim_time = bool_of(v);
+            Ok(())
+        },
+    },
 ];
+
+/// The row of parameter `name`.
+fn spec(name: &str) -> Option<&'static Spec> {
+    TABLE.iter().find(|s| s.name == name)
+}
+
+/// The names of all parameters (beside `qos_overrides`), in declaration order.
+pub fn names() -> impl Iterator<Item = &'static str> {
+    TABLE.iter().map(|s| s.name)
+}
+
+/// Checks a TF frame id (REP 105 names such as `base_link`, `arm/base`): non-empty, letters,
+/// digits, `_`, `-`, `.` and `/`, no leading `/` (tf2 rejects it), no empty segment.
+pub fn check_frame_id(id: &str) -> Result<&str, String> {
+    let ok_char = |c: char| c.is_ascii_alphanumeric() || "_-./".contains(c);
+    if id.is_empty() || id.starts_with('/') || id.contains("//") || id.ends_with('/') {
+        return Err(format!(
+            "{id:?} is not a TF frame id (empty, or a leading, trailing or double '/')"
+        ));
+    }
+    if let Some(c) = id.chars().find(|&c| !ok_char(c)) {
+        return Err(format!(
+            "{id:?} is not a TF frame id ({c:?}: use letters, digits, '_', '-', '.', '/')"
+        ));
+    }
+    Ok(id)
+}
+
+impl Kind {
+    /// Checks the type and range of `v` for parameter `name`.
+    fn check(self, name: &str, v: &ParameterValue) -> Result<(), ParamError> {
+        match self {
+            Kind::Double { lo, hi, lo_open } => {
+                let x = double(name, v)?;
+                let above = if lo_open { x > lo } else { x >= lo };
+                check(name, x.is_finite() && above && x <= hi, || {
+                    format!("must be {}, got {x}", self.constraint())
+                })
+            }
+            Kind::Integer { lo, hi } => integer(name, v, lo, hi).map(|_| ()),
+            Kind::Bool => boolean(name, v).map(|_| ()),
+            Kind::Str => match v {
+                ParameterValue::String(_) => Ok(()),
+                other => Err(ParamError::WrongType {
+                    name: name.into(),
+                    expected: "a string",
+                    got: type_name(other),
+                }),
+            },
+        }
+    }
+
+    /// The accepted values, in words ("> 0", "in [1e-14, 1e-2]").
+    fn constraint(self) -> String {
+        match self {
+            Kind::Double { lo, hi, lo_open } if hi.is_infinite() => {
+                format!("{} {lo}", if lo_open { ">" } else { ">=" })
+            }
+            Kind::Double { lo, hi, lo_open } => {
+                let (lo, hi) = (number(lo), number(hi));
+                format!("in {}{lo}, {hi}]", if lo_open { "(" } else { "[" })
+            }
+            Kind::Integer { lo, hi } => format!("in [{lo}, {hi}]"),
+            Kind::Bool | Kind::Str => String::new(),
+        }
+    }
+
+    /// The numeric range of the descriptor (ROS ranges include both bounds).
+    fn range(self) -> Range {
+        match self {
+            Kind::Double { lo, hi, .. } if hi.is_finite() => Range::Double(lo, hi),
+            Kind::Integer { lo, hi } => Range::Integer(lo, hi),
+            _ => Range::Unbounded,
+        }
+    }
+}
+
+/// A bound as people write it: 0.5, 10000, 1e-14.
+fn number(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e5).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+impl DefaultValue {
+    fn value(self) -> ParameterValue {
+        match self {
+            DefaultValue::Double(d) => ParameterValue::Double(d),
+            DefaultValue::Integer(i) => ParameterValue::Integer(i),
+            DefaultValue::Bool(b) => ParameterValue::Boolean(b),
+            DefaultValue::Str(s) => ParameterValue::String(s.into()),
+        }
+    }
+}
 
 fn type_name(v: &ParameterValue) -> String {
     match v {
@@ -289,10 +648,9 @@ impl Params {
             .filter(|p| QOS_POLICIES.contains(p))
     }
 
-    /// Every parameter name of this node: [`NAMES`], then the `qos_overrides` ones.
+    /// Every parameter name of this node: the table's, then the `qos_overrides` ones.
     pub fn names(&self) -> Vec<String> {
-        NAMES
-            .iter()
+        names()
             .map(|n| n.to_string())
             .chain(QOS_POLICIES.iter().map(|p| self.qos_parameter(p)))
             .collect()
@@ -300,7 +658,7 @@ impl Params {
 
     /// Whether `name` is one of this node's parameters.
     pub fn is_known(&self, name: &str) -> bool {
-        NAMES.contains(&name) || self.qos_policy_of(name).is_some()
+        spec(name).is_some() || self.qos_policy_of(name).is_some()
     }
 
     fn apply_qos(
@@ -326,91 +684,14 @@ impl Params {
         if let Some(policy) = self.qos_policy_of(name) {
             return self.apply_qos(name, policy, value);
         }
-        match name {
-            "rod_length" => {
-                let v = double(name, value)?;
-                check(name, v.is_finite() && v > 0.0, || {
-                    format!("must be a finite length > 0 m, got {v}")
-                })?;
-                self.rod_length = v;
-            }
-            "base_frame" => match value {
-                ParameterValue::String(s) => self.base_frame = s.clone(),
-                other => {
-                    return Err(ParamError::WrongType {
-                        name: name.into(),
-                        expected: "a string",
-                        got: type_name(other),
-                    })
-                }
-            },
-            "path_samples" => self.path_samples = integer(name, value, 2, 100_000)? as usize,
-            "tolerance" => {
-                let v = double(name, value)?;
-                let (min, max) = (
-                    rod_ig_core::ig::MIN_TOLERANCE,
-                    rod_ig_core::ig::MAX_TOLERANCE,
-                );
-                check(name, (min..=max).contains(&v), || {
-                    format!("must be in [{min:e}, {max:e}], got {v}")
-                })?;
-                self.tolerance = v;
-            }
-            "max_iterations" => self.max_iterations = integer(name, value, 1, 100_000)? as u32,
-            "method" => match value {
-                ParameterValue::String(s) => self.method = Method::parse(s)?,
-                other => {
-                    return Err(ParamError::WrongType {
-                        name: name.into(),
-                        expected: "a string",
-                        got: type_name(other),
-                    })
-                }
-            },
-            "bending_stiffness" => {
-                let v = double(name, value)?;
-                check(name, v.is_finite() && v >= 0.0, || {
-                    format!("must be a finite EI >= 0 N m^2 (0 = unknown), got {v}")
-                })?;
-                self.bending_stiffness = v;
-            }
-            "planar_tolerance" => {
-                let v = double(name, value)?;
-                check(name, v.is_finite() && (0.0..=0.5).contains(&v), || {
-                    format!("must be in [0, 0.5], got {v}")
-                })?;
-                self.planar_tolerance = v;
-            }
-            "publish_marker" => match value {
-                ParameterValue::Boolean(b) => self.publish_marker = *b,
-                other => {
-                    return Err(ParamError::WrongType {
-                        name: name.into(),
-                        expected: "a bool",
-                        got: type_name(other),
-                    })
-                }
-            },
-            "marker_width" => {
-                let v = double(name, value)?;
-                check(name, v.is_finite() && v > 0.0, || {
-                    format!("must be a finite width > 0 m, got {v}")
-                })?;
-                self.marker_width = v;
-            }
-            "solve_3d" => self.solve_3d = boolean(name, value)?,
-            "follow_branch" => self.follow_branch = boolean(name, value)?,
-            "deadline_ms" => {
-                let v = double(name, value)?;
-                let max = rod_ig_core::ig::MAX_DEADLINE.as_secs_f64() * 1e3;
-                check(name, v.is_finite() && v > 0.0 && v <= max, || {
-                    format!("must be in (0, {max}] ms, got {v}")
-                })?;
-                self.deadline_ms = v;
-            }
-            "use_sim_time" => self.use_sim_time = boolean(name, value)?,
-            _ => return Err(ParamError::Unknown(name.into())),
-        }
+        let spec = spec(name).ok_or_else(|| ParamError::Unknown(name.into()))?;
+        spec.kind.check(name, value)?;
+        let mut next = self.clone();
+        (spec.set)(&mut next, value).map_err(|reason| ParamError::Invalid {
+            name: name.into(),
+            reason,
+        })?;
+        *self = next;
         Ok(())
     }
 
@@ -432,23 +713,7 @@ impl Params {
                 _ => ParameterValue::Integer(q.depth),
             });
         }
-        Some(match name {
-            "rod_length" => ParameterValue::Double(self.rod_length),
-            "base_frame" => ParameterValue::String(self.base_frame.clone()),
-            "path_samples" => ParameterValue::Integer(self.path_samples as i64),
-            "tolerance" => ParameterValue::Double(self.tolerance),
-            "max_iterations" => ParameterValue::Integer(i64::from(self.max_iterations)),
-            "method" => ParameterValue::String(self.method.as_str().into()),
-            "bending_stiffness" => ParameterValue::Double(self.bending_stiffness),
-            "planar_tolerance" => ParameterValue::Double(self.planar_tolerance),
-            "publish_marker" => ParameterValue::Boolean(self.publish_marker),
-            "marker_width" => ParameterValue::Double(self.marker_width),
-            "solve_3d" => ParameterValue::Boolean(self.solve_3d),
-            "follow_branch" => ParameterValue::Boolean(self.follow_branch),
-            "deadline_ms" => ParameterValue::Double(self.deadline_ms),
-            "use_sim_time" => ParameterValue::Boolean(self.use_sim_time),
-            _ => return None,
-        })
+        spec(name).map(|s| (s.get)(self))
     }
 
     /// All parameters as (name, value), to declare them on the node.
@@ -461,16 +726,16 @@ impl Params {
 
     /// What `describe_parameters` (`ros2 param describe`) says about `name`.
     pub fn descriptor(&self, name: &str) -> Option<Descriptor> {
-        use Range::{Double, Integer, Unbounded};
-        let max_deadline = rod_ig_core::ig::MAX_DEADLINE.as_secs_f64() * 1e3;
-        let (description, constraints, range): (&str, String, Range) = if let Some(policy) =
-            self.qos_policy_of(name)
-        {
+        if let Some(policy) = self.qos_policy_of(name) {
             let (what, allowed, range) = match policy {
-                "reliability" => ("reliability", "reliable or best_effort", Unbounded),
-                "durability" => ("durability", "volatile or transient_local", Unbounded),
-                "history" => ("history", "keep_last or keep_all", Unbounded),
-                _ => ("keep_last depth", "1..10000", Integer(1, 10_000)),
+                "reliability" => ("reliability", "reliable or best_effort", Range::Unbounded),
+                "durability" => (
+                    "durability",
+                    "volatile or transient_local",
+                    Range::Unbounded,
+                ),
+                "history" => ("history", "keep_last or keep_all", Range::Unbounded),
+                _ => ("keep_last depth", "1..10000", Range::Integer(1, 10_000)),
             };
             return Some(Descriptor {
                 description: format!(
@@ -481,30 +746,17 @@ impl Params {
                 read_only: true,
                 range,
             });
-        } else {
-            match name {
-                "rod_length" => ("Physical length L of the rod (m); outputs are scaled by it", "> 0".into(), Unbounded),
-                "base_frame" => ("frame_id used when a target's frame_id is empty (the base gripper's frame)", String::new(), Unbounded),
-                "path_samples" => ("Poses per published nav_msgs/Path", String::new(), Integer(2, 100_000)),
-                "tolerance" => ("Solver convergence tolerance on the tip pose (normalised by rod length)", format!("[{:e}, {:e}]", rod_ig_core::ig::MIN_TOLERANCE, rod_ig_core::ig::MAX_TOLERANCE), Double(rod_ig_core::ig::MIN_TOLERANCE, rod_ig_core::ig::MAX_TOLERANCE)),
-                "max_iterations" => ("Solver iteration limit per start of the search (Newton: of the run)", String::new(), Integer(1, 100_000)),
-                "method" => ("Solver: robust (stable, default) or newton (the paper's iteration)", "robust or newton".into(), Unbounded),
-                "bending_stiffness" => ("Bending stiffness EI (N m^2) for the wrench and energy in joules; 0 = unknown", ">= 0".into(), Unbounded),
-                "planar_tolerance" => ("Largest |z| (m) and tilt out of the plane (rad) accepted as planar", String::new(), Double(0.0, 0.5)),
-                "publish_marker" => ("Publish the RViz line strip on rod/marker", String::new(), Unbounded),
-                "marker_width" => ("Line width of the marker (m)", "> 0".into(), Unbounded),
-                "solve_3d" => ("Answer non-planar targets with the 3-D solver instead of rejecting them", String::new(), Unbounded),
-                "follow_branch" => ("rod/target moves the gripper: the rod follows its branch and snaps where it folds (event in RodSolution); false: independent solves", String::new(), Unbounded),
-                "deadline_ms" => ("Wall-time budget of one solve (ms); a solve that runs out answers 'deadline reached'", "> 0".into(), Double(0.0, max_deadline)),
-                "use_sim_time" => ("Use /clock (rosgraph_msgs/Clock) as the node's time", String::new(), Unbounded),
-                _ => return None,
-            }
-        };
+        }
+        let spec = spec(name)?;
         Some(Descriptor {
-            description: description.into(),
-            constraints,
+            description: spec.description.into(),
+            constraints: if spec.constraints.is_empty() {
+                spec.kind.constraint()
+            } else {
+                spec.constraints.into()
+            },
             read_only: false,
-            range,
+            range: spec.kind.range(),
         })
     }
 }
@@ -555,47 +807,39 @@ pub struct Startup {
     pub rosout_logs: bool,
 }
 
-/// Usage text for `--help`.
+/// Usage text for `--help`: the parameters from [`TABLE`].
 pub fn usage() -> String {
     let d = Params::default();
-    format!(
+    let mut text = String::from(
         "rod_ig_node: ROS 2 node serving elastic-rod inverse geometry.\n\n\
          Usage: rod_ig_node [--ros-args [-r FROM:=TO]... [-p NAME:=VALUE]... [--params-file FILE]...\n\
          \x20                  [--log-level [LOGGER:=]LEVEL]... [--]]\n\n\
          ROS 2 arguments as rcl reads them: -r __ns:=/NS and -r __node:=NAME move and rename the\n\
          node, -r rod/target:=/arm/goal remaps a topic or service (names are relative: rod/...\n\
-         in the node's namespace). Later settings override earlier ones. Parameters (default):\n\
-         \x20 rod_length        m, > 0 ({})\n\
-         \x20 base_frame        frame_id when a target has none ({:?})\n\
-         \x20 path_samples      poses per path, 2..100000 ({})\n\
-         \x20 tolerance         solver tolerance, normalised ({:e})\n\
-         \x20 max_iterations    solver iteration limit ({})\n\
-         \x20 method            robust | newton ({})\n\
-         \x20 bending_stiffness EI in N m^2, 0 = unknown ({})\n\
-         \x20 planar_tolerance  accepted |z| (m) and tilt (rad) of targets ({:e})\n\
-         \x20 publish_marker    publish /rod/marker ({})\n\
-         \x20 marker_width      m ({})\n\
-         \x20 solve_3d          answer non-planar targets with the 3-D solver ({})\n\
-         \x20 follow_branch     the rod follows its branch, snaps where it folds ({})\n\
-         \x20 deadline_ms       wall-time budget of one solve, ms, <= 10000 ({})\n\
-         \x20 use_sim_time      stamp with /clock time (rosgraph_msgs/Clock) ({})\n\n\
-         Environment: ROS_DOMAIN_ID (0..232), ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST or\n\
+         in the node's namespace). Later settings override earlier ones. Parameters (default):\n",
+    );
+    for spec in &TABLE {
+        let value = match (spec.get)(&d) {
+            ParameterValue::String(s) => format!("{s:?}"),
+            ParameterValue::Double(x) => format!("{x}"),
+            ParameterValue::Integer(i) => format!("{i}"),
+            ParameterValue::Boolean(b) => format!("{b}"),
+            other => format!("{other:?}"),
+        };
+        let constraint = match spec.kind.constraint() {
+            c if c.is_empty() => String::new(),
+            c => format!(", {c}"),
+        };
+        text.push_str(&format!(
+            "  {:<18}{}{constraint} ({value})\n",
+            spec.name, spec.description
+        ));
+    }
+    text.push_str(
+        "\nEnvironment: ROS_DOMAIN_ID (0..232), ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST or\n\
          ROS_LOCALHOST_ONLY=1 (loopback only), RUST_LOG (console log level).\n",
-        d.rod_length,
-        d.base_frame,
-        d.path_samples,
-        d.tolerance,
-        d.max_iterations,
-        d.method.as_str(),
-        d.bending_stiffness,
-        d.planar_tolerance,
-        d.publish_marker,
-        d.marker_width,
-        d.solve_3d,
-        d.follow_branch,
-        d.deadline_ms,
-        d.use_sim_time,
-    )
+    );
+    text
 }
 
 /// Parses a command-line value the way `ros2 run ... -p` does (YAML scalar rules, subset):
@@ -626,7 +870,7 @@ fn yaml_to_value(v: &serde_yaml::Value) -> Option<ParameterValue> {
 }
 
 /// Parses the command line (without the program name) into a [`Command`]: the node's
-/// identity (default `rod_ig_node` in `/`, see [`crate::node::NODE_NAME`]), then every
+/// identity (default `rod_ig_node` in `/`, see [`crate::graph::NODE_NAME`]), then every
 /// parameter source in order.
 pub fn parse_args<I, S>(args: I) -> Result<Command, ParamError>
 where
@@ -643,11 +887,11 @@ where
         )));
     }
     let identity = ros
-        .identity(crate::node::NODE_NAME, "/")
+        .identity(crate::graph::NODE_NAME, "/")
         .map_err(|e| ParamError::Args(e.to_string()))?;
     let mut params = Params {
         target_topic: identity
-            .resolve(crate::node::names::TARGET)
+            .resolve(crate::graph::names::TARGET)
             .map_err(|e| ParamError::Args(e.to_string()))?,
         ..Params::default()
     };
@@ -657,7 +901,7 @@ where
             ParamSource::Value { node, name, value } => {
                 if node
                     .as_deref()
-                    .is_some_and(|n| n != identity.name && n != crate::node::NODE_NAME)
+                    .is_some_and(|n| n != identity.name && n != crate::graph::NODE_NAME)
                 {
                     continue; // for another node
                 }
@@ -1013,7 +1257,7 @@ mod tests {
     fn declarations_round_trip() {
         let p = Params::default();
         let decl = p.to_declarations();
-        assert_eq!(decl.len(), NAMES.len() + QOS_POLICIES.len());
+        assert_eq!(decl.len(), names().count() + QOS_POLICIES.len());
         let mut q = Params {
             rod_length: 9.0,
             ..Params::default()
@@ -1022,5 +1266,33 @@ mod tests {
             q.apply(n, v).unwrap();
         }
         assert_eq!(p, q);
+    }
+
+    #[test]
+    fn every_table_row_is_consistent() {
+        // Defaults pass their own checks, get returns them, every row has a descriptor.
+        let d = Params::default();
+        for spec in &TABLE {
+            let v = spec.default.value();
+            spec.kind.check(spec.name, &v).expect(spec.name);
+            assert_eq!((spec.get)(&d), v, "{}", spec.name);
+            let desc = d.descriptor(spec.name).expect(spec.name);
+            assert!(!desc.description.is_empty() && !desc.read_only);
+        }
+        assert!(usage().contains("deadline_ms") && usage().contains("(0, 10000]"));
+    }
+
+    #[test]
+    fn base_frame_must_be_a_tf_frame_id() {
+        let mut p = Params::default();
+        for good in ["base_link", "arm/base", "robot-1.base"] {
+            p.apply("base_frame", &ParameterValue::String(good.into())).expect(good);
+            assert_eq!(p.base_frame, good);
+        }
+        for bad in ["", "bad frame!", "/world", "a//b", "a/"] {
+            let e = p.apply("base_frame", &ParameterValue::String(bad.into()));
+            assert!(matches!(e, Err(ParamError::Invalid { .. })), "{bad:?}: {e:?}");
+            assert_eq!(p.base_frame, "robot-1.base", "unchanged after {bad:?}");
+        }
     }
 }
