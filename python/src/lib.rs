@@ -9,9 +9,9 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rod_ig_core::plan::{Obstacle, PlanRequest, Planner as CorePlanner};
-use rod_ig_core::solver::{
-    self, BranchEvent, BranchFollower, Method, Objective, PlanarClosedForm, SolveOptions, Spatial,
-};
+use rod_ig_core::solver::{self, BranchEvent, BranchFollower, Method, Objective, SolveOptions};
+use rod_ig_core::planar::PlanarClosedForm;
+use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, SpatialPose, StabilityOptions, Stiffness};
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use std::time::Duration;
@@ -322,7 +322,7 @@ fn solve<'py>(
         alpha,
         a0.is_some(),
     )?;
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let target_of = |i: usize| Ok(PlanarPose::new(t[3 * i], t[3 * i + 1], t[3 * i + 2]));
     solve_batch(
         py,
@@ -523,7 +523,7 @@ impl Tracker {
             None,
             false,
         )?;
-        rod_ig_core::ig::warm_up();
+        rod_ig_core::planar::ig::warm_up();
         let follower = match a0 {
             Some(a) => BranchFollower::holding(PlanarClosedForm, o, PlanarParams::from(a))
                 .map_err(|e| PyValueError::new_err(format!("a0 cannot be held: {e}")))?,
@@ -624,7 +624,7 @@ impl Planner {
         };
         let planner = &mut self.planner;
         let r = py.detach(|| {
-            rod_ig_core::ig::warm_up();
+            rod_ig_core::planar::ig::warm_up();
             planner.plan(&request)
         });
         let d = PyDict::new(py);
@@ -702,7 +702,7 @@ fn _time_evaluate(py: Python<'_>, a: PyReadonlyArray1<'_, f64>) -> PyResult<f64>
 /// Builds the planar solver's atlas now (≈ 0.15 s on two cores); returns its size.
 #[pyfunction]
 fn warm_up(py: Python<'_>) -> usize {
-    py.detach(rod_ig_core::ig::warm_up)
+    py.detach(rod_ig_core::planar::ig::warm_up)
 }
 
 #[pymodule]

@@ -3,8 +3,8 @@
 //! (sample 0 is the uniform box, 1 the log-scale sample).
 
 use rod_ig_bench::families::samples;
-use rod_ig_core::ig::{self, SolveOptions};
 use rod_ig_core::planar;
+use rod_ig_core::planar::ig::{self, SolveOptions};
 use std::hint::black_box;
 use std::time::Instant;
 

@@ -4,7 +4,7 @@
 //! Timings are wall-clock per solve on the calling thread, with the atlas built beforehand
 //! ([`ig::warm_up`]) so that its one-off construction is not charged to the first solve.
 
-use rod_ig_core::ig::{self, solve, IgError, Method, Objective, SolveOptions, Tracker};
+use rod_ig_core::planar::ig::{self, solve, IgError, Method, Objective, SolveOptions, Tracker};
 use rod_ig_core::{planar, wrap_angle, PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;

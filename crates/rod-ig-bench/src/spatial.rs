@@ -1,7 +1,8 @@
 //! Benchmark figures of the 3-D inverse geometry on random stable rods. No I/O.
 
 use rod_ig_core::rng::SplitMix64;
-use rod_ig_core::solver::{self, observe, Counters, IgError, SolveOptions, Spatial};
+use rod_ig_core::solver::{self, observe, Counters, IgError, SolveOptions};
+use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
 
 /// Half-widths of the random-target box: |a1..3| ≤ 5, |a4..6| ≤ 30 (FINDINGS3D: ≈ 70 % stable,

@@ -3,8 +3,8 @@
 use crate::timing::{measure, Timing};
 use rod_ig_bench::planar::{self as ig_bench, IgCase, ParamBox};
 use rod_ig_bench::SplitMix64;
-use rod_ig_core::ig::SolveOptions;
 use rod_ig_core::ode::planar_reference as reference;
+use rod_ig_core::planar::ig::SolveOptions;
 use rod_ig_core::{planar, PlanarParams};
 use std::path::Path;
 

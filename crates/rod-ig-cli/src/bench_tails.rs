@@ -3,7 +3,7 @@
 //! regime a cable lives in (issue 9), with the ratio log-scale / box.
 
 use rod_ig_bench::families::samples;
-use rod_ig_core::ig::{self, SolveOptions};
+use rod_ig_core::planar::ig::{self, SolveOptions};
 use rod_ig_core::{planar, PlanarPose};
 use std::hint::black_box;
 use std::time::Instant;

@@ -216,7 +216,7 @@ fn write_svg(path: &std::path::Path, text: &str) -> Result<(), String> {
 /// a process that serves a stream pays it once at start-up, and every request's deadline then
 /// counts from its own line (issue 24).
 fn warm_up() {
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
 }
 
 fn main() -> ExitCode {

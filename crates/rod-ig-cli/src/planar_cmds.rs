@@ -2,8 +2,8 @@
 
 use crate::answer::answer;
 use crate::jsonl::{self, Knobs, MethodName, ObjectiveName};
-use rod_ig_core::ig::{self, SolveOptions};
-use rod_ig_core::solver::PlanarClosedForm;
+use rod_ig_core::planar::ig::{self, SolveOptions};
+use rod_ig_core::planar::PlanarClosedForm;
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;

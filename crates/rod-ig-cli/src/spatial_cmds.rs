@@ -4,7 +4,8 @@
 use crate::answer::answer;
 use crate::jsonl::{self, Knobs, MethodName, ObjectiveName};
 use nalgebra::Vector3;
-use rod_ig_core::solver::{SolveOptions, Spatial};
+use rod_ig_core::solver::SolveOptions;
+use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;

@@ -11,7 +11,7 @@
 #[path = "../tests/workloads/mod.rs"]
 mod workloads;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use rod_ig_core::ig::{self, Method, SolveOptions, Tracker};
+use rod_ig_core::planar::ig::{self, Method, SolveOptions, Tracker};
 use rod_ig_core::PlanarParams;
 use workloads::planar::{self as planar_workloads, ParamBox};
 

@@ -4,7 +4,8 @@
 #[path = "../tests/workloads/mod.rs"]
 mod workloads;
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, Criterion};
-use rod_ig_core::solver::{self, SolveOptions, Spatial};
+use rod_ig_core::solver::{self, SolveOptions};
+use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, SpatialParams, StabilityOptions, Stiffness};
 use workloads::spatial::random_targets;
 use workloads::SplitMix64;

@@ -20,7 +20,7 @@
 //! - [`solver`]: one inverse-geometry API for every rod model (the [`solver::RodModel`]
 //!   trait, the paper's Newton, the robust search, least energy, all solutions, deadlines,
 //!   observers).
-//! - [`ig`]: the planar closed forms' search behind it (atlas, multi-start, tracking).
+//! - [`planar::ig`]: the planar closed forms' search behind it (atlas, multi-start, tracking).
 //! - [`plan`]: stable gripper paths for the planar rod, planned over a roadmap of stable rods
 //!   in a-space.
 //! - [`rng`]: a small deterministic generator for reproducible samples.
@@ -31,7 +31,6 @@ mod angle;
 mod eft;
 pub mod elliptic;
 mod error;
-pub mod ig;
 pub mod ode;
 pub mod plan;
 pub mod planar;

@@ -20,9 +20,9 @@
 //! the checked rods between them are its midpoints. Obstacles (discs, polygons) must not touch
 //! the rod's body, sampled at [`BODY_SAMPLES`] points.
 //!
-//! [`solve_all`]: crate::ig::solve_all
+//! [`solve_all`]: crate::planar::ig::solve_all
 
-use crate::ig::{self, SolveOptions};
+use crate::planar::ig::{self, SolveOptions};
 use crate::planar::{self, PlanarRod};
 use crate::{PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
@@ -185,7 +185,7 @@ impl Planner {
         let t0 = Instant::now();
         // The roadmap comes from the atlas, built once per process in steps charged to the
         // deadline of the query that needs it.
-        let _deadline = ig::deadline::scope(request.deadline);
+        let _deadline = crate::solver::deadline::scope(request.deadline);
         if !self.ensure_roadmap() {
             return Err(PlanError::Deadline { edges_checked: 0 });
         }
@@ -199,7 +199,7 @@ impl Planner {
         }
         let options = SolveOptions {
             tolerance: GOAL_TOLERANCE,
-            deadline: request.deadline.min(crate::ig::MAX_DEADLINE),
+            deadline: request.deadline.min(crate::planar::ig::MAX_DEADLINE),
             ..SolveOptions::default()
         };
         let mut goals = ig::solve_all(&request.goal, &options);
@@ -226,11 +226,11 @@ fn check_request(request: &PlanRequest) -> Result<(), PlanError> {
         return Err(PlanError::Invalid("start rod is not finite".into()));
     }
     ig::check_target(&request.goal).map_err(|e| PlanError::GoalUnreachable(e.to_string()))?;
-    if request.deadline.is_zero() || request.deadline > crate::ig::MAX_DEADLINE {
+    if request.deadline.is_zero() || request.deadline > crate::planar::ig::MAX_DEADLINE {
         return Err(PlanError::Invalid(format!(
             "deadline {:?} is not in (0, {:?}]",
             request.deadline,
-            crate::ig::MAX_DEADLINE
+            crate::planar::ig::MAX_DEADLINE
         )));
     }
     request.obstacles.iter().try_for_each(check_obstacle)

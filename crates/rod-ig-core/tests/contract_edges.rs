@@ -1,12 +1,14 @@
 //! The solver's contract at its edges (issue 24): options enforced as documented, huge angles
 //! solved as their exact reduction, obstacle coordinates bounded.
 
-use rod_ig_core::ig::{self, SolveOptions, Termination};
 use rod_ig_core::plan::{Obstacle, PlanError, PlanRequest, Planner, MAX_OBSTACLE_COORDINATE};
+use rod_ig_core::planar::ig::{self, SolveOptions, Termination};
+use rod_ig_core::planar::PlanarClosedForm;
 use rod_ig_core::solver::{
-    self, observe, BranchFollower, Event, IterationLog, PlanarClosedForm, Spatial,
-    MAX_ITERATIONS_LIMIT, MAX_TOLERANCE, MIN_TOLERANCE,
+    self, observe, BranchFollower, Event, IterationLog, MAX_ITERATIONS_LIMIT, MAX_TOLERANCE,
+    MIN_TOLERANCE,
 };
+use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::SpatialPose;
 use rod_ig_core::{wrap_angle, PlanarParams, PlanarPose};
 use std::time::Duration;
@@ -72,7 +74,7 @@ fn max_iterations_bounds_every_start_of_the_search() {
 #[test]
 fn the_paper_newton_stops_at_max_iterations() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let target = PlanarPose::new(0.6, 0.3, 0.5);
     for max in [1u32, 3] {
         let options = SolveOptions {
@@ -94,7 +96,7 @@ fn the_paper_newton_stops_at_max_iterations() {
 #[test]
 fn out_of_range_options_are_refused() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let target = PlanarPose::new(0.6, 0.3, 0.5);
     let bad: [(&str, SolveOptions); 6] = [
         (

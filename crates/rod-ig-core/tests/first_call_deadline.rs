@@ -2,9 +2,10 @@
 //! first use, is charged to the calls that need it, in pieces that poll their deadline. This
 //! binary holds one test so that nothing else builds the atlas first.
 
-use rod_ig_core::ig::{self, SolveOptions, Termination};
 use rod_ig_core::plan::{PlanError, PlanRequest, Planner};
-use rod_ig_core::solver::{BranchFollower, PlanarClosedForm};
+use rod_ig_core::planar::ig::{self, SolveOptions, Termination};
+use rod_ig_core::planar::PlanarClosedForm;
+use rod_ig_core::solver::BranchFollower;
 use rod_ig_core::{PlanarParams, PlanarPose};
 use std::time::{Duration, Instant};
 

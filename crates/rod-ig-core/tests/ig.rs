@@ -4,7 +4,7 @@
 //! the figures of FINDINGS.md §8 (the project's paper notes, cited, not copied).
 
 mod workloads;
-use rod_ig_core::ig::{self, IgError, Method, Objective, SolveOptions, Tracker};
+use rod_ig_core::planar::ig::{self, IgError, Method, Objective, SolveOptions, Tracker};
 use rod_ig_core::{wrap_angle, PlanarParams, PlanarPose};
 use workloads::planar::{self as bench, IgCase, ParamBox};
 
@@ -56,7 +56,7 @@ const FINDINGS_8: [(f64, f64, f64); 6] = [
 #[test]
 fn newton_reproduces_findings_table() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let cases = ig_cases();
     assert_eq!(cases.len(), 30);
     let alphas: Vec<f64> = FINDINGS_8.iter().map(|r| r.0).collect();
@@ -84,7 +84,7 @@ fn newton_reproduces_findings_table() {
 #[test]
 fn newton_successes_are_verified_solutions() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let cases = ig_cases();
     let mut n = 0;
     for c in cases.iter().take(10) {
@@ -125,7 +125,7 @@ fn newton_successes_are_verified_solutions() {
 #[test]
 fn robust_solves_every_public_case_from_every_start_and_from_none() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let cases = ig_cases();
     for c in &cases {
         let none = ig::solve(&c.target, &SolveOptions::default())
@@ -147,7 +147,7 @@ fn robust_solves_every_public_case_from_every_start_and_from_none() {
 #[test]
 fn a_good_initial_guess_selects_its_branch() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     // A guess 0.1 % off a stable solution is used first and leads back to that solution (the
     // node's use: keep the branch of the previous solution).
     let cases = ig_cases();
@@ -171,7 +171,7 @@ fn a_good_initial_guess_selects_its_branch() {
 #[test]
 fn robust_random_stable_targets_paper_box() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     // 2000 random reachable targets of stable rods in |a3| ≤ 2π, |a4|, |a5| ≤ 100.
     let targets = bench::random_stable_targets(2000, 2024, ParamBox::PAPER);
     assert_eq!(targets.len(), 2000);
@@ -314,7 +314,7 @@ fn boundary_targets() {
 #[test]
 fn never_panics_on_odd_inputs() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let vals = [
         0.0,
         -0.0,
@@ -363,7 +363,7 @@ fn never_panics_on_odd_inputs() {
 #[test]
 fn tracking_few_iterations_per_step() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let o = SolveOptions::default();
     let mut paths = vec![
         (
@@ -421,7 +421,7 @@ fn tracking_few_iterations_per_step() {
 #[test]
 fn least_energy_is_minimum_of_solve_all() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let cases = ig_cases();
     let mut multi = 0;
     for c in cases.iter().take(12) {

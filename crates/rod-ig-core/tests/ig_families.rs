@@ -14,7 +14,7 @@
 //! integrator is, by the double-double series, which `relaxed_oracle.rs` checks against
 //! 40-digit references.
 
-use rod_ig_core::ig::{self, Objective, SolveOptions};
+use rod_ig_core::planar::ig::{self, Objective, SolveOptions};
 use rod_ig_core::rng::SplitMix64;
 use rod_ig_core::{planar, wrap_angle, PlanarParams, PlanarPose};
 use std::time::Duration;
@@ -178,14 +178,14 @@ fn run(objective: Objective, per_family: usize, seed: u64) {
 #[test]
 fn robust_solve_every_family_default_objective() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     run(Objective::FirstFound, 400, 91);
 }
 
 #[test]
 fn robust_solve_every_family_least_energy() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     run(Objective::LeastEnergy, 150, 92);
 }
 
@@ -196,7 +196,7 @@ fn robust_solve_every_family_least_energy() {
 #[test]
 fn near_full_extension_solves_from_the_small_angle_start() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let opts = SolveOptions::default();
     for (name, family) in &FAMILIES[..3] {
         let ts: Vec<PlanarPose> = targets(*family, 93, 400)

@@ -5,9 +5,9 @@
 mod workloads;
 use nalgebra::Vector3;
 use rod_ig_core::planar::PlanarRod;
+use rod_ig_core::planar::{PlanarClosedForm, PlanarReference};
 use rod_ig_core::solver::{
-    self, relative_distance, BranchEvent, BranchFollower, PlanarClosedForm, PlanarReference,
-    RodModel, SolveOptions,
+    self, relative_distance, BranchEvent, BranchFollower, RodModel, SolveOptions,
 };
 use rod_ig_core::{PlanarParams, PlanarPose};
 use workloads::SplitMix64;
@@ -24,7 +24,7 @@ fn mid_height(a: &PlanarParams) -> f64 {
 
 /// The clamped–clamped buckled rod with its bump up: grippers 0.8 apart, tangents aligned.
 fn buckled_up() -> PlanarParams {
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let target = PlanarPose::new(0.8, 0.0, 0.0);
     let all = solver::solve_all(&PlanarClosedForm, &target, &SolveOptions::default());
     all.iter()
@@ -37,7 +37,7 @@ fn buckled_up() -> PlanarParams {
 #[test]
 fn a_buckled_rod_snaps_when_its_tip_gripper_turns() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     // The classic experiment: turn the tip gripper of a buckled rod; at a critical angle the
     // bump flips to the other side.
     let up = buckled_up();
@@ -132,7 +132,7 @@ fn a_buckled_rod_snaps_when_its_tip_gripper_turns() {
 #[test]
 fn long_random_walks_never_jump_branches_silently() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     // Random gripper walks from random stable rods, then the same walk back: on a branch
     // followed without a snap the way back returns to the very rod the walk started from (a
     // silent jump to another branch would not be undone). Every rod is checked stable by the
@@ -217,8 +217,8 @@ fn long_random_walks_never_jump_branches_silently() {
 #[test]
 fn followers_work_on_the_3d_model_and_report_bad_input() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
-    use rod_ig_core::solver::Spatial;
+    rod_ig_core::planar::ig::warm_up();
+    use rod_ig_core::spatial::Spatial;
     use rod_ig_core::spatial::Stiffness;
     use workloads::spatial::random_targets;
     let (a0, tip) = random_targets(1, 5, &Stiffness::default())[0];

@@ -4,8 +4,9 @@
 
 mod workloads;
 use rod_ig_core::plan::{Obstacle, PlanError, PlanRequest, Planner, MIN_MARGIN};
+use rod_ig_core::planar::PlanarReference;
 use rod_ig_core::planar::{self, PlanarRod};
-use rod_ig_core::solver::{PlanarReference, RodModel};
+use rod_ig_core::solver::RodModel;
 use rod_ig_core::{wrap_angle, PlanarParams, PlanarPose};
 use std::time::Duration;
 use workloads::SplitMix64;
@@ -76,7 +77,7 @@ fn verify(plan: &rod_ig_core::plan::Plan, request: &PlanRequest, reference: bool
 #[test]
 fn plans_between_random_stable_rods_are_stable_all_the_way() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let mut rng = SplitMix64::new(2026);
     let mut planner = Planner::new();
     let (mut solved, mut times) = (0, Vec::new());
@@ -114,7 +115,7 @@ fn plans_between_random_stable_rods_are_stable_all_the_way() {
 #[test]
 fn plans_avoid_obstacles_and_failures_say_why() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let mut planner = Planner::new();
     let start = PlanarParams::new(1.0, 2.0, -1.0);
     let goal = PlanarPose::new(0.3, 0.6, 2.5);

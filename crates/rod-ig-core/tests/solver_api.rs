@@ -3,11 +3,12 @@
 
 mod workloads;
 use nalgebra::{Vector3, Vector6};
+use rod_ig_core::planar::{PlanarClosedForm, PlanarReference};
 use rod_ig_core::solver::{
     self, observe, relative_distance, Counters, Event, IgError, InverseGeometry, IterationLog,
-    Method, Objective, PlanarClosedForm, PlanarReference, RodModel, SolveOptions, Spatial,
-    Termination, DISTINCT,
+    Method, Objective, RodModel, SolveOptions, Termination, DISTINCT,
 };
+use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{SpatialPose, Stiffness};
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use std::time::Duration;
@@ -54,7 +55,7 @@ fn assert_verified<const N: usize, M: RodModel<N>>(
 #[test]
 fn the_paper_newton_is_one_implementation_for_every_model() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     // From a guess near the answer, the paper's Newton (α = 1) converges on each model to the
     // rod the target came from. Tolerance 1e-10: a is compared to 1e-5, and J⁻¹ amplifies tip
     // errors up to ~1e4 on these rods (the compressed one).
@@ -93,7 +94,7 @@ fn the_paper_newton_is_one_implementation_for_every_model() {
 #[test]
 fn the_reference_model_agrees_with_the_closed_forms() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     // The robust strategy on the reference integrator returns the closed-form answer polished
     // by the integrator: both solve their own model to 1e-6, and agree to the conditioning of
     // J times the models' difference (≲ 1e-9 here).
@@ -146,7 +147,7 @@ fn check_all_and_least_energy<const N: usize, M: InverseGeometry<N>>(
 #[test]
 fn least_energy_and_all_serve_planar_and_spatial_alike() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     for (_, target) in planar_cases() {
         check_all_and_least_energy(&PlanarClosedForm, &target, &SolveOptions::default());
     }
@@ -158,7 +159,7 @@ fn least_energy_and_all_serve_planar_and_spatial_alike() {
 #[test]
 fn errors_carry_typed_terminations_on_every_model() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let planar_far = PlanarPose::new(1.5, 0.0, 0.0);
     let f = solver::solve(&PlanarClosedForm, &planar_far, &SolveOptions::default()).unwrap_err();
     assert_eq!(f.termination(), Termination::Unreachable);
@@ -209,7 +210,7 @@ fn errors_carry_typed_terminations_on_every_model() {
 #[test]
 fn a_failed_multistart_says_why_its_last_start_failed() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     // On the reach boundary (|p| → 1 with a bent tip), no stable rod exists: the robust
     // search ends with NoStableSolution and the last start's own reason.
     let target = PlanarPose::new(0.9999, 0.0, 2.5);
@@ -234,7 +235,7 @@ fn a_failed_multistart_says_why_its_last_start_failed() {
 #[test]
 fn observers_see_every_start_and_iteration() {
     // The atlas, once per process, outside the deadlines under test.
-    rod_ig_core::ig::warm_up();
+    rod_ig_core::planar::ig::warm_up();
     let (_, target) = planar_cases()[1];
     let (r, log) = observe(IterationLog::default(), || {
         solver::solve(&PlanarClosedForm, &target, &SolveOptions::default())

@@ -5,7 +5,8 @@ mod workloads;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3, Vector6};
 use proptest::prelude::*;
 use rod_ig_core::ode::planar_reference as pr;
-use rod_ig_core::solver::{self, IgError, Method, SolveOptions, Spatial};
+use rod_ig_core::solver::{self, IgError, Method, SolveOptions};
+use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
 use workloads::spatial::{benchmark_random_targets, random_targets};
 

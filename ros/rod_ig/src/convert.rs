@@ -678,7 +678,7 @@ mod tests {
         let w = base_wrench(&[1.0, 2.0, -3.0], 0.5, 2.0);
         assert_eq!((w.force.x, w.force.y, w.torque.z), (16.0, -24.0, 4.0));
         let s = Solved {
-            solution: rod_ig_core::ig::Solution {
+            solution: rod_ig_core::planar::ig::Solution {
                 a: crate::solver::PlanarParams::new(1.0, 2.0, -3.0),
                 tip: PlanarPose::new(0.5, 0.1, 0.2),
                 stable: true,

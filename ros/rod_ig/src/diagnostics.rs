@@ -232,7 +232,7 @@ mod tests {
 
     #[test]
     fn solver_work_comes_from_the_observer() {
-        use rod_ig_core::ig::{self, SolveOptions};
+        use rod_ig_core::planar::ig::{self, SolveOptions};
         use rod_ig_core::solver::observe;
         use rod_ig_core::PlanarPose;
         // The atlas, once per process (the node builds it at start-up).

@@ -318,7 +318,7 @@ fn spawn_solver_thread(
         .name("rod_ig_solver".into())
         .spawn(move || {
             let t0 = std::time::Instant::now();
-            let seeds = rod_ig_core::ig::warm_up();
+            let seeds = rod_ig_core::planar::ig::warm_up();
             log::debug!("atlas of {seeds} stable rods built in {:?}", t0.elapsed());
             let _ = warm_tx.send(seeds);
             let rt = match tokio::runtime::Builder::new_current_thread()

@@ -120,7 +120,7 @@ impl Default for TargetQos {
 pub const QOS_POLICIES: [&str; 4] = ["reliability", "durability", "history", "depth"];
 
 impl Default for Params {
-    /// The defaults of [`TABLE`].
+    /// The defaults of the parameter table.
     fn default() -> Self {
         let mut p = Self {
             rod_length: 1.0,
@@ -251,7 +251,7 @@ fn str_of(v: &ParameterValue) -> &str {
     }
 }
 
-const MAX_DEADLINE_MS: f64 = rod_ig_core::ig::MAX_DEADLINE.as_secs_f64() * 1e3;
+const MAX_DEADLINE_MS: f64 = rod_ig_core::planar::ig::MAX_DEADLINE.as_secs_f64() * 1e3;
 /// Most poses per published path: a nav_msgs/Path of 100,000 poses is ~6 MB.
 const MAX_PATH_SAMPLES: i64 = 100_000;
 
@@ -303,8 +303,8 @@ const TABLE: [Spec; 14] = [
     Spec {
         name: "tolerance",
         kind: Kind::Double {
-            lo: rod_ig_core::ig::MIN_TOLERANCE,
-            hi: rod_ig_core::ig::MAX_TOLERANCE,
+            lo: rod_ig_core::planar::ig::MIN_TOLERANCE,
+            hi: rod_ig_core::planar::ig::MAX_TOLERANCE,
             lo_open: false,
         },
         default: DefaultValue::Double(rod_ig_core::solver::DEFAULT_TOLERANCE),
@@ -320,7 +320,7 @@ const TABLE: [Spec; 14] = [
         name: "max_iterations",
         kind: Kind::Integer {
             lo: 1,
-            hi: rod_ig_core::ig::MAX_ITERATIONS_LIMIT as i64,
+            hi: rod_ig_core::planar::ig::MAX_ITERATIONS_LIMIT as i64,
         },
         default: DefaultValue::Integer(rod_ig_core::solver::DEFAULT_MAX_ITERATIONS as i64),
         description: "Solver iteration limit per start of the search (Newton: of the run)",
@@ -436,7 +436,7 @@ const TABLE: [Spec; 14] = [
             hi: MAX_DEADLINE_MS,
             lo_open: true,
         },
-        default: DefaultValue::Double(rod_ig_core::ig::DEFAULT_DEADLINE.as_secs_f64() * 1e3),
+        default: DefaultValue::Double(rod_ig_core::planar::ig::DEFAULT_DEADLINE.as_secs_f64() * 1e3),
         description: "Wall-time budget of one solve (ms); a solve that runs out answers \
                       'deadline reached'",
         constraints: "",
@@ -807,7 +807,7 @@ pub struct Startup {
     pub rosout_logs: bool,
 }
 
-/// Usage text for `--help`: the parameters from [`TABLE`].
+/// Usage text for `--help`: the parameters from the parameter table.
 pub fn usage() -> String {
     let d = Params::default();
     let mut text = String::from(

@@ -55,7 +55,7 @@ impl Overrides {
             o.initial_guess = Some(PlanarParams::new(g[0], g[1], g[2]));
         }
         if req.tolerance != 0.0 {
-            use rod_ig_core::ig::{MAX_TOLERANCE, MIN_TOLERANCE};
+            use rod_ig_core::planar::ig::{MAX_TOLERANCE, MIN_TOLERANCE};
             if !(MIN_TOLERANCE..=MAX_TOLERANCE).contains(&req.tolerance) {
                 return Err(format!(
                     "tolerance must be in [{MIN_TOLERANCE:e}, {MAX_TOLERANCE:e}], got {}",
@@ -65,7 +65,7 @@ impl Overrides {
             o.tolerance = Some(req.tolerance);
         }
         if req.max_iterations != 0 {
-            let limit = rod_ig_core::ig::MAX_ITERATIONS_LIMIT;
+            let limit = rod_ig_core::planar::ig::MAX_ITERATIONS_LIMIT;
             if req.max_iterations > limit {
                 return Err(format!(
                     "max_iterations must be in [1, {limit}] (per start), got {}",

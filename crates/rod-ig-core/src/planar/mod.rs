@@ -14,11 +14,14 @@
 //! near-separatrix regime (m1 = 1 − m from λ4) handled without cancellation.
 
 mod closed;
+pub mod ig;
+pub mod model;
 mod stability;
 mod taylor;
 
 pub use closed::Case;
 use closed::{Closed, SeriesNeed, CLOSED_J_TOLERANCE, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F};
+pub use model::{check_target, PlanarClosedForm, PlanarReference};
 
 use crate::scalar::Dual3;
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};

@@ -203,7 +203,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
             };
         }
         let target = &self.model.canonical_target(target);
-        let _deadline = crate::ig::deadline::scope(self.options.deadline);
+        let _deadline = crate::solver::deadline::scope(self.options.deadline);
         let mut work = Work::default();
         let mut current = held;
         let mut first_snap: Option<(M::Pose, SVector<f64, N>, f64)> = None;
@@ -325,7 +325,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         let mut current = *held;
         let (mut s, mut ds) = (0.0f64, 1.0f64);
         while s < 1.0 {
-            if crate::ig::deadline::expired() {
+            if crate::solver::deadline::expired() {
                 return Err(Stop::Error(IgError::Deadline {
                     iteration: work.iterations,
                 }));
@@ -372,7 +372,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         let mut eval = from.eval;
         let mut previous_step = f64::INFINITY;
         for _ in 0..=CORRECTOR_ITERATIONS {
-            if crate::ig::deadline::expired() {
+            if crate::solver::deadline::expired() {
                 return None;
             }
             let (pe, oe) = self.model.pose_error(&eval.tip, goal);

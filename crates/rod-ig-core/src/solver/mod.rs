@@ -1,8 +1,10 @@
 //! One inverse-geometry API for every rod model.
 //!
 //! - **Models** ([`RodModel`]): what a rod provides — Υ(a), J(1, a), the stability verdict with
-//!   its margin, the energy, the parameter scale. [`PlanarClosedForm`] (paper §2),
-//!   [`PlanarReference`] (the reference integrator) and [`Spatial`] (the 3-D rod).
+//!   its margin, the energy, the parameter scale. Each model lives beside its physics:
+//!   [`PlanarClosedForm`](crate::planar::PlanarClosedForm) (paper §2),
+//!   [`PlanarReference`](crate::planar::PlanarReference) (the reference integrator) and
+//!   [`Spatial`](crate::spatial::Spatial) (the 3-D rod). This module knows none of them.
 //! - **Strategies**, chosen by [`SolveOptions`]: the paper's Newton with step length α
 //!   ([`Method::Newton`], written once for every model), the robust multi-start search
 //!   ([`Method::Robust`], each model's [`InverseGeometry::robust`]), the least-energy
@@ -13,12 +15,14 @@
 //! - **Observers** ([`observe`]): watch the starts and iterations of any solve.
 //!
 //! ```
-//! use rod_ig_core::solver::{self, PlanarClosedForm, SolveOptions, Spatial};
+//! use rod_ig_core::solver::{self, SolveOptions};
+//! use rod_ig_core::planar::PlanarClosedForm;
+//! use rod_ig_core::spatial::Spatial;
 //! use rod_ig_core::spatial::SpatialPose;
 //! use rod_ig_core::PlanarPose;
 //!
 //! // Planar: the closed forms (the atlas of stable rods built first, outside the deadline).
-//! rod_ig_core::ig::warm_up();
+//! rod_ig_core::planar::ig::warm_up();
 //! let s = solver::solve(&PlanarClosedForm, &PlanarPose::new(0.5, 0.4, 1.0), &SolveOptions::default())
 //!     .expect("a reachable target");
 //! assert!(s.stable && s.position_error <= 1e-6);
@@ -30,6 +34,7 @@
 //! ```
 
 mod continuation;
+pub(crate) mod deadline;
 mod model;
 pub(crate) mod newton;
 mod observer;
@@ -39,10 +44,7 @@ mod outcome;
 pub use continuation::{
     BranchEvent, BranchFollower, Move, CORRECTOR_ITERATIONS, MAX_SNAPS, MIN_STEP, SUBSTEP_TOLERANCE,
 };
-pub use model::{
-    relative_distance, ModelEvaluation, PlanarClosedForm, PlanarReference, RodModel, Spatial,
-    DISTINCT,
-};
+pub use model::{relative_distance, ModelEvaluation, RodModel, DISTINCT};
 pub(crate) use observer::emit;
 pub use observer::{observe, Counters, Event, IterationLog, Observer};
 pub use options::{
@@ -122,7 +124,7 @@ pub fn solve<const N: usize, M: InverseGeometry<N> + ?Sized>(
     let result = match check(model, target, options) {
         Err(e) => Err(Failure::early(e)),
         Ok(()) => {
-            let _deadline = crate::ig::deadline::scope(options.deadline);
+            let _deadline = crate::solver::deadline::scope(options.deadline);
             dispatch(model, &model.canonical_target(target), options)
         }
     };
@@ -162,7 +164,7 @@ fn dispatch<const N: usize, M: InverseGeometry<N> + ?Sized>(
             else {
                 // No default start: the model's tables were not ready within the deadline, or
                 // it has none for this target.
-                let reason = if crate::ig::deadline::expired() {
+                let reason = if crate::solver::deadline::expired() {
                     IgError::Deadline { iteration: 0 }
                 } else {
                     IgError::NoStableSolution {
@@ -215,7 +217,7 @@ pub fn solve_all<const N: usize, M: InverseGeometry<N> + ?Sized>(
         return Vec::new();
     }
     let t0 = std::time::Instant::now();
-    let _deadline = crate::ig::deadline::scope(options.deadline);
+    let _deadline = crate::solver::deadline::scope(options.deadline);
     let target = &model.canonical_target(target);
     let found = model.robust_all(target, options);
     let mut solutions = found.solutions;

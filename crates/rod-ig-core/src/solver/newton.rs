@@ -53,7 +53,7 @@ fn run<const N: usize, M: RodModel<N> + ?Sized>(
     };
     let mut k: u32 = 0;
     loop {
-        if crate::ig::deadline::expired() {
+        if crate::solver::deadline::expired() {
             return Err(fail(IgError::Deadline { iteration: k }, k, residual, a));
         }
         evaluations += 1;

@@ -3,10 +3,11 @@
 //! and its observers, without a parameter threaded through every inner loop).
 //!
 //! ```
-//! use rod_ig_core::solver::{self, observe, Event, IterationLog, PlanarClosedForm};
+//! use rod_ig_core::solver::{self, observe, Event, IterationLog};
+//! use rod_ig_core::planar::PlanarClosedForm;
 //! use rod_ig_core::PlanarPose;
 //!
-//! rod_ig_core::ig::warm_up(); // the atlas, outside the solve's deadline
+//! rod_ig_core::planar::ig::warm_up(); // the atlas, outside the solve's deadline
 //! let target = PlanarPose::new(0.6, 0.3, 0.5);
 //! let options = solver::SolveOptions::default();
 //! let (result, log) = observe(IterationLog::default(), || {

@@ -16,10 +16,10 @@
 //! All loops are bounded (iterations × backtracking steps × starts).
 
 use super::stability::evaluate_if_stable;
+use super::Spatial;
 use super::{Evaluation3d, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
 use crate::solver::{
-    emit, Event, Failure, Found, IgError, InverseGeometry, Solution, SolveOptions, Spatial,
-    Termination,
+    emit, Event, Failure, Found, IgError, InverseGeometry, Solution, SolveOptions, Termination,
 };
 use nalgebra::{Matrix6, Vector3, Vector6};
 
@@ -108,7 +108,7 @@ impl Ctx<'_> {
     }
 
     fn eval(&mut self, a: &SpatialParams, rtol: f64, verify: bool) -> Result<EvalOutcome, IgError> {
-        if crate::ig::deadline::expired() {
+        if crate::solver::deadline::expired() {
             return Err(IgError::Deadline {
                 iteration: self.iterations,
             });
@@ -543,7 +543,7 @@ impl InverseGeometry<6> for Spatial {
         let mut solutions: Vec<Solution3d> = Vec::new();
         let (mut seeds, mut last) = (Vec::new(), IgError::LeftStableSet { iteration: 0 });
         for a0 in list {
-            if crate::ig::deadline::expired() {
+            if crate::solver::deadline::expired() {
                 break;
             }
             if let Some((a, ev, _)) = attempt_plain(&mut ctx, a0, rtol0, &mut seeds, &mut last) {

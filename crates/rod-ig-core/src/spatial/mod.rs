@@ -24,9 +24,11 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
 pub mod ig;
+mod model;
 mod reduced;
 mod stability;
 
+pub use model::Spatial;
 pub use stability::{
     det_leading_term, stability, stability_full_grid, stability_with, StabilityOptions,
     STABILITY_T_MIN,

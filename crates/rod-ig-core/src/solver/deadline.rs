@@ -1,7 +1,7 @@
 //! The deadline of the solve running on this thread (issue 9: bounded time on every call).
 //!
-//! Set once by the public entry points ([`super::solve`], [`super::solve_all`],
-//! [`super::Tracker::solve`]) through a guard, and polled by every loop inside them (Newton
+//! Set once by the public entry points ([`super::solve`], [`super::solve_all`], the planar
+//! tracker, the branch follower, the planner) through a guard, and polled by every loop inside them (Newton
 //! iterations, line searches, starts, polishing), so that no nested loop needs a parameter to
 //! stop in time. The guard restores the previous deadline on drop.
 

@@ -8,9 +8,8 @@
 //! branch) costs one 3×3 solve and no evaluation. It is counted as an iteration all the same;
 //! the `evaluations` field of [`Solution`] counts every evaluation of Υ and J.
 
-use super::{
-    local, model, newton::make_solution, newton::solve3, robust, Failure, Solution, SolveOptions,
-};
+use super::{local, newton::make_solution, robust, Failure, Solution, SolveOptions};
+use crate::planar::model::{self as model, solve3};
 use crate::{wrap_angle, PlanarJacobian, PlanarParams, PlanarPose};
 use nalgebra::Vector3;
 
@@ -91,7 +90,7 @@ impl Tracker {
     /// J(1, a) (slower, ~1 ms, but the branch then tracks well).
     pub fn solve(&mut self, target: &PlanarPose) -> Result<Solution, Failure> {
         let t0 = std::time::Instant::now();
-        let _deadline = super::deadline::scope(self.options.deadline);
+        let _deadline = crate::solver::deadline::scope(self.options.deadline);
         if let Err(e) = super::check_target(target) {
             let mut f = Failure::early(e);
             f.elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
@@ -138,7 +137,7 @@ impl Tracker {
             // followed afterwards is the easiest to track.
             let all = robust::solve_all(target, &opts, Some(opts.max_iterations));
             let conditioning = |a: &PlanarParams| {
-                model::tip_and_jacobian(a, model::Precision::Fast)
+                model::tip_and_jacobian_for_iteration(a, model::Precision::Fast)
                     .ok()
                     .map(|(_, j)| {
                         let sv = j.singular_values();

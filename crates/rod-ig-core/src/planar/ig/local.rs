@@ -14,9 +14,10 @@
 //! det J(t, a(s)) has the sign of det J(s t, a): scaling by s < t₁ (the first conjugate time)
 //! brings any a into the stable set ([`pull_into_stable`]).
 
-use super::model::Precision;
-use super::newton::{eval, solve3, Eval};
+use super::newton::{eval, Eval};
 use super::scan;
+use crate::planar::model::solve3;
+use crate::planar::model::Precision;
 use crate::solver::{emit, Event};
 use crate::{PlanarParams, PlanarPose};
 
@@ -193,7 +194,7 @@ fn run(
             out.stop = Stop::MaxIterations;
             return out;
         }
-        if super::deadline::expired() {
+        if crate::solver::deadline::expired() {
             out.stop = Stop::Deadline;
             return out;
         }

@@ -3,33 +3,11 @@
 //! at full accuracy. The paper's Newton itself is written once for every model in
 //! `crate::solver::newton`.
 
-use super::model::Precision;
-use super::{model, Solution};
+use super::Solution;
+use crate::planar::model;
+use crate::planar::model::Precision;
 use crate::{PlanarJacobian, PlanarParams, PlanarPose};
 use nalgebra::Vector3;
-
-/// Solves J p = r. `None` when J is numerically singular: |det J| below 1e-14 times the
-/// product of its column norms (Hadamard bound), or a non-finite result.
-pub(crate) fn solve3(j: &PlanarJacobian, r: &Vector3<f64>) -> Result<Vector3<f64>, f64> {
-    let det = j.determinant();
-    let hadamard = j.column(0).norm() * j.column(1).norm() * j.column(2).norm();
-    if !(det.is_finite() && hadamard.is_finite()) || det.abs() <= 1e-14 * hadamard || det == 0.0 {
-        return Err(det);
-    }
-    // Cramer's rule via the adjugate: exact enough for a well-conditioned 3×3 and branch-free.
-    let c0 = j.column(0);
-    let c1 = j.column(1);
-    let c2 = j.column(2);
-    let x0 = r.dot(&c1.cross(&c2)) / det;
-    let x1 = c0.dot(&r.cross(&c2)) / det;
-    let x2 = c0.dot(&c1.cross(r)) / det;
-    let p = Vector3::new(x0, x1, x2);
-    if p.iter().all(|v| v.is_finite()) {
-        Ok(p)
-    } else {
-        Err(det)
-    }
-}
 
 /// One evaluated iterate.
 pub(crate) struct Eval {
@@ -44,7 +22,10 @@ pub(crate) struct Eval {
 }
 
 pub(crate) fn eval(a: &PlanarParams, target: &PlanarPose, precision: Precision) -> Option<Eval> {
-    eval_from(model::tip_and_jacobian(a, precision).ok()?, target)
+    eval_from(
+        model::tip_and_jacobian_for_iteration(a, precision).ok()?,
+        target,
+    )
 }
 
 /// The converged iterate `a` re-evaluated at full accuracy: Some when it still meets the

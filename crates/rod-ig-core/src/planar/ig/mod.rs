@@ -23,18 +23,17 @@
 //! least elastic energy among them. [`Tracker`] follows a stream of nearby targets.
 
 pub(crate) mod atlas;
-pub(crate) mod deadline;
 mod fronts;
 mod local;
-mod model;
 mod newton;
 mod robust;
 mod scan;
 mod straight;
 mod tracker;
 
-use crate::solver::{Found, InverseGeometry, ModelEvaluation, PlanarClosedForm, PlanarReference};
-use crate::{PlanarParams, PlanarPose, RodError};
+use crate::planar::{PlanarClosedForm, PlanarReference};
+use crate::solver::{Found, InverseGeometry};
+use crate::{PlanarParams, PlanarPose};
 
 pub use tracker::Tracker;
 
@@ -52,20 +51,7 @@ pub type Solution = crate::solver::Solution<PlanarParams, PlanarPose>;
 /// A failed planar solve.
 pub type Failure = crate::solver::Failure<PlanarParams>;
 
-/// Checks the target: finite, and ‖(x, y)‖ < 1 (the unit rod is inextensible; the straight rod
-/// at distance 1 is unstable, FINDINGS §5).
-pub fn check_target(target: &PlanarPose) -> Result<(), IgError> {
-    for (component, value) in [("x", target.x), ("y", target.y), ("theta", target.theta)] {
-        if !value.is_finite() {
-            return Err(IgError::NonFiniteTarget { component, value });
-        }
-    }
-    let distance = target.x.hypot(target.y);
-    if distance >= 1.0 {
-        return Err(IgError::Unreachable { distance });
-    }
-    Ok(())
-}
+pub use crate::planar::model::check_target;
 
 /// Solves the planar inverse geometry for `target` with the closed forms: shorthand for
 /// [`crate::solver::solve`] on [`PlanarClosedForm`].
@@ -82,30 +68,6 @@ pub fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Fa
 /// [`crate::solver::solve_all`] on [`PlanarClosedForm`].
 pub fn solve_all(target: &PlanarPose, options: &SolveOptions) -> Vec<Solution> {
     crate::solver::solve_all(&PlanarClosedForm, target, options)
-}
-
-/// J δa = r for a planar 3×3 J (Cramer's rule): `Err(det)` when J is numerically singular.
-pub(crate) fn solve_linear3(
-    j: &crate::PlanarJacobian,
-    r: &nalgebra::Vector3<f64>,
-) -> Result<nalgebra::Vector3<f64>, f64> {
-    newton::solve3(j, r)
-}
-
-/// An iterate of a run from `start` by the closed forms at the precision that start needs
-/// ([`model::Precision`]); stability by the full FINDINGS §5 test.
-pub(crate) fn evaluate_iterate(
-    a: &PlanarParams,
-    start: &PlanarParams,
-) -> Result<ModelEvaluation<3, PlanarPose>, RodError> {
-    let (tip, jacobian) = model::tip_and_jacobian(a, model::Precision::for_start(start))?;
-    Ok(ModelEvaluation {
-        tip,
-        jacobian,
-        energy: model::energy_from_tip(a, &tip),
-        stability: model::stability(a)?,
-        full_accuracy: false,
-    })
 }
 
 fn found(all: robust::All) -> Found<PlanarParams, PlanarPose> {

@@ -4,9 +4,10 @@
 //! is returned.
 
 use super::{
-    atlas, fronts, local, model, newton, newton::make_solution, straight, Failure, IgError,
-    Solution, SolveOptions,
+    atlas, fronts, local, newton, newton::make_solution, straight, Failure, IgError, Solution,
+    SolveOptions,
 };
+use crate::planar::model;
 use crate::solver::{emit, Event, Termination};
 use crate::{PlanarParams, PlanarPose};
 
@@ -206,7 +207,7 @@ impl<'t> Starts<'t> {
         // unstable guess of even index is caught by the final stability test), else brought into
         // the stable set by weighted scaling.
         let guess_eval = |g: &PlanarParams| {
-            model::tip_and_jacobian(g, model::Precision::for_start(g))
+            model::tip_and_jacobian_for_iteration(g, model::Precision::for_start(g))
                 .ok()
                 .map(|(tip, j)| (model::residual(&tip, target).norm(), j.determinant()))
         };
@@ -332,7 +333,7 @@ pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solut
     let budget = per_start_budget(options);
     let mut n = 0;
     while n < MAX_STARTS {
-        if super::deadline::expired() {
+        if crate::solver::deadline::expired() {
             return Err(deadline_failure(&counts));
         }
         let Some((start, is_guess)) = starts.next() else {
@@ -440,7 +441,7 @@ pub(crate) fn solve_all(
     let mut solutions: Vec<Solution> = Vec::new();
     let mut starts = 0;
     for start in &list {
-        if super::deadline::expired() {
+        if crate::solver::deadline::expired() {
             break;
         }
         if total_budget.is_some_and(|b| counts.iterations >= b) && !solutions.is_empty() {

@@ -190,7 +190,7 @@ enum Work {
     Done(Atlas),
 }
 
-/// The atlas, built on first use within the current deadline ([`super::deadline`]) on every
+/// The atlas, built on first use within the current deadline ([`crate::solver::deadline`]) on every
 /// core: `None` when the deadline passes first. The work done is kept and resumed by the next
 /// call; threads calling it together share the build (each polls the deadline between pieces
 /// of ≈ 0.5 ms).
@@ -198,12 +198,12 @@ pub(crate) fn get() -> Option<&'static Atlas> {
     if let Some(atlas) = ATLAS.get() {
         return Some(atlas);
     }
-    let end = super::deadline::current();
+    let end = crate::solver::deadline::current();
     let helpers = std::thread::available_parallelism().map_or(1, |n| n.get()) - 1;
     std::thread::scope(|scope| {
         for _ in 0..helpers {
             scope.spawn(move || {
-                let _deadline = super::deadline::until(end);
+                let _deadline = crate::solver::deadline::until(end);
                 build()
             });
         }
@@ -217,7 +217,7 @@ fn build() -> Option<&'static Atlas> {
         if let Some(atlas) = ATLAS.get() {
             return Some(atlas);
         }
-        if super::deadline::expired() {
+        if crate::solver::deadline::expired() {
             return None;
         }
         let work = {
@@ -260,7 +260,7 @@ fn lock_builder() -> std::sync::MutexGuard<'static, Option<Builder>> {
 
 /// The atlas, built now if needed whatever the time it takes (no deadline applies).
 pub(crate) fn get_blocking() -> &'static Atlas {
-    let _unbounded = super::deadline::unbounded();
+    let _unbounded = crate::solver::deadline::unbounded();
     loop {
         if let Some(atlas) = get() {
             return atlas;
