@@ -210,6 +210,11 @@ pub fn inverse_geometry(quick: bool, cases_path: &Path) {
         "(verified% = solutions re-checked independently: forward map within tolerance and stable)"
     );
     println!();
+    tracking(quick, &options);
+}
+
+/// Tracking rows: the warm-started tracker along two paths of targets.
+fn tracking(quick: bool, options: &SolveOptions) {
     println!(
         "{:<60} {:>6} {:>8} {:>9} {:>10} {:>6} {:>9} {:>9}",
         "## Tracking (warm start from the previous solution)",
@@ -233,7 +238,7 @@ pub fn inverse_geometry(quick: bool, cases_path: &Path) {
         ),
     ];
     for (label, path) in paths {
-        let t = ig_bench::tracking(&label, &path, &options);
+        let t = ig_bench::tracking(&label, &path, options);
         println!(
             "{:<60} {:>6} {:>8.2} {:>9.1} {:>10.2} {:>6} {:>9.2} {:>9.2}",
             t.label,

@@ -219,6 +219,66 @@ fn warm_up() {
     rod_ig_core::planar::ig::warm_up();
 }
 
+/// `rod-ig track`: the JSON-lines loop, then the sequence drawn into `svg`.
+fn track(
+    stdin: impl io::BufRead,
+    stdout: impl Write,
+    svg: Option<&std::path::Path>,
+) -> Result<(), String> {
+    warm_up();
+    let mut tracking = motion_cmds::Tracking::default();
+    jsonl::run(stdin, stdout, |line| tracking.line(line)).map_err(|e| e.to_string())?;
+    match svg {
+        Some(path) => write_svg(
+            path,
+            &svg::draw_sequence(
+                &tracking.drawn,
+                &[],
+                "rod-ig track: the rod following the gripper",
+            ),
+        ),
+        None => Ok(()),
+    }
+}
+
+/// `rod-ig plan`: the JSON-lines loop, then the last plan drawn into `svg`.
+fn plan(
+    stdin: impl io::BufRead,
+    stdout: impl Write,
+    svg: Option<&std::path::Path>,
+) -> Result<(), String> {
+    warm_up();
+    let mut planning = motion_cmds::Planning::default();
+    jsonl::run(stdin, stdout, |line| planning.line(line)).map_err(|e| e.to_string())?;
+    match svg {
+        Some(path) => write_svg(
+            path,
+            &svg::draw_sequence(
+                &planning.drawn,
+                &planning.obstacles,
+                "rod-ig plan: a stable gripper path",
+            ),
+        ),
+        None => Ok(()),
+    }
+}
+
+/// `rod-ig bench`: the parts asked for, in order.
+fn bench(quick: bool, ig_cases: &std::path::Path, only: BenchPart) {
+    if matches!(only, BenchPart::All | BenchPart::Forward) {
+        bench::planar_forward(quick);
+    }
+    if matches!(only, BenchPart::All | BenchPart::Tails) {
+        bench_tails::run(quick);
+    }
+    if matches!(only, BenchPart::All | BenchPart::Ig) {
+        bench::inverse_geometry(quick, ig_cases);
+    }
+    if matches!(only, BenchPart::All | BenchPart::Spatial) {
+        bench::spatial(quick);
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let stdin = io::stdin().lock();
@@ -239,40 +299,8 @@ fn main() -> ExitCode {
             spatial_cmds::solve3d_line(line, verbose)
         })
         .map_err(|e| e.to_string()),
-        Command::Track { svg } => {
-            warm_up();
-            let mut tracking = motion_cmds::Tracking::default();
-            jsonl::run(stdin, stdout, |line| tracking.line(line))
-                .map_err(|e| e.to_string())
-                .and_then(|()| match svg {
-                    Some(path) => write_svg(
-                        &path,
-                        &svg::draw_sequence(
-                            &tracking.drawn,
-                            &[],
-                            "rod-ig track: the rod following the gripper",
-                        ),
-                    ),
-                    None => Ok(()),
-                })
-        }
-        Command::Plan { svg } => {
-            warm_up();
-            let mut planning = motion_cmds::Planning::default();
-            jsonl::run(stdin, stdout, |line| planning.line(line))
-                .map_err(|e| e.to_string())
-                .and_then(|()| match svg {
-                    Some(path) => write_svg(
-                        &path,
-                        &svg::draw_sequence(
-                            &planning.drawn,
-                            &planning.obstacles,
-                            "rod-ig plan: a stable gripper path",
-                        ),
-                    ),
-                    None => Ok(()),
-                })
-        }
+        Command::Track { svg } => track(stdin, stdout, svg.as_deref()),
+        Command::Plan { svg } => plan(stdin, stdout, svg.as_deref()),
         Command::Shape {
             params,
             target,
@@ -285,18 +313,7 @@ fn main() -> ExitCode {
             ig_cases,
             only,
         } => {
-            if matches!(only, BenchPart::All | BenchPart::Forward) {
-                bench::planar_forward(quick);
-            }
-            if matches!(only, BenchPart::All | BenchPart::Tails) {
-                bench_tails::run(quick);
-            }
-            if matches!(only, BenchPart::All | BenchPart::Ig) {
-                bench::inverse_geometry(quick, &ig_cases);
-            }
-            if matches!(only, BenchPart::All | BenchPart::Spatial) {
-                bench::spatial(quick);
-            }
+            bench(quick, &ig_cases, only);
             Ok(())
         }
     };

@@ -371,6 +371,163 @@ fn ready_message(
     )
 }
 
+/// The node's topics and output publishers, created before the solver warms up.
+struct Endpoints {
+    target_topic: ros2_client::dds::rustdds::Topic,
+    solve_name: Name,
+    plan_name: Name,
+    diagnostics: Publisher<crate::messages::DiagnosticArray>,
+    /// Fully qualified names of the topics, then the services (for the start-up line).
+    resolved: Vec<String>,
+    services: [String; 2],
+}
+
+/// Creates the topics and the output publishers (the inputs come after the warm-up).
+fn create_endpoints(
+    node: &mut ros2_client::Node,
+    identity: &NodeIdentity,
+) -> Result<(Endpoints, Outputs), NodeError> {
+    let qos = topic_qos();
+    let out_qos = output_qos();
+    let mut resolved = Vec::new();
+    let mut topic = |node: &mut ros2_client::Node, name: &str, ty| {
+        let (n, full) = resolved_name(identity, name)?;
+        resolved.push(full);
+        node.create_topic(&n, ty, &qos).map_err(create_err("topic"))
+    };
+    let target_topic = topic(node, names::TARGET, type_names::pose_stamped())?;
+    let path_topic = topic(node, names::PATH, type_names::path())?;
+    let solution_topic = topic(node, names::SOLUTION, type_names::rod_solution())?;
+    let marker_topic = topic(node, names::MARKER, type_names::marker())?;
+    let plan_rods_topic = topic(node, names::PLAN_RODS, type_names::marker())?;
+    let diagnostics_topic = topic(node, names::DIAGNOSTICS, type_names::diagnostic_array())?;
+    let (solve_name, solve_full) = resolved_name(identity, names::SOLVE)?;
+    let (plan_name, plan_full) = resolved_name(identity, names::PLAN)?;
+    let diagnostics = node
+        .create_publisher(&diagnostics_topic, Some(qos.clone()))
+        .map_err(create_err("/diagnostics publisher"))?;
+    let outputs = Outputs {
+        path: node
+            .create_publisher(&path_topic, Some(out_qos.clone()))
+            .map_err(create_err("/rod/path publisher"))?,
+        solution: node
+            .create_publisher(&solution_topic, Some(out_qos.clone()))
+            .map_err(create_err("/rod/solution publisher"))?,
+        marker: node
+            .create_publisher(&marker_topic, Some(out_qos.clone()))
+            .map_err(create_err("/rod/marker publisher"))?,
+        plan_rods: node
+            .create_publisher(&plan_rods_topic, Some(out_qos.clone()))
+            .map_err(create_err("/rod/plan_rods publisher"))?,
+    };
+    let endpoints = Endpoints {
+        target_topic,
+        solve_name,
+        plan_name,
+        diagnostics,
+        resolved,
+        services: [solve_full, plan_full],
+    };
+    Ok((endpoints, outputs))
+}
+
+/// The node's inputs: the target subscription and the two services.
+struct Inputs {
+    targets: ros2_client::Subscription<PoseStamped>,
+    solve: ros2_client::Server<SolveRodRequest, SolveRodResponse>,
+    plan: ros2_client::Server<PlanRodRequest, PlanRodResponse>,
+}
+
+/// Creates the inputs, once the solver is warm: a client that sees the subscription or the
+/// service can count on an answer at steady-state cost, instead of its first targets being
+/// coalesced (latest wins) behind the warm-up.
+fn create_inputs(
+    node: &mut ros2_client::Node,
+    endpoints: &Endpoints,
+    params: &Params,
+) -> Result<Inputs, NodeError> {
+    let qos = topic_qos();
+    Ok(Inputs {
+        targets: node
+            .create_subscription::<PoseStamped>(
+                &endpoints.target_topic,
+                Some(target_qos(&params.target_qos)),
+            )
+            .map_err(create_err("/rod/target subscription"))?,
+        solve: node
+            .create_server(
+                ServiceMapping::Enhanced,
+                &endpoints.solve_name,
+                &type_names::solve_rod(),
+                qos.clone(),
+                qos.clone(),
+            )
+            .map_err(create_err("/rod/solve service"))?,
+        plan: node
+            .create_server(
+                ServiceMapping::Enhanced,
+                &endpoints.plan_name,
+                &type_names::plan_rod(),
+                qos.clone(),
+                qos,
+            )
+            .map_err(create_err("/rod/plan service"))?,
+    })
+}
+
+/// Spawns the node's tasks: the subscriber (newest target into the slot), the two services
+/// (requests to the solver thread) and the diagnostics reporter.
+fn spawn_tasks(
+    node: &Arc<ros2_client::Node>,
+    inputs: Inputs,
+    diagnostics: Publisher<crate::messages::DiagnosticArray>,
+    target_tx: watch::Sender<Option<PoseStamped>>,
+    job_tx: mpsc::Sender<ServiceJob>,
+    stats: &Arc<Stats>,
+    identity: &NodeIdentity,
+) -> [tokio::task::JoinHandle<()>; 4] {
+    let logger = || Logger {
+        handle: node.logging_handle(),
+    };
+    let subscriber = tokio::spawn(receive_targets(
+        inputs.targets,
+        target_tx,
+        Arc::clone(stats),
+        logger(),
+        Arc::clone(node),
+    ));
+    let diag_name = format!("{}: inverse geometry", identity.fully_qualified_name());
+    let reporter = tokio::spawn(report_diagnostics(
+        diagnostics,
+        Arc::clone(stats),
+        Arc::clone(node),
+        diag_name,
+    ));
+    let plan_clock = Arc::clone(node);
+    let plan = tokio::spawn(serve_requests(
+        inputs.plan,
+        job_tx.clone(),
+        Arc::clone(stats),
+        logger(),
+        move |request: &mut PlanRodRequest| {
+            stamp_if_zero(&mut request.goal, || ros_now(&plan_clock))
+        },
+        Job::Plan,
+    ));
+    let solve_clock = Arc::clone(node);
+    let solve = tokio::spawn(serve_requests(
+        inputs.solve,
+        job_tx,
+        Arc::clone(stats),
+        logger(),
+        move |request: &mut SolveRodRequest| {
+            stamp_if_zero(&mut request.target, || ros_now(&solve_clock))
+        },
+        Job::Solve,
+    ));
+    [subscriber, solve, plan, reporter]
+}
+
 /// Runs the node until SIGINT or SIGTERM.
 pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError> {
     let Startup {
@@ -391,82 +548,20 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         params_rx.clone(),
         Arc::clone(&params_tx),
     );
-
-    let node_name =
-        NodeName::new(&identity.namespace, &identity.name).map_err(create_err("node name"))?;
-    let mut node = context
-        .new_node(node_name, options)
-        .map_err(create_err("node"))?;
+    let mut node = create_node(&context, &identity, options)?;
     let logger = Logger {
         handle: node.logging_handle(),
     };
-
-    let qos = topic_qos();
-    let out_qos = output_qos();
-    let mut resolved = Vec::new();
-    let mut topic = |node: &mut ros2_client::Node, name: &str, ty| {
-        let (n, full) = resolved_name(&identity, name)?;
-        resolved.push(full);
-        node.create_topic(&n, ty, &qos).map_err(create_err("topic"))
-    };
-    let target_topic = topic(&mut node, names::TARGET, type_names::pose_stamped())?;
-    let path_topic = topic(&mut node, names::PATH, type_names::path())?;
-    let solution_topic = topic(&mut node, names::SOLUTION, type_names::rod_solution())?;
-    let marker_topic = topic(&mut node, names::MARKER, type_names::marker())?;
-    let (solve_name, solve_full) = resolved_name(&identity, names::SOLVE)?;
-    let (plan_name, plan_full) = resolved_name(&identity, names::PLAN)?;
-    let plan_rods_topic = topic(&mut node, names::PLAN_RODS, type_names::marker())?;
-    let diagnostics_topic = topic(
-        &mut node,
-        names::DIAGNOSTICS,
-        type_names::diagnostic_array(),
-    )?;
-    let diagnostics_pub = node
-        .create_publisher::<crate::messages::DiagnosticArray>(&diagnostics_topic, Some(qos.clone()))
-        .map_err(create_err("/diagnostics publisher"))?;
-
-    let outputs = Outputs {
-        path: node
-            .create_publisher(&path_topic, Some(out_qos.clone()))
-            .map_err(create_err("/rod/path publisher"))?,
-        solution: node
-            .create_publisher(&solution_topic, Some(out_qos.clone()))
-            .map_err(create_err("/rod/solution publisher"))?,
-        marker: node
-            .create_publisher(&marker_topic, Some(out_qos.clone()))
-            .map_err(create_err("/rod/marker publisher"))?,
-        plan_rods: node
-            .create_publisher(&plan_rods_topic, Some(out_qos.clone()))
-            .map_err(create_err("/rod/plan_rods publisher"))?,
-    };
-
-    let spinner = node.spinner().map_err(create_err("spinner"))?;
-    if params.use_sim_time {
-        // The declaration above holds the start-up value; setting it again makes the
-        // parameter store switch its clock (and announce it on /parameter_events).
-        node.set_parameter("use_sim_time", ParameterValue::Boolean(true))
-            .map_err(|e| NodeError::Create {
-                what: "use_sim_time",
-                reason: e,
-            })?;
-    }
-    let spin_task = tokio::spawn(async move {
-        if let Err(e) = spinner.spin().await {
-            log::error!("spinner stopped: {e:?}");
-        }
-    });
-
-    let stats = Arc::new(Stats::default());
-    let (target_tx, target_rx) = watch::channel::<Option<PoseStamped>>(None);
-    let (job_tx, job_rx) = mpsc::channel::<ServiceJob>(16);
+    let (endpoints, outputs) = create_endpoints(&mut node, &identity)?;
+    let spin_task = start_spinner(&mut node, &params)?;
 
     // Solver thread: owns the Processor (and so the warm start). Solving is CPU-bound (up to
     // the deadline per call), so it runs on a thread of its own, not on the async runtime's
     // workers that serve DDS; it builds the inverse-geometry atlas first, so that the first
     // target costs what later ones do, and the node announces readiness only then.
-    let solver_log = Logger {
-        handle: node.logging_handle(),
-    };
+    let stats = Arc::new(Stats::default());
+    let (target_tx, target_rx) = watch::channel::<Option<PoseStamped>>(None);
+    let (job_tx, job_rx) = mpsc::channel::<ServiceJob>(16);
     let (solver_thread, warm_rx) = spawn_solver_thread(
         Processor::new(&params),
         params_rx,
@@ -474,94 +569,31 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         job_rx,
         outputs,
         Arc::clone(&stats),
-        solver_log,
+        Logger {
+            handle: node.logging_handle(),
+        },
     )?;
     let atlas_seeds = warm_rx.await.unwrap_or(0);
     log::debug!("solver warm: {atlas_seeds} atlas seeds");
 
-    // The inputs only now: a client that sees the subscription or the service can count on
-    // an answer at steady-state cost, instead of its first targets being coalesced (latest
-    // wins) behind the warm-up.
-    let subscription = node
-        .create_subscription::<PoseStamped>(&target_topic, Some(target_qos(&params.target_qos)))
-        .map_err(create_err("/rod/target subscription"))?;
-    let server = node
-        .create_server::<SolveRodRequest, SolveRodResponse>(
-            ServiceMapping::Enhanced,
-            &solve_name,
-            &type_names::solve_rod(),
-            qos.clone(),
-            qos.clone(),
-        )
-        .map_err(create_err("/rod/solve service"))?;
-    let plan_server = node
-        .create_server::<PlanRodRequest, PlanRodResponse>(
-            ServiceMapping::Enhanced,
-            &plan_name,
-            &type_names::plan_rod(),
-            qos.clone(),
-            qos.clone(),
-        )
-        .map_err(create_err("/rod/plan service"))?;
-
-    // Subscriber task: overwrite the single slot with the newest target.
-    let sub_log = Logger {
-        handle: node.logging_handle(),
-    };
+    let inputs = create_inputs(&mut node, &endpoints, &params)?;
     let node = Arc::new(node);
-    let subscriber_task = tokio::spawn(receive_targets(
-        subscription,
+    let tasks = spawn_tasks(
+        &node,
+        inputs,
+        endpoints.diagnostics,
         target_tx,
-        Arc::clone(&stats),
-        sub_log,
-        Arc::clone(&node),
-    ));
-
-    // Diagnostics task: one DiagnosticArray per period from the solve record.
-    let diag_name = format!("{}: inverse geometry", identity.fully_qualified_name());
-    let diagnostics_task = tokio::spawn(report_diagnostics(
-        diagnostics_pub,
-        Arc::clone(&stats),
-        Arc::clone(&node),
-        diag_name,
-    ));
-
-    // Service task: forward each request to the solver task, send back its answer.
-    let srv_log = Logger {
-        handle: node.logging_handle(),
-    };
-    let plan_log = Logger {
-        handle: node.logging_handle(),
-    };
-    let plan_clock = Arc::clone(&node);
-    let plan_task = tokio::spawn(serve_requests(
-        plan_server,
-        job_tx.clone(),
-        Arc::clone(&stats),
-        plan_log,
-        move |request: &mut PlanRodRequest| {
-            stamp_if_zero(&mut request.goal, || ros_now(&plan_clock))
-        },
-        Job::Plan,
-    ));
-    let solve_clock = Arc::clone(&node);
-    let service_task = tokio::spawn(serve_requests(
-        server,
         job_tx,
-        Arc::clone(&stats),
-        srv_log,
-        move |request: &mut SolveRodRequest| {
-            stamp_if_zero(&mut request.target, || ros_now(&solve_clock))
-        },
-        Job::Solve,
-    ));
-
+        &stats,
+        &identity,
+    );
+    let [solve_full, plan_full] = &endpoints.services;
     logger.info(&ready_message(
         &identity,
         &mw,
         &params,
-        &resolved,
-        &[&solve_full, &plan_full],
+        &endpoints.resolved,
+        &[solve_full, plan_full],
     ));
 
     let signal = wait_for_signal().await;
@@ -572,7 +604,20 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         stats.failed.load(Ordering::Relaxed),
         stats.service_calls.load(Ordering::Relaxed),
     ));
-    for task in [subscriber_task, service_task, plan_task, diagnostics_task] {
+    shut_down(tasks, solver_thread, node, spin_task).await;
+    drop(params_tx);
+    Ok(())
+}
+
+/// Stops the tasks, lets the solver thread finish its solve in progress (bounded by its
+/// deadline), then drops the node and waits for the spinner.
+async fn shut_down(
+    tasks: [tokio::task::JoinHandle<()>; 4],
+    solver_thread: std::thread::JoinHandle<()>,
+    node: Arc<ros2_client::Node>,
+    spin_task: tokio::task::JoinHandle<()>,
+) {
+    for task in tasks {
         task.abort();
         // Awaited so that the tasks' clones of the node are dropped before the node.
         let _ = task.await;
@@ -584,9 +629,41 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
     // would log an error).
     drop(node);
     let _ = tokio::time::timeout(std::time::Duration::from_secs(2), spin_task).await;
-    drop(params_tx);
-    Ok(())
 }
+
+/// The node, named and placed as `identity` says.
+fn create_node(
+    context: &Context,
+    identity: &NodeIdentity,
+    options: NodeOptions,
+) -> Result<ros2_client::Node, NodeError> {
+    let name =
+        NodeName::new(&identity.namespace, &identity.name).map_err(create_err("node name"))?;
+    context.new_node(name, options).map_err(create_err("node"))
+}
+
+/// Starts the node's spinner (parameter services, /rosout, the clock) on the runtime.
+fn start_spinner(
+    node: &mut ros2_client::Node,
+    params: &Params,
+) -> Result<tokio::task::JoinHandle<()>, NodeError> {
+    let spinner = node.spinner().map_err(create_err("spinner"))?;
+    if params.use_sim_time {
+        // The declaration holds the start-up value; setting it again makes the parameter
+        // store switch its clock (and announce it on /parameter_events).
+        node.set_parameter("use_sim_time", ParameterValue::Boolean(true))
+            .map_err(|e| NodeError::Create {
+                what: "use_sim_time",
+                reason: e,
+            })?;
+    }
+    Ok(tokio::spawn(async move {
+        if let Err(e) = spinner.spin().await {
+            log::error!("spinner stopped: {e:?}");
+        }
+    }))
+}
+
 /// The subscriber task: every valid target replaces the one waiting in the slot (latest wins);
 /// unstamped targets get the node's clock time.
 async fn receive_targets(
@@ -721,56 +798,16 @@ async fn solver_loop(
             job = job_rx.recv() => {
                 let Some(job) = job else { break };
                 let params = params_rx.borrow_and_update().clone();
-                let (request, reply) = match job {
-                    Job::Solve(request, reply) => (request, reply),
+                match job {
                     Job::Plan(request, reply) => {
-                        let started = std::time::Instant::now();
-                        let planned = processor.plan(&request, &params);
-                        let r = &planned.response;
-                        if r.success {
-                            log::debug!(
-                                "/rod/plan: {} rods in {:?}",
-                                r.rods.len() / 3,
-                                started.elapsed()
-                            );
-                        } else {
-                            log.warn(&format!("/rod/plan: no plan: {}", r.reason));
-                        }
-                        if let Some(marker) = planned.marker {
-                            if let Err(e) = outputs.plan_rods.publish(marker) {
-                                log.error(&format!("cannot publish /rod/plan_rods: {e:?}"));
-                            }
-                        }
-                        let _ = reply.send(planned.response); // the caller may have gone
-                        continue;
+                        let response = serve_plan(&mut processor, &request, &params, &outputs, &log);
+                        let _ = reply.send(response); // the caller may have gone
                     }
-                };
-                let response = match Overrides::from_request(&request) {
-                    Ok(overrides) => {
-                        let started = std::time::Instant::now();
-                        let (outcome, work) = observe(Counters::default(), || {
-                            processor.process(&request.target, &params, &overrides)
-                        });
-                        report(&log, &stats, "/rod/solve", &outcome, &work, started.elapsed());
-                        SolveRodResponse {
-                            path: outcome.path.unwrap_or_else(|| Path {
-                                header: outcome.solution.header.clone(),
-                                poses: Vec::new(),
-                            }),
-                            solution: outcome.solution,
-                        }
+                    Job::Solve(request, reply) => {
+                        let response = serve_solve(&mut processor, &request, &params, &stats, &log);
+                        let _ = reply.send(response); // the caller may have gone
                     }
-                    Err(reason) => {
-                        log.warn(&format!("/rod/solve: bad request: {reason}"));
-                        let header = crate::convert::output_header(&request.target.header, &params);
-                        SolveRodResponse {
-                            solution: crate::convert::failure_message(
-                                format!("bad request: {reason}"), None, &header, &params, 0.0),
-                            path: Path { header, poses: Vec::new() },
-                        }
-                    }
-                };
-                let _ = reply.send(response); // the caller may have gone
+                }
             }
             changed = target_rx.changed() => {
                 if changed.is_err() {
@@ -787,6 +824,77 @@ async fn solver_loop(
                 });
                 report(&log, &stats, "/rod/target", &outcome, &work, started.elapsed());
                 publish(&log, &outputs, outcome);
+            }
+        }
+    }
+}
+
+/// Answers one `/rod/plan` call (the planned rods also go out on `/rod/plan_rods`).
+fn serve_plan(
+    processor: &mut Processor,
+    request: &PlanRodRequest,
+    params: &Params,
+    outputs: &Outputs,
+    log: &Logger,
+) -> PlanRodResponse {
+    let started = std::time::Instant::now();
+    let planned = processor.plan(request, params);
+    let r = &planned.response;
+    if r.success {
+        log::debug!(
+            "/rod/plan: {} rods in {:?}",
+            r.rods.len() / 3,
+            started.elapsed()
+        );
+    } else {
+        log.warn(&format!("/rod/plan: no plan: {}", r.reason));
+    }
+    if let Some(marker) = planned.marker {
+        if let Err(e) = outputs.plan_rods.publish(marker) {
+            log.error(&format!("cannot publish /rod/plan_rods: {e:?}"));
+        }
+    }
+    planned.response
+}
+
+/// Answers one `/rod/solve` call.
+fn serve_solve(
+    processor: &mut Processor,
+    request: &SolveRodRequest,
+    params: &Params,
+    stats: &Stats,
+    log: &Logger,
+) -> SolveRodResponse {
+    match Overrides::from_request(request) {
+        Ok(overrides) => {
+            let started = std::time::Instant::now();
+            let (outcome, work) = observe(Counters::default(), || {
+                processor.process(&request.target, params, &overrides)
+            });
+            report(log, stats, "/rod/solve", &outcome, &work, started.elapsed());
+            SolveRodResponse {
+                path: outcome.path.unwrap_or_else(|| Path {
+                    header: outcome.solution.header.clone(),
+                    poses: Vec::new(),
+                }),
+                solution: outcome.solution,
+            }
+        }
+        Err(reason) => {
+            log.warn(&format!("/rod/solve: bad request: {reason}"));
+            let header = crate::convert::output_header(&request.target.header, params);
+            SolveRodResponse {
+                solution: crate::convert::failure_message(
+                    format!("bad request: {reason}"),
+                    None,
+                    &header,
+                    params,
+                    0.0,
+                ),
+                path: Path {
+                    header,
+                    poses: Vec::new(),
+                },
             }
         }
     }

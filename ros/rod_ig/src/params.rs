@@ -436,7 +436,9 @@ const TABLE: [Spec; 14] = [
             hi: MAX_DEADLINE_MS,
             lo_open: true,
         },
-        default: DefaultValue::Double(rod_ig_core::planar::ig::DEFAULT_DEADLINE.as_secs_f64() * 1e3),
+        default: DefaultValue::Double(
+            rod_ig_core::planar::ig::DEFAULT_DEADLINE.as_secs_f64() * 1e3,
+        ),
         description: "Wall-time budget of one solve (ms); a solve that runs out answers \
                       'deadline reached'",
         constraints: "",
@@ -1286,12 +1288,16 @@ mod tests {
     fn base_frame_must_be_a_tf_frame_id() {
         let mut p = Params::default();
         for good in ["base_link", "arm/base", "robot-1.base"] {
-            p.apply("base_frame", &ParameterValue::String(good.into())).expect(good);
+            p.apply("base_frame", &ParameterValue::String(good.into()))
+                .expect(good);
             assert_eq!(p.base_frame, good);
         }
         for bad in ["", "bad frame!", "/world", "a//b", "a/"] {
             let e = p.apply("base_frame", &ParameterValue::String(bad.into()));
-            assert!(matches!(e, Err(ParamError::Invalid { .. })), "{bad:?}: {e:?}");
+            assert!(
+                matches!(e, Err(ParamError::Invalid { .. })),
+                "{bad:?}: {e:?}"
+            );
             assert_eq!(p.base_frame, "robot-1.base", "unchanged after {bad:?}");
         }
     }

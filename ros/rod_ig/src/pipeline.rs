@@ -246,41 +246,49 @@ impl Processor {
     /// Plans a stable gripper path (`rod/plan`): metres and the base frame in, the core
     /// planner in normalised units, metres out.
     pub fn plan(&mut self, request: &PlanRodRequest, params: &Params) -> Planned {
-        use rod_ig_core::plan::{Obstacle, PlanRequest, DEFAULT_PLAN_DEADLINE};
         let header = output_header(&request.goal.header, params);
-        let l = params.rod_length;
-        let fail = |reason: String| Planned {
-            response: PlanRodResponse {
-                success: false,
-                reason,
-                gripper_path: Path {
-                    header: header.clone(),
-                    poses: Vec::new(),
+        let plan = self
+            .plan_query(request, params)
+            .and_then(|query| self.planner.plan(&query).map_err(|e| e.to_string()));
+        match plan {
+            Ok(plan) => planned(&plan, header, params),
+            Err(reason) => Planned {
+                response: PlanRodResponse {
+                    success: false,
+                    reason,
+                    gripper_path: Path {
+                        header,
+                        poses: Vec::new(),
+                    },
+                    rods: Vec::new(),
+                    min_margin: f64::NAN,
                 },
-                rods: Vec::new(),
-                min_margin: f64::NAN,
+                marker: None,
             },
-            marker: None,
-        };
+        }
+    }
+
+    /// The core planner's query for `request`: the start rod (given, or the one held now), the
+    /// goal, the obstacles and the deadline, in normalised units.
+    fn plan_query(
+        &self,
+        request: &PlanRodRequest,
+        params: &Params,
+    ) -> Result<rod_ig_core::plan::PlanRequest, String> {
+        use rod_ig_core::plan::{Obstacle, PlanRequest, DEFAULT_PLAN_DEADLINE};
+        let l = params.rod_length;
         let start = if request.use_current {
-            match self.solver.current_rod() {
-                Some(a) => a,
-                None => {
-                    return fail(
-                        "no current rod: send a target on rod/target first, or give start".into(),
-                    )
-                }
-            }
+            self.solver.current_rod().ok_or(
+                "no current rod: send a target on rod/target first, or give start".to_string(),
+            )?
         } else {
             PlanarParams::from(request.start)
         };
-        let goal = match target_to_planar(&request.goal.pose, params) {
-            Ok(g) => g,
-            Err(e) => return fail(format!("goal: {e}")),
-        };
+        let goal =
+            target_to_planar(&request.goal.pose, params).map_err(|e| format!("goal: {e}"))?;
         let n = request.disc_x.len();
         if request.disc_y.len() != n || request.disc_radius.len() != n {
-            return fail("disc_x, disc_y and disc_radius must have the same length".into());
+            return Err("disc_x, disc_y and disc_radius must have the same length".into());
         }
         let mut obstacles: Vec<Obstacle> = (0..n)
             .map(|i| Obstacle::Disc {
@@ -297,62 +305,64 @@ impl Processor {
                     .collect(),
             }
         }));
-        let deadline = if request.deadline_ms == 0.0 {
-            DEFAULT_PLAN_DEADLINE
-        } else if request.deadline_ms.is_finite()
-            && request.deadline_ms > 0.0
-            && request.deadline_ms <= 1e4
-        {
-            std::time::Duration::from_secs_f64(request.deadline_ms / 1e3)
-        } else {
-            return fail(format!(
-                "deadline_ms must be in (0, 10000] (0 = 500), got {}",
-                request.deadline_ms
-            ));
+        let max_ms = rod_ig_core::solver::MAX_DEADLINE.as_secs_f64() * 1e3;
+        let deadline = match request.deadline_ms {
+            0.0 => DEFAULT_PLAN_DEADLINE,
+            ms if ms.is_finite() && ms > 0.0 && ms <= max_ms => {
+                std::time::Duration::from_secs_f64(ms / 1e3)
+            }
+            ms => {
+                return Err(format!(
+                    "deadline_ms must be in (0, {max_ms}] (0 = {}), got {ms}",
+                    DEFAULT_PLAN_DEADLINE.as_millis()
+                ))
+            }
         };
-        let query = PlanRequest {
+        Ok(PlanRequest {
             start,
             goal,
             obstacles,
             deadline,
-        };
-        let plan = match self.planner.plan(&query) {
-            Ok(p) => p,
-            Err(e) => return fail(e.to_string()),
-        };
-        let poses = plan
-            .gripper
-            .iter()
-            .map(|q| crate::messages::PoseStamped {
-                header: header.clone(),
-                pose: crate::convert::planar_to_pose(q, l),
-            })
-            .collect();
-        let stride = plan.rods.len().div_ceil(PLAN_RODS_DRAWN).max(1);
-        let mut drawn: Vec<&PlanarParams> = plan.rods.iter().step_by(stride).collect();
-        if let Some(last) = plan.rods.last() {
-            drawn.push(last);
-        }
-        let shapes: Vec<Vec<rod_ig_core::PlanarPose>> = drawn
-            .iter()
-            .filter_map(|a| rod_ig_core::planar::PlanarRod::new(a).ok())
-            .map(|r| r.shape(PLAN_ROD_SAMPLES))
-            .collect();
-        Planned {
-            marker: Some(crate::convert::rods_to_marker(&shapes, &header, params)),
-            response: PlanRodResponse {
-                success: true,
-                reason: String::new(),
-                gripper_path: Path { header, poses },
-                rods: plan.rods.iter().flat_map(|a| [a[0], a[1], a[2]]).collect(),
-                min_margin: plan.min_margin,
-            },
-        }
+        })
     }
 
     /// Forgets the warm start.
     pub fn reset(&mut self) {
         self.solver.reset();
+    }
+}
+
+/// The answer to a successful plan: the gripper path in metres, the rods, and a marker with
+/// at most [`PLAN_RODS_DRAWN`] of them.
+fn planned(plan: &rod_ig_core::plan::Plan, header: Header, params: &Params) -> Planned {
+    let l = params.rod_length;
+    let poses = plan
+        .gripper
+        .iter()
+        .map(|q| crate::messages::PoseStamped {
+            header: header.clone(),
+            pose: crate::convert::planar_to_pose(q, l),
+        })
+        .collect();
+    let stride = plan.rods.len().div_ceil(PLAN_RODS_DRAWN).max(1);
+    let mut drawn: Vec<&PlanarParams> = plan.rods.iter().step_by(stride).collect();
+    if let Some(last) = plan.rods.last() {
+        drawn.push(last);
+    }
+    let shapes: Vec<Vec<rod_ig_core::PlanarPose>> = drawn
+        .iter()
+        .filter_map(|a| rod_ig_core::planar::PlanarRod::new(a).ok())
+        .map(|r| r.shape(PLAN_ROD_SAMPLES))
+        .collect();
+    Planned {
+        marker: Some(crate::convert::rods_to_marker(&shapes, &header, params)),
+        response: PlanRodResponse {
+            success: true,
+            reason: String::new(),
+            gripper_path: Path { header, poses },
+            rods: plan.rods.iter().flat_map(|a| [a[0], a[1], a[2]]).collect(),
+            min_margin: plan.min_margin,
+        },
     }
 }
 

@@ -9,11 +9,11 @@
 //! happens in [`crate::convert`].
 
 use rod_ig_core::planar::ig::{self, Failure, Solution, SolveOptions, Tracker};
+use rod_ig_core::planar::PlanarClosedForm;
 use rod_ig_core::planar::PlanarRod;
 use rod_ig_core::solver::{self as rod_solver, BranchEvent, BranchFollower};
-use rod_ig_core::planar::PlanarClosedForm;
-use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::ig::{Failure3d, Solution3d, SolveOptions3d};
+use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, Stiffness};
 pub use rod_ig_core::spatial::{SpatialParams, SpatialPose};
 pub use rod_ig_core::{PlanarParams, PlanarPose};

@@ -398,8 +398,9 @@ impl<const N: usize> Dop853<N> {
         }
     }
 
-    /// Stages k1..k12 of the step of size `h` from (t, y) (Hairer's DOP853 tableau; k1 is the
-    /// stored FSAL derivative), the last evaluated at `t_new` = t + h exactly.
+    /// Stages k1..k12 of the step of size `h` from (t, y) (Hairer's DOP853 tableau written out:
+    /// a coefficient table; k1 is the stored FSAL derivative), the last evaluated at
+    /// `t_new` = t + h exactly.
     #[inline(always)]
     fn stages<F>(&self, f: &mut F, t: f64, h: f64, t_new: f64, k: &mut [[f64; N]; 12])
     where

@@ -498,13 +498,12 @@ impl<T: Real> Closed<T> {
         }
     }
 
-    /// Precomputes the closed form for a = (a3, a4, a5) (FINDINGS §2 table and phase).
-    /// Returns None when an intermediate quantity is not finite (overflow).
-    pub fn new(a3: T, a4: T, a5: T) -> Option<Self> {
+    /// The exactly straight rod's form (case [`Case::Straight`]), every field set: the start
+    /// of [`Self::new`], which fills in the others' constants.
+    fn straight(a3: T, a4: T, a5: T) -> Self {
         let zero = T::from_f64(0.0);
         let one = T::from_f64(1.0);
-        let (a3r, a4r, a5r) = (a3.re(), a4.re(), a5.re());
-        let eps = if a3r < 0.0 { -1.0 } else { 1.0 };
+        let eps = if a3.re() < 0.0 { -1.0 } else { 1.0 };
         let dummy_landen = Duplication::placeholder();
         let dummy_j = JacobiValues {
             sn: zero,
@@ -513,7 +512,7 @@ impl<T: Real> Closed<T> {
             am: zero,
             zm: zero,
         };
-        let mut s = Self {
+        Self {
             case: Case::Straight,
             eps,
             a3,
@@ -538,7 +537,14 @@ impl<T: Real> Closed<T> {
             th0: zero,
             e0: zero,
             _p: (),
-        };
+        }
+    }
+
+    /// Precomputes the closed form for a = (a3, a4, a5) (FINDINGS §2 table and phase).
+    /// Returns None when an intermediate quantity is not finite (overflow).
+    pub fn new(a3: T, a4: T, a5: T) -> Option<Self> {
+        let (a3r, a4r, a5r) = (a3.re(), a4.re(), a5.re());
+        let mut s = Self::straight(a3, a4, a5);
         if a3r == 0.0 && a5r == 0.0 {
             return Some(s);
         }

@@ -383,18 +383,49 @@ fn scan(
     a3: f64,
     a5: f64,
 ) -> Result<Scan, RodError> {
+    let (ts, np) = sample_times(t0, h_target, a3, a5);
+    let mut gs = [0.0f64; MAX_SAMPLES];
+    for i in 0..np {
+        gs[i] = g(ts[i]);
+        if !gs[i].is_finite() {
+            return Err(RodError::Overflow(
+                "stability: det J(t) is not finite (parameters too large)".into(),
+            ));
+        }
+    }
+    let (ts, gs) = (&ts[..np], &gs[..np]);
+    // First sign change (det ≤ 0), and the value seen there.
+    let mut first = first_sign_change(g, ts, gs);
+    let (mut margin, mut t_margin) = refine_margin(g, ts, gs, &mut first);
+    if let Some((_, neg_value, neg_t)) = first.filter(|_| margin >= 0.0) {
+        // The sign change lies below T_MARGIN: report the negative value seen there.
+        margin = neg_value.min(0.0);
+        t_margin = neg_t;
+    }
+    if !margin.is_finite() {
+        margin = 0.0;
+    }
+    Ok(Scan {
+        first: first.map(|f| f.0),
+        margin,
+        t_margin,
+    })
+}
+
+/// The sample times: a grid of spacing ≈ `h_target` on [t0, 1], and T_MARGIN and three times
+/// around t* = √(33600/8640)|a3/a5|, sorted; returns them and their number.
+fn sample_times(t0: f64, h_target: f64, a3: f64, a5: f64) -> ([f64; MAX_SAMPLES], usize) {
     let n = ((1.0 - t0) / h_target).ceil().max(1.0) as usize;
     let n = n.min(MAX_SAMPLES - 4);
     let h = (1.0 - t0) / n as f64;
     let mut ts = [0.0f64; MAX_SAMPLES];
-    let mut gs = [0.0f64; MAX_SAMPLES];
     let mut np = n + 1;
     for (i, t) in ts.iter_mut().enumerate().take(np) {
         *t = if i == n { 1.0 } else { t0 + i as f64 * h };
     }
-    // The normalisation t⁹(a3²/8640 + a5²t²/33600) changes regime at t* = √(33600/8640)|a3/a5|,
-    // where g often has a narrow dip: sample around it too (for the margin). The margin's
-    // window starts at T_MARGIN, where g is often smallest (|a3| ≪ |a5|): sample it exactly.
+    // The normalisation t⁹(a3²/8640 + a5²t²/33600) changes regime at t*, where g often has a
+    // narrow dip: sample around it too (for the margin). The margin's window starts at
+    // T_MARGIN, where g is often smallest (|a3| ≪ |a5|): sample it exactly.
     let ts_star = if a5 != 0.0 {
         (33600.0f64 / 8640.0).sqrt() * (a3 / a5).abs()
     } else {
@@ -412,83 +443,67 @@ fn scan(
             np += 1;
         }
     }
-    for i in 0..np {
-        let t = ts[i];
-        gs[i] = g(t);
-        if !gs[i].is_finite() {
-            return Err(RodError::Overflow(
-                "stability: det J(t) is not finite (parameters too large)".into(),
-            ));
-        }
-    }
-    // First sign change (det ≤ 0).
-    let mut first: Option<f64> = None;
-    let mut neg_value = f64::INFINITY;
-    let mut neg_t = 1.0;
-    for i in 0..np {
-        if gs[i] <= 0.0 {
-            neg_value = gs[i];
-            neg_t = ts[i];
-            first = Some(if i == 0 {
-                ts[0]
-            } else {
-                regula_falsi(g, ts[i - 1], gs[i - 1], ts[i], gs[i])
-            });
-            break;
-        }
-    }
-    // Margin: min over t ≥ T_MARGIN, with local minima refined by parabolic steps.
+    (ts, np)
+}
+
+/// The first sign change of g over the samples (det ≤ 0): (where, by regula falsi, the
+/// negative value sampled, its time).
+fn first_sign_change(g: &impl Fn(f64) -> f64, ts: &[f64], gs: &[f64]) -> Option<(f64, f64, f64)> {
+    let i = gs.iter().position(|&v| v <= 0.0)?;
+    let t = if i == 0 {
+        ts[0]
+    } else {
+        regula_falsi(g, ts[i - 1], gs[i - 1], ts[i], gs[i])
+    };
+    Some((t, gs[i], ts[i]))
+}
+
+/// The margin: min g over t ≥ T_MARGIN with the coarse minima that matter refined by
+/// parabolic steps (those low enough to hide a dip below zero or to be the global minimum;
+/// only the global one once a sign change is known). A dip below zero found between two
+/// samples becomes the first sign change. Returns (margin, where).
+fn refine_margin(
+    g: &impl Fn(f64) -> f64,
+    ts: &[f64],
+    gs: &[f64],
+    first: &mut Option<(f64, f64, f64)>,
+) -> (f64, f64) {
     let mut margin = f64::INFINITY;
     let mut t_margin = 1.0;
-    for i in 0..np {
-        if ts[i] >= T_MARGIN && gs[i] < margin {
-            margin = gs[i];
-            t_margin = ts[i];
+    for (&t, &v) in ts.iter().zip(gs) {
+        if t >= T_MARGIN && v < margin {
+            margin = v;
+            t_margin = t;
         }
     }
-    // Refine the coarse minima that matter: those low enough to hide a dip below zero or to
-    // be the global minimum (only the global one once a sign change is known).
-    let coarse_min = margin;
     let cutoff = if first.is_some() {
-        coarse_min
+        margin
     } else {
-        2.0 * coarse_min.max(0.0) + 0.05
+        2.0 * margin.max(0.0) + 0.05
     };
-    for i in 1..np.saturating_sub(1) {
-        if gs[i] <= gs[i - 1] && gs[i] <= gs[i + 1] && ts[i + 1] >= T_MARGIN && gs[i] <= cutoff {
-            let (tm, gm) = refine_min(g, ts[i - 1], ts[i], ts[i + 1], gs[i - 1], gs[i], gs[i + 1]);
-            if tm >= T_MARGIN {
-                if gm < margin {
-                    margin = gm;
-                    t_margin = tm;
-                }
-                if first.is_none() && gm <= 0.0 {
-                    // A dip below zero between two coarse samples.
-                    let tc = if gs[i - 1] > 0.0 {
-                        regula_falsi(g, ts[i - 1], gs[i - 1], tm, gm)
-                    } else {
-                        tm
-                    };
-                    first = Some(tc);
-                    neg_value = gm;
-                    neg_t = tm;
-                }
-            }
+    for i in 1..ts.len().saturating_sub(1) {
+        if !(gs[i] <= gs[i - 1] && gs[i] <= gs[i + 1] && ts[i + 1] >= T_MARGIN && gs[i] <= cutoff) {
+            continue;
+        }
+        let (tm, gm) = refine_min(g, ts[i - 1], ts[i], ts[i + 1], gs[i - 1], gs[i], gs[i + 1]);
+        if tm < T_MARGIN {
+            continue;
+        }
+        if gm < margin {
+            margin = gm;
+            t_margin = tm;
+        }
+        if first.is_none() && gm <= 0.0 {
+            // A dip below zero between two coarse samples.
+            let tc = if gs[i - 1] > 0.0 {
+                regula_falsi(g, ts[i - 1], gs[i - 1], tm, gm)
+            } else {
+                tm
+            };
+            *first = Some((tc, gm, tm));
         }
     }
-    if first.is_some() && margin >= 0.0 {
-        // The sign change lies below T_MARGIN: report the negative value seen there.
-        margin = neg_value.min(0.0);
-        t_margin = neg_t;
-    }
-    if !margin.is_finite() {
-        margin = 0.0;
-    }
-    Ok(Scan {
-        first,
-        margin,
-        t_margin,
-    })
+    (margin, t_margin)
 }
 
 /// Sample budget of one scan (coarse grid plus three samples around t*).

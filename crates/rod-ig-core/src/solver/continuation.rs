@@ -179,16 +179,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
 
     fn follow_inner(&mut self, target: &M::Pose) -> Move<SVector<f64, N>, M::Pose> {
         let Some(held) = self.held else {
-            let result = solve(&self.model, target, &self.options);
-            self.held = result.as_ref().ok().and_then(|s| {
-                let eval = self.model.evaluate(&s.a).ok()?;
-                Some(Held { a: s.a, eval })
-            });
-            let event = match result {
-                Ok(_) => BranchEvent::None,
-                Err(_) => BranchEvent::Lost,
-            };
-            return Move { result, event };
+            return self.fresh_solve(target);
         };
         if let Err(e) = self
             .model
@@ -235,13 +226,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                 }
                 Err(Stop::Fold(critical, s)) => {
                     snaps += 1;
-                    let start = self.gripper_start(&current);
-                    let critical_pose = critical.eval.tip;
-                    let past =
-                        self.model
-                            .interpolate(&start, target, (s + 2.0 * MIN_STEP).min(1.0));
-                    let past = if snaps > MAX_SNAPS { None } else { Some(past) };
-                    let settled = past.and_then(|p| self.settle(&critical, &p, &mut work));
+                    let settled = self.snap(&current, &critical, s, target, snaps, &mut work);
                     let Some(settled) = settled else {
                         self.held = None;
                         let e = IgError::NoStableSolution {
@@ -254,12 +239,48 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                     };
                     if first_snap.is_none() {
                         let released = critical.eval.energy - settled.eval.energy;
-                        first_snap = Some((critical_pose, critical.a, released));
+                        first_snap = Some((critical.eval.tip, critical.a, released));
                     }
                     current = settled;
                 }
             }
         }
+    }
+
+    /// Without a held rod: a fresh solve, whose rod is then held (event `None`, or `Lost`).
+    fn fresh_solve(&mut self, target: &M::Pose) -> Move<SVector<f64, N>, M::Pose> {
+        let result = solve(&self.model, target, &self.options);
+        self.held = result.as_ref().ok().and_then(|s| {
+            let eval = self.model.evaluate(&s.a).ok()?;
+            Some(Held { a: s.a, eval })
+        });
+        let event = match result {
+            Ok(_) => BranchEvent::None,
+            Err(_) => BranchEvent::Lost,
+        };
+        Move { result, event }
+    }
+
+    /// The rod the branch snaps to when it folds at `critical`, a fraction `s` of the way from
+    /// `current`'s gripper pose to `target`: settled just past the fold (module docs); `None`
+    /// after [`MAX_SNAPS`] snaps in one move or when no stable rod is found there.
+    fn snap(
+        &self,
+        current: &Held<N, M::Pose>,
+        critical: &Held<N, M::Pose>,
+        s: f64,
+        target: &M::Pose,
+        snaps: u32,
+        work: &mut Work,
+    ) -> Option<Held<N, M::Pose>> {
+        if snaps > MAX_SNAPS {
+            return None;
+        }
+        let start = self.gripper_start(current);
+        let past = self
+            .model
+            .interpolate(&start, target, (s + 2.0 * MIN_STEP).min(1.0));
+        self.settle(critical, &past, work)
     }
 
     /// The gripper pose a held rod is at.

@@ -35,6 +35,7 @@
 
 mod continuation;
 pub(crate) mod deadline;
+pub(crate) mod globalised;
 mod model;
 pub(crate) mod newton;
 mod observer;

@@ -7,7 +7,7 @@
 //! error and orientation error both ≤ tolerance, confirmed at the model's full accuracy. A NaN
 //! residual never counts as converged.
 
-use super::model::RodModel;
+use super::model::{ModelEvaluation, RodModel};
 use super::observer::{emit, Event};
 use super::{Failure, FailureOf, IgError, Solution, SolutionOf, SolveOptions, Termination};
 use nalgebra::SVector;
@@ -44,97 +44,106 @@ fn run<const N: usize, M: RodModel<N> + ?Sized>(
     let mut a = *a0;
     let mut residual = f64::INFINITY;
     let mut evaluations = 0;
-    let fail = |reason, k, residual, a| Failure {
-        reason,
-        iterations: k,
-        residual,
-        last_a: Some(a),
-        elapsed_us: 0.0,
-    };
     let mut k: u32 = 0;
     loop {
+        let fail = |reason, residual| Failure {
+            reason,
+            iterations: k,
+            residual,
+            last_a: Some(a),
+            elapsed_us: 0.0,
+        };
         if crate::solver::deadline::expired() {
-            return Err(fail(IgError::Deadline { iteration: k }, k, residual, a));
+            return Err(fail(IgError::Deadline { iteration: k }, residual));
         }
         evaluations += 1;
-        let e = match model.evaluate_iterate(&a, a0) {
-            Ok(e) => e,
-            Err(err) => {
-                let detail = format!("evaluation of iterate failed: {err}");
-                let reason = IgError::NonFinite {
-                    iteration: k,
-                    detail,
-                };
-                return Err(fail(reason, k, residual, a));
-            }
-        };
-        let (position_error, orientation_error) = model.pose_error(&e.tip, target);
-        residual = position_error.hypot(orientation_error);
-        let finite = residual.is_finite() && e.jacobian.iter().all(|v| v.is_finite());
-        if !finite {
-            let detail = "Υ(a), J(1, a) or the residual is not finite".to_string();
-            let reason = IgError::NonFinite {
-                iteration: k,
-                detail,
-            };
-            return Err(fail(reason, k, residual, a));
-        }
-        if !e.stability.stable {
-            return Err(fail(
-                IgError::LeftStableSet { iteration: k },
-                k,
-                residual,
-                a,
-            ));
-        }
-        if position_error <= options.tolerance && orientation_error <= options.tolerance {
-            let verified = if e.full_accuracy {
-                Some(e)
-            } else {
-                evaluations += 1;
-                model.evaluate(&a).ok()
-            };
-            if let Some(v) = verified {
-                let (pe, oe) = model.pose_error(&v.tip, target);
-                if pe <= options.tolerance && oe <= options.tolerance && v.stability.stable {
-                    return Ok(Solution {
-                        a,
-                        tip: v.tip,
-                        stable: true,
-                        stability_margin: v.stability.margin,
-                        iterations: k,
-                        position_error: pe,
-                        orientation_error: oe,
-                        residual: pe.hypot(oe),
-                        energy: v.energy,
-                        evaluations,
-                        starts: 1,
-                        elapsed_us: 0.0,
-                    });
-                }
+        let (e, errors) =
+            stable_iterate(model, target, &a, a0, k).map_err(|r| fail(r, residual))?;
+        residual = errors.0.hypot(errors.1);
+        if errors.0 <= options.tolerance && errors.1 <= options.tolerance {
+            if let Some(mut s) = verified(model, target, &a, e, options, &mut evaluations) {
+                s.iterations = k;
+                s.evaluations = evaluations;
+                return Ok(s);
             }
         }
         if k >= options.max_iterations {
-            let reason = IgError::MaxIterations {
-                iterations: options.max_iterations,
-            };
-            return Err(fail(reason, k, residual, a));
+            let iterations = options.max_iterations;
+            return Err(fail(IgError::MaxIterations { iterations }, residual));
         }
-        match model.newton_increment(&e.tip, &e.jacobian, target) {
-            Ok(d) => {
-                a += options.alpha * d;
-                k += 1;
-                emit(Event::Iteration {
-                    iteration: k,
-                    residual,
-                    step: options.alpha * d.norm(),
-                    alpha: options.alpha,
-                });
-            }
-            Err(det) => {
-                let reason = IgError::SingularJacobian { iteration: k, det };
-                return Err(fail(reason, k, residual, a));
-            }
-        }
+        let d = model
+            .newton_increment(&e.tip, &e.jacobian, target)
+            .map_err(|det| fail(IgError::SingularJacobian { iteration: k, det }, residual))?;
+        a += options.alpha * d;
+        k += 1;
+        emit(Event::Iteration {
+            iteration: k,
+            residual,
+            step: options.alpha * d.norm(),
+            alpha: options.alpha,
+        });
     }
+}
+
+/// Iterate `k` evaluated (at the precision the run from `a0` uses) with its (position,
+/// orientation) errors; an error when it is not finite or not stable (FINDINGS §8: the run
+/// fails as soon as an iterate is unstable).
+fn stable_iterate<const N: usize, M: RodModel<N> + ?Sized>(
+    model: &M,
+    target: &M::Pose,
+    a: &SVector<f64, N>,
+    a0: &SVector<f64, N>,
+    k: u32,
+) -> Result<(ModelEvaluation<N, M::Pose>, (f64, f64)), IgError> {
+    let e = model
+        .evaluate_iterate(a, a0)
+        .map_err(|err| IgError::NonFinite {
+            iteration: k,
+            detail: format!("evaluation of iterate failed: {err}"),
+        })?;
+    let errors = model.pose_error(&e.tip, target);
+    if !(errors.0.hypot(errors.1).is_finite() && e.jacobian.iter().all(|v| v.is_finite())) {
+        return Err(IgError::NonFinite {
+            iteration: k,
+            detail: "Υ(a), J(1, a) or the residual is not finite".to_string(),
+        });
+    }
+    if !e.stability.stable {
+        return Err(IgError::LeftStableSet { iteration: k });
+    }
+    Ok((e, errors))
+}
+
+/// The converged iterate `a` as a solution, confirmed at the model's full accuracy (one more
+/// evaluation when the iterate's was cheaper): `None` when it no longer meets the tolerance or
+/// is not stable there.
+fn verified<const N: usize, M: RodModel<N> + ?Sized>(
+    model: &M,
+    target: &M::Pose,
+    a: &SVector<f64, N>,
+    e: ModelEvaluation<N, M::Pose>,
+    options: &SolveOptions<SVector<f64, N>>,
+    evaluations: &mut u32,
+) -> Option<SolutionOf<N, M>> {
+    let v = if e.full_accuracy {
+        e
+    } else {
+        *evaluations += 1;
+        model.evaluate(a).ok()?
+    };
+    let (pe, oe) = model.pose_error(&v.tip, target);
+    (pe <= options.tolerance && oe <= options.tolerance && v.stability.stable).then(|| Solution {
+        a: *a,
+        tip: v.tip,
+        stable: true,
+        stability_margin: v.stability.margin,
+        iterations: 0,
+        position_error: pe,
+        orientation_error: oe,
+        residual: pe.hypot(oe),
+        energy: v.energy,
+        evaluations: *evaluations,
+        starts: 1,
+        elapsed_us: 0.0,
+    })
 }

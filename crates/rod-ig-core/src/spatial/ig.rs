@@ -8,16 +8,18 @@
 //! This module is the 3-D model's search behind [`crate::solver`] ([`Spatial`] implements
 //! [`InverseGeometry`]); the paper's Newton is the generic `crate::solver` one.
 //!
-//! * The robust search: damped Newton with backtracking (the merit |e|² must decrease, and
-//!   trial points that leave the stable set are rejected), a Levenberg–Marquardt fallback when J
-//!   is singular, a cap on the step length, and multi-start from a short list of stable seeds
-//!   derived from the target. Every returned solution has passed the stability test.
+//! * The robust search: the globalised Newton/LM of [`crate::solver::globalised`] (backtracking
+//!   on the merit |e|, trial points that leave the stable set rejected, Levenberg–Marquardt
+//!   steps when Newton's fail, a cap on the step length), multi-started from a short list of
+//!   stable seeds derived from the target. Every returned solution has passed the stability
+//!   test.
 //!
 //! All loops are bounded (iterations × backtracking steps × starts).
 
 use super::stability::evaluate_if_stable;
 use super::Spatial;
 use super::{Evaluation3d, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
+use crate::solver::globalised::{self, Iterate, Problem, Settings};
 use crate::solver::{
     emit, Event, Failure, Found, IgError, InverseGeometry, Solution, SolveOptions, Termination,
 };
@@ -173,34 +175,59 @@ impl Ctx<'_> {
     }
 }
 
-/// Newton direction: J d = e by LU; Levenberg–Marquardt (JᵀJ + λI) d = Jᵀ e when J is
-/// (numerically) singular.
-fn newton_direction(j: &Matrix6<f64>, e: &Vector6<f64>, allow_lm: bool) -> Option<Vector6<f64>> {
-    if let Some(d) = j.lu().solve(e) {
-        if d.iter().all(|v| v.is_finite()) {
-            return Some(d);
-        }
-    }
-    if !allow_lm {
-        return None;
-    }
-    let jt = j.transpose();
-    let jtj = jt * j;
-    let lambda = 1e-6 * jtj.trace().max(1e-12);
-    let m = jtj + Matrix6::identity() * lambda;
-    m.cholesky()
-        .map(|c| c.solve(&(jt * e)))
-        .filter(|d| d.iter().all(|v| v.is_finite()))
-}
-
 /// Largest step ‖δa‖₂ the robust method takes at once.
 fn step_cap(a: &SpatialParams) -> f64 {
     10.0 + 0.5 * a.norm()
 }
 
-const MAX_BACKTRACK: u32 = 12;
 /// Evaluations one start may use before the robust method moves on to the next seed.
 const START_BUDGET: u32 = 40;
+
+/// One run of the globalised Newton/LM ([`globalised`]) on the 3-D rod towards `ctx.goal`:
+/// residual f = −e(a) (module docs), trials integrated at a tolerance adapted to the residual
+/// and rejected when they leave the stable set, steps capped at [`step_cap`] in length.
+struct SpatialSteps<'c, 'a> {
+    ctx: &'c mut Ctx<'a>,
+}
+
+fn iterate(goal: &SpatialPose, ev: Box<Evaluation3d>) -> Iterate<6, Box<Evaluation3d>> {
+    let e = ev.tip.body_error_to(goal);
+    Iterate {
+        f: -e,
+        norm: e.norm(),
+        jacobian: ev.jacobian,
+        data: ev,
+    }
+}
+
+impl Problem<6> for SpatialSteps<'_, '_> {
+    type Data = Box<Evaluation3d>;
+
+    fn evaluate(
+        &mut self,
+        a: &SpatialParams,
+        from: f64,
+    ) -> Result<Option<Iterate<6, Self::Data>>, IgError> {
+        // The residual after a full step is ~0 near the solution: tighten with it.
+        let rtol = self.ctx.rtol_for(from * 0.1);
+        Ok(match self.ctx.eval(a, rtol, false)? {
+            EvalOutcome::Stable(ev) => Some(iterate(&self.ctx.goal, ev)),
+            EvalOutcome::Unstable => None,
+        })
+    }
+
+    fn converged(&self, x: &Iterate<6, Self::Data>) -> bool {
+        self.ctx.converged(&x.data).is_some()
+    }
+
+    fn step_scale(&self, a: &SpatialParams, p: &Vector6<f64>) -> f64 {
+        p.norm() / step_cap(a)
+    }
+
+    fn solve(&self, m: &Matrix6<f64>, r: &Vector6<f64>) -> Option<Vector6<f64>> {
+        m.lu().solve(r).filter(|x| x.iter().all(|v| v.is_finite()))
+    }
+}
 
 /// Damped Newton towards `ctx.goal` from one stable start (module docs), using at most
 /// `budget` evaluations. Iterates are integrated at a tolerance adapted to their residual. With
@@ -214,100 +241,55 @@ fn damped_newton(
     verify: bool,
 ) -> Result<(SpatialParams, Box<Evaluation3d>, u32), IgError> {
     let mut a = a0;
-    let mut ev = ev0;
-    let mut e = ev.tip.body_error_to(&ctx.goal);
-    let mut merit = e.norm_squared();
+    let mut x = iterate(&ctx.goal, ev0);
     let mut it = 0;
     let budget_end = ctx.evaluations.saturating_add(budget);
     loop {
-        if ctx.converged(&ev).is_some() {
-            if !verify {
-                return Ok((a, ev, it));
-            }
-            // Verify at the requested accuracy with the fine stability scan.
-            match ctx.eval(&a, ctx.model.rtol, true)? {
-                EvalOutcome::Stable(vev) => {
-                    if ctx.converged(&vev).is_some() {
-                        return Ok((a, vev, it));
-                    }
-                    ev = vev;
-                    e = ev.tip.body_error_to(&ctx.goal);
-                    merit = e.norm_squared();
-                }
-                EvalOutcome::Unstable => {
-                    return Err(IgError::LeftStableSet {
-                        iteration: ctx.iterations,
-                    })
-                }
-            }
-        }
-        if it >= ctx.opts.max_iterations || ctx.evaluations >= budget_end {
-            return Err(IgError::MaxIterations {
-                iterations: ctx.opts.max_iterations,
-            });
-        }
-        it += 1;
-        ctx.iterations += 1;
-        let Some(mut d) = newton_direction(&ev.jacobian, &e, true) else {
-            return Err(IgError::SingularJacobian {
-                iteration: ctx.iterations,
-                det: ev.jacobian.determinant(),
-            });
+        let settings = Settings {
+            alpha: ctx.opts.alpha,
+            max_iterations: ctx.opts.max_iterations.saturating_sub(it),
+            max_evaluations: budget_end.saturating_sub(ctx.evaluations),
         };
-        let n = d.norm();
-        let cap = step_cap(&a);
-        if n > cap {
-            d *= cap / n;
-        }
-        let mut alpha = ctx.opts.alpha;
-        let mut accepted = None;
-        let mut last_unstable = false;
-        // Predicted residual after a full step is ~0 near the solution: tighten with it.
-        let trial_rtol = ctx.rtol_for(merit.sqrt() * 0.1);
-        for _ in 0..MAX_BACKTRACK {
-            let trial = a + alpha * d;
-            match ctx.eval(&trial, trial_rtol, false)? {
-                EvalOutcome::Stable(tev) => {
-                    let te = tev.tip.body_error_to(&ctx.goal);
-                    let tm = te.norm_squared();
-                    if tm < (1.0 - 1e-4 * alpha) * merit || ctx.converged(&tev).is_some() {
-                        accepted = Some((trial, tev, te, tm));
-                        break;
+        let r = globalised::run(&mut SpatialSteps { ctx }, a, x, &settings)?;
+        it += r.iterations;
+        ctx.iterations += r.iterations;
+        match r.stop {
+            globalised::Stop::Converged if !verify => return Ok((r.a, r.last.data, it)),
+            globalised::Stop::Converged => {
+                // Verify at the requested accuracy with the fine stability scan.
+                match ctx.eval(&r.a, ctx.model.rtol, true)? {
+                    EvalOutcome::Stable(vev) if ctx.converged(&vev).is_some() => {
+                        return Ok((r.a, vev, it))
                     }
-                    last_unstable = false;
+                    EvalOutcome::Stable(vev) => {
+                        a = r.a;
+                        x = iterate(&ctx.goal, vev);
+                    }
+                    EvalOutcome::Unstable => {
+                        return Err(IgError::LeftStableSet {
+                            iteration: ctx.iterations,
+                        })
+                    }
                 }
-                EvalOutcome::Unstable => last_unstable = true,
             }
-            if ctx.evaluations >= budget_end {
-                break;
+            globalised::Stop::MaxIterations | globalised::Stop::Budget => {
+                return Err(IgError::MaxIterations {
+                    iterations: ctx.opts.max_iterations,
+                })
             }
-            alpha *= 0.5;
-        }
-        match accepted {
-            Some((ta, tev, te, tm)) => {
-                crate::solver::emit(crate::solver::Event::Iteration {
-                    iteration: it,
-                    residual: {
-                        let (pe, ang) = ev.tip.distance_to(&ctx.goal);
-                        pe.hypot(ang)
-                    },
-                    step: (ta - a).norm(),
-                    alpha,
-                });
-                a = ta;
-                ev = tev;
-                e = te;
-                merit = tm;
+            globalised::Stop::Deadline => {
+                return Err(IgError::Deadline {
+                    iteration: ctx.iterations,
+                })
             }
-            None => {
-                return Err(if last_unstable {
-                    IgError::LeftStableSet {
-                        iteration: ctx.iterations,
-                    }
-                } else {
-                    IgError::Stalled {
-                        iteration: ctx.iterations,
-                    }
+            globalised::Stop::Stalled if r.last_trial_rejected => {
+                return Err(IgError::LeftStableSet {
+                    iteration: ctx.iterations,
+                })
+            }
+            globalised::Stop::Stalled => {
+                return Err(IgError::Stalled {
+                    iteration: ctx.iterations,
                 })
             }
         }

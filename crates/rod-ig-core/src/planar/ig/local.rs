@@ -1,7 +1,7 @@
-//! Globalised Newton from one start (the robust solver's inner loop).
-//!
-//! Newton direction p = −J(1, a)⁻¹ f(a) (paper eq. 3.1), then backtracking on the merit ‖f‖
-//! (Armijo-type sufficient decrease), with two safeguards:
+//! Globalised Newton from one start (the robust solver's inner loop): the iteration of
+//! [`crate::solver::globalised`] (Newton direction p = −J(1, a)⁻¹ f(a), paper eq. 3.1,
+//! backtracking on the merit ‖f‖, Levenberg–Marquardt steps when it fails), with two planar
+//! safeguards:
 //! - a trust box on the step in parameter space (|Δa3| ≤ 4, |Δa4|, |Δa5| ≤ 40), so that one
 //!   step cannot jump across several solution branches;
 //! - a trial is rejected when det J(1, a) ≤ 0. Along a continuous path in a, a conjugate point
@@ -18,8 +18,10 @@ use super::newton::{eval, Eval};
 use super::scan;
 use crate::planar::model::solve3;
 use crate::planar::model::Precision;
-use crate::solver::{emit, Event};
+use crate::solver::globalised::{self, Iterate, Problem, Settings};
+use crate::solver::{emit, Event, IgError};
 use crate::{PlanarParams, PlanarPose};
+use nalgebra::{Matrix3, Vector3};
 
 /// Outcome of one local solve.
 pub(crate) struct Local {
@@ -77,10 +79,6 @@ impl Stop {
 /// An engineering choice, not a derivation: it bounds how far one step can jump across
 /// branches while leaving Newton's full step free in the interior of the box.
 pub(crate) const MAX_DA3: f64 = 4.0;
-/// Trials of the backtracking on the Newton direction before switching to LM steps.
-const NEWTON_TRIALS: usize = 5;
-/// LM trials (μ × 10 each) per iteration.
-const LM_TRIALS: usize = 10;
 /// Half-width in a4 and a5 of the box a step may move in (see [`MAX_DA3`]).
 pub(crate) const MAX_DA45: f64 = 40.0;
 
@@ -157,6 +155,52 @@ pub(crate) fn solve_predicted(
     }
 }
 
+/// One run of the globalised Newton/LM ([`globalised`]) on the planar rod: trials evaluated at
+/// the start's precision and rejected where det J(1, a) ≤ 0 (module docs), steps limited to
+/// the box (±[`MAX_DA3`], ±[`MAX_DA45`], ±[`MAX_DA45`]).
+struct PlanarSteps<'t> {
+    target: &'t PlanarPose,
+    precision: Precision,
+    tolerance: f64,
+}
+
+fn iterate(e: Eval) -> Iterate<3, Eval> {
+    Iterate {
+        f: e.f,
+        norm: e.norm,
+        jacobian: e.jac,
+        data: e,
+    }
+}
+
+impl Problem<3> for PlanarSteps<'_> {
+    type Data = Eval;
+
+    fn evaluate(
+        &mut self,
+        a: &PlanarParams,
+        _from: f64,
+    ) -> Result<Option<Iterate<3, Eval>>, IgError> {
+        Ok(eval(a, self.target, self.precision)
+            .filter(|e| e.jac.determinant() > 0.0)
+            .map(iterate))
+    }
+
+    fn converged(&self, x: &Iterate<3, Eval>) -> bool {
+        x.data.pos_err <= self.tolerance && x.data.ang_err <= self.tolerance
+    }
+
+    fn step_scale(&self, _a: &PlanarParams, p: &Vector3<f64>) -> f64 {
+        (p[0].abs() / MAX_DA3)
+            .max(p[1].abs() / MAX_DA45)
+            .max(p[2].abs() / MAX_DA45)
+    }
+
+    fn solve(&self, m: &Matrix3<f64>, r: &Vector3<f64>) -> Option<Vector3<f64>> {
+        solve3(m, r).ok()
+    }
+}
+
 /// The iteration proper, from an evaluated start (`evaluations` excludes the start's), every
 /// evaluation at the start's `precision`.
 fn run(
@@ -168,120 +212,40 @@ fn run(
     max_iterations: u32,
     tolerance: f64,
 ) -> Local {
-    let mut out = Local {
-        found: None,
-        iterations: 0,
-        evaluations: 0,
-        residual: e0.norm,
-        last_a: a0,
-        stop: Stop::BadStart,
+    let mut steps = PlanarSteps {
+        target,
+        precision,
+        tolerance,
     };
-    let mut a = a0;
-    let mut e = e0;
-    let mut mu = 0.0f64;
-    let alpha = if alpha > 0.0 && alpha <= 1.0 {
-        alpha
-    } else {
-        1.0
+    let settings = Settings {
+        alpha,
+        max_iterations,
+        max_evaluations: u32::MAX,
     };
-    loop {
-        if e.pos_err <= tolerance && e.ang_err <= tolerance {
-            out.stop = Stop::Converged;
-            out.found = Some((a, e));
-            return out;
-        }
-        if out.iterations >= max_iterations {
-            out.stop = Stop::MaxIterations;
-            return out;
-        }
-        if crate::solver::deadline::expired() {
-            out.stop = Stop::Deadline;
-            return out;
-        }
-        let mut accepted = None;
-        // 1. Newton direction with backtracking (paper eq. 3.1, globalised).
-        if let Ok(p) = solve3(&e.jac, &e.f) {
-            let size = (p[0].abs() / MAX_DA3)
-                .max(p[1].abs() / MAX_DA45)
-                .max(p[2].abs() / MAX_DA45);
-            let mut lambda = if size > 1.0 { alpha / size } else { alpha };
-            for _ in 0..NEWTON_TRIALS {
-                let trial = a - lambda * p;
-                out.evaluations += 1;
-                if let Some(et) = eval(&trial, target, precision) {
-                    if et.jac.determinant() > 0.0 && et.norm <= (1.0 - 1e-4 * lambda) * e.norm {
-                        accepted = Some((trial, et, lambda));
-                        break;
-                    }
-                    // Quadratic model of ‖f‖² along the step: φ(λ) ≈ φ0 − 2λφ0 + cλ² (the
-                    // Newton direction has slope −2φ0 for φ = ‖f‖²); its minimiser, bounded.
-                    let phi0 = e.norm * e.norm;
-                    let phil = et.norm * et.norm;
-                    if phil.is_finite() && et.jac.determinant() > 0.0 {
-                        let c = (phil - phi0 + 2.0 * lambda * phi0) / (lambda * lambda);
-                        let lnew = if c > 0.0 { phi0 / c } else { 0.5 * lambda };
-                        lambda = lnew.clamp(0.1 * lambda, 0.5 * lambda);
-                        continue;
-                    }
-                }
-                lambda *= 0.3;
-            }
-        }
-        // 2. Levenberg–Marquardt steps (JᵀJ + μ diag(JᵀJ)) p = Jᵀf when the Newton direction
-        //    fails (ill-conditioned J near the fold det J(1, a) = 0, where Newton steps point
-        //    across the stability boundary): μ grows until a step is accepted.
-        if accepted.is_none() {
-            let jtj = e.jac.transpose() * e.jac;
-            let g = e.jac.transpose() * e.f;
-            let dmax = jtj.diagonal().max();
-            let diag = jtj.diagonal().map(|v| v.max(1e-12 * dmax));
-            if mu.is_nan() || mu <= 0.0 {
-                mu = 1e-3;
-            }
-            for _ in 0..LM_TRIALS {
-                let mut m = jtj;
-                for q in 0..3 {
-                    m[(q, q)] += mu * diag[q];
-                }
-                let Ok(p) = solve3(&m, &g) else {
-                    mu *= 10.0;
-                    continue;
-                };
-                let size = (p[0].abs() / MAX_DA3)
-                    .max(p[1].abs() / MAX_DA45)
-                    .max(p[2].abs() / MAX_DA45);
-                let p = if size > 1.0 { p / size } else { p };
-                let trial = a - p;
-                out.evaluations += 1;
-                if let Some(et) = eval(&trial, target, precision) {
-                    if et.jac.determinant() > 0.0 && et.norm <= (1.0 - 1e-4) * e.norm {
-                        accepted = Some((trial, et, 1.0));
-                        mu *= 0.1;
-                        break;
-                    }
-                }
-                mu *= 10.0;
-            }
-        }
-        match accepted {
-            Some((na, ne, factor)) => {
-                out.iterations += 1;
-                emit(Event::Iteration {
-                    iteration: out.iterations,
-                    residual: e.norm,
-                    step: (na - a).norm(),
-                    alpha: factor,
-                });
-                a = na;
-                e = ne;
-                out.residual = e.norm;
-                out.last_a = a;
-            }
-            None => {
-                out.stop = Stop::Stalled;
-                return out;
-            }
-        }
+    let start_norm = e0.norm;
+    match globalised::run(&mut steps, a0, iterate(e0), &settings) {
+        Ok(r) => Local {
+            stop: match r.stop {
+                globalised::Stop::Converged => Stop::Converged,
+                globalised::Stop::Stalled => Stop::Stalled,
+                globalised::Stop::MaxIterations | globalised::Stop::Budget => Stop::MaxIterations,
+                globalised::Stop::Deadline => Stop::Deadline,
+            },
+            iterations: r.iterations,
+            evaluations: r.evaluations,
+            residual: r.last.norm,
+            last_a: r.a,
+            found: (r.stop == globalised::Stop::Converged).then_some((r.a, r.last.data)),
+        },
+        // PlanarSteps never returns an error; kept total all the same.
+        Err(_) => Local {
+            found: None,
+            iterations: 0,
+            evaluations: 0,
+            residual: start_norm,
+            last_a: a0,
+            stop: Stop::Stalled,
+        },
     }
 }
 

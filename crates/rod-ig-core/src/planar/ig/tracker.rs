@@ -90,73 +90,33 @@ impl Tracker {
     /// J(1, a) (slower, ~1 ms, but the branch then tracks well).
     pub fn solve(&mut self, target: &PlanarPose) -> Result<Solution, Failure> {
         let t0 = std::time::Instant::now();
-        let _deadline = crate::solver::deadline::scope(self.options.deadline);
-        if let Err(e) = super::check_target(target) {
-            let mut f = Failure::early(e);
-            f.elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
-            return Err(f);
+        let mut result = self.solve_untimed(target);
+        let us = t0.elapsed().as_secs_f64() * 1e6;
+        match &mut result {
+            Ok(s) => s.elapsed_us = us,
+            Err(f) => f.elapsed_us = us,
         }
+        result
+    }
+
+    fn solve_untimed(&mut self, target: &PlanarPose) -> Result<Solution, Failure> {
+        let _deadline = crate::solver::deadline::scope(self.options.deadline);
+        super::check_target(target).map_err(Failure::early)?;
         // The angle reduced exactly (as every entry point does, `RodModel::canonical_target`).
         let target = &PlanarPose::new(target.x, target.y, wrap_angle(target.theta));
         let warm = self.last.map(|l| l.0).or(self.options.initial_guess);
-        let predicted = self.predict(target);
-        let mut iterations = 0;
-        let mut evaluations = 0;
-        let budget = self.options.max_iterations.clamp(1, 20);
+        let (mut iterations, mut evaluations) = (0, 0);
         if let Some(a0) = warm {
-            let r =
-                local::solve_predicted(target, &a0, predicted, 1.0, budget, self.options.tolerance);
-            iterations += r.iterations;
-            evaluations += r.evaluations;
-            let verified = r.found.and_then(|(a, _)| {
-                Some((
-                    a,
-                    super::newton::verify(&a, target, self.options.tolerance)?,
-                ))
-            });
-            if let Some((a, e)) = verified {
-                if let Ok(st) = model::stability(&a) {
-                    if st.stable {
-                        let mut s = make_solution(&a, &e, true, st.margin, iterations);
-                        s.evaluations = evaluations;
-                        s.elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
-                        self.prev = self.last.map(|l| (l.0, l.1));
-                        self.last = Some((a, *target, Some(e.jac)));
-                        return Ok(s);
-                    }
-                }
+            match self.warm_step(target, &a0) {
+                Ok(s) => return Ok(s),
+                Err((it, ev)) => (iterations, evaluations) = (it, ev),
             }
         }
         let mut opts = self.options;
         opts.initial_guess = warm;
         opts.alpha = 1.0;
         if warm.is_none() {
-            // Cold start: among the stable solutions near the target, take the best conditioned
-            // J(1, a) (largest σ_min/σ_max): far from the fold det J(1, a) = 0 and from the
-            // separatrix λ4 = 0, where branches end or Newton's basin shrinks, so the branch
-            // followed afterwards is the easiest to track.
-            let all = robust::solve_all(target, &opts, Some(opts.max_iterations));
-            let conditioning = |a: &PlanarParams| {
-                model::tip_and_jacobian_for_iteration(a, model::Precision::Fast)
-                    .ok()
-                    .map(|(_, j)| {
-                        let sv = j.singular_values();
-                        sv.min() / sv.max()
-                    })
-                    .filter(|c| c.is_finite())
-                    .unwrap_or(0.0)
-            };
-            if let Some(mut s) = all
-                .solutions
-                .into_iter()
-                .max_by(|p, q| conditioning(&p.a).total_cmp(&conditioning(&q.a)))
-            {
-                s.iterations = all.iterations;
-                s.evaluations = all.evaluations;
-                s.starts = all.starts;
-                s.elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
-                self.prev = None;
-                self.last = Some((s.a, *target, None));
+            if let Some(s) = self.cold_start(target, &opts) {
                 return Ok(s);
             }
         }
@@ -164,16 +124,67 @@ impl Tracker {
             Ok(mut s) => {
                 s.iterations += iterations;
                 s.evaluations += evaluations;
-                s.elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
                 self.prev = None;
                 self.last = Some((s.a, *target, None));
                 Ok(s)
             }
             Err(mut f) => {
                 f.iterations += iterations;
-                f.elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
                 Err(f)
             }
         }
+    }
+
+    /// The warm start: a few Newton iterations from `a0` (with the predicted first step),
+    /// verified and tested for stability. `Err((iterations, evaluations))` when it fails.
+    fn warm_step(
+        &mut self,
+        target: &PlanarPose,
+        a0: &PlanarParams,
+    ) -> Result<Solution, (u32, u32)> {
+        let predicted = self.predict(target);
+        let budget = self.options.max_iterations.clamp(1, 20);
+        let tolerance = self.options.tolerance;
+        let r = local::solve_predicted(target, a0, predicted, 1.0, budget, tolerance);
+        let work = (r.iterations, r.evaluations);
+        let (a, _) = r.found.ok_or(work)?;
+        let e = super::newton::verify(&a, target, tolerance).ok_or(work)?;
+        let st = model::stability(&a)
+            .ok()
+            .filter(|st| st.stable)
+            .ok_or(work)?;
+        let mut s = make_solution(&a, &e, true, st.margin, r.iterations);
+        s.evaluations = r.evaluations;
+        self.prev = self.last.map(|l| (l.0, l.1));
+        self.last = Some((a, *target, Some(e.jac)));
+        Ok(s)
+    }
+
+    /// Cold start: among the stable solutions near the target, the best conditioned J(1, a)
+    /// (largest σ_min/σ_max): far from the fold det J(1, a) = 0 and from the separatrix
+    /// λ4 = 0, where branches end or Newton's basin shrinks, so the branch followed afterwards
+    /// is the easiest to track.
+    fn cold_start(&mut self, target: &PlanarPose, opts: &SolveOptions) -> Option<Solution> {
+        let all = robust::solve_all(target, opts, Some(opts.max_iterations));
+        let conditioning = |a: &PlanarParams| {
+            model::tip_and_jacobian_for_iteration(a, model::Precision::Fast)
+                .ok()
+                .map(|(_, j)| {
+                    let sv = j.singular_values();
+                    sv.min() / sv.max()
+                })
+                .filter(|c| c.is_finite())
+                .unwrap_or(0.0)
+        };
+        let mut s = all
+            .solutions
+            .into_iter()
+            .max_by(|p, q| conditioning(&p.a).total_cmp(&conditioning(&q.a)))?;
+        s.iterations = all.iterations;
+        s.evaluations = all.evaluations;
+        s.starts = all.starts;
+        self.prev = None;
+        self.last = Some((s.a, *target, None));
+        Some(s)
     }
 }
