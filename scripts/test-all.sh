@@ -51,6 +51,12 @@ lint() { # name [--manifest-path M]
 lint crates
 lint node "${NODE[@]}"
 lint python "${PYPKG[@]}"
+# The layering (no module imports one that imports it back) and no function over 80 lines.
+for src in crates/rod-ig-core/src crates/rod-ig-cli/src ros/rod_ig/src; do
+    python3 scripts/import_cycles.py "$src" --depth 3 >>"$LOGS/layering.log" || { echo "import cycle in $src (see $LOGS/layering.log)"; status=1; }
+done
+python3 scripts/long_functions.py crates/*/src ros/rod_ig/src python/src >>"$LOGS/layering.log" \
+    || { echo "functions over 80 lines (see $LOGS/layering.log)"; status=1; }
 
 echo "== cargo test: the crates, then the node (release profile: shares the build with the node under test)"
 { cargo test --release --workspace --no-fail-fast 2>&1; cargo test --release "${NODE[@]}" --no-fail-fast 2>&1; } \

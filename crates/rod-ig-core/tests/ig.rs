@@ -110,7 +110,7 @@ fn newton_successes_are_verified_solutions() {
                             IgError::LeftStableSet { .. }
                                 | IgError::MaxIterations { .. }
                                 | IgError::SingularJacobian { .. }
-                                | IgError::NonFinite { .. }
+                                | IgError::Evaluation { .. }
                         ),
                         "{f}"
                     );

@@ -133,7 +133,10 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                 value: a0[index],
             });
         }
-        let eval = model.evaluate(&a0)?;
+        let eval = model.evaluate(&a0).map_err(|e| IgError::Evaluation {
+            iteration: 0,
+            detail: e.to_string(),
+        })?;
         if !eval.stability.stable {
             return Err(IgError::LeftStableSet { iteration: 0 });
         }

@@ -85,6 +85,9 @@ fn run<const N: usize, M: RodModel<N> + ?Sized>(
     }
 }
 
+/// An iterate's evaluation with its (position, orientation) errors.
+type Checked<const N: usize, X> = (ModelEvaluation<N, X>, (f64, f64));
+
 /// Iterate `k` evaluated (at the precision the run from `a0` uses) with its (position,
 /// orientation) errors; an error when it is not finite or not stable (FINDINGS §8: the run
 /// fails as soon as an iterate is unstable).
@@ -94,16 +97,16 @@ fn stable_iterate<const N: usize, M: RodModel<N> + ?Sized>(
     a: &SVector<f64, N>,
     a0: &SVector<f64, N>,
     k: u32,
-) -> Result<(ModelEvaluation<N, M::Pose>, (f64, f64)), IgError> {
+) -> Result<Checked<N, M::Pose>, IgError> {
     let e = model
         .evaluate_iterate(a, a0)
-        .map_err(|err| IgError::NonFinite {
+        .map_err(|err| IgError::Evaluation {
             iteration: k,
             detail: format!("evaluation of iterate failed: {err}"),
         })?;
     let errors = model.pose_error(&e.tip, target);
     if !(errors.0.hypot(errors.1).is_finite() && e.jacobian.iter().all(|v| v.is_finite())) {
-        return Err(IgError::NonFinite {
+        return Err(IgError::Evaluation {
             iteration: k,
             detail: "Υ(a), J(1, a) or the residual is not finite".to_string(),
         });

@@ -1,7 +1,6 @@
 //! What a solve returns: one [`Solution`] type, one [`Failure`] type and one error enum
 //! ([`IgError`]) for every rod model, with a typed [`Termination`] reason.
 
-use crate::RodError;
 use thiserror::Error;
 
 /// A converged solve of the inverse geometry, for any rod model: `P` is the model's parameter
@@ -142,12 +141,13 @@ pub enum IgError {
         /// The budget.
         iterations: u32,
     },
-    /// The forward map or the residual became non-finite.
-    #[error("non-finite values at iteration {iteration}: {detail}")]
-    NonFinite {
+    /// An evaluation of the rod failed (the model refused the parameters) or gave non-finite
+    /// values.
+    #[error("rod evaluation failed at iteration {iteration}: {detail}")]
+    Evaluation {
         /// Iteration at which it happened.
         iteration: u32,
-        /// What was non-finite.
+        /// What failed.
         detail: String,
     },
     /// The solve's deadline ([`super::SolveOptions::deadline`]) passed before it converged.
@@ -168,9 +168,6 @@ pub enum IgError {
         /// Why the last start failed, when known.
         last: Option<Box<IgError>>,
     },
-    /// A forward evaluation failed.
-    #[error("rod evaluation failed: {0}")]
-    Evaluation(#[from] RodError),
 }
 
 impl IgError {
@@ -187,7 +184,7 @@ impl IgError {
             Self::MaxIterations { .. } => Termination::IterationLimit,
             Self::Deadline { .. } => Termination::Deadline,
             Self::NoStableSolution { .. } => Termination::NoStableSolution,
-            Self::NonFinite { .. } | Self::Evaluation(_) => Termination::EvaluationFailed,
+            Self::Evaluation { .. } => Termination::EvaluationFailed,
         }
     }
 }

@@ -8,7 +8,7 @@
 //! This module is the 3-D model's search behind [`crate::solver`] ([`Spatial`] implements
 //! [`InverseGeometry`]); the paper's Newton is the generic `crate::solver` one.
 //!
-//! * The robust search: the globalised Newton/LM of [`crate::solver::globalised`] (backtracking
+//! * The robust search: the globalised Newton/LM of `solver::globalised` (backtracking
 //!   on the merit |e|, trial points that leave the stable set rejected, Levenberg–Marquardt
 //!   steps when Newton's fail, a cap on the step length), multi-started from a short list of
 //!   stable seeds derived from the target. Every returned solution has passed the stability
@@ -126,7 +126,10 @@ impl Ctx<'_> {
                 Ok(EvalOutcome::Stable(Box::new(ev)))
             }
             Ok((None, _)) => Ok(EvalOutcome::Unstable),
-            Err(e) => Err(IgError::Evaluation(e)),
+            Err(e) => Err(IgError::Evaluation {
+                iteration: self.iterations,
+                detail: e.to_string(),
+            }),
         }
     }
 
@@ -349,7 +352,7 @@ fn continuation(
                 s = s_new;
                 ds = (ds * 2.0).min(0.5);
             }
-            Err(e @ IgError::Evaluation(_)) => return Err(e),
+            Err(e @ IgError::Evaluation { .. }) => return Err(e),
             Err(e) => {
                 last = e;
                 ds *= 0.5;
