@@ -4,7 +4,7 @@
 //! Timings are wall-clock per solve on the calling thread, with the atlas built beforehand
 //! ([`ig::warm_up`]) so that its one-off construction is not charged to the first solve.
 
-use rod_ig_core::planar::ig::{self, solve, IgError, Method, Objective, SolveOptions, Tracker};
+use rod_ig_core::planar::ig::{self, solve, IgError, Method, SolveOptions, Tracker};
 use rod_ig_core::{planar, wrap_angle, PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -168,9 +168,7 @@ pub fn table1(
                 alpha,
                 max_iterations,
                 tolerance,
-                initial_guess: None,
-                objective: Objective::FirstFound,
-                deadline: ig::DEFAULT_DEADLINE,
+                ..SolveOptions::default()
             };
             let (mut ok, mut unst, mut maxit, mut sing, mut nonf) = (0, 0, 0, 0, 0);
             let mut iters = Vec::new();

@@ -42,7 +42,8 @@ mod types;
 
 pub use error::RodError;
 pub use types::{
-    wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, StabilityReport, STABILITY_T_MIN,
+    planar_det_leading_term, wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, StabilityReport,
+    STABILITY_T_MIN,
 };
 
 // The README's Rust example is compiled and run as a doc-test.

@@ -72,6 +72,15 @@ pub use crate::angle::wrap_angle;
 /// stability test (closed form, series, RK4 scan, 3-D grid) starts here.
 pub const STABILITY_T_MIN: f64 = 0.02;
 
+/// The leading small-t term of det J(t, a) for the planar rod, t⁹ (a3²/8640 + a5² t²/33600)
+/// (FINDINGS §5): the normalisation of the stability margin g(t) = det J(t) / this, written
+/// once for the closed form's test and the reference integrator's.
+pub fn planar_det_leading_term(a3: f64, a5: f64, t: f64) -> f64 {
+    let t2 = t * t;
+    let t9 = t2 * t2 * t2 * t2 * t;
+    t9 * (a3 * a3 / 8640.0 + a5 * a5 * t2 / 33600.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

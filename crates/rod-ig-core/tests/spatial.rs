@@ -465,12 +465,10 @@ fn ig_newton_and_failures() {
     };
     let opts = SolveOptions {
         max_iterations: 30,
+        max_starts: Some(3),
         ..Default::default()
     };
-    let model = Spatial {
-        max_starts: 3,
-        ..Spatial::default()
-    };
+    let model = Spatial::default();
     if let Ok(sol) = solver::solve(&model, &straight, &opts) {
         assert!(sol.stable);
     }

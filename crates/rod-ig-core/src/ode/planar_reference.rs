@@ -236,9 +236,9 @@ pub fn stability_grid() -> Vec<f64> {
     g
 }
 
-/// Leading small-t term of det J (FINDINGS §5): t⁹ (a3²/8640 + a5² t²/33600).
+/// Leading small-t term of det J (FINDINGS §5, [`crate::planar_det_leading_term`]).
 pub fn det_leading_term(a: &PlanarParams, t: f64) -> f64 {
-    t.powi(9) * (a[0] * a[0] / 8640.0 + a[2] * a[2] * t * t / 33600.0)
+    crate::planar_det_leading_term(a[0], a[2], t)
 }
 
 /// Accumulates the stability verdict over a sequence of (t, det J(t)).

@@ -600,18 +600,10 @@ pub fn energy(a: &PlanarParams) -> Result<f64, RodError> {
     }
 }
 
-/// Everything `rod-ig forward` reports for one a.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Evaluation {
-    /// Tip pose q(1).
-    pub tip: PlanarPose,
-    /// J(1, a), rows (x, y, θ), columns (a3, a4, a5).
-    pub jacobian: PlanarJacobian,
-    /// ½∫κ².
-    pub energy: f64,
-    /// Stability verdict and margin.
-    pub stability: StabilityReport,
-}
+/// Tip, J(1, a) (rows x, y, θ; columns a3, a4, a5), ½∫κ² and the stability verdict of one rod
+/// at full accuracy: the solvers' evaluation type ([`crate::solver::ModelEvaluation`]) for the
+/// planar rod.
+pub type Evaluation = crate::solver::ModelEvaluation<3, PlanarPose>;
 
 /// [`evaluate`] on the Taylor series (one dense integration serves all four quantities).
 fn evaluate_series(a: &PlanarParams) -> Result<Evaluation, RodError> {
@@ -624,6 +616,7 @@ fn evaluate_series(a: &PlanarParams) -> Result<Evaluation, RodError> {
         jacobian,
         energy,
         stability,
+        full_accuracy: true,
     })
 }
 
@@ -647,6 +640,7 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
                     jacobian,
                     energy,
                     stability,
+                    full_accuracy: true,
                 });
             }
             let (tip, jacobian) = pose_and_jac_of(c, a, 1.0)?;
@@ -664,6 +658,7 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
                     jacobian,
                     energy: rod.energy().v,
                     stability: stability::stability_of_series(a, Some(&rod), None, false)?,
+                    full_accuracy: true,
                 });
             }
             let energy = closed_energy(c, a, &tip)?;
@@ -673,6 +668,7 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
                 jacobian,
                 energy,
                 stability,
+                full_accuracy: true,
             })
         },
         || evaluate_series(a),

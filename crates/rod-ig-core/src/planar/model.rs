@@ -8,19 +8,6 @@ use crate::solver::{IgError, ModelEvaluation, RodModel};
 use crate::{wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 use nalgebra::{SMatrix, Vector3};
 
-/// A full-accuracy planar evaluation (closed form or series).
-impl From<crate::planar::Evaluation> for ModelEvaluation<3, PlanarPose> {
-    fn from(e: crate::planar::Evaluation) -> Self {
-        Self {
-            tip: e.tip,
-            jacobian: e.jacobian,
-            energy: e.energy,
-            stability: e.stability,
-            full_accuracy: true,
-        }
-    }
-}
-
 /// Checks the target: finite, and ‖(x, y)‖ < 1 (the unit rod is inextensible; the straight rod
 /// at distance 1 is unstable, FINDINGS §5).
 pub fn check_target(target: &PlanarPose) -> Result<(), IgError> {
@@ -243,7 +230,7 @@ impl RodModel<3> for PlanarClosedForm {
     }
 
     fn evaluate(&self, a: &Vector3<f64>) -> Result<ModelEvaluation<3, PlanarPose>, RodError> {
-        crate::planar::evaluate(a).map(ModelEvaluation::from)
+        crate::planar::evaluate(a)
     }
 
     fn evaluate_iterate(

@@ -2,6 +2,7 @@
 
 use super::closed::{Case, Closed, SeriesNeed};
 use super::taylor::{Gradient, TaylorRod};
+use crate::planar_det_leading_term as normalisation;
 use crate::scalar::Dual3;
 use crate::{PlanarParams, RodError, StabilityReport};
 
@@ -60,13 +61,6 @@ fn det3(j: &[[f64; 3]; 3]) -> f64 {
     let m1 = j[1][0] * j[2][2] - j[1][2] * j[2][0];
     let m2 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
     j[0][0] * m0 - j[0][1] * m1 + j[0][2] * m2
-}
-
-/// The FINDINGS §5 normalisation t⁹ (a3²/8640 + a5² t²/33600).
-fn normalisation(a3: f64, a5: f64, t: f64) -> f64 {
-    let t2 = t * t;
-    let t9 = t2 * t2 * t2 * t2 * t;
-    t9 * (a3 * a3 / 8640.0 + a5 * a5 * t2 / 33600.0)
 }
 
 fn rows(p: &[Dual3; 3]) -> [[f64; 3]; 3] {

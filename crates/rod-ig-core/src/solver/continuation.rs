@@ -26,6 +26,7 @@
 use super::model::{relative_distance, ModelEvaluation, RodModel};
 use super::{
     solve, solve_all, Failure, IgError, InverseGeometry, Solution, SolutionOf, SolveOptions,
+    Verified, Work,
 };
 use nalgebra::SVector;
 
@@ -427,28 +428,15 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
     }
 
     fn solution(&self, end: &Held<N, M::Pose>, target: &M::Pose, work: &Work) -> SolutionOf<N, M> {
-        let (pe, oe) = self.model.pose_error(&end.eval.tip, target);
-        Solution {
-            a: end.a,
+        let verified = Verified {
             tip: end.eval.tip,
-            stable: end.eval.stability.stable,
-            stability_margin: end.eval.stability.margin,
-            iterations: work.iterations,
-            position_error: pe,
-            orientation_error: oe,
-            residual: pe.hypot(oe),
+            errors: self.model.pose_error(&end.eval.tip, target),
             energy: end.eval.energy,
-            evaluations: work.evaluations,
-            starts: work.starts.max(1),
-            elapsed_us: 0.0,
+            margin: end.eval.stability.margin,
+        };
+        Solution {
+            stable: end.eval.stability.stable,
+            ..Solution::new(end.a, verified, *work)
         }
     }
-}
-
-/// Work counted over one move.
-#[derive(Clone, Copy, Debug, Default)]
-struct Work {
-    iterations: u32,
-    evaluations: u32,
-    starts: u32,
 }

@@ -53,7 +53,7 @@ pub use options::{
     DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, MAX_DEADLINE, MAX_ITERATIONS_LIMIT, MAX_TOLERANCE,
     MIN_TOLERANCE,
 };
-pub use outcome::{Failure, IgError, Solution, Termination};
+pub use outcome::{Failure, IgError, Solution, Termination, Verified, Work};
 
 use nalgebra::SVector;
 

@@ -9,7 +9,9 @@
 
 use super::model::{ModelEvaluation, RodModel};
 use super::observer::{emit, Event};
-use super::{Failure, FailureOf, IgError, Solution, SolutionOf, SolveOptions, Termination};
+use super::{
+    Failure, FailureOf, IgError, Solution, SolutionOf, SolveOptions, Termination, Verified, Work,
+};
 use nalgebra::SVector;
 
 /// The paper's Newton from `a0` (the deadline and observer of the enclosing scope apply).
@@ -135,18 +137,17 @@ fn verified<const N: usize, M: RodModel<N> + ?Sized>(
         model.evaluate(a).ok()?
     };
     let (pe, oe) = model.pose_error(&v.tip, target);
-    (pe <= options.tolerance && oe <= options.tolerance && v.stability.stable).then(|| Solution {
-        a: *a,
+    let verified = Verified {
         tip: v.tip,
-        stable: true,
-        stability_margin: v.stability.margin,
-        iterations: 0,
-        position_error: pe,
-        orientation_error: oe,
-        residual: pe.hypot(oe),
+        errors: (pe, oe),
         energy: v.energy,
+        margin: v.stability.margin,
+    };
+    let work = Work {
+        iterations: 0,
         evaluations: *evaluations,
         starts: 1,
-        elapsed_us: 0.0,
-    })
+    };
+    (pe <= options.tolerance && oe <= options.tolerance && v.stability.stable)
+        .then(|| Solution::new(*a, verified, work))
 }

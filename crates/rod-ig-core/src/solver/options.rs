@@ -49,6 +49,9 @@ pub struct SolveOptions<P> {
     /// Wall-time budget of one call (at most [`MAX_DEADLINE`]). Every loop of the solvers polls
     /// it; a solve that runs out returns [`IgError::Deadline`].
     pub deadline: Duration,
+    /// Starts the robust search tries at most (≥ 1); `None`: the model's search's default
+    /// (planar 48, 3-D 12). A setting of the search, not of the model.
+    pub max_starts: Option<u32>,
 }
 
 /// Default wall-time budget of one planar solve: 250 ms. The robust solver's p99.9 on the
@@ -87,6 +90,7 @@ impl<P> SolveOptions<P> {
             initial_guess: None,
             objective: Objective::FirstFound,
             deadline,
+            max_starts: None,
         }
     }
 }
@@ -131,6 +135,9 @@ pub fn check_options<const N: usize>(
             "deadline = {:?} is not in (0, {MAX_DEADLINE:?}]",
             options.deadline
         )));
+    }
+    if options.max_starts == Some(0) {
+        return Err(IgError::InvalidOptions("max_starts must be >= 1".into()));
     }
     if let Some(a0) = options.initial_guess {
         if let Some(index) = a0.iter().position(|v| !v.is_finite()) {

@@ -37,6 +37,54 @@ pub struct Solution<P, X> {
     pub elapsed_us: f64,
 }
 
+/// The work a search did, kept in one state and copied into its outcome.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Work {
+    /// Newton iterations (accepted steps).
+    pub iterations: u32,
+    /// Evaluations of the model, trials included.
+    pub evaluations: u32,
+    /// Starts tried.
+    pub starts: u32,
+}
+
+/// The evaluation a solution is built from: its tip, its (position, orientation) errors to
+/// the target, its energy and stability margin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Verified<X> {
+    /// Υ(a*).
+    pub tip: X,
+    /// (position error, orientation error) to the target.
+    pub errors: (f64, f64),
+    /// Elastic energy.
+    pub energy: f64,
+    /// Normalised stability margin (the rod passed the stability test).
+    pub margin: f64,
+}
+
+impl<P, X> Solution<P, X> {
+    /// A stable solution `a` evaluated as `v` after `work`: the one place a solution is
+    /// assembled (the residual is ‖errors‖₂; the wall time is set by the entry point that
+    /// times the call).
+    pub fn new(a: P, v: Verified<X>, work: Work) -> Self {
+        let (position_error, orientation_error) = v.errors;
+        Solution {
+            a,
+            tip: v.tip,
+            stable: true,
+            stability_margin: v.margin,
+            iterations: work.iterations,
+            position_error,
+            orientation_error,
+            residual: position_error.hypot(orientation_error),
+            energy: v.energy,
+            evaluations: work.evaluations,
+            starts: work.starts.max(1),
+            elapsed_us: 0.0,
+        }
+    }
+}
+
 /// Why a solve ended, as a small copyable code (for logs, metrics and the CLI's
 /// `termination` field). [`IgError::termination`] maps every error to one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

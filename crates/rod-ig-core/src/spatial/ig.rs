@@ -22,11 +22,18 @@ use super::{Evaluation3d, SpatialParams, SpatialPose, StabilityOptions, Stiffnes
 use crate::solver::globalised::{self, Iterate, Problem, Settings};
 use crate::solver::{
     emit, Event, Failure, Found, IgError, InverseGeometry, Solution, SolveOptions, Termination,
+    Verified, Work,
 };
 use nalgebra::{Matrix6, Vector3, Vector6};
 
-/// Seeds tried at most by the robust search (the length of [`seeds_for`]'s list).
+/// Seeds tried at most by the robust search (the length of [`seeds_for`]'s list) unless
+/// `SolveOptions::max_starts` says otherwise.
 pub const DEFAULT_MAX_STARTS: u32 = 12;
+
+/// The starts the 3-D search tries at most.
+fn max_starts(options: &SolveOptions3d) -> usize {
+    options.max_starts.unwrap_or(DEFAULT_MAX_STARTS).max(1) as usize
+}
 
 /// A 3-D solution.
 pub type Solution3d = Solution<SpatialParams, SpatialPose>;
@@ -150,20 +157,20 @@ impl Ctx<'_> {
 
     /// The solution `a` (evaluated as `ev`) found by start number `start` (0-based).
     fn solution(&self, a: SpatialParams, ev: &Evaluation3d, start: u32) -> Solution3d {
-        let (pe, ang) = ev.tip.distance_to(self.target);
-        Solution {
-            a,
+        let verified = Verified {
             tip: ev.tip,
-            stable: ev.stability.stable,
-            stability_margin: ev.stability.margin,
+            errors: ev.tip.distance_to(self.target),
+            energy: ev.energy,
+            margin: ev.stability.margin,
+        };
+        let work = Work {
             iterations: self.iterations,
             evaluations: self.evaluations,
             starts: start + 1,
-            position_error: pe,
-            orientation_error: ang,
-            residual: pe.hypot(ang),
-            energy: ev.energy,
-            elapsed_us: 0.0,
+        };
+        Solution {
+            stable: ev.stability.stable,
+            ..Solution::new(a, verified, work)
         }
     }
 
@@ -435,7 +442,7 @@ fn robust(ctx: &mut Ctx) -> Result<Solution3d, Failure3d> {
         list.push(g);
     }
     list.extend(seeds_for(ctx.target, &ctx.model.stiffness));
-    list.truncate(ctx.model.max_starts.max(1) as usize);
+    list.truncate(max_starts(ctx.opts));
     let mut last = IgError::LeftStableSet {
         iteration: ctx.iterations,
     };
@@ -520,9 +527,7 @@ impl InverseGeometry<6> for Spatial {
         let mut ctx = Ctx::new(self, target, options);
         let mut list: Vec<SpatialParams> = options.initial_guess.into_iter().collect();
         list.extend(seeds_for(target, &self.stiffness));
-        list.truncate(
-            self.max_starts.max(1) as usize + usize::from(options.initial_guess.is_some()),
-        );
+        list.truncate(max_starts(options) + usize::from(options.initial_guess.is_some()));
         let rtol0 = LOOSE_RTOL.max(self.rtol);
         let scale = crate::solver::RodModel::param_scale(self);
         let mut solutions: Vec<Solution3d> = Vec::new();

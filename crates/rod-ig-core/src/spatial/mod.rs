@@ -567,19 +567,10 @@ pub fn energy(a: &SpatialParams, k: &Stiffness, rtol: f64) -> Result<f64, RodErr
     Ok(states(a, k, &[1.0], rtol)?[0].energy)
 }
 
-/// Everything the inverse-geometry solver needs from one integration: tip, J(1, a), energy
-/// and the stability verdict.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Evaluation3d {
-    /// q(1).
-    pub tip: SpatialPose,
-    /// J(1, a).
-    pub jacobian: SpatialJacobian,
-    /// ½∫ Σ μ_i²/c_i.
-    pub energy: f64,
-    /// Stability verdict by the coarse scan with refinement ([`stability_with`]).
-    pub stability: crate::StabilityReport,
-}
+/// Tip, J(1, a), energy (½∫ Σ μ_i²/c_i) and the stability verdict (coarse scan with refinement,
+/// [`stability_with`]) from one integration: the solvers' evaluation type
+/// ([`crate::solver::ModelEvaluation`]) for the 3-D rod.
+pub type Evaluation3d = crate::solver::ModelEvaluation<6, SpatialPose>;
 
 /// Tip, J(1, a), energy and stability from a single dense integration at relative tolerance
 /// `opts.rtol` and absolute tolerance `opts.atol` (see [`StabilityOptions`]).

@@ -5,19 +5,6 @@ use crate::solver::{IgError, ModelEvaluation, RodModel};
 use crate::RodError;
 use nalgebra::{SMatrix, SVector};
 
-/// A full-accuracy 3-D evaluation (at the model's rtol).
-impl From<crate::spatial::Evaluation3d> for ModelEvaluation<6, SpatialPose> {
-    fn from(e: crate::spatial::Evaluation3d) -> Self {
-        Self {
-            tip: e.tip,
-            jacobian: e.jacobian,
-            energy: e.energy,
-            stability: e.stability,
-            full_accuracy: true,
-        }
-    }
-}
-
 /// The 3-D rod (FINDINGS3D) by DOP853 on the Hamiltonian system with its variational
 /// equations, for stiffnesses `stiffness` at relative tolerance `rtol`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,8 +14,6 @@ pub struct Spatial {
     /// Relative tolerance of the integrations ([`crate::spatial::PRODUCTION_RTOL`] by
     /// default).
     pub rtol: f64,
-    /// Robust strategy: number of seeds tried at most ([`crate::spatial::ig::seeds_for`]).
-    pub max_starts: u32,
 }
 
 impl Default for Spatial {
@@ -36,13 +21,12 @@ impl Default for Spatial {
         Self {
             stiffness: Stiffness::default(),
             rtol: crate::spatial::PRODUCTION_RTOL,
-            max_starts: crate::spatial::ig::DEFAULT_MAX_STARTS,
         }
     }
 }
 
 impl Spatial {
-    /// The 3-D model with stiffnesses `stiffness` and the default tolerance and starts.
+    /// The 3-D model with stiffnesses `stiffness` and the default tolerance.
     pub fn with_stiffness(stiffness: Stiffness) -> Self {
         Self {
             stiffness,
@@ -67,7 +51,7 @@ impl RodModel<6> for Spatial {
             rtol: self.rtol,
             ..crate::spatial::StabilityOptions::production()
         };
-        crate::spatial::evaluate(a, &self.stiffness, &options).map(ModelEvaluation::from)
+        crate::spatial::evaluate(a, &self.stiffness, &options)
     }
 
     fn energy(&self, a: &SVector<f64, 6>) -> Result<f64, RodError> {
@@ -124,9 +108,6 @@ impl RodModel<6> for Spatial {
         self.stiffness
             .validate()
             .map_err(|e| IgError::InvalidOptions(e.to_string()))?;
-        if self.max_starts == 0 {
-            return Err(IgError::InvalidOptions("max_starts must be >= 1".into()));
-        }
         Ok(())
     }
 }

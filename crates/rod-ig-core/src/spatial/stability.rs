@@ -433,6 +433,7 @@ pub(crate) fn evaluate_if_stable(
             jacobian: jac_of(&y),
             energy: y[ENERGY],
             stability,
+            full_accuracy: true,
         }),
         stability,
     ))
@@ -450,6 +451,7 @@ pub(super) fn evaluate_impl(
         jacobian: jac_of(&y),
         energy: y[ENERGY],
         stability,
+        full_accuracy: true,
     })
 }
 

@@ -182,7 +182,7 @@ struct SlabLists {
 static BUILDER: Mutex<Option<Builder>> = Mutex::new(None);
 
 /// What a thread does next for the build.
-enum Work {
+enum Step {
     Chunk(usize),
     Slab(usize, Arc<Atlas>),
     /// Another thread computes the pieces still missing.
@@ -226,26 +226,26 @@ fn build() -> Option<&'static Atlas> {
                 continue;
             }
             let work = guard.get_or_insert_with(Builder::new).next_work();
-            if matches!(work, Work::Done(_)) {
+            if matches!(work, Step::Done(_)) {
                 *guard = None;
             }
             work
         };
         match work {
-            Work::Chunk(c) => {
+            Step::Chunk(c) => {
                 let seeds = chunk_seeds(c);
                 if let Some(b) = lock_builder().as_mut() {
                     b.file_chunk(c, seeds);
                 }
             }
-            Work::Slab(ix, seeded) => {
+            Step::Slab(ix, seeded) => {
                 let lists = seeded.short_lists(ix);
                 if let Some(b) = lock_builder().as_mut() {
                     b.slabs[ix].get_or_insert(lists);
                 }
             }
-            Work::Wait => std::thread::sleep(Duration::from_micros(50)),
-            Work::Done(atlas) => {
+            Step::Wait => std::thread::sleep(Duration::from_micros(50)),
+            Step::Done(atlas) => {
                 let _ = ATLAS.set(atlas);
             }
         }
@@ -282,42 +282,42 @@ impl Builder {
     }
 
     /// The next piece of work.
-    fn next_work(&mut self) -> Work {
+    fn next_work(&mut self) -> Step {
         let now = Instant::now();
         if self.handed_out < CHUNKS {
             return self.hand_out(now);
         }
         if self.filed < CHUNKS {
-            return self.missing(self.filed, now, Work::Chunk(self.filed));
+            return self.missing(self.filed, now, Step::Chunk(self.filed));
         }
         let Some(seeded) = self.seeded.clone() else {
-            return Work::Wait;
+            return Step::Wait;
         };
         if self.handed_out < CHUNKS + NXY {
             let ix = self.handed_out - CHUNKS;
             self.hand_out(now);
-            return Work::Slab(ix, seeded);
+            return Step::Slab(ix, seeded);
         }
         if let Some(ix) = self.slabs.iter().position(Option::is_none) {
-            return self.missing(CHUNKS + ix, now, Work::Slab(ix, seeded));
+            return self.missing(CHUNKS + ix, now, Step::Slab(ix, seeded));
         }
-        Work::Done(self.assemble(seeded))
+        Step::Done(self.assemble(seeded))
     }
 
-    fn hand_out(&mut self, now: Instant) -> Work {
+    fn hand_out(&mut self, now: Instant) -> Step {
         self.handed_at.push(now);
         self.handed_out += 1;
-        Work::Chunk(self.handed_out - 1)
+        Step::Chunk(self.handed_out - 1)
     }
 
     /// Piece `id` is handed out but not delivered: `again` if its thread seems to have died
     /// (a piece takes ~0.5 ms), else wait for it.
-    fn missing(&mut self, id: usize, now: Instant, again: Work) -> Work {
+    fn missing(&mut self, id: usize, now: Instant, again: Step) -> Step {
         if now.duration_since(self.handed_at[id]) > LOST_WORK {
             self.handed_at[id] = now;
             again
         } else {
-            Work::Wait
+            Step::Wait
         }
     }
 

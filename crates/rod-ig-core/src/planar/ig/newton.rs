@@ -6,6 +6,7 @@
 use super::Solution;
 use crate::planar::model;
 use crate::planar::model::Precision;
+use crate::solver::{Verified, Work};
 use crate::{PlanarJacobian, PlanarParams, PlanarPose};
 use nalgebra::Vector3;
 
@@ -75,23 +76,25 @@ pub(crate) fn make_solution(
     margin: f64,
     iterations: u32,
 ) -> Solution {
-    Solution {
-        a: *a,
+    // The identity cancels on nearly straight rods under force: the evaluation's energy
+    // (integrated where needed) when there is one.
+    let energy = e
+        .energy
+        .or_else(|| crate::planar::energy(a).ok())
+        .unwrap_or_else(|| model::energy_from_tip(a, &e.tip));
+    let verified = Verified {
         tip: e.tip,
-        stable,
-        stability_margin: margin,
+        errors: (e.pos_err, e.ang_err),
+        energy,
+        margin,
+    };
+    let work = Work {
         iterations,
-        position_error: e.pos_err,
-        orientation_error: e.ang_err,
-        residual: e.norm,
-        // The identity cancels on nearly straight rods under force: the evaluation's energy
-        // (integrated where needed) when there is one.
-        energy: e
-            .energy
-            .or_else(|| crate::planar::energy(a).ok())
-            .unwrap_or_else(|| model::energy_from_tip(a, &e.tip)),
         evaluations: iterations + 1,
         starts: 1,
-        elapsed_us: 0.0,
+    };
+    Solution {
+        stable,
+        ..Solution::new(*a, verified, work)
     }
 }

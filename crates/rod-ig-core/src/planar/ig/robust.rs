@@ -11,8 +11,8 @@ use crate::planar::model;
 use crate::solver::{emit, Event, Termination};
 use crate::{PlanarParams, PlanarPose};
 
-/// Total start budget of one robust solve.
-const MAX_STARTS: usize = 48;
+/// Total start budget of one robust solve, unless `SolveOptions::max_starts` says otherwise.
+pub(crate) const MAX_STARTS: usize = 48;
 /// The polishing stage runs when the best residual is below this.
 const POLISH_BELOW: f64 = 0.05;
 /// Iteration budget of the polishing stage (at most the caller's `max_iterations`).
@@ -332,7 +332,8 @@ pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solut
     let mut starts = Starts::new(target, atlas, options);
     let budget = per_start_budget(options);
     let mut n = 0;
-    while n < MAX_STARTS {
+    let max_starts = options.max_starts.map_or(MAX_STARTS, |m| m.max(1) as usize);
+    while n < max_starts {
         if crate::solver::deadline::expired() {
             return Err(deadline_failure(&counts));
         }
