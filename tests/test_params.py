@@ -191,3 +191,38 @@ def test_params_file_with_unknown_keys_warns_and_starts(tmp_path):
     finally:
         c.close()
         assert node.stop() == 0
+
+
+def test_params_file_sections_as_rcl_reads_them(tmp_path):
+    """Issue 20: the sections rcl applies: `/**/rod_ig_node` and a nested namespace section
+    reach the node in /left; a file with only other nodes' sections, and `-p` of a name the
+    node does not have, leave it starting on its defaults (it used to exit with code 2)."""
+    nested = tmp_path / "nested.yaml"
+    nested.write_text("/**/rod_ig_node:\n  ros__parameters:\n    path_samples: 21\n"
+                      "/left:\n  rod_ig_node:\n    ros__parameters:\n      rod_length: 0.8\n"
+                      "/right:\n  rod_ig_node:\n    ros__parameters:\n      rod_length: 3.0\n")
+    others = tmp_path / "others.yaml"
+    others.write_text("camera:\n  ros__parameters:\n    rate: 30\n")
+    domain = h.free_domain()
+    node = h.NodeProcess(domain, ["--ros-args", "-r", "__ns:=/left", "--params-file", str(nested),
+                                  "--params-file", str(others), "-p", "nosuch:=1"])
+    c = h.Client(domain, ns="/left", node_fqn="/left/rod_ig_node")
+    try:
+        assert c.wait_connected(), node.log_text()
+        assert c.get_params("path_samples", "rod_length") == {"path_samples": 21, "rod_length": 0.8}
+        log = node.log_text()
+        assert "-p nosuch: not a parameter of this node, ignored" in log, log
+        assert "no section for /left/rod_ig_node" in log, log
+    finally:
+        c.close()
+        assert node.stop() == 0
+
+
+def test_base_frame_must_be_a_frame_id(node_and_client):
+    """Issue 20: '' and 'bad frame!' were accepted and then published as frame ids."""
+    _, c = node_and_client
+    for bad in ["", "bad frame!", "/world"]:
+        results = c.set_params(base_frame=bad)
+        assert not results[0].successful, bad
+        assert "frame id" in results[0].reason, results[0].reason
+    assert c.get_params("base_frame") == {"base_frame": "rod_base"}

@@ -164,6 +164,12 @@ def test_diagnostics_report_solves_failures_and_latency(node_and_client):
         st, values = found
         assert int(values["solved_total"]) >= 1
         assert any(k.startswith("failed: ") and "reach" in k for k in values), values
+        # Issue 20: failure keys are typed reasons (a bounded set), never free text or numbers.
+        typed = {"unreachable", "non_planar", "invalid_input", "deadline", "no_stable_solution",
+                 "iteration_limit", "singular", "left_stable_set", "stalled", "evaluation_failed"}
+        reasons = [k.removeprefix("failed: ") for k in values if k.startswith("failed: ")]
+        assert set(reasons) <= typed, reasons
+        assert st.hardware_id == "/rod_ig_node", st.hardware_id
         assert float(values["latency_p50_ms"]) > 0 and float(values["latency_p99_ms"]) >= float(values["latency_p50_ms"])
         assert values["last_error"], values
         assert float(values["solves_per_second"]) >= 0

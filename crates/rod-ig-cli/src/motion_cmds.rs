@@ -42,6 +42,12 @@ struct TrackAnswer {
     /// After a snap: the elastic energy it released.
     #[serde(skip_serializing_if = "Option::is_none")]
     energy_released: Option<f64>,
+    /// How far along the gripper's path the rod was followed (1 when the target was reached;
+    /// on a deadline, where the rod now held is).
+    progress: f64,
+    /// The rod held after this line (null once lost): on a deadline, the last equilibrium
+    /// reached, from which the next line goes on.
+    held_a: Option<[f64; 3]>,
 }
 
 /// The state of a `track` stream: the follower and, for `--svg`, the rods so far.
@@ -112,6 +118,8 @@ impl Tracking {
             critical: None,
             critical_a: None,
             energy_released: None,
+            progress: m.progress,
+            held_a: follower.rod().map(|a| params3(&a)),
         };
         if let BranchEvent::Snap {
             critical,

@@ -247,7 +247,8 @@ fn followers_work_on_the_3d_model_and_report_bad_input() {
         assert!(matches!(m.event, BranchEvent::None));
         assert_eq!(m.result.expect("stays").a, buckled_up());
     }
-    // A move that runs out of time loses the rod (its state is unknown), with the reason.
+    // A move that runs out of time keeps the rod it reached (here: before any step), with the
+    // reason (issue 20: it used to lose it).
     let mut follower =
         BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), buckled_up())
             .expect("held");
@@ -256,11 +257,47 @@ fn followers_work_on_the_3d_model_and_report_bad_input() {
         ..SolveOptions::default()
     });
     let m = follower.follow(&PlanarPose::new(0.7, 0.1, 0.2));
-    assert!(matches!(m.event, BranchEvent::Lost));
+    assert!(matches!(m.event, BranchEvent::None));
     let f = m.result.expect_err("no time to move");
     assert_eq!(f.termination(), rod_ig_core::solver::Termination::Deadline);
-    assert!(follower.rod().is_none());
+    assert_eq!(follower.rod(), Some(buckled_up()));
+    assert_eq!(m.progress, 0.0);
     // An unstable rod cannot be held.
     let straight = PlanarParams::zeros();
     assert!(BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), straight).is_err());
+}
+
+/// Issue 20: a move that runs out of time keeps the last equilibrium reached (event none,
+/// termination deadline, the rod held and how far it got) instead of losing the rod; the next
+/// move goes on from there.
+#[test]
+fn a_move_out_of_time_keeps_the_rod() {
+    rod_ig_core::planar::ig::warm_up();
+    let options = SolveOptions {
+        deadline: std::time::Duration::from_millis(30),
+        ..SolveOptions::default()
+    };
+    let mut follower = BranchFollower::new(PlanarClosedForm, options);
+    let start = follower.follow(&PlanarPose::new(0.4, 0.1, 0.5));
+    assert!(start.result.is_ok());
+    // A long move through strongly compressed rods (expensive evaluations): 30 ms is short.
+    let m = follower.follow(&PlanarPose::new(0.875, 0.0, 0.3));
+    match &m.result {
+        Ok(_) => assert_eq!(m.progress, 1.0),
+        Err(f) => {
+            assert_eq!(f.termination(), rod_ig_core::solver::Termination::Deadline);
+            assert!(matches!(m.event, BranchEvent::None), "{:?}", m.event);
+            assert!(m.progress > 0.0 && m.progress < 1.0, "{}", m.progress);
+            let held = follower.rod().expect("the rod is kept");
+            assert_eq!(Some(held), f.last_a);
+            // The rod kept is a stable equilibrium (reference integrator's verdict).
+            let verdict = PlanarReference::default()
+                .stability(&held)
+                .expect("evaluates");
+            assert!(verdict.stable, "{verdict:?}");
+            // Its tip is on the gripper's path, where the follower says it is.
+            let tip = follower.gripper().expect("held");
+            assert!((tip.x - 0.4).abs() <= 0.475 + 1e-6 && tip.y.abs() <= 0.1 + 1e-6);
+        }
+    }
 }

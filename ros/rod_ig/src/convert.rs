@@ -49,6 +49,16 @@ pub enum TargetError {
 }
 
 impl TargetError {
+    /// The bounded key the diagnostics count this refusal by: "unreachable" as the solver
+    /// says it, "non_planar", or "invalid_input" (non-finite, not a rotation).
+    pub fn key(&self) -> &'static str {
+        match self {
+            Self::OutOfReach { .. } => "unreachable",
+            Self::OffPlane { .. } | Self::Tilted { .. } => "non_planar",
+            Self::NonFinite(_) | Self::ZeroQuaternion(_) => "invalid_input",
+        }
+    }
+
     /// The target is valid except that it is not planar (z or tilt beyond
     /// `planar_tolerance`): the 3-D solver can take it when `solve_3d` is set.
     pub fn is_non_planar(&self) -> bool {

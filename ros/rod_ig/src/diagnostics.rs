@@ -32,28 +32,10 @@ pub struct SolveStats {
     work: Counters,
 }
 
-/// The short reason of a failure message, for counting: the text before the first `:`,
-/// and for `"solver failed: <reason>: ..."` the solver's reason (e.g. "deadline reached").
-pub fn reason_key(message: &str) -> String {
-    let mut parts = message.split(':').map(str::trim);
-    let first = parts.next().unwrap_or_default();
-    let key = match (first, parts.next()) {
-        ("solver failed", Some(reason)) if !reason.is_empty() => reason,
-        _ => first,
-    };
-    let key = key.split(" (").next().unwrap_or(key).trim();
-    let key: String = key.chars().take(48).collect();
-    if key.is_empty() {
-        "unknown".into()
-    } else {
-        key
-    }
-}
-
 impl SolveStats {
-    /// Records one solve: its success, its message (the reason when it failed) and its wall
-    /// time in seconds.
-    pub fn record(&mut self, success: bool, message: &str, seconds: f64) {
+    /// Records one solve: its success, why it failed (`failure`: a bounded key, the solver's
+    /// termination or `rejected_target`), its message and its wall time in seconds.
+    pub fn record(&mut self, success: bool, failure: &str, message: &str, seconds: f64) {
         if seconds.is_finite() && seconds >= 0.0 {
             if self.latencies_s.len() == LATENCY_WINDOW {
                 self.latencies_s.pop_front();
@@ -66,10 +48,12 @@ impl SolveStats {
         } else {
             self.failed += 1;
             self.failed_in_period += 1;
-            *self
-                .failures_by_reason
-                .entry(reason_key(message))
-                .or_default() += 1;
+            let key = if failure.is_empty() {
+                "unknown"
+            } else {
+                failure
+            };
+            *self.failures_by_reason.entry(key.to_string()).or_default() += 1;
             self.last_error = Some(message.to_string());
         }
     }
@@ -144,7 +128,16 @@ impl SolveStats {
             kv("last_error", self.last_error.clone().unwrap_or_default()),
             kv("solver_iterations_total", self.work.iterations.to_string()),
             kv("solver_starts_total", self.work.starts.to_string()),
-            kv("solver_deadlines_total", self.work.deadlines.to_string()),
+            // Every deadline, the branch follower's too (whose moves are not solves the
+            // observer sees end).
+            kv(
+                "solver_deadlines_total",
+                self.failures_by_reason
+                    .get("deadline")
+                    .copied()
+                    .unwrap_or(0)
+                    .to_string(),
+            ),
             kv(
                 "solver_max_starts_per_solve",
                 self.work.max_starts_per_solve.to_string(),
@@ -161,7 +154,8 @@ impl SolveStats {
             level,
             name: name.to_string(),
             message,
-            hardware_id: String::new(),
+            // A software component: diagnostic_updater's convention is its node's name.
+            hardware_id: name.split(':').next().unwrap_or(name).trim().to_string(),
             values,
         }
     }
@@ -183,30 +177,46 @@ mod tests {
     }
 
     #[test]
-    fn reasons_are_short_and_grouped() {
-        assert_eq!(
-            reason_key("solver failed: deadline reached (250 ms)"),
-            "deadline reached"
-        );
-        assert_eq!(reason_key("out of reach: |p| = 1.2 > 1"), "out of reach");
-        assert_eq!(reason_key("bad target: NaN in position"), "bad target");
-        assert_eq!(reason_key(""), "unknown");
+    fn failure_keys_are_bounded_whatever_the_messages() {
+        // Issue 20: keys embedded free text and numbers ("failed: deadline reached after 161
+        // iterations without co"), so the key set grew without bound.
+        let mut s = SolveStats::default();
+        for k in 0..500 {
+            let message = format!("solver failed: deadline reached after {k} iterations");
+            s.record(false, "deadline", &message, 0.25);
+            s.record(
+                false,
+                "unreachable",
+                &format!("out of reach: |p| = {k}"),
+                1e-4,
+            );
+        }
+        let r = s.report("/rod_ig_node: inverse geometry", 1.0, 1000, 0);
+        let failure_keys: Vec<&str> = r
+            .values
+            .iter()
+            .map(|kv| kv.key.as_str())
+            .filter(|k| k.starts_with("failed: "))
+            .collect();
+        assert_eq!(failure_keys, ["failed: deadline", "failed: unreachable"]);
+        assert_eq!(value(&r, "solver_deadlines_total"), "500");
+        assert_eq!(r.hardware_id, "/rod_ig_node");
     }
 
     #[test]
     fn report_counts_rates_and_percentiles() {
         let mut s = SolveStats::default();
         for i in 1..=100 {
-            s.record(true, "", f64::from(i) * 1e-3); // 1..100 ms
+            s.record(true, "", "", f64::from(i) * 1e-3); // 1..100 ms
         }
-        s.record(false, "out of reach: far", 0.5e-3);
-        s.record(false, "solver failed: deadline reached", 0.25);
+        s.record(false, "unreachable", "out of reach: far", 0.5e-3);
+        s.record(false, "deadline", "solver failed: deadline reached", 0.25);
         let r = s.report("/rod_ig_node: inverse geometry", 2.0, 102, 0);
         assert_eq!(r.level, level::WARN);
         assert!(r.message.contains("2 of 102"), "{}", r.message);
         assert_eq!(value(&r, "solves_per_second"), "51.00");
-        assert_eq!(value(&r, "failed: out of reach"), "1");
-        assert_eq!(value(&r, "failed: deadline reached"), "1");
+        assert_eq!(value(&r, "failed: unreachable"), "1");
+        assert_eq!(value(&r, "failed: deadline"), "1");
         assert_eq!(value(&r, "last_error"), "solver failed: deadline reached");
         // Nearest rank over 102 latencies: p50 is the 51st smallest (50 ms), p99 the 101st
         // (100 ms).
@@ -223,9 +233,9 @@ mod tests {
     fn latency_window_is_bounded() {
         let mut s = SolveStats::default();
         for _ in 0..3 * LATENCY_WINDOW {
-            s.record(true, "", 1e-3);
+            s.record(true, "", "", 1e-3);
         }
-        s.record(true, "", f64::NAN);
+        s.record(true, "", "", f64::NAN);
         assert_eq!(s.latencies_s.len(), LATENCY_WINDOW);
         assert_eq!(s.latency_quantile(0.99), Some(1e-3));
     }

@@ -912,6 +912,7 @@ fn report(
         solves.record_work(work);
         solves.record(
             outcome.solution.success,
+            outcome.failure,
             &outcome.solution.message,
             elapsed.as_secs_f64(),
         );

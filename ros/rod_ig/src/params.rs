@@ -897,7 +897,7 @@ where
             .map_err(|e| ParamError::Args(e.to_string()))?,
         ..Params::default()
     };
-    let keys = node_keys(&identity);
+    let fqn = identity.fully_qualified_name();
     for source in &ros.params {
         match source {
             ParamSource::Value { node, name, value } => {
@@ -907,9 +907,15 @@ where
                 {
                     continue; // for another node
                 }
-                params.apply(name.trim(), &parse_value(value))?;
+                let name = name.trim();
+                if !params.is_known(name) {
+                    // rcl declares nothing for a name the node does not use: say so, go on.
+                    log::warn!("-p {name}: not a parameter of this node, ignored");
+                    continue;
+                }
+                params.apply(name, &parse_value(value))?;
             }
-            ParamSource::File(path) => load_params_file_for(&mut params, path, &keys)?,
+            ParamSource::File(path) => load_params_file_for(&mut params, path, &fqn)?,
         }
     }
     Ok(Command::Run(Box::new(Startup {
@@ -920,43 +926,25 @@ where
     })))
 }
 
-/// The keys a parameters file may use for this node: its name, its fully qualified name (with
-/// and without the leading `/`), and the wildcards `/**` and `**`.
-fn node_keys(identity: &NodeIdentity) -> Vec<String> {
-    let fq = identity.fully_qualified_name();
-    vec![
-        identity.name.clone(),
-        fq.trim_start_matches('/').to_string(),
-        fq,
-        "/**".into(),
-        "**".into(),
-    ]
-}
-
-/// Node-name keys a ROS 2 parameters file may use for this node.
-const NODE_KEYS: [&str; 4] = ["rod_ig_node", "/rod_ig_node", "/**", "**"];
+/// The default node's fully qualified name.
+const DEFAULT_FQN: &str = "/rod_ig_node";
 
 /// Applies a ROS 2 parameters file (`rod_ig_node: {ros__parameters: {...}}`; also
 /// `/rod_ig_node` and the wildcard `/**`) to `params`. Unknown parameters are skipped with a
 /// warning (a shared file may configure other nodes' parameters, e.g. `use_sim_time`, under
 /// `/**`); invalid values of known ones are errors.
 pub fn load_params_file(params: &mut Params, path: &Path) -> Result<(), ParamError> {
-    let keys: Vec<String> = NODE_KEYS.iter().map(|k| k.to_string()).collect();
-    load_params_file_for(params, path, &keys)
+    load_params_file_for(params, path, DEFAULT_FQN)
 }
 
-/// [`load_params_file`] for a node known under `keys` (see `node_keys`).
-fn load_params_file_for(
-    params: &mut Params,
-    path: &Path,
-    keys: &[String],
-) -> Result<(), ParamError> {
+/// [`load_params_file`] for the node whose fully qualified name is `fqn`.
+fn load_params_file_for(params: &mut Params, path: &Path, fqn: &str) -> Result<(), ParamError> {
     let file_err = |reason: String| ParamError::File {
         path: path.to_path_buf(),
         reason,
     };
     let text = std::fs::read_to_string(path).map_err(|e| file_err(e.to_string()))?;
-    apply_params_yaml_for(params, &text, keys).map_err(|e| match e {
+    apply_params_yaml_for(params, &text, fqn).map_err(|e| match e {
         ParamError::File { reason, .. } => file_err(reason),
         other => file_err(other.to_string()),
     })
@@ -964,35 +952,33 @@ fn load_params_file_for(
 
 /// Applies the text of a ROS 2 parameters file (see [`load_params_file`]).
 pub fn apply_params_yaml(params: &mut Params, text: &str) -> Result<(), ParamError> {
-    let keys: Vec<String> = NODE_KEYS.iter().map(|k| k.to_string()).collect();
-    apply_params_yaml_for(params, text, &keys)
+    apply_params_yaml_for(params, text, DEFAULT_FQN)
 }
 
-fn apply_params_yaml_for(
-    params: &mut Params,
-    text: &str,
-    keys: &[String],
-) -> Result<(), ParamError> {
+fn apply_params_yaml_for(params: &mut Params, text: &str, fqn: &str) -> Result<(), ParamError> {
     let err = |reason: String| ParamError::File {
         path: PathBuf::new(),
         reason,
     };
     let doc: serde_yaml::Value = serde_yaml::from_str(text).map_err(|e| err(e.to_string()))?;
-    let top = doc
-        .as_mapping()
-        .ok_or_else(|| err("top level must be a mapping of node names".into()))?;
-    let mut found = false;
-    for (key, section) in top {
-        let Some(key) = key.as_str() else { continue };
-        if !keys.iter().any(|k| k == key) {
-            continue;
-        }
-        let Some(ros_params) = section.get("ros__parameters") else {
-            return Err(err(format!("section '{key}' has no 'ros__parameters'")));
-        };
-        if !ros_params.is_mapping() {
-            return Err(err(format!("'{key}.ros__parameters' must be a mapping")));
-        }
+    if !doc.is_mapping() {
+        return Err(err("top level must be a mapping of node names".into()));
+    }
+    let mut sections = Vec::new();
+    node_sections("", &doc, &mut sections).map_err(err)?;
+    let node = name_tokens(fqn);
+    let mine: Vec<_> = sections
+        .iter()
+        .filter(|(key, _)| section_matches(&name_tokens(key), &node))
+        .collect();
+    if mine.is_empty() {
+        let keys: Vec<&str> = sections.iter().map(|(k, _)| k.as_str()).collect();
+        log::info!(
+            "parameters file: no section for {fqn} (sections: {}): defaults kept",
+            keys.join(", ")
+        );
+    }
+    for (key, ros_params) in mine {
         // Nested mappings name parameters with dots, as rcl reads them
         // (`qos_overrides: {/rod/target: {subscription: {depth: 1}}}`).
         let mut flat = Vec::new();
@@ -1010,15 +996,52 @@ fn apply_params_yaml_for(
                 .ok_or_else(|| err(format!("parameter '{name}': unsupported value {value:?}")))?;
             params.apply(&name, &value)?;
         }
-        found = true;
     }
-    if found {
-        Ok(())
-    } else {
-        Err(err(format!(
-            "no section for this node (expected one of {})",
-            keys.join(", ")
-        )))
+    Ok(())
+}
+
+/// Every `ros__parameters` mapping of a parameters file with the node key it sits under: keys
+/// nest as rcl reads them (`/left:` → `rod_ig_node:` is `/left/rod_ig_node`).
+fn node_sections<'a>(
+    prefix: &str,
+    value: &'a serde_yaml::Value,
+    out: &mut Vec<(String, &'a serde_yaml::Value)>,
+) -> Result<(), String> {
+    let Some(map) = value.as_mapping() else {
+        return Err(format!("'{prefix}' must be a mapping"));
+    };
+    for (k, v) in map {
+        let k = k
+            .as_str()
+            .ok_or_else(|| format!("node names must be strings, got {k:?}"))?;
+        if k == "ros__parameters" {
+            if !v.is_mapping() {
+                return Err(format!("'{prefix}.ros__parameters' must be a mapping"));
+            }
+            out.push((prefix.to_string(), v));
+        } else {
+            node_sections(&format!("{prefix}/{k}"), v, out)?;
+        }
+    }
+    Ok(())
+}
+
+/// The tokens of a node name or key (`/left//rod_ig_node` → ["left", "rod_ig_node"]).
+fn name_tokens(name: &str) -> Vec<&str> {
+    name.split('/').filter(|t| !t.is_empty()).collect()
+}
+
+/// rcl's matching of a params-file key against a node's fully qualified name: token by token,
+/// `*` matching one token and `**` any number (none included).
+fn section_matches(key: &[&str], node: &[&str]) -> bool {
+    match (key.first(), node.first()) {
+        (None, None) => true,
+        (Some(&"**"), _) => {
+            section_matches(&key[1..], node)
+                || (!node.is_empty() && section_matches(key, &node[1..]))
+        }
+        (Some(&k), Some(&n)) if k == "*" || k == n => section_matches(&key[1..], &node[1..]),
+        _ => false,
     }
 }
 
@@ -1127,10 +1150,8 @@ mod tests {
     fn bad_command_lines_are_rejected_with_a_reason() {
         let e = run(&["-p", "rod_length:=-1"]).unwrap_err();
         assert!(e.to_string().contains("rod_length"), "{e}");
-        assert!(matches!(
-            run(&["-p", "nope:=1"]),
-            Err(ParamError::Unknown(_))
-        ));
+        // A name the node does not have is skipped with a warning (rcl declares nothing).
+        assert!(run(&["-p", "nope:=1"]).is_ok());
         assert!(matches!(
             run(&["-p", "rod_length"]),
             Err(ParamError::Args(_))
@@ -1175,7 +1196,8 @@ mod tests {
         assert_eq!(q.path_samples, 7);
 
         let mut r = Params::default();
-        assert!(apply_params_yaml(&mut r, "other_node:\n  ros__parameters: {}\n").is_err());
+        // Only other nodes' sections (a launch file's shared YAML): the defaults, no error.
+        assert!(apply_params_yaml(&mut r, "other_node:\n  ros__parameters: {}\n").is_ok());
         // Unknown keys are skipped with a warning (issue 10), not fatal.
         assert!(apply_params_yaml(&mut r, "rod_ig_node:\n  ros__parameters:\n    x: 1\n").is_ok());
         assert!(apply_params_yaml(&mut r, "[1, 2]").is_err());
@@ -1300,5 +1322,71 @@ mod tests {
             );
             assert_eq!(p.base_frame, "robot-1.base", "unchanged after {bad:?}");
         }
+    }
+
+    /// The sections rcl applies to a node (issue 20): wildcards, fully qualified names, nested
+    /// namespaces, the renamed node; a file without one leaves the defaults; `-p` of a name
+    /// the node does not have is skipped.
+    #[test]
+    fn params_file_sections_as_rcl_reads_them() {
+        let dir = std::env::temp_dir().join(format!("rod_ig_params_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let cases: [(&str, &[&str], Option<i64>); 9] = [
+            (
+                "/**:\n  ros__parameters:\n    path_samples: 11\n",
+                &[],
+                Some(11),
+            ),
+            (
+                "/**/rod_ig_node:\n  ros__parameters:\n    path_samples: 12\n",
+                &["-r", "__ns:=/left"],
+                Some(12),
+            ),
+            (
+                "/left/rod_ig_node:\n  ros__parameters:\n    path_samples: 13\n",
+                &["-r", "__ns:=/left"],
+                Some(13),
+            ),
+            (
+                "/left:\n  rod_ig_node:\n    ros__parameters:\n      path_samples: 14\n",
+                &["-r", "__ns:=/left"],
+                Some(14),
+            ),
+            (
+                "/left:\n  rod_ig_node:\n    ros__parameters:\n      path_samples: 15\n",
+                &["-r", "__ns:=/right"],
+                None,
+            ),
+            (
+                "arm_rod:\n  ros__parameters:\n    path_samples: 16\n",
+                &["-r", "__node:=arm_rod"],
+                Some(16),
+            ),
+            (
+                "/*/rod_ig_node:\n  ros__parameters:\n    path_samples: 17\n",
+                &["-r", "__ns:=/a/b"],
+                None,
+            ),
+            (
+                "/**/rod_ig_node:\n  ros__parameters:\n    path_samples: 18\n",
+                &["-r", "__ns:=/a/b"],
+                Some(18),
+            ),
+            ("camera:\n  ros__parameters:\n    rate: 30\n", &[], None),
+        ];
+        for (k, (yaml, args, expected)) in cases.iter().enumerate() {
+            let path = dir.join(format!("p{k}.yaml"));
+            std::fs::write(&path, yaml).unwrap();
+            let mut argv: Vec<&str> = vec!["--ros-args"];
+            argv.extend_from_slice(args);
+            let file = path.to_str().unwrap();
+            argv.extend_from_slice(&["--params-file", file]);
+            let p = run(&argv).unwrap_or_else(|e| panic!("{yaml:?} {args:?}: {e}"));
+            let want = expected.unwrap_or(100) as usize;
+            assert_eq!(p.path_samples, want, "{yaml:?} with {args:?}");
+        }
+        let p = run(&["--ros-args", "-p", "nosuch:=1", "-p", "path_samples:=5"]).unwrap();
+        assert_eq!(p.path_samples, 5);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -22,6 +22,9 @@ use crate::solver::{spatial_of_planar, Failed, PlanarParams, RodSolver, SolverSe
 pub struct Outcome {
     /// Always present.
     pub solution: RodSolution,
+    /// Why it failed, as a bounded key: the solver's termination, or for a target refused
+    /// before any solve [`crate::convert::TargetError::key`]; "" on success.
+    pub failure: &'static str,
     /// The shape, on success.
     pub path: Option<Path>,
     /// The RViz line strip, on success when `publish_marker` is set.
@@ -112,11 +115,13 @@ fn outcome<T, S: ShapeSample>(
                 .then(|| shape_to_marker(&shape, header, params, stable));
             Outcome {
                 solution,
+                failure: "",
                 path: Some(path),
                 marker,
             }
         }
         Err(failed) => Outcome {
+            failure: failed.termination,
             solution: failure_message(
                 format!("solver failed: {}", failed.reason),
                 Some(&failed),
@@ -196,9 +201,10 @@ impl Processor {
             deadline: settings.deadline,
             follow_branch: false,
         });
-        let rejected = |message: String| Outcome {
+        let rejected = |e: crate::convert::TargetError| Outcome {
+            failure: e.key(),
             solution: failure_message(
-                message,
+                e.to_string(),
                 None,
                 &header,
                 params,
@@ -226,7 +232,7 @@ impl Processor {
             Err(e) if e.is_non_planar() && params.solve_3d => {
                 let spatial = match target_to_spatial(&target.pose, params) {
                     Ok(t) => t,
-                    Err(e) => return rejected(e.to_string()),
+                    Err(e) => return rejected(e),
                 };
                 let guess = overrides.initial_guess.as_ref().map(spatial_of_planar);
                 let result = self.solver.solve_3d(&spatial, guess, one_off, samples);
@@ -239,7 +245,7 @@ impl Processor {
                     )
                 })
             }
-            Err(e) => rejected(e.to_string()),
+            Err(e) => rejected(e),
         }
     }
 

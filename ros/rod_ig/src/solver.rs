@@ -60,6 +60,9 @@ pub type Solved3d = WithShape<Solution3d, SpatialPose>;
 pub struct Failed {
     /// Why (the solver's own message).
     pub reason: String,
+    /// The typed reason (`Termination::as_str`: "deadline", "no_stable_solution", ...): the
+    /// bounded key the diagnostics count failures by.
+    pub termination: &'static str,
     /// Iterations used.
     pub iterations: u32,
     /// Last residual.
@@ -79,6 +82,7 @@ impl From<Failure> for Failed {
     fn from(f: Failure) -> Self {
         Self {
             reason: f.reason.to_string(),
+            termination: f.termination().as_str(),
             iterations: f.iterations,
             residual: f.residual,
             last_a: f.last_a,
@@ -93,6 +97,7 @@ impl From<Failure3d> for Failed {
     fn from(f: Failure3d) -> Self {
         Self {
             reason: f.reason.to_string(),
+            termination: f.termination().as_str(),
             iterations: f.iterations,
             residual: f.residual,
             last_a: f.last_a.as_ref().map(planar_part),
@@ -267,6 +272,7 @@ impl RodSolver {
 fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
     let rod = PlanarRod::new(&s.a).map_err(|e| Failed {
         reason: format!("cannot evaluate the solution's shape: {e}"),
+        termination: rod_ig_core::solver::Termination::EvaluationFailed.as_str(),
         iterations: s.iterations,
         residual: s.residual,
         last_a: Some(s.a),
@@ -285,6 +291,7 @@ fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
 fn with_shape_3d(s: &Solution3d, samples: usize) -> Result<Solved3d, Failed> {
     let shape = spatial::shape(&s.a, &Stiffness::default(), samples).map_err(|e| Failed {
         reason: format!("cannot evaluate the solution's shape: {e}"),
+        termination: rod_ig_core::solver::Termination::EvaluationFailed.as_str(),
         iterations: s.iterations,
         residual: s.residual,
         last_a: Some(planar_part(&s.a)),

@@ -229,6 +229,10 @@ impl RodModel<3> for PlanarClosedForm {
         crate::planar::tip(a)
     }
 
+    fn tip_and_jacobian(&self, a: &Vector3<f64>) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+        crate::planar::tip_and_jacobian(a)
+    }
+
     fn evaluate(&self, a: &Vector3<f64>) -> Result<ModelEvaluation<3, PlanarPose>, RodError> {
         crate::planar::evaluate(a)
     }
@@ -261,6 +265,10 @@ impl RodModel<3> for PlanarReference {
 
     fn tip(&self, a: &Vector3<f64>) -> Result<PlanarPose, RodError> {
         Ok(crate::ode::planar_reference::tip_and_jacobian(a, self.rtol)?.0)
+    }
+
+    fn tip_and_jacobian(&self, a: &Vector3<f64>) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+        crate::ode::planar_reference::tip_and_jacobian(a, self.rtol)
     }
 
     fn evaluate(&self, a: &Vector3<f64>) -> Result<ModelEvaluation<3, PlanarPose>, RodError> {

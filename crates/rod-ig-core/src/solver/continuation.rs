@@ -22,13 +22,19 @@
 //! (relative parameter distance) is taken: the end of a descent of the energy from the
 //! critical shape, which moves the rod the least. Then the motion goes on from there to b₁.
 //! When no such equilibrium exists the rod is **lost** (`success: false`).
+//!
+//! **Out of time.** A move that runs out of its deadline keeps the last equilibrium reached
+//! (an equilibrium of the branch, stable since det J(1, a) kept its sign) and says so:
+//! `Deadline` with event `None`, [`Move::progress`] the fraction of the move done; the next
+//! move starts from that rod. The corrector evaluates only Υ(a) and J(1, a); the full
+//! stability test runs once, on the rod the move ends with.
 
 use super::model::{relative_distance, ModelEvaluation, RodModel};
 use super::{
     solve, solve_all, Failure, IgError, InverseGeometry, Solution, SolutionOf, SolveOptions,
     Verified, Work,
 };
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 /// Smallest continuation step, as a fraction of the gripper's move: the critical pose of a
 /// snap is located to within this fraction (1/4096 of a 1 cm move is 2.4 µm).
@@ -85,21 +91,36 @@ pub struct Move<P, X> {
     pub result: Result<Solution<P, X>, Failure<P>>,
     /// Branch event of the move.
     pub event: BranchEvent<P, X>,
+    /// How far along the gripper's path the rod was followed (1 when the target was reached; on
+    /// a deadline the fraction at which the rod kept, [`BranchFollower::rod`], is held).
+    pub progress: f64,
 }
 
-/// The rod held by the grippers: current equilibrium and the gripper pose it is held at.
+/// The rod held by the grippers: an equilibrium, its gripper pose and J(1, a) (whose
+/// determinant's sign marks its branch's side of the stability boundary).
 #[derive(Clone, Copy, Debug)]
 struct Held<const N: usize, X> {
     a: SVector<f64, N>,
-    eval: ModelEvaluation<N, X>,
+    tip: X,
+    jacobian: SMatrix<f64, N, N>,
+}
+
+impl<const N: usize, X> Held<N, X> {
+    fn of(a: SVector<f64, N>, e: ModelEvaluation<N, X>) -> Self {
+        Self {
+            a,
+            tip: e.tip,
+            jacobian: e.jacobian,
+        }
+    }
 }
 
 /// Why a continuation stopped before the target.
 enum Stop<const N: usize, X> {
     /// The branch folded: the last stable rod, at gripper pose fraction `s`.
     Fold(Held<N, X>, f64),
-    /// The solve's deadline or an evaluation failure.
-    Error(IgError),
+    /// The deadline passed: the last rod reached, at gripper pose fraction `s`.
+    Deadline(Held<N, X>, f64),
 }
 
 /// Follows the rod's equilibrium branch as the gripper moves (module docs). Works for every
@@ -144,7 +165,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         Ok(Self {
             model,
             options,
-            held: Some(Held { a: a0, eval }),
+            held: Some(Held::of(a0, eval)),
         })
     }
 
@@ -160,7 +181,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
 
     /// The gripper pose the rod is held at now, if any.
     pub fn gripper(&self) -> Option<M::Pose> {
-        self.held.map(|h| h.eval.tip)
+        self.held.map(|h| h.tip)
     }
 
     /// The model.
@@ -195,6 +216,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
             return Move {
                 result: Err(Failure::early(e)),
                 event: BranchEvent::None,
+                progress: 0.0,
             };
         }
         let target = &self.model.canonical_target(target);
@@ -203,35 +225,23 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         let mut current = held;
         let mut first_snap: Option<(M::Pose, SVector<f64, N>, f64)> = None;
         let mut snaps = 0;
+        // The fraction of the whole move done before `current`'s segment began.
+        let mut done = 0.0;
         loop {
             match self.continue_to(&current, target, &mut work) {
-                Ok(end) => {
-                    self.held = Some(end);
-                    let s = self.solution(&end, target, &work);
-                    let event = match first_snap {
-                        None => BranchEvent::None,
-                        Some((critical, critical_a, released)) => BranchEvent::Snap {
-                            critical,
-                            critical_a,
-                            energy_released: released,
-                            snaps,
-                        },
-                    };
-                    return Move {
-                        result: Ok(s),
-                        event,
-                    };
-                }
-                Err(Stop::Error(e)) => {
-                    // Deadline or evaluation failure mid-move: the gripper is somewhere on
-                    // the way, the rod's state is not known.
-                    self.held = None;
-                    return self.lost(e, &work, current.a);
+                Ok(end) => return self.arrived(end, target, &work, first_snap, snaps),
+                Err(Stop::Deadline(at, s)) => {
+                    // Out of time mid-move: the rod reached so far is an equilibrium of the
+                    // branch (stable by the det J(1, a) sign it kept), so it stays held.
+                    self.held = Some(at);
+                    let progress = 1.0 - (1.0 - done) * (1.0 - s);
+                    return self.out_of_time(&at, target, &work, progress);
                 }
                 Err(Stop::Fold(critical, s)) => {
                     snaps += 1;
-                    let settled = self.snap(&current, &critical, s, target, snaps, &mut work);
-                    let Some(settled) = settled else {
+                    let critical_energy = self.model.energy(&critical.a).unwrap_or(f64::NAN);
+                    let settled = self.snap(&current, &critical, critical_energy, s, target, snaps);
+                    let Some((settled, energy)) = settled else {
                         self.held = None;
                         let e = IgError::NoStableSolution {
                             starts: work.starts,
@@ -242,12 +252,75 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                         return self.lost(e, &work, critical.a);
                     };
                     if first_snap.is_none() {
-                        let released = critical.eval.energy - settled.eval.energy;
-                        first_snap = Some((critical.eval.tip, critical.a, released));
+                        first_snap = Some((critical.tip, critical.a, critical_energy - energy));
                     }
+                    done = 1.0 - (1.0 - done) * (1.0 - (s + 2.0 * MIN_STEP).min(1.0));
                     current = settled;
                 }
             }
+        }
+    }
+
+    /// The move reached its target with `end`: verified at full accuracy (energy, stability)
+    /// and held; the event says whether the rod snapped on the way.
+    fn arrived(
+        &mut self,
+        end: Held<N, M::Pose>,
+        target: &M::Pose,
+        work: &Work,
+        first_snap: Option<(M::Pose, SVector<f64, N>, f64)>,
+        snaps: u32,
+    ) -> Move<SVector<f64, N>, M::Pose> {
+        let eval = match self.model.evaluate(&end.a) {
+            Ok(e) if e.stability.stable => e,
+            // The branch's stability is tracked by the sign of det J(1, a) alone; a rod that
+            // fails the full test at the end is not held.
+            _ => {
+                self.held = None;
+                let e = IgError::LeftStableSet {
+                    iteration: work.iterations,
+                };
+                return self.lost(e, work, end.a);
+            }
+        };
+        self.held = Some(end);
+        let event = match first_snap {
+            None => BranchEvent::None,
+            Some((critical, critical_a, released)) => BranchEvent::Snap {
+                critical,
+                critical_a,
+                energy_released: released,
+                snaps,
+            },
+        };
+        Move {
+            result: Ok(self.solution(&end, &eval, target, work)),
+            event,
+            progress: 1.0,
+        }
+    }
+
+    /// The deadline passed with the rod `at` held, a fraction `progress` of the way.
+    fn out_of_time(
+        &self,
+        at: &Held<N, M::Pose>,
+        target: &M::Pose,
+        work: &Work,
+        progress: f64,
+    ) -> Move<SVector<f64, N>, M::Pose> {
+        let (pe, oe) = self.model.pose_error(&at.tip, target);
+        Move {
+            result: Err(Failure {
+                reason: IgError::Deadline {
+                    iteration: work.iterations,
+                },
+                iterations: work.iterations,
+                residual: pe.hypot(oe),
+                last_a: Some(at.a),
+                elapsed_us: 0.0,
+            }),
+            event: BranchEvent::None,
+            progress,
         }
     }
 
@@ -255,41 +328,44 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
     fn fresh_solve(&mut self, target: &M::Pose) -> Move<SVector<f64, N>, M::Pose> {
         let result = solve(&self.model, target, &self.options);
         self.held = result.as_ref().ok().and_then(|s| {
-            let eval = self.model.evaluate(&s.a).ok()?;
-            Some(Held { a: s.a, eval })
+            let (tip, jacobian) = self.model.tip_and_jacobian(&s.a).ok()?;
+            Some(Held {
+                a: s.a,
+                tip,
+                jacobian,
+            })
         });
-        let event = match result {
-            Ok(_) => BranchEvent::None,
-            Err(_) => BranchEvent::Lost,
+        let (event, progress) = match result {
+            Ok(_) => (BranchEvent::None, 1.0),
+            Err(_) => (BranchEvent::Lost, 0.0),
         };
-        Move { result, event }
+        Move {
+            result,
+            event,
+            progress,
+        }
     }
 
-    /// The rod the branch snaps to when it folds at `critical`, a fraction `s` of the way from
-    /// `current`'s gripper pose to `target`: settled just past the fold (module docs); `None`
-    /// after [`MAX_SNAPS`] snaps in one move or when no stable rod is found there.
+    /// The rod the branch snaps to when it folds at `critical` (of energy `critical_energy`),
+    /// a fraction `s` of the way from `current`'s gripper pose to `target`: settled just past
+    /// the fold (module docs), with its energy; `None` after [`MAX_SNAPS`] snaps in one move or
+    /// when no stable rod is found there.
     fn snap(
         &self,
         current: &Held<N, M::Pose>,
         critical: &Held<N, M::Pose>,
+        critical_energy: f64,
         s: f64,
         target: &M::Pose,
         snaps: u32,
-        work: &mut Work,
-    ) -> Option<Held<N, M::Pose>> {
+    ) -> Option<(Held<N, M::Pose>, f64)> {
         if snaps > MAX_SNAPS {
             return None;
         }
-        let start = self.gripper_start(current);
         let past = self
             .model
-            .interpolate(&start, target, (s + 2.0 * MIN_STEP).min(1.0));
-        self.settle(critical, &past, work)
-    }
-
-    /// The gripper pose a held rod is at.
-    fn gripper_start(&self, held: &Held<N, M::Pose>) -> M::Pose {
-        held.eval.tip
+            .interpolate(&current.tip, target, (s + 2.0 * MIN_STEP).min(1.0));
+        self.settle(critical, critical_energy, &past)
     }
 
     fn lost(
@@ -307,6 +383,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                 elapsed_us: 0.0,
             }),
             event: BranchEvent::Lost,
+            progress: 0.0,
         }
     }
 
@@ -315,19 +392,18 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
     fn settle(
         &self,
         critical: &Held<N, M::Pose>,
+        critical_energy: f64,
         pose: &M::Pose,
-        work: &mut Work,
-    ) -> Option<Held<N, M::Pose>> {
+    ) -> Option<(Held<N, M::Pose>, f64)> {
         let options = SolveOptions {
             initial_guess: None,
             ..self.options
         };
         let candidates = solve_all(&self.model, pose, &options);
-        work.starts += candidates.iter().map(|c| c.starts).sum::<u32>();
         let scale = self.model.param_scale();
         let best = candidates
             .iter()
-            .filter(|c| c.energy < critical.eval.energy)
+            .filter(|c| c.energy < critical_energy)
             .min_by(|p, q| {
                 relative_distance(&p.a, &critical.a, &scale).total_cmp(&relative_distance(
                     &q.a,
@@ -336,7 +412,9 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                 ))
             })?;
         let eval = self.model.evaluate(&best.a).ok()?;
-        eval.stability.stable.then_some(Held { a: best.a, eval })
+        eval.stability
+            .stable
+            .then_some((Held::of(best.a, eval), best.energy))
     }
 
     /// Predictor–corrector from `held` (at its gripper pose) to `target` (module docs).
@@ -346,14 +424,12 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         target: &M::Pose,
         work: &mut Work,
     ) -> Result<Held<N, M::Pose>, Stop<N, M::Pose>> {
-        let start = held.eval.tip;
+        let start = held.tip;
         let mut current = *held;
         let (mut s, mut ds) = (0.0f64, 1.0f64);
         while s < 1.0 {
             if crate::solver::deadline::expired() {
-                return Err(Stop::Error(IgError::Deadline {
-                    iteration: work.iterations,
-                }));
+                return Err(Stop::Deadline(current, s));
             }
             let s_new = (s + ds).min(1.0);
             let last = s_new >= 1.0;
@@ -384,8 +460,9 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         Ok(current)
     }
 
-    /// Tangent predictor and contracting Newton corrections from `from` to `goal`; the rod
-    /// reached if it meets `tolerance` and is stable.
+    /// Tangent predictor and contracting Newton corrections from `from` to `goal`: the rod
+    /// reached if it meets `tolerance` without crossing det J(1, a) = 0 (the only way off the
+    /// stable branch, module docs), so that no iterate needs the full stability test.
     fn correct(
         &self,
         from: &Held<N, M::Pose>,
@@ -393,50 +470,51 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         tolerance: f64,
         work: &mut Work,
     ) -> Option<Held<N, M::Pose>> {
-        let mut a = from.a;
-        let mut eval = from.eval;
+        let side = self.model.jacobian_det(&from.jacobian);
+        let mut x = *from;
         let mut previous_step = f64::INFINITY;
         for _ in 0..=CORRECTOR_ITERATIONS {
             if crate::solver::deadline::expired() {
                 return None;
             }
-            let (pe, oe) = self.model.pose_error(&eval.tip, goal);
+            let (pe, oe) = self.model.pose_error(&x.tip, goal);
             if pe <= tolerance && oe <= tolerance {
-                return eval.stability.stable.then_some(Held { a, eval });
+                return Some(x);
             }
             let d = self
                 .model
-                .newton_increment(&eval.tip, &eval.jacobian, goal)
+                .newton_increment(&x.tip, &x.jacobian, goal)
                 .ok()?;
             let step = d.norm();
             if step > CONTRACTION * previous_step {
                 return None;
             }
             previous_step = step;
-            a += d;
+            x.a += d;
             work.iterations += 1;
             work.evaluations += 1;
-            eval = self.model.evaluate(&a).ok()?;
-            // The stable set is left only through det J(1, a) = 0: a sign change means the
-            // step crossed the fold.
-            let det = self.model.jacobian_det(&eval.jacobian);
-            if det * self.model.jacobian_det(&from.eval.jacobian) <= 0.0 {
+            (x.tip, x.jacobian) = self.model.tip_and_jacobian(&x.a).ok()?;
+            // A sign change of det J(1, a) means the step crossed the fold.
+            if self.model.jacobian_det(&x.jacobian) * side <= 0.0 {
                 return None;
             }
         }
         None
     }
 
-    fn solution(&self, end: &Held<N, M::Pose>, target: &M::Pose, work: &Work) -> SolutionOf<N, M> {
+    fn solution(
+        &self,
+        end: &Held<N, M::Pose>,
+        eval: &ModelEvaluation<N, M::Pose>,
+        target: &M::Pose,
+        work: &Work,
+    ) -> SolutionOf<N, M> {
         let verified = Verified {
-            tip: end.eval.tip,
-            errors: self.model.pose_error(&end.eval.tip, target),
-            energy: end.eval.energy,
-            margin: end.eval.stability.margin,
+            tip: eval.tip,
+            errors: self.model.pose_error(&eval.tip, target),
+            energy: eval.energy,
+            margin: eval.stability.margin,
         };
-        Solution {
-            stable: end.eval.stability.stable,
-            ..Solution::new(end.a, verified, *work)
-        }
+        Solution::new(end.a, verified, *work)
     }
 }

@@ -39,6 +39,15 @@ pub trait RodModel<const N: usize> {
     /// Tip, J(1, a), energy and stability, at the model's full accuracy.
     fn evaluate(&self, a: &SVector<f64, N>) -> Result<ModelEvaluation<N, Self::Pose>, RodError>;
 
+    /// Υ(a) and J(1, a) alone (no energy, no stability test): what a continuation's corrector
+    /// needs, whose iterates stay on one branch by the sign of det J(1, a).
+    fn tip_and_jacobian(
+        &self,
+        a: &SVector<f64, N>,
+    ) -> Result<(Self::Pose, SMatrix<f64, N, N>), RodError> {
+        self.evaluate(a).map(|e| (e.tip, e.jacobian))
+    }
+
     /// As [`Self::evaluate`], for an iterate of a run that began at `start`: a model may use a
     /// cheaper accuracy there (setting `full_accuracy` false).
     fn evaluate_iterate(

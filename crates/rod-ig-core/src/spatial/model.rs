@@ -54,6 +54,13 @@ impl RodModel<6> for Spatial {
         crate::spatial::evaluate(a, &self.stiffness, &options)
     }
 
+    fn tip_and_jacobian(
+        &self,
+        a: &SVector<f64, 6>,
+    ) -> Result<(SpatialPose, SMatrix<f64, 6, 6>), RodError> {
+        super::tip_and_jacobian(a, &self.stiffness, self.rtol)
+    }
+
     fn energy(&self, a: &SVector<f64, 6>) -> Result<f64, RodError> {
         crate::spatial::energy(a, &self.stiffness, self.rtol)
     }
