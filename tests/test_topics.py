@@ -170,3 +170,54 @@ def test_first_target_respects_max_iterations():
     finally:
         c.close()
         assert node.stop() == 0
+
+
+def test_rosout_as_rclcpp_writes_it():
+    """Issue 20: the logger is `<namespace>.<node>` with dots, `--log-level debug` reaches
+    /rosout too, messages name the remapped topics, and file, function and line are filled."""
+    domain = h.free_domain()
+    node = h.NodeProcess(domain, ["--ros-args", "-r", "__ns:=/left", "-r", "rod/target:=/arm/goal",
+                                  "--log-level", "debug"])
+    c = h.Client(domain, ns="/left", node_fqn="/left/rod_ig_node", target_topic="/arm/goal")
+    try:
+        assert c.wait_connected(), node.log_text()
+        far, near = h.next_seq(), h.next_seq()
+        c.pub.publish(c.make_target(5.0, 0.0, 0.0, far))
+        assert c.solution_for(far) is not None
+        c.pub.publish(c.make_target(0.5, 0.2, 1.0, near))
+        assert c.solution_for(near) is not None
+        warn = c.wait_for(lambda: next((m for m in c.logs if m.level == 30 and "out of reach" in m.msg),
+                                       None), timeout=5)
+        assert warn is not None, [m.msg for m in c.logs][-5:]
+        assert warn.name == "left.rod_ig_node", warn.name
+        assert "/arm/goal" in warn.msg, warn.msg
+        assert warn.function not in ("", "<unknown_func>") and warn.line > 0, (warn.function, warn.line)
+        assert warn.file.endswith(".rs"), warn.file
+        debug = c.wait_for(lambda: next((m for m in c.logs if m.level == 10
+                                         and m.name == "left.rod_ig_node"), None), timeout=5)
+        assert debug is not None, "DEBUG records reach /rosout with --log-level debug"
+        mine = [m.msg for m in c.logs if m.name == "left.rod_ig_node"]
+        assert not any("/rod/target" in m for m in mine), mine
+    finally:
+        c.close()
+        assert node.stop() == 0
+
+
+def test_stdout_logs_can_be_disabled():
+    """Issue 20: `--disable-stdout-logs` silences the console; /rosout still has the records."""
+    domain = h.free_domain()
+    node = h.NodeProcess(domain, ["--ros-args", "--disable-stdout-logs"])
+    c = h.Client(domain)
+    try:
+        assert c.wait_connected(timeout=30)
+        ready = c.wait_for(lambda: next((m for m in c.logs if "ready" in m.msg), None), timeout=10)
+        # The ready line may predate the client's subscription; a later record proves /rosout.
+        s = h.next_seq()
+        c.pub.publish(c.make_target(5.0, 0.0, 0.0, s))
+        assert c.solution_for(s) is not None
+        warn = c.wait_for(lambda: next((m for m in c.logs if "out of reach" in m.msg), None), timeout=5)
+        assert warn is not None or ready is not None
+        assert "ready" not in node.log_text() and "out of reach" not in node.log_text(), node.log_text()
+    finally:
+        c.close()
+        assert node.stop() == 0

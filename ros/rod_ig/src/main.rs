@@ -16,11 +16,13 @@ fn main() -> ExitCode {
     let mut logger = env_logger::Builder::from_env(
         env_logger::Env::default().default_filter_or(DEFAULT_LOG_FILTER),
     );
-    if let Some(f) = rod_ig_node::ros_args::parse(&args)
-        .ok()
-        .and_then(|a| a.log_filter())
-    {
+    let ros = rod_ig_node::ros_args::parse(&args).ok();
+    if let Some(f) = ros.as_ref().and_then(|a| a.log_filter()) {
         logger.parse_filters(&f);
+    }
+    if ros.as_ref().and_then(|a| a.stdout_logs) == Some(false) {
+        // `--disable-stdout-logs`: nothing on the console (rcl's switch).
+        logger.parse_filters("off");
     }
     // Milliseconds: start-up and matching events are a few ms apart (ROS logs stamp finer).
     logger.format_timestamp_millis().init();

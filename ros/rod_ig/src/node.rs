@@ -12,6 +12,27 @@
 //! A flood of targets cannot pile up: the subscriber task only overwrites the one slot of a
 //! `tokio::sync::watch` channel, and the solver task always takes the newest target.
 
+/// The enclosing function's name ([`function_of`]).
+macro_rules! function_name {
+    () => {{
+        fn here() {}
+        $crate::node::function_of(std::any::type_name_of_val(&here))
+    }};
+}
+
+/// Logs through a [`Logger`] at a [`RosLevel`] with the call site's file, function and line.
+macro_rules! node_log {
+    ($logger:expr, $level:ident, $($arg:tt)+) => {
+        $logger.log(
+            RosLevel::$level,
+            function_name!(),
+            file!(),
+            line!(),
+            &format!($($arg)+),
+        )
+    };
+}
+
 use std::pin::pin;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -22,8 +43,8 @@ use ros2_client::dds::rustdds::DomainParticipantBuilder;
 use ros2_client::log::LogLevel;
 use ros2_client::qos::{Durability, History, WhenFull};
 use ros2_client::{
-    rosout, Context, Name, NodeLoggingHandle, NodeName, NodeOptions, ParameterValue, Publisher,
-    QosProfile, ServiceMapping,
+    Context, Name, NodeLoggingHandle, NodeName, NodeOptions, ParameterValue, Publisher, QosProfile,
+    ServiceMapping,
 };
 use thiserror::Error;
 use tokio::sync::{mpsc, oneshot, watch};
@@ -35,7 +56,8 @@ use crate::messages::{
 };
 use crate::params::{Params, Startup};
 use crate::pipeline::{Outcome, Overrides, Processor};
-use crate::ros_args::NodeIdentity;
+use crate::ros_args::{LogLevel as RosLevel, NodeIdentity};
+use ros2_client::rosout::RosoutRaw;
 
 pub use crate::graph::{names, NODE_NAME};
 
@@ -171,27 +193,58 @@ fn ros_descriptor(
     }
 }
 
-/// Console (env_logger) plus /rosout logging.
+/// Console (env_logger) plus /rosout logging, as rclcpp's loggers: named `<namespace>.<node>`
+/// with dots, the `--log-level` threshold applied to /rosout too, the call site's file,
+/// function and line in every record ([`node_log!`]).
+#[derive(Clone)]
 pub struct Logger {
-    handle: NodeLoggingHandle,
+    handle: Arc<NodeLoggingHandle>,
+    name: Arc<str>,
+    threshold: RosLevel,
 }
 
 impl Logger {
-    /// Logs at info level.
-    pub fn info(&self, msg: &str) {
-        log::info!("{msg}");
-        rosout!(self.handle, LogLevel::Info, "{}", msg);
+    /// The logger of `node` named `name`, publishing records at `threshold` or above.
+    fn new(node: &ros2_client::Node, (name, threshold): &(String, RosLevel)) -> Self {
+        Self {
+            handle: Arc::new(node.logging_handle()),
+            name: name.as_str().into(),
+            threshold: *threshold,
+        }
     }
-    /// Logs at warn level.
-    pub fn warn(&self, msg: &str) {
-        log::warn!("{msg}");
-        rosout!(self.handle, LogLevel::Warn, "{}", msg);
+
+    /// One record at `level` from `function` at `file`:`line`.
+    pub fn log(&self, level: RosLevel, function: &str, file: &str, line: u32, msg: &str) {
+        let (console, ros) = match level {
+            RosLevel::Debug => (log::Level::Debug, LogLevel::Debug),
+            RosLevel::Info => (log::Level::Info, LogLevel::Info),
+            RosLevel::Warn => (log::Level::Warn, LogLevel::Warn),
+            RosLevel::Error => (log::Level::Error, LogLevel::Error),
+            RosLevel::Fatal => (log::Level::Error, LogLevel::Fatal),
+        };
+        log::log!(console, "{msg}");
+        if level >= self.threshold {
+            self.handle.rosout_raw(
+                ros2_client::builtin_interfaces::Time::now(),
+                ros,
+                &self.name,
+                msg,
+                file,
+                function,
+                line,
+            );
+        }
     }
-    /// Logs at error level.
-    pub fn error(&self, msg: &str) {
-        log::error!("{msg}");
-        rosout!(self.handle, LogLevel::Error, "{}", msg);
+}
+
+/// The name of a function from the type name of an item inside it (closures and async
+/// blocks stripped): what rclcpp's macros take from `__FUNCTION__`.
+pub fn function_of(path: &str) -> &str {
+    let mut p = path.strip_suffix("::here").unwrap_or(path);
+    while let Some(q) = p.strip_suffix("::{{closure}}") {
+        p = q;
     }
+    p.rsplit("::").next().unwrap_or(p)
 }
 
 /// Counters reported at shutdown and, with the solve record, on /diagnostics.
@@ -224,6 +277,20 @@ struct Outputs {
     solution: Publisher<RodSolution>,
     marker: Publisher<Marker>,
     plan_rods: Publisher<Marker>,
+    /// The resolved names, for the logs (remapped and namespaced as the graph shows them).
+    names: Names,
+}
+
+/// The node's resolved topic and service names.
+#[derive(Clone, Debug, Default)]
+struct Names {
+    target: String,
+    path: String,
+    solution: String,
+    marker: String,
+    plan_rods: String,
+    solve: String,
+    plan: String,
 }
 
 /// Creates the DDS context for `mw` (domain, loopback restriction).
@@ -327,7 +394,7 @@ fn spawn_solver_thread(
             {
                 Ok(rt) => rt,
                 Err(e) => {
-                    log.error(&format!("cannot start the solver thread's runtime: {e}"));
+                    node_log!(log, Error, "cannot start the solver thread's runtime: {e}");
                     return;
                 }
             };
@@ -419,6 +486,15 @@ fn create_endpoints(
         plan_rods: node
             .create_publisher(&plan_rods_topic, Some(out_qos.clone()))
             .map_err(create_err("/rod/plan_rods publisher"))?,
+        names: Names {
+            target: resolved[0].clone(),
+            path: resolved[1].clone(),
+            solution: resolved[2].clone(),
+            marker: resolved[3].clone(),
+            plan_rods: resolved[4].clone(),
+            solve: solve_full.clone(),
+            plan: plan_full.clone(),
+        },
     };
     let endpoints = Endpoints {
         target_topic,
@@ -434,6 +510,8 @@ fn create_endpoints(
 /// The node's inputs: the target subscription and the two services.
 struct Inputs {
     targets: ros2_client::Subscription<PoseStamped>,
+    /// The resolved target topic (for the logs).
+    target_name: String,
     solve: ros2_client::Server<SolveRodRequest, SolveRodResponse>,
     plan: ros2_client::Server<PlanRodRequest, PlanRodResponse>,
 }
@@ -448,6 +526,7 @@ fn create_inputs(
 ) -> Result<Inputs, NodeError> {
     let qos = topic_qos();
     Ok(Inputs {
+        target_name: endpoints.resolved[0].clone(),
         targets: node
             .create_subscription::<PoseStamped>(
                 &endpoints.target_topic,
@@ -480,23 +559,21 @@ fn create_inputs(
 fn spawn_tasks(
     node: &Arc<ros2_client::Node>,
     inputs: Inputs,
-    diagnostics: Publisher<crate::messages::DiagnosticArray>,
+    (diagnostics, diag_name): (Publisher<crate::messages::DiagnosticArray>, String),
     target_tx: watch::Sender<Option<PoseStamped>>,
     job_tx: mpsc::Sender<ServiceJob>,
     stats: &Arc<Stats>,
-    identity: &NodeIdentity,
+    log: &Logger,
 ) -> [tokio::task::JoinHandle<()>; 4] {
-    let logger = || Logger {
-        handle: node.logging_handle(),
-    };
+    let logger = || log.clone();
     let subscriber = tokio::spawn(receive_targets(
         inputs.targets,
         target_tx,
         Arc::clone(stats),
         logger(),
         Arc::clone(node),
+        inputs.target_name,
     ));
-    let diag_name = format!("{}: inverse geometry", identity.fully_qualified_name());
     let reporter = tokio::spawn(report_diagnostics(
         diagnostics,
         Arc::clone(stats),
@@ -534,6 +611,7 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         params,
         identity,
         rosout_logs,
+        logger: log_settings,
         ..
     } = startup;
     let context = create_context(&mw)?;
@@ -549,9 +627,7 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         Arc::clone(&params_tx),
     );
     let mut node = create_node(&context, &identity, options)?;
-    let logger = Logger {
-        handle: node.logging_handle(),
-    };
+    let logger = Logger::new(&node, &log_settings);
     let (endpoints, outputs) = create_endpoints(&mut node, &identity)?;
     let spin_task = start_spinner(&mut node, &params)?;
 
@@ -569,9 +645,7 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         job_rx,
         outputs,
         Arc::clone(&stats),
-        Logger {
-            handle: node.logging_handle(),
-        },
+        logger.clone(),
     )?;
     let atlas_seeds = warm_rx.await.unwrap_or(0);
     log::debug!("solver warm: {atlas_seeds} atlas seeds");
@@ -581,32 +655,43 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
     let tasks = spawn_tasks(
         &node,
         inputs,
-        endpoints.diagnostics,
+        (
+            endpoints.diagnostics,
+            format!("{}: inverse geometry", identity.fully_qualified_name()),
+        ),
         target_tx,
         job_tx,
         &stats,
-        &identity,
+        &logger,
     );
     let [solve_full, plan_full] = &endpoints.services;
-    logger.info(&ready_message(
+    let ready = ready_message(
         &identity,
         &mw,
         &params,
         &endpoints.resolved,
         &[solve_full, plan_full],
-    ));
+    );
+    node_log!(logger, Info, "{ready}");
 
     let signal = wait_for_signal().await;
-    logger.info(&format!(
+    log_shutdown(&logger, signal, &stats);
+    shut_down(tasks, solver_thread, node, spin_task).await;
+    drop(params_tx);
+    Ok(())
+}
+
+/// The shutdown record: the signal and what the node did.
+fn log_shutdown(logger: &Logger, signal: &str, stats: &Stats) {
+    node_log!(
+        logger,
+        Info,
         "{signal}: shutting down after {} targets received, {} solved, {} failed, {} service calls",
         stats.received.load(Ordering::Relaxed),
         stats.solved.load(Ordering::Relaxed),
         stats.failed.load(Ordering::Relaxed),
         stats.service_calls.load(Ordering::Relaxed),
-    ));
-    shut_down(tasks, solver_thread, node, spin_task).await;
-    drop(params_tx);
-    Ok(())
+    );
 }
 
 /// Stops the tasks, lets the solver thread finish its solve in progress (bounded by its
@@ -672,6 +757,7 @@ async fn receive_targets(
     stats: Arc<Stats>,
     log: Logger,
     clock_node: Arc<ros2_client::Node>,
+    topic: String,
 ) {
     let mut stream = pin!(subscription.async_stream());
     while let Some(item) = stream.next().await {
@@ -679,15 +765,17 @@ async fn receive_targets(
             Ok((mut msg, _info)) => {
                 stamp_if_zero(&mut msg, || ros_now(&clock_node));
                 let t = &msg.header.stamp;
-                log::debug!(
-                    "/rod/target: received the target stamped {}.{:09}",
+                node_log!(
+                    log,
+                    Debug,
+                    "{topic}: received the target stamped {}.{:09}",
                     t.sec,
                     t.nanosec
                 );
                 stats.received.fetch_add(1, Ordering::Relaxed);
                 target_tx.send_replace(Some(msg));
             }
-            Err(e) => log.warn(&format!("/rod/target: dropped a bad message: {e:?}")),
+            Err(e) => node_log!(log, Warn, "{topic}: dropped a bad message: {e:?}"),
         }
     }
 }
@@ -749,7 +837,7 @@ async fn serve_requests<Req, Resp>(
         let (id, mut request) = match item {
             Ok(r) => r,
             Err(e) => {
-                log.warn(&format!("service: dropped a bad request: {e:?}"));
+                node_log!(log, Warn, "service: dropped a bad request: {e:?}");
                 continue;
             }
         };
@@ -761,7 +849,7 @@ async fn serve_requests<Req, Resp>(
         }
         let Ok(response) = reply_rx.await else { break };
         if let Err(e) = server.async_send_response(id, response).await {
-            log.warn(&format!("service: cannot send the response: {e:?}"));
+            node_log!(log, Warn, "service: cannot send the response: {e:?}");
         }
     }
 }
@@ -804,7 +892,8 @@ async fn solver_loop(
                         let _ = reply.send(response); // the caller may have gone
                     }
                     Job::Solve(request, reply) => {
-                        let response = serve_solve(&mut processor, &request, &params, &stats, &log);
+                        let response =
+                            serve_solve(&mut processor, &request, &params, &stats, &log, &outputs.names);
                         let _ = reply.send(response); // the caller may have gone
                     }
                 }
@@ -815,14 +904,14 @@ async fn solver_loop(
                 }
                 let Some(target) = target_rx.borrow_and_update().clone() else { continue };
                 if params_rx.has_changed().unwrap_or(false) {
-                    log.info(&format!("parameters now: {:?}", *params_rx.borrow_and_update()));
+                    node_log!(log, Info, "parameters now: {:?}", *params_rx.borrow_and_update());
                 }
                 let params = params_rx.borrow().clone();
                 let started = std::time::Instant::now();
                 let (outcome, work) = observe(Counters::default(), || {
                     processor.process(&target, &params, &Overrides::default())
                 });
-                report(&log, &stats, "/rod/target", &outcome, &work, started.elapsed());
+                report(&log, &stats, &outputs.names.target, &outcome, &work, started.elapsed());
                 publish(&log, &outputs, outcome);
             }
         }
@@ -842,16 +931,22 @@ fn serve_plan(
     let r = &planned.response;
     if r.success {
         log::debug!(
-            "/rod/plan: {} rods in {:?}",
+            "{}: {} rods in {:?}",
+            outputs.names.plan,
             r.rods.len() / 3,
             started.elapsed()
         );
     } else {
-        log.warn(&format!("/rod/plan: no plan: {}", r.reason));
+        node_log!(log, Warn, "{}: no plan: {}", outputs.names.plan, r.reason);
     }
     if let Some(marker) = planned.marker {
         if let Err(e) = outputs.plan_rods.publish(marker) {
-            log.error(&format!("cannot publish /rod/plan_rods: {e:?}"));
+            node_log!(
+                log,
+                Error,
+                "cannot publish {}: {e:?}",
+                outputs.names.plan_rods
+            );
         }
     }
     planned.response
@@ -864,6 +959,7 @@ fn serve_solve(
     params: &Params,
     stats: &Stats,
     log: &Logger,
+    names: &Names,
 ) -> SolveRodResponse {
     match Overrides::from_request(request) {
         Ok(overrides) => {
@@ -871,7 +967,7 @@ fn serve_solve(
             let (outcome, work) = observe(Counters::default(), || {
                 processor.process(&request.target, params, &overrides)
             });
-            report(log, stats, "/rod/solve", &outcome, &work, started.elapsed());
+            report(log, stats, &names.solve, &outcome, &work, started.elapsed());
             SolveRodResponse {
                 path: outcome.path.unwrap_or_else(|| Path {
                     header: outcome.solution.header.clone(),
@@ -881,7 +977,7 @@ fn serve_solve(
             }
         }
         Err(reason) => {
-            log.warn(&format!("/rod/solve: bad request: {reason}"));
+            node_log!(log, Warn, "{}: bad request: {reason}", names.solve);
             let header = crate::convert::output_header(&request.target.header, params);
             SolveRodResponse {
                 solution: crate::convert::failure_message(
@@ -919,13 +1015,15 @@ fn report(
     }
     if outcome.solution.success {
         stats.solved.fetch_add(1, Ordering::Relaxed);
-        log::debug!("{source}: {}", outcome.solution.message);
+        node_log!(log, Debug, "{source}: {}", outcome.solution.message);
     } else {
         stats.failed.fetch_add(1, Ordering::Relaxed);
-        log.warn(&format!(
+        node_log!(
+            log,
+            Warn,
             "{source}: no solution: {}",
             outcome.solution.message
-        ));
+        );
     }
 }
 
@@ -933,15 +1031,20 @@ fn publish(log: &Logger, outputs: &Outputs, outcome: Outcome) {
     // Path first: it is what latency-sensitive clients wait for.
     if let Some(path) = outcome.path {
         if let Err(e) = outputs.path.publish(path) {
-            log.error(&format!("cannot publish /rod/path: {e:?}"));
+            node_log!(log, Error, "cannot publish {}: {e:?}", outputs.names.path);
         }
     }
     if let Err(e) = outputs.solution.publish(outcome.solution) {
-        log.error(&format!("cannot publish /rod/solution: {e:?}"));
+        node_log!(
+            log,
+            Error,
+            "cannot publish {}: {e:?}",
+            outputs.names.solution
+        );
     }
     if let Some(marker) = outcome.marker {
         if let Err(e) = outputs.marker.publish(marker) {
-            log.error(&format!("cannot publish /rod/marker: {e:?}"));
+            node_log!(log, Error, "cannot publish {}: {e:?}", outputs.names.marker);
         }
     }
 }
@@ -985,5 +1088,21 @@ mod tests {
         assert!(c.localhost_only);
         assert!(MiddlewareConfig::from_lookup(env(&[("ROS_DOMAIN_ID", "300")])).is_err());
         assert!(MiddlewareConfig::from_lookup(env(&[("ROS_DOMAIN_ID", "x")])).is_err());
+    }
+
+    #[test]
+    fn function_names_for_rosout() {
+        assert_eq!(
+            function_of("rod_ig_node::node::serve_plan::here"),
+            "serve_plan"
+        );
+        assert_eq!(
+            function_of("rod_ig_node::node::receive_targets::{{closure}}::here"),
+            "receive_targets"
+        );
+        fn probe() -> &'static str {
+            function_name!()
+        }
+        assert_eq!(probe(), "probe");
     }
 }

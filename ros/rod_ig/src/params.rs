@@ -807,6 +807,9 @@ pub struct Startup {
     pub log_filter: Option<String>,
     /// Publish logs on /rosout (`--disable-rosout-logs` turns it off).
     pub rosout_logs: bool,
+    /// The node's ROS logger name (`left.rod_ig_node`) and its threshold (`--log-level`,
+    /// global or for this logger), applied to /rosout as to the console.
+    pub logger: (String, crate::ros_args::LogLevel),
 }
 
 /// Usage text for `--help`: the parameters from the parameter table.
@@ -918,11 +921,16 @@ where
             ParamSource::File(path) => load_params_file_for(&mut params, path, &fqn)?,
         }
     }
+    let logger = (
+        identity.logger_name(),
+        ros.level_of(&identity.logger_name()),
+    );
     Ok(Command::Run(Box::new(Startup {
         params,
         identity,
         log_filter: ros.log_filter(),
         rosout_logs: ros.rosout_logs.unwrap_or(true),
+        logger,
     })))
 }
 

@@ -51,8 +51,8 @@ pub enum RosArgsError {
     LogLevel(String),
 }
 
-/// Severity levels of `--log-level` (rcutils).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Severity levels of `--log-level` (rcutils), least severe first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum LogLevel {
     /// DEBUG.
     Debug,
@@ -346,6 +346,17 @@ impl RosArgs {
         })
     }
 
+    /// The threshold of the ROS logger `logger` (`left.rod_ig_node`): the last `--log-level`
+    /// that names it or no logger at all, else INFO (rcutils' default), as rcl applies it to
+    /// the console and /rosout alike.
+    pub fn level_of(&self, logger: &str) -> LogLevel {
+        self.log_levels
+            .iter()
+            .rev()
+            .find(|(l, _)| l.as_deref().is_none_or(|l| l == logger))
+            .map_or(LogLevel::Info, |(_, level)| *level)
+    }
+
     /// An `env_logger` filter from the `--log-level` settings (global first, then per logger;
     /// ROS logger names use `.` where Rust modules use `::`), or `None` when there are none.
     pub fn log_filter(&self) -> Option<String> {
@@ -365,6 +376,17 @@ impl RosArgs {
 }
 
 impl NodeIdentity {
+    /// The node's ROS logger name, as rclcpp names it: the namespace and the name joined by
+    /// dots (`/left` + `rod_ig_node` → `left.rod_ig_node`; `rod_ig_node` in `/`).
+    pub fn logger_name(&self) -> String {
+        self.namespace
+            .split('/')
+            .filter(|t| !t.is_empty())
+            .chain([self.name.as_str()])
+            .collect::<Vec<_>>()
+            .join(".")
+    }
+
     /// `namespace/name`.
     pub fn fully_qualified_name(&self) -> String {
         join(&self.namespace, &self.name)
@@ -579,5 +601,19 @@ mod tests {
             id("").resolve_split("/clock").unwrap(),
             ("/".to_string(), "clock".to_string())
         );
+    }
+
+    #[test]
+    fn logger_names_and_thresholds_as_rcl() {
+        let a = args("--ros-args -r __ns:=/left/arm --log-level warn --log-level left.arm.rod_ig_node:=debug")
+            .unwrap();
+        let id = a.identity("rod_ig_node", "/").unwrap();
+        assert_eq!(id.logger_name(), "left.arm.rod_ig_node");
+        assert_eq!(a.level_of(&id.logger_name()), LogLevel::Debug);
+        assert_eq!(a.level_of("other"), LogLevel::Warn);
+        let root = args("").unwrap().identity("rod_ig_node", "/").unwrap();
+        assert_eq!(root.logger_name(), "rod_ig_node");
+        assert_eq!(args("").unwrap().level_of("rod_ig_node"), LogLevel::Info);
+        assert!(LogLevel::Debug < LogLevel::Info && LogLevel::Error < LogLevel::Fatal);
     }
 }
