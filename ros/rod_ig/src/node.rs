@@ -195,7 +195,7 @@ fn ros_descriptor(
 
 /// Console (env_logger) plus /rosout logging, as rclcpp's loggers: named `<namespace>.<node>`
 /// with dots, the `--log-level` threshold applied to /rosout too, the call site's file,
-/// function and line in every record ([`node_log!`]).
+/// function and line in every record (the `node_log!` macro of this module).
 #[derive(Clone)]
 pub struct Logger {
     handle: Arc<NodeLoggingHandle>,
