@@ -11,8 +11,15 @@ middleware set-up, topics and QoS, answers each target at once with a Path of th
 no solving). The difference of the two is what rod_ig_node adds (solve + shape + the extra
 RodSolution / Marker messages).
 
+With --large: the large-message and concurrency figures instead. A Path of 10,000 and of
+100,000 poses from target to an rclpy raw subscription (the delivery of the serialized
+message; rclpy's own conversion to Python objects is timed apart, on the same bytes), the
+same sizes as /rod/solve replies (whole call, conversion included), and a 5-pose call made
+while a 100,000-pose call from another process is in flight. Medians and worst of --runs.
+
 Usage (after scripts/setup-env.sh and `source scripts/env.sh`):
     python tests/latency_bench.py [--n 1200] [--rounds 3] [--samples 100] [--warmup 100]
+    python tests/latency_bench.py --large [--runs 8]
 """
 import argparse
 import statistics
@@ -106,6 +113,124 @@ def first_target(starts, follow=100):
     return first_rt, first_solve, steady_rt, steady_solve
 
 
+def raw_path_times(samples, runs):
+    """Target publish -> raw (serialized) /rod/path of `samples` poses at an rclpy subscriber."""
+    from nav_msgs.msg import Path as PathMsg
+    domain = h.free_domain()
+    node = h.NodeProcess(domain, ["-p", f"path_samples:={samples}"])
+    client = h.Client(domain, name="rod_ig_large_bench", path_only=True)
+    got = []
+    ready = threading.Event()
+
+    def on_raw(msg):
+        got.append((time.perf_counter(), msg))
+        ready.set()
+
+    client.node.create_subscription(PathMsg, "/rod/path", on_raw, h.topic_qos(), raw=True)
+    # Only the raw subscription: the harness's own /rod/path one would convert each message.
+    client.node.destroy_subscription(next(s for s in client.node.subscriptions if s.raw is False))
+    try:
+        if not client.wait_connected_topics():
+            raise SystemExit(f"no connection; log {node.log_path}")
+        times, rss = [], []
+        for i in range(runs + 1):
+            ready.clear()
+            t = client.make_target(0.6 - 0.01 * (i % 10), 0.3, 0.5, h.next_seq())
+            t0 = time.perf_counter()
+            client.pub.publish(t)
+            if not ready.wait(30):
+                raise SystemExit(f"no path of {samples} poses; log {node.log_path}")
+            if i > 0:  # the first one after matching is not steady state
+                times.append(got[-1][0] - t0)
+            rss.append(h.rss_kib(node.pid))
+            time.sleep(0.1)
+        return times, got[-1][1], max(rss)
+    finally:
+        client.close()
+        node.stop()
+
+
+def solve_call_times(samples, runs):
+    """Whole /rod/solve calls with `samples` path poses, rclpy's conversion included."""
+    node, client = h.start_node_and_client(name="rod_ig_large_bench")
+    try:
+        times = []
+        for i in range(runs + 1):
+            t = client.make_target(0.6 - 0.01 * (i % 10), 0.3, 0.5, h.next_seq())
+            t0 = time.perf_counter()
+            r = client.solve(t, path_samples=samples, timeout=60)
+            if r is None or len(r.path.poses) != samples:
+                raise SystemExit(f"no reply of {samples} poses; log {node.log_path}")
+            if i > 0:
+                times.append(time.perf_counter() - t0)
+        return times
+    finally:
+        h.stop_node_and_client(node, client)
+
+
+def small_call_during_large(runs, delay):
+    """A 5-pose /rod/solve call made `delay` s after a 100,000-pose one (from another process)."""
+    import subprocess
+    domain = h.free_domain()
+    node = h.NodeProcess(domain, [])
+    client = h.Client(domain, name="rod_ig_small_caller")
+    times = []
+    try:
+        if not client.wait_connected():
+            raise SystemExit(f"no connection; log {node.log_path}")
+        client.solve(client.make_target(0.6, 0.3, 0.5, h.next_seq()), path_samples=8)
+        for _ in range(runs):
+            big = subprocess.Popen([sys.executable, "-c", f"""
+import sys
+sys.path.insert(0, {str(h.REPO / 'tests')!r})
+import rodig_harness as h
+c = h.Client({domain}, name='rod_ig_big_caller')
+assert c.wait_connected()
+print('ready', flush=True)
+sys.stdin.readline()
+r = c.solve(c.make_target(0.6, 0.3, 0.5, 5), path_samples=100000, timeout=60)
+print('done', flush=True)
+c.close()
+"""], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+            big.stdout.readline()
+            big.stdin.write("\n")
+            big.stdin.flush()
+            time.sleep(delay)
+            t0 = time.perf_counter()
+            r = client.solve(client.make_target(0.5, 0.3, 0.5, h.next_seq()), path_samples=5)
+            times.append(time.perf_counter() - t0)
+            if r is None:
+                raise SystemExit(f"small call unanswered; log {node.log_path}")
+            big.stdout.readline()
+            big.wait()
+        return times
+    finally:
+        h.stop_node_and_client(node, client)
+
+
+def large(runs):
+    from nav_msgs.msg import Path as PathMsg
+    from rclpy.serialization import deserialize_message
+    ms = lambda xs: f"median {statistics.median(xs) * 1e3:7.1f} ms, worst {max(xs) * 1e3:7.1f} ms"  # noqa: E731
+    print(f"large messages over loopback to rclpy (Fast DDS), {runs} runs each:")
+    for samples, goal in ((10_000, 0.05), (100_000, 0.5)):
+        times, raw, rss = raw_path_times(samples, runs)
+        t0 = time.perf_counter()
+        deserialize_message(raw, PathMsg)
+        convert = time.perf_counter() - t0
+        worst = max(times)
+        print(f"  /rod/path {samples:>7} poses ({len(raw) / 1e6:.1f} MB) target->raw delivery: {ms(times)} "
+              f"(goal <= {goal * 1e3:.0f} ms: {'met' if worst <= goal else 'NOT met'}); node RSS max "
+              f"{rss / 1024:.0f} MB; rclpy's conversion of it to Python objects alone {convert * 1e3:.0f} ms")
+    for samples in (10_000, 100_000):
+        print(f"  /rod/solve {samples:>7} poses, whole call (conversion included): "
+              f"{ms(solve_call_times(samples, max(2, runs // 2)))}")
+    for delay in (0.2, 0.05):
+        times = small_call_during_large(max(2, runs // 2), delay)
+        print(f"  5-pose /rod/solve {delay * 1e3:.0f} ms after a 100,000-pose call from another "
+              f"client: {ms(times)} (goal <= 50 ms: {'met' if max(times) <= 0.05 else 'NOT met'})")
+
+
 def summary(name, lat, lost):
     return (f"{name:<28} n={len(lat):5d} lost={lost:3d}  p50={percentile(lat, 0.5):7.3f} ms  "
             f"p90={percentile(lat, 0.9):7.3f} ms  p99={percentile(lat, 0.99):7.3f} ms  "
@@ -122,7 +247,12 @@ def main():
     ap.add_argument("--rounds", type=int, default=3,
                     help="alternate echo and node runs this many times, pooling the samples, so "
                          "drifting machine load affects both alike (default 3)")
+    ap.add_argument("--large", action="store_true", help="the large-message figures instead")
+    ap.add_argument("--runs", type=int, default=8, help="runs per large-message figure (default 8)")
     a = ap.parse_args()
+    if a.large:
+        large(a.runs)
+        return
 
     first_rt, first_solve, steady_rt, steady_solve = first_target(a.starts)
     us = lambda xs: ", ".join(f"{x * 1e6:.0f}" for x in xs)  # noqa: E731

@@ -37,6 +37,7 @@ use std::pin::pin;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
+use crate::solver::PlanarParams;
 use futures::StreamExt;
 use rod_ig_core::solver::{observe, Counters};
 use ros2_client::dds::rustdds::DomainParticipantBuilder;
@@ -260,23 +261,19 @@ struct Stats {
 /// Period of the /diagnostics report (diagnostic_updater's default, 1 Hz).
 const DIAGNOSTICS_PERIOD: std::time::Duration = std::time::Duration::from_secs(1);
 
-/// A service request on its way to the solver task, with the slot for the answer.
-type ServiceJob = Job;
+/// A `rod/solve` request on its way to the solver thread, with the slot for its answer.
+type SolveJob = (SolveRodRequest, oneshot::Sender<SolveRodResponse>);
 
-/// A service request on its way to the solver thread, with the slot for its answer.
-enum Job {
-    /// `rod/solve`.
-    Solve(SolveRodRequest, oneshot::Sender<SolveRodResponse>),
-    /// `rod/plan`.
-    Plan(PlanRodRequest, oneshot::Sender<PlanRodResponse>),
-}
+/// A `rod/plan` request on its way to the planner thread, with the slot for its answer.
+type PlanJob = (PlanRodRequest, oneshot::Sender<PlanRodResponse>);
 
 /// The node's publishers.
 struct Outputs {
     path: Publisher<Path>,
     solution: Publisher<RodSolution>,
     marker: Publisher<Marker>,
-    plan_rods: Publisher<Marker>,
+    /// Written by the planner thread.
+    plan_rods: Arc<Publisher<Marker>>,
     /// The resolved names, for the logs (remapped and namespaced as the graph shows them).
     names: Names,
 }
@@ -373,9 +370,7 @@ fn node_options(
 #[allow(clippy::too_many_arguments)]
 fn spawn_solver_thread(
     processor: Processor,
-    params_rx: watch::Receiver<Params>,
-    target_rx: watch::Receiver<Option<PoseStamped>>,
-    job_rx: mpsc::Receiver<ServiceJob>,
+    links: SolverLinks,
     outputs: Outputs,
     stats: Arc<Stats>,
     log: Logger,
@@ -398,12 +393,50 @@ fn spawn_solver_thread(
                     return;
                 }
             };
-            rt.block_on(solver_loop(
-                processor, params_rx, target_rx, job_rx, outputs, stats, log,
-            ));
+            rt.block_on(solver_loop(processor, links, outputs, stats, log));
         })
         .map_err(create_err("solver thread"))?;
     Ok((thread, warm_rx))
+}
+
+/// What the solver thread reads (parameters, targets, `rod/solve` calls) and tells (the rod
+/// it holds, for `use_current` plans).
+struct SolverLinks {
+    params_rx: watch::Receiver<Params>,
+    target_rx: watch::Receiver<Option<PoseStamped>>,
+    job_rx: mpsc::Receiver<SolveJob>,
+    held_tx: watch::Sender<Option<PlanarParams>>,
+}
+
+/// Starts the planner thread: `rod/plan` calls are answered there, so that a plan (up to its
+/// deadline) never delays targets or `rod/solve` calls. It starts `use_current` plans from
+/// the rod the solver thread holds.
+fn spawn_planner_thread(
+    params_rx: watch::Receiver<Params>,
+    mut job_rx: mpsc::Receiver<PlanJob>,
+    held_rx: watch::Receiver<Option<PlanarParams>>,
+    plan_rods: Arc<Publisher<Marker>>,
+    names: Names,
+    log: Logger,
+) -> Result<std::thread::JoinHandle<()>, NodeError> {
+    std::thread::Builder::new()
+        .name("rod_ig_planner".into())
+        .spawn(move || {
+            let mut processor = Processor::new(&params_rx.borrow());
+            while let Some((request, reply)) = job_rx.blocking_recv() {
+                let params = params_rx.borrow().clone();
+                let held = *held_rx.borrow();
+                let response = serve_plan(
+                    &mut processor,
+                    &request,
+                    (&params, held),
+                    (&plan_rods, &names),
+                    &log,
+                );
+                let _ = reply.send(response); // the caller may have gone
+            }
+        })
+        .map_err(create_err("planner thread"))
 }
 
 /// The start-up line: identity, domain, the main parameters and every resolved name.
@@ -483,9 +516,10 @@ fn create_endpoints(
         marker: node
             .create_publisher(&marker_topic, Some(out_qos.clone()))
             .map_err(create_err("/rod/marker publisher"))?,
-        plan_rods: node
-            .create_publisher(&plan_rods_topic, Some(out_qos.clone()))
-            .map_err(create_err("/rod/plan_rods publisher"))?,
+        plan_rods: Arc::new(
+            node.create_publisher(&plan_rods_topic, Some(out_qos.clone()))
+                .map_err(create_err("/rod/plan_rods publisher"))?,
+        ),
         names: Names {
             target: resolved[0].clone(),
             path: resolved[1].clone(),
@@ -561,7 +595,7 @@ fn spawn_tasks(
     inputs: Inputs,
     (diagnostics, diag_name): (Publisher<crate::messages::DiagnosticArray>, String),
     target_tx: watch::Sender<Option<PoseStamped>>,
-    job_tx: mpsc::Sender<ServiceJob>,
+    (solve_tx, plan_tx): (mpsc::Sender<SolveJob>, mpsc::Sender<PlanJob>),
     stats: &Arc<Stats>,
     log: &Logger,
 ) -> [tokio::task::JoinHandle<()>; 4] {
@@ -583,30 +617,64 @@ fn spawn_tasks(
     let plan_clock = Arc::clone(node);
     let plan = tokio::spawn(serve_requests(
         inputs.plan,
-        job_tx.clone(),
+        plan_tx,
         Arc::clone(stats),
         logger(),
         move |request: &mut PlanRodRequest| {
             stamp_if_zero(&mut request.goal, || ros_now(&plan_clock))
         },
-        Job::Plan,
     ));
     let solve_clock = Arc::clone(node);
     let solve = tokio::spawn(serve_requests(
         inputs.solve,
-        job_tx,
+        solve_tx,
         Arc::clone(stats),
         logger(),
         move |request: &mut SolveRodRequest| {
             stamp_if_zero(&mut request.target, || ros_now(&solve_clock))
         },
-        Job::Solve,
     ));
     [subscriber, solve, plan, reporter]
 }
 
 /// Runs the node until SIGINT or SIGTERM.
 pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError> {
+    // The signal handlers first: a SIGINT or SIGTERM during start-up (the atlas build takes
+    // ~0.2 s) ends the node cleanly too, as rclcpp's does, instead of killing it.
+    let mut signals = Signals::install();
+    let running = tokio::select! {
+        running = start(startup, mw) => running?,
+        signal = signals.recv() => {
+            log::info!("{signal} during start-up: exiting");
+            return Ok(());
+        }
+    };
+    let signal = signals.recv().await;
+    log_shutdown(&running.logger, signal, &running.stats);
+    shut_down(
+        running.tasks,
+        running.threads,
+        running.node,
+        running.spin_task,
+    )
+    .await;
+    drop(running.params_tx);
+    Ok(())
+}
+
+/// The node once started: what shutting down stops.
+struct Running {
+    logger: Logger,
+    stats: Arc<Stats>,
+    tasks: [tokio::task::JoinHandle<()>; 4],
+    threads: [std::thread::JoinHandle<()>; 2],
+    node: Arc<ros2_client::Node>,
+    spin_task: tokio::task::JoinHandle<()>,
+    params_tx: Arc<watch::Sender<Params>>,
+}
+
+/// Starts the node: endpoints, worker threads (after the atlas is built), then the inputs.
+async fn start(startup: Startup, mw: MiddlewareConfig) -> Result<Running, NodeError> {
     let Startup {
         params,
         identity,
@@ -631,23 +699,9 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
     let (endpoints, outputs) = create_endpoints(&mut node, &identity)?;
     let spin_task = start_spinner(&mut node, &params)?;
 
-    // Solver thread: owns the Processor (and so the warm start). Solving is CPU-bound (up to
-    // the deadline per call), so it runs on a thread of its own, not on the async runtime's
-    // workers that serve DDS; it builds the inverse-geometry atlas first, so that the first
-    // target costs what later ones do, and the node announces readiness only then.
     let stats = Arc::new(Stats::default());
-    let (target_tx, target_rx) = watch::channel::<Option<PoseStamped>>(None);
-    let (job_tx, job_rx) = mpsc::channel::<ServiceJob>(16);
-    let (solver_thread, warm_rx) = spawn_solver_thread(
-        Processor::new(&params),
-        params_rx,
-        target_rx,
-        job_rx,
-        outputs,
-        Arc::clone(&stats),
-        logger.clone(),
-    )?;
-    let atlas_seeds = warm_rx.await.unwrap_or(0);
+    let workers = start_workers(&params, params_rx, outputs, &stats, &logger)?;
+    let atlas_seeds = workers.warm.await.unwrap_or(0);
     log::debug!("solver warm: {atlas_seeds} atlas seeds");
 
     let inputs = create_inputs(&mut node, &endpoints, &params)?;
@@ -659,8 +713,8 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
             endpoints.diagnostics,
             format!("{}: inverse geometry", identity.fully_qualified_name()),
         ),
-        target_tx,
-        job_tx,
+        workers.target_tx,
+        workers.jobs,
         &stats,
         &logger,
     );
@@ -673,12 +727,68 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         &[solve_full, plan_full],
     );
     node_log!(logger, Info, "{ready}");
+    Ok(Running {
+        logger,
+        stats,
+        tasks,
+        threads: workers.threads,
+        node,
+        spin_task,
+        params_tx,
+    })
+}
 
-    let signal = wait_for_signal().await;
-    log_shutdown(&logger, signal, &stats);
-    shut_down(tasks, solver_thread, node, spin_task).await;
-    drop(params_tx);
-    Ok(())
+/// The solver and planner threads, and the channels into them.
+struct Workers {
+    threads: [std::thread::JoinHandle<()>; 2],
+    /// Fires when the solver's atlas is built (with its number of seeds).
+    warm: oneshot::Receiver<usize>,
+    target_tx: watch::Sender<Option<PoseStamped>>,
+    jobs: (mpsc::Sender<SolveJob>, mpsc::Sender<PlanJob>),
+}
+
+/// Starts the solver thread (it owns the Processor, and so the warm start: solving is
+/// CPU-bound, up to the deadline per call, so it runs on a thread of its own, not on the
+/// async runtime's workers that serve DDS; it builds the inverse-geometry atlas first, so
+/// that the first target costs what later ones do) and the planner thread.
+fn start_workers(
+    params: &Params,
+    params_rx: watch::Receiver<Params>,
+    outputs: Outputs,
+    stats: &Arc<Stats>,
+    logger: &Logger,
+) -> Result<Workers, NodeError> {
+    let (target_tx, target_rx) = watch::channel::<Option<PoseStamped>>(None);
+    let (solve_tx, solve_rx) = mpsc::channel::<SolveJob>(16);
+    let (plan_tx, plan_rx) = mpsc::channel::<PlanJob>(16);
+    let (held_tx, held_rx) = watch::channel::<Option<PlanarParams>>(None);
+    let planner = spawn_planner_thread(
+        params_rx.clone(),
+        plan_rx,
+        held_rx,
+        Arc::clone(&outputs.plan_rods),
+        outputs.names.clone(),
+        logger.clone(),
+    )?;
+    let links = SolverLinks {
+        params_rx,
+        target_rx,
+        job_rx: solve_rx,
+        held_tx,
+    };
+    let (solver, warm) = spawn_solver_thread(
+        Processor::new(params),
+        links,
+        outputs,
+        Arc::clone(stats),
+        logger.clone(),
+    )?;
+    Ok(Workers {
+        threads: [solver, planner],
+        warm,
+        target_tx,
+        jobs: (solve_tx, plan_tx),
+    })
 }
 
 /// The shutdown record: the signal and what the node did.
@@ -698,7 +808,7 @@ fn log_shutdown(logger: &Logger, signal: &str, stats: &Stats) {
 /// deadline), then drops the node and waits for the spinner.
 async fn shut_down(
     tasks: [tokio::task::JoinHandle<()>; 4],
-    solver_thread: std::thread::JoinHandle<()>,
+    threads: [std::thread::JoinHandle<()>; 2],
     node: Arc<ros2_client::Node>,
     spin_task: tokio::task::JoinHandle<()>,
 ) {
@@ -709,7 +819,9 @@ async fn shut_down(
     }
     // With the subscriber and the service task gone, the solver loop's channels close and it
     // returns (after the solve in progress, bounded by its deadline).
-    let _ = tokio::task::spawn_blocking(move || solver_thread.join()).await;
+    for thread in threads {
+        let _ = tokio::task::spawn_blocking(move || thread.join()).await;
+    }
     // Dropping the node tells the spinner to stop (stop_spinner() too, but then the drop
     // would log an error).
     drop(node);
@@ -819,21 +931,26 @@ async fn report_diagnostics(
     }
 }
 
-/// A service task: each request (stamped by `prepare` when unstamped) goes to the solver
-/// thread as the job `wrap` makes of it, its answer back to the caller.
+/// A service task: each request (stamped by `prepare` when unstamped) goes to its worker
+/// thread, and its answer goes back to the caller from a task of its own, so that the next
+/// request is taken while a large answer is still being written.
 async fn serve_requests<Req, Resp>(
     server: ros2_client::Server<Req, Resp>,
-    job_tx: mpsc::Sender<ServiceJob>,
+    job_tx: mpsc::Sender<(Req, oneshot::Sender<Resp>)>,
     stats: Arc<Stats>,
     log: Logger,
     prepare: impl Fn(&mut Req),
-    wrap: fn(Req, oneshot::Sender<Resp>) -> Job,
 ) where
     Req: ros2_client::Message + 'static,
-    Resp: ros2_client::Message + 'static,
+    Resp: ros2_client::Message + Send + Sync + 'static,
+    ros2_client::Server<Req, Resp>: Send + Sync,
 {
+    let server = Arc::new(server);
+    // Dropped (and so aborted) with this task at shutdown.
+    let mut replies = tokio::task::JoinSet::new();
     let mut stream = pin!(server.receive_request_stream());
     while let Some(item) = stream.next().await {
+        while replies.try_join_next().is_some() {} // reap the answers sent
         let (id, mut request) = match item {
             Ok(r) => r,
             Err(e) => {
@@ -844,28 +961,56 @@ async fn serve_requests<Req, Resp>(
         stats.service_calls.fetch_add(1, Ordering::Relaxed);
         prepare(&mut request);
         let (reply_tx, reply_rx) = oneshot::channel();
-        if job_tx.send(wrap(request, reply_tx)).await.is_err() {
-            break; // solver task gone: shutting down
+        if job_tx.send((request, reply_tx)).await.is_err() {
+            break; // worker gone: shutting down
         }
-        let Ok(response) = reply_rx.await else { break };
-        if let Err(e) = server.async_send_response(id, response).await {
-            node_log!(log, Warn, "service: cannot send the response: {e:?}");
-        }
+        let server = Arc::clone(&server);
+        let log = log.clone();
+        replies.spawn(async move {
+            let Ok(response) = reply_rx.await else { return };
+            if let Err(e) = server.async_send_response(id, response).await {
+                node_log!(log, Warn, "service: cannot send the response: {e:?}");
+            }
+        });
     }
 }
 
-/// Waits for SIGINT or SIGTERM; returns its name.
-async fn wait_for_signal() -> &'static str {
-    use tokio::signal::unix::{signal, SignalKind};
-    match signal(SignalKind::terminate()) {
-        Ok(mut term) => tokio::select! {
-            _ = tokio::signal::ctrl_c() => "SIGINT",
-            _ = term.recv() => "SIGTERM",
-        },
-        Err(e) => {
-            log::warn!("cannot install a SIGTERM handler ({e}); SIGINT only");
-            let _ = tokio::signal::ctrl_c().await;
-            "SIGINT"
+/// SIGINT and SIGTERM, listened to from the node's first instant.
+struct Signals {
+    interrupt: Option<tokio::signal::unix::Signal>,
+    terminate: Option<tokio::signal::unix::Signal>,
+}
+
+impl Signals {
+    /// Installs the handlers (a handler that cannot be installed is logged and skipped).
+    fn install() -> Self {
+        use tokio::signal::unix::{signal, SignalKind};
+        let install = |kind, name| match signal(kind) {
+            Ok(s) => Some(s),
+            Err(e) => {
+                log::warn!("cannot install a {name} handler: {e}");
+                None
+            }
+        };
+        Self {
+            interrupt: install(SignalKind::interrupt(), "SIGINT"),
+            terminate: install(SignalKind::terminate(), "SIGTERM"),
+        }
+    }
+
+    /// Waits for either signal; returns its name.
+    async fn recv(&mut self) -> &'static str {
+        async fn next(s: &mut Option<tokio::signal::unix::Signal>) {
+            match s {
+                Some(s) => {
+                    s.recv().await;
+                }
+                None => std::future::pending().await,
+            }
+        }
+        tokio::select! {
+            _ = next(&mut self.interrupt) => "SIGINT",
+            _ = next(&mut self.terminate) => "SIGTERM",
         }
     }
 }
@@ -873,30 +1018,26 @@ async fn wait_for_signal() -> &'static str {
 /// Solves service requests (first) and the newest target, and publishes the results.
 async fn solver_loop(
     mut processor: Processor,
-    mut params_rx: watch::Receiver<Params>,
-    mut target_rx: watch::Receiver<Option<PoseStamped>>,
-    mut job_rx: mpsc::Receiver<ServiceJob>,
+    links: SolverLinks,
     outputs: Outputs,
     stats: Arc<Stats>,
     log: Logger,
 ) {
+    let SolverLinks {
+        mut params_rx,
+        mut target_rx,
+        mut job_rx,
+        held_tx,
+    } = links;
     loop {
         tokio::select! {
             biased;
             job = job_rx.recv() => {
-                let Some(job) = job else { break };
+                let Some((request, reply)) = job else { break };
                 let params = params_rx.borrow_and_update().clone();
-                match job {
-                    Job::Plan(request, reply) => {
-                        let response = serve_plan(&mut processor, &request, &params, &outputs, &log);
-                        let _ = reply.send(response); // the caller may have gone
-                    }
-                    Job::Solve(request, reply) => {
-                        let response =
-                            serve_solve(&mut processor, &request, &params, &stats, &log, &outputs.names);
-                        let _ = reply.send(response); // the caller may have gone
-                    }
-                }
+                let response =
+                    serve_solve(&mut processor, &request, &params, &stats, &log, &outputs.names);
+                let _ = reply.send(response); // the caller may have gone
             }
             changed = target_rx.changed() => {
                 if changed.is_err() {
@@ -915,38 +1056,35 @@ async fn solver_loop(
                 publish(&log, &outputs, outcome);
             }
         }
+        held_tx.send_replace(processor.held_rod());
     }
 }
 
-/// Answers one `/rod/plan` call (the planned rods also go out on `/rod/plan_rods`).
+/// Answers one `/rod/plan` call (the planned rods also go out on `/rod/plan_rods`), starting
+/// a `use_current` plan from `held`.
 fn serve_plan(
     processor: &mut Processor,
     request: &PlanRodRequest,
-    params: &Params,
-    outputs: &Outputs,
+    (params, held): (&Params, Option<PlanarParams>),
+    (plan_rods, names): (&Publisher<Marker>, &Names),
     log: &Logger,
 ) -> PlanRodResponse {
     let started = std::time::Instant::now();
-    let planned = processor.plan(request, params);
+    let planned = processor.plan(request, params, held);
     let r = &planned.response;
     if r.success {
         log::debug!(
             "{}: {} rods in {:?}",
-            outputs.names.plan,
+            names.plan,
             r.rods.len() / 3,
             started.elapsed()
         );
     } else {
-        node_log!(log, Warn, "{}: no plan: {}", outputs.names.plan, r.reason);
+        node_log!(log, Warn, "{}: no plan: {}", names.plan, r.reason);
     }
     if let Some(marker) = planned.marker {
-        if let Err(e) = outputs.plan_rods.publish(marker) {
-            node_log!(
-                log,
-                Error,
-                "cannot publish {}: {e:?}",
-                outputs.names.plan_rods
-            );
+        if let Err(e) = plan_rods.publish(marker) {
+            node_log!(log, Error, "cannot publish {}: {e:?}", names.plan_rods);
         }
     }
     planned.response

@@ -176,6 +176,11 @@ impl Processor {
         }
     }
 
+    /// The planar rod held now (the start of a `use_current` plan).
+    pub fn held_rod(&self) -> Option<PlanarParams> {
+        self.solver.current_rod()
+    }
+
     /// Solves for one target with the current `params` (and optional per-request overrides).
     pub fn process(
         &mut self,
@@ -251,10 +256,18 @@ impl Processor {
 
     /// Plans a stable gripper path (`rod/plan`): metres and the base frame in, the core
     /// planner in normalised units, metres out.
-    pub fn plan(&mut self, request: &PlanRodRequest, params: &Params) -> Planned {
+    ///
+    /// `held` is the rod the node holds now (the last target's solution), the start of a
+    /// request with `use_current`; the planner runs on a thread of its own, so it is passed
+    /// in rather than read from this processor's solver.
+    pub fn plan(
+        &mut self,
+        request: &PlanRodRequest,
+        params: &Params,
+        held: Option<PlanarParams>,
+    ) -> Planned {
         let header = output_header(&request.goal.header, params);
-        let plan = self
-            .plan_query(request, params)
+        let plan = Self::plan_query(request, params, held)
             .and_then(|query| self.planner.plan(&query).map_err(|e| e.to_string()));
         match plan {
             Ok(plan) => planned(&plan, header, params),
@@ -277,14 +290,14 @@ impl Processor {
     /// The core planner's query for `request`: the start rod (given, or the one held now), the
     /// goal, the obstacles and the deadline, in normalised units.
     fn plan_query(
-        &self,
         request: &PlanRodRequest,
         params: &Params,
+        held: Option<PlanarParams>,
     ) -> Result<rod_ig_core::plan::PlanRequest, String> {
         use rod_ig_core::plan::{Obstacle, PlanRequest, DEFAULT_PLAN_DEADLINE};
         let l = params.rod_length;
         let start = if request.use_current {
-            self.solver.current_rod().ok_or(
+            held.ok_or(
                 "no current rod: send a target on rod/target first, or give start".to_string(),
             )?
         } else {
