@@ -136,15 +136,3 @@ def test_solve_is_answered_while_a_plan_runs():
     finally:
         h.stop_node_and_client(node, c)
 
-
-def test_a_signal_during_start_up_ends_the_node_cleanly():
-    """SIGINT or SIGTERM at any moment of start-up (the atlas build takes ~0.2 s) exits 0, as
-    rclcpp's nodes do, instead of the node dying by the signal (issue 20, item 3)."""
-    import signal
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        for delay in (0.01, 0.03, 0.05, 0.1, 0.3):
-            node = h.NodeProcess(h.free_domain(), [])
-            time.sleep(delay)
-            code = node.stop(sig, timeout=5.0)
-            assert code == 0, f"{sig.name} {delay * 1e3:.0f} ms after start: exit {code}; " \
-                              f"log:\n{node.log_path.read_text()[-1500:]}"

@@ -139,6 +139,57 @@ def test_parameter_events_with_ros_default_qos(node_and_client):
     assert qos.reliability == ReliabilityPolicy.RELIABLE, qos
 
 
+def test_clock_subscribed_only_with_sim_time_and_by_the_node():
+    """/clock is read only with use_sim_time on (rclcpp's TimeSource), and its subscription
+    is the node's in the graph, not an anonymous one (issue 20, item 7)."""
+    for sim_time in (False, True):
+        domain = h.free_domain()
+        node = h.NodeProcess(domain, ["--ros-args", "-p", f"use_sim_time:={str(sim_time).lower()}"])
+        c = h.Client(domain)
+        try:
+            assert c.wait_connected(), node.log_text()[-2000:]
+            time.sleep(0.5)
+            infos = c.node.get_subscriptions_info_by_topic("/clock")
+            if sim_time:
+                assert [i.node_name for i in infos] == ["rod_ig_node"], infos
+            else:
+                assert infos == [], infos
+            # Every endpoint of the node's participant is attributed to the node.
+            for topic, _types in c.node.get_topic_names_and_types():
+                for i in (c.node.get_publishers_info_by_topic(topic)
+                          + c.node.get_subscriptions_info_by_topic(topic)):
+                    assert i.node_name != "_NODE_NAME_UNKNOWN_", (topic, i)
+        finally:
+            c.close()
+            assert node.stop() == 0
+
+
+def test_parameter_events_on_every_change(node_and_client):
+    """Every accepted change is announced on /parameter_events (rclcpp's behaviour, which
+    `ros2 param` watchers and dynamic reconfigure GUIs rely on); a refused one is not."""
+    from rcl_interfaces.msg import ParameterEvent
+    _, c = node_and_client
+    events = []
+    c.node.create_subscription(ParameterEvent, "/parameter_events",
+                               lambda m: events.append(m) if m.node == "/rod_ig_node" else None,
+                               QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE))
+    assert _wait(lambda: c.node.count_publishers("/parameter_events") > 0, 10)
+    time.sleep(0.5)
+    changes = [("path_samples", 37), ("tolerance", 1e-9), ("method", "newton"), ("path_samples", 41)]
+    for name, value in changes:
+        assert c.set_params(**{name: value})[0].successful
+    assert not c.set_params(path_samples=-5)[0].successful
+
+    def seen():
+        return [(p.name, p.value) for e in events for p in e.changed_parameters]
+    assert _wait(lambda: len(seen()) >= len(changes), 10), seen()
+    time.sleep(0.5)
+    got = seen()
+    assert [n for n, _ in got] == [n for n, _ in changes], got
+    assert got[0][1].integer_value == 37 and got[-1][1].integer_value == 41
+    assert got[1][1].double_value == 1e-9 and got[2][1].string_value == "newton"
+
+
 def test_diagnostics_report_solves_failures_and_latency(node_and_client):
     _, c = node_and_client
     got = []

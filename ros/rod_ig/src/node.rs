@@ -141,8 +141,8 @@ pub fn output_qos() -> QosProfile {
     topic_qos()
 }
 
-/// QoS of the target subscription, from the `qos_overrides` parameters.
-pub fn target_qos(q: &crate::params::TargetQos) -> QosProfile {
+/// QoS of an endpoint, from its `qos_overrides` parameters.
+pub fn endpoint_qos(q: &crate::params::TopicQos) -> QosProfile {
     let base = QosProfile::publisher_default();
     let base = if q.best_effort {
         base.reliability_best_effort()
@@ -486,9 +486,10 @@ struct Endpoints {
 fn create_endpoints(
     node: &mut ros2_client::Node,
     identity: &NodeIdentity,
+    params: &Params,
 ) -> Result<(Endpoints, Outputs), NodeError> {
     let qos = topic_qos();
-    let out_qos = output_qos();
+    let out_qos = |name| Some(endpoint_qos(&params.qos_of(name)));
     let mut resolved = Vec::new();
     let mut topic = |node: &mut ros2_client::Node, name: &str, ty| {
         let (n, full) = resolved_name(identity, name)?;
@@ -504,20 +505,20 @@ fn create_endpoints(
     let (solve_name, solve_full) = resolved_name(identity, names::SOLVE)?;
     let (plan_name, plan_full) = resolved_name(identity, names::PLAN)?;
     let diagnostics = node
-        .create_publisher(&diagnostics_topic, Some(qos.clone()))
+        .create_publisher(&diagnostics_topic, out_qos(names::DIAGNOSTICS))
         .map_err(create_err("/diagnostics publisher"))?;
     let outputs = Outputs {
         path: node
-            .create_publisher(&path_topic, Some(out_qos.clone()))
+            .create_publisher(&path_topic, out_qos(names::PATH))
             .map_err(create_err("/rod/path publisher"))?,
         solution: node
-            .create_publisher(&solution_topic, Some(out_qos.clone()))
+            .create_publisher(&solution_topic, out_qos(names::SOLUTION))
             .map_err(create_err("/rod/solution publisher"))?,
         marker: node
-            .create_publisher(&marker_topic, Some(out_qos.clone()))
+            .create_publisher(&marker_topic, out_qos(names::MARKER))
             .map_err(create_err("/rod/marker publisher"))?,
         plan_rods: Arc::new(
-            node.create_publisher(&plan_rods_topic, Some(out_qos.clone()))
+            node.create_publisher(&plan_rods_topic, out_qos(names::PLAN_RODS))
                 .map_err(create_err("/rod/plan_rods publisher"))?,
         ),
         names: Names {
@@ -564,7 +565,7 @@ fn create_inputs(
         targets: node
             .create_subscription::<PoseStamped>(
                 &endpoints.target_topic,
-                Some(target_qos(&params.target_qos)),
+                Some(endpoint_qos(&params.qos_of(names::TARGET))),
             )
             .map_err(create_err("/rod/target subscription"))?,
         solve: node
@@ -650,15 +651,20 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
         }
     };
     let signal = signals.recv().await;
-    log_shutdown(&running.logger, signal, &running.stats);
-    shut_down(
-        running.tasks,
-        running.threads,
-        running.node,
-        running.spin_task,
-    )
-    .await;
-    drop(running.params_tx);
+    let Running {
+        logger,
+        stats,
+        tasks,
+        threads,
+        node,
+        spin_task,
+        params_tx,
+    } = running;
+    log_shutdown(&logger, signal, &stats);
+    // The logger's /rosout writer goes before the node (and its participant).
+    drop(logger);
+    shut_down(tasks, threads, node, spin_task).await;
+    drop(params_tx);
     Ok(())
 }
 
@@ -696,7 +702,7 @@ async fn start(startup: Startup, mw: MiddlewareConfig) -> Result<Running, NodeEr
     );
     let mut node = create_node(&context, &identity, options)?;
     let logger = Logger::new(&node, &log_settings);
-    let (endpoints, outputs) = create_endpoints(&mut node, &identity)?;
+    let (endpoints, outputs) = create_endpoints(&mut node, &identity, &params)?;
     let spin_task = start_spinner(&mut node, &params)?;
 
     let stats = Arc::new(Stats::default());

@@ -81,20 +81,63 @@ pub struct Params {
     /// `use_sim_time` (rclcpp's built-in): stamp outputs of targets stamped zero with the time
     /// of `/clock` (rosgraph_msgs/msg/Clock) instead of the system clock.
     pub use_sim_time: bool,
-    /// `qos_overrides.<target topic>.subscription.{reliability,durability,history,depth}`:
-    /// the QoS of the target subscription, read-only (set at start-up), as rclcpp's
-    /// `QosOverridingOptions`.
-    pub target_qos: TargetQos,
-    /// The resolved name of the target topic (`/rod/target` unless remapped or namespaced):
-    /// it names the `qos_overrides` parameters.
-    pub target_topic: String,
+    /// `qos_overrides.<topic>.{subscription,publisher}.{reliability,durability,history,depth}`:
+    /// the QoS of the target subscription and of every publisher, read-only (set at
+    /// start-up), as rclcpp's `QosOverridingOptions`. Topics by their resolved names.
+    pub qos_overrides: Vec<QosOverride>,
 }
 
-/// QoS of the `/rod/target` subscription (see [`Params::target_qos`]). The default,
-/// reliable + volatile + keep last 10, matches rclpy's `create_publisher(T, topic, 10)`; a
-/// BEST_EFFORT (sensor data) publisher needs `reliability: best_effort` here.
+/// The QoS of one of the node's endpoints, as its `qos_overrides` parameters set it.
 #[derive(Clone, Debug, PartialEq)]
-pub struct TargetQos {
+pub struct QosOverride {
+    /// The topic's name in [`crate::graph::names`] (before remapping).
+    pub name: &'static str,
+    /// Its resolved name (remapped, namespaced): it names the parameters.
+    pub topic: String,
+    /// `subscription` or `publisher`.
+    pub role: &'static str,
+    /// The QoS.
+    pub qos: TopicQos,
+}
+
+/// The endpoints whose QoS the `qos_overrides` parameters set: the target subscription, then
+/// the publishers.
+const QOS_ENDPOINTS: [(&str, &str); 6] = {
+    use crate::graph::names;
+    [
+        (names::TARGET, "subscription"),
+        (names::PATH, "publisher"),
+        (names::SOLUTION, "publisher"),
+        (names::MARKER, "publisher"),
+        (names::PLAN_RODS, "publisher"),
+        (names::DIAGNOSTICS, "publisher"),
+    ]
+};
+
+impl QosOverride {
+    /// The node's endpoints at their defaults, their topics resolved by `resolve`.
+    pub fn for_node<E>(resolve: impl Fn(&str) -> Result<String, E>) -> Result<Vec<Self>, E> {
+        QOS_ENDPOINTS
+            .iter()
+            .map(|&(name, role)| {
+                Ok(Self {
+                    name,
+                    topic: resolve(name)?,
+                    role,
+                    qos: TopicQos::default(),
+                })
+            })
+            .collect()
+    }
+}
+
+/// QoS of one endpoint (see [`Params::qos_overrides`]). The default, reliable + volatile +
+/// keep last 10, matches rclpy's `create_publisher(T, topic, 10)`; a BEST_EFFORT (sensor data)
+/// target publisher needs `reliability: best_effort` on the subscription, and an RViz display
+/// or late joiner that asks for TRANSIENT_LOCAL needs `durability: transient_local` on the
+/// publisher.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TopicQos {
     /// `reliable` (default) or `best_effort`.
     pub best_effort: bool,
     /// `volatile` (default) or `transient_local`.
@@ -105,7 +148,7 @@ pub struct TargetQos {
     pub depth: i64,
 }
 
-impl Default for TargetQos {
+impl Default for TopicQos {
     fn default() -> Self {
         Self {
             best_effort: false,
@@ -137,8 +180,14 @@ impl Default for Params {
             follow_branch: false,
             deadline_ms: 0.0,
             use_sim_time: false,
-            target_qos: TargetQos::default(),
-            target_topic: "/rod/target".into(),
+            qos_overrides: QosOverride::for_node(|n| {
+                Ok::<_, std::convert::Infallible>(if n.starts_with('/') {
+                    n.to_string()
+                } else {
+                    format!("/{n}")
+                })
+            })
+            .unwrap_or_default(),
         };
         for spec in &TABLE {
             // The table's defaults are within its ranges (tested: `defaults`).
@@ -637,24 +686,44 @@ fn choice(name: &str, v: &ParameterValue, choices: [&str; 2]) -> Result<bool, Pa
 }
 
 impl Params {
-    /// The name of the `qos_overrides` parameter for `policy` (one of [`QOS_POLICIES`]).
-    pub fn qos_parameter(&self, policy: &str) -> String {
-        format!("qos_overrides.{}.subscription.{policy}", self.target_topic)
+    /// The QoS of the endpoint on topic `name` (one of [`crate::graph::names`]).
+    pub fn qos_of(&self, name: &str) -> TopicQos {
+        self.qos_overrides
+            .iter()
+            .find(|o| o.name == name)
+            .map(|o| o.qos.clone())
+            .unwrap_or_default()
     }
 
-    /// The policy a `qos_overrides` parameter name sets, if it is one of this node's.
-    fn qos_policy_of<'a>(&self, name: &'a str) -> Option<&'a str> {
-        name.strip_prefix("qos_overrides.")?
-            .strip_prefix(self.target_topic.as_str())?
-            .strip_prefix(".subscription.")
-            .filter(|p| QOS_POLICIES.contains(p))
+    /// The name of the `qos_overrides` parameter for `policy` (one of [`QOS_POLICIES`]) of
+    /// endpoint `o`.
+    fn qos_parameter(o: &QosOverride, policy: &str) -> String {
+        format!("qos_overrides.{}.{}.{policy}", o.topic, o.role)
+    }
+
+    /// The endpoint (index) and policy a `qos_overrides` parameter name sets, if it is one of
+    /// this node's.
+    fn qos_policy_of<'a>(&self, name: &'a str) -> Option<(usize, &'a str)> {
+        let rest = name.strip_prefix("qos_overrides.")?;
+        self.qos_overrides.iter().enumerate().find_map(|(i, o)| {
+            rest.strip_prefix(o.topic.as_str())?
+                .strip_prefix('.')?
+                .strip_prefix(o.role)?
+                .strip_prefix('.')
+                .filter(|p| QOS_POLICIES.contains(p))
+                .map(|p| (i, p))
+        })
     }
 
     /// Every parameter name of this node: the table's, then the `qos_overrides` ones.
     pub fn names(&self) -> Vec<String> {
         names()
             .map(|n| n.to_string())
-            .chain(QOS_POLICIES.iter().map(|p| self.qos_parameter(p)))
+            .chain(
+                self.qos_overrides
+                    .iter()
+                    .flat_map(|o| QOS_POLICIES.iter().map(move |p| Self::qos_parameter(o, p))),
+            )
             .collect()
     }
 
@@ -666,10 +735,13 @@ impl Params {
     fn apply_qos(
         &mut self,
         name: &str,
-        policy: &str,
+        (index, policy): (usize, &str),
         value: &ParameterValue,
     ) -> Result<(), ParamError> {
-        let q = &mut self.target_qos;
+        let Some(o) = self.qos_overrides.get_mut(index) else {
+            return Err(ParamError::Unknown(name.into()));
+        };
+        let q = &mut o.qos;
         match policy {
             "reliability" => q.best_effort = choice(name, value, ["reliable", "best_effort"])?,
             "durability" => {
@@ -683,8 +755,8 @@ impl Params {
 
     /// Sets parameter `name` to `value` after validating it; on error `self` is unchanged.
     pub fn apply(&mut self, name: &str, value: &ParameterValue) -> Result<(), ParamError> {
-        if let Some(policy) = self.qos_policy_of(name) {
-            return self.apply_qos(name, policy, value);
+        if let Some(endpoint) = self.qos_policy_of(name) {
+            return self.apply_qos(name, endpoint, value);
         }
         let spec = spec(name).ok_or_else(|| ParamError::Unknown(name.into()))?;
         spec.kind.check(name, value)?;
@@ -704,8 +776,8 @@ impl Params {
 
     /// The value of `name` as a ROS parameter value (the type it is declared with).
     pub fn get(&self, name: &str) -> Option<ParameterValue> {
-        if let Some(policy) = self.qos_policy_of(name) {
-            let q = &self.target_qos;
+        if let Some((index, policy)) = self.qos_policy_of(name) {
+            let q = &self.qos_overrides.get(index)?.qos;
             let pick =
                 |b: bool, [a, z]: [&str; 2]| ParameterValue::String(if b { z } else { a }.into());
             return Some(match policy {
@@ -728,7 +800,8 @@ impl Params {
 
     /// What `describe_parameters` (`ros2 param describe`) says about `name`.
     pub fn descriptor(&self, name: &str) -> Option<Descriptor> {
-        if let Some(policy) = self.qos_policy_of(name) {
+        if let Some((index, policy)) = self.qos_policy_of(name) {
+            let o = self.qos_overrides.get(index)?;
             let (what, allowed, range) = match policy {
                 "reliability" => ("reliability", "reliable or best_effort", Range::Unbounded),
                 "durability" => (
@@ -740,10 +813,7 @@ impl Params {
                 _ => ("keep_last depth", "1..10000", Range::Integer(1, 10_000)),
             };
             return Some(Descriptor {
-                description: format!(
-                    "QoS {what} of the target subscription ({}); start-up only",
-                    self.target_topic
-                ),
+                description: format!("QoS {what} of the {} on {}; start-up only", o.role, o.topic),
                 constraints: allowed.into(),
                 read_only: true,
                 range,
@@ -895,8 +965,7 @@ where
         .identity(crate::graph::NODE_NAME, "/")
         .map_err(|e| ParamError::Args(e.to_string()))?;
     let mut params = Params {
-        target_topic: identity
-            .resolve(crate::graph::names::TARGET)
+        qos_overrides: QosOverride::for_node(|n| identity.resolve(n))
             .map_err(|e| ParamError::Args(e.to_string()))?,
         ..Params::default()
     };
@@ -1289,7 +1358,10 @@ mod tests {
     fn declarations_round_trip() {
         let p = Params::default();
         let decl = p.to_declarations();
-        assert_eq!(decl.len(), names().count() + QOS_POLICIES.len());
+        assert_eq!(
+            decl.len(),
+            names().count() + QOS_ENDPOINTS.len() * QOS_POLICIES.len()
+        );
         let mut q = Params {
             rod_length: 9.0,
             ..Params::default()

@@ -1,0 +1,45 @@
+"""Clean shutdown (issue 20, item 3): SIGINT or SIGTERM at any moment exits 0, and the
+node's participant and endpoints are disposed, so other participants drop them at once rather
+than when its lease expires (~50 s with Fast DDS before the fix)."""
+import signal
+import time
+
+import rodig_harness as h
+
+
+def test_a_signal_during_start_up_ends_the_node_cleanly():
+    """SIGINT or SIGTERM at any moment of start-up (the atlas build takes ~0.2 s) exits 0, as
+    rclcpp's nodes do, instead of the node dying by the signal (issue 20, item 3)."""
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        for delay in (0.01, 0.03, 0.05, 0.1, 0.3):
+            node = h.NodeProcess(h.free_domain(), [])
+            time.sleep(delay)
+            code = node.stop(sig, timeout=5.0)
+            assert code == 0, f"{sig.name} {delay * 1e3:.0f} ms after start: exit {code}; " \
+                              f"log:\n{node.log_path.read_text()[-1500:]}"
+
+
+def test_other_participants_drop_the_node_within_a_second():
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        domain = h.free_domain()
+        node = h.NodeProcess(domain, [])
+        c = h.Client(domain)
+        try:
+            assert c.wait_connected(), node.log_text()[-2000:]
+            assert c.node.count_publishers("/rod/path") == 1
+            assert node.stop(sig) == 0
+            stopped = time.perf_counter()
+            gone = c.wait_for(
+                lambda: c.node.count_publishers("/rod/path") == 0
+                and c.node.count_subscribers("/rod/target") == 0
+                and not c.solve_client.service_is_ready()
+                and not c.plan_client.service_is_ready()
+                and not any("rod_ig_node" in n for n in c.node.get_node_names()),
+                timeout=5.0)
+            elapsed = time.perf_counter() - stopped
+            # Measured: gone at the first check (< 50 ms).
+            assert gone and elapsed < 1.0, f"{sig.name}: still in the graph after {elapsed:.2f} s"
+            log = node.log_path.read_text()
+            assert "shutting down" in log and " ERROR " not in log, log[-2000:]
+        finally:
+            c.close()
