@@ -911,6 +911,13 @@ pub fn usage() -> String {
         ));
     }
     text.push_str(
+        "  qos_overrides.TOPIC.ROLE.POLICY  start-up QoS, as rclcpp's: TOPIC /rod/target (ROLE\n\
+         \x20   subscription) or /rod/path, /rod/solution, /rod/marker, /rod/plan_rods, /diagnostics\n\
+         \x20   (ROLE publisher); POLICY reliability (reliable|best_effort), durability\n\
+         \x20   (volatile|transient_local), history (keep_last|keep_all), depth (1..10000)\n\
+         \x20   (reliable, volatile, keep_last, 10)\n",
+    );
+    text.push_str(
         "\nEnvironment: ROS_DOMAIN_ID (0..232), ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST or\n\
          ROS_LOCALHOST_ONLY=1 (loopback only), RUST_LOG (console log level).\n",
     );
