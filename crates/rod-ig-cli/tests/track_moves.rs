@@ -68,3 +68,31 @@ fn every_move_ends_reached_kept_or_lost_and_a_deadline_keeps_the_rod() {
         answers.len()
     );
 }
+
+/// Given the time, every move between reachable poses of stable rods ends on a stable rod
+/// (`none` or `snap`): `lost` is kept for poses with no stable equilibrium near. Two cases
+/// used to end `lost`: a branch that folded between two continuation steps (det J(1, a)
+/// changed sign twice, so the end rod failed the full test), and a snap whose stable rods all
+/// had, by rounding, the critical rod's energy or more.
+#[test]
+fn given_the_time_no_move_between_stable_poses_is_lost() {
+    let tips = reachable_tips(300, 0x5EED_2026);
+    let lines: String = tips
+        .iter()
+        .map(|t| {
+            format!(
+                "{{\"target\":{{\"x\":{},\"y\":{},\"theta\":{}}},\"deadline_ms\":10000}}\n",
+                t[0], t[1], t[2]
+            )
+        })
+        .collect();
+    let answers = run(&["track"], &lines);
+    assert_eq!(answers.len(), tips.len());
+    for (k, a) in answers.iter().enumerate() {
+        let event = a["event"].as_str().expect("event");
+        assert!(a["success"] == true, "line {k}: {a}");
+        assert!(event == "none" || event == "snap", "line {k}: {a}");
+        assert_eq!(a["held_a"], a["a"], "line {k}: the rod held is the answer");
+        assert_eq!(a["stable"], true, "line {k}: {a}");
+    }
+}

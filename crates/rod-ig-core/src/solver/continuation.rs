@@ -51,6 +51,10 @@ pub const CORRECTOR_ITERATIONS: u32 = 8;
 const CONTRACTION: f64 = 0.5;
 /// Most snaps followed within one move (each needs a fold and a lower-energy equilibrium).
 pub const MAX_SNAPS: u32 = 8;
+/// Largest relative distance (in the model's parameter scale) between the rod a stop of the
+/// continuation settles on and the rod it stopped at for the two to be the same branch: past
+/// a fold the rod jumps to another configuration, O(1) away.
+const SAME_BRANCH: f64 = 0.05;
 
 /// What happened to the rod during one gripper move.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -238,9 +242,16 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                     return self.out_of_time(&at, target, &work, progress);
                 }
                 Err(Stop::Fold(critical, s)) => {
-                    snaps += 1;
                     let critical_energy = self.model.energy(&critical.a).unwrap_or(f64::NAN);
-                    let settled = self.snap(&current, &critical, critical_energy, s, target, snaps);
+                    // Just past the fold; when no stable rod is there (the straight path of
+                    // the gripper may cross poses no stable rod reaches), at the target.
+                    let settled = self
+                        .snap(&current, &critical, critical_energy, s, target, snaps + 1)
+                        .or_else(|| {
+                            (snaps < MAX_SNAPS)
+                                .then(|| self.settle(&critical, critical_energy, target))
+                                .flatten()
+                        });
                     let Some((settled, energy)) = settled else {
                         self.held = None;
                         let e = IgError::NoStableSolution {
@@ -251,8 +262,17 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                         };
                         return self.lost(e, &work, critical.a);
                     };
-                    if first_snap.is_none() {
-                        first_snap = Some((critical.tip, critical.a, critical_energy - energy));
+                    // A stop that settles on the branch it was following (the rod nearest
+                    // the critical one, within SAME_BRANCH) was no fold, only a turn of the
+                    // branch too sharp for the corrector at the smallest step: no snap, and
+                    // the continuation goes on from there.
+                    let scale = self.model.param_scale();
+                    let jump = relative_distance(&settled.a, &critical.a, &scale);
+                    if jump > SAME_BRANCH {
+                        snaps += 1;
+                        if first_snap.is_none() {
+                            first_snap = Some((critical.tip, critical.a, critical_energy - energy));
+                        }
                     }
                     done = 1.0 - (1.0 - done) * (1.0 - (s + 2.0 * MIN_STEP).min(1.0));
                     current = settled;
@@ -271,16 +291,33 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         first_snap: Option<(M::Pose, SVector<f64, N>, f64)>,
         snaps: u32,
     ) -> Move<SVector<f64, N>, M::Pose> {
-        let eval = match self.model.evaluate(&end.a) {
-            Ok(e) if e.stability.stable => e,
-            // The branch's stability is tracked by the sign of det J(1, a) alone; a rod that
-            // fails the full test at the end is not held.
-            _ => {
-                self.held = None;
-                let e = IgError::LeftStableSet {
-                    iteration: work.iterations,
+        let (end, eval, first_snap, snaps) = match self.model.evaluate(&end.a) {
+            Ok(e) if e.stability.stable => (end, e, first_snap, snaps),
+            // The branch's stability is tracked by the sign of det J(1, a); a rod that fails
+            // the full test at the end passed a fold between two steps (det J(1, a) changed
+            // sign twice): the rod snapped on the way, and settles at the target as at any
+            // fold. Lost only when no stable rod of lower energy is there.
+            other => {
+                let energy = match &other {
+                    Ok(e) => e.energy,
+                    Err(_) => self.model.energy(&end.a).unwrap_or(f64::INFINITY),
                 };
-                return self.lost(e, work, end.a);
+                let Some((settled, settled_energy)) = self.settle(&end, energy, target) else {
+                    self.held = None;
+                    let e = IgError::LeftStableSet {
+                        iteration: work.iterations,
+                    };
+                    return self.lost(e, work, end.a);
+                };
+                let Ok(eval) = self.model.evaluate(&settled.a) else {
+                    self.held = None;
+                    let e = IgError::LeftStableSet {
+                        iteration: work.iterations,
+                    };
+                    return self.lost(e, work, end.a);
+                };
+                let snap = first_snap.or(Some((end.tip, end.a, energy - settled_energy)));
+                (settled, eval, snap, snaps + 1)
             }
         };
         self.held = Some(end);
@@ -401,16 +438,22 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         };
         let candidates = solve_all(&self.model, pose, &options);
         let scale = self.model.param_scale();
-        let best = candidates
-            .iter()
-            .filter(|c| c.energy < critical_energy)
-            .min_by(|p, q| {
-                relative_distance(&p.a, &critical.a, &scale).total_cmp(&relative_distance(
-                    &q.a,
-                    &critical.a,
-                    &scale,
-                ))
-            })?;
+        let nearest = |lower_only: bool| {
+            candidates
+                .iter()
+                .filter(|c| !lower_only || c.energy < critical_energy)
+                .min_by(|p, q| {
+                    relative_distance(&p.a, &critical.a, &scale).total_cmp(&relative_distance(
+                        &q.a,
+                        &critical.a,
+                        &scale,
+                    ))
+                })
+        };
+        // The rule's rod; when rounding puts every stable rod there at or above the critical
+        // energy (a fold of nearly equal energies), the nearest stable rod: the rod is lost
+        // only when no stable equilibrium is found at the pose at all.
+        let best = nearest(true).or_else(|| nearest(false))?;
         let eval = self.model.evaluate(&best.a).ok()?;
         eval.stability
             .stable
@@ -427,6 +470,11 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         let start = held.tip;
         let mut current = *held;
         let (mut s, mut ds) = (0.0f64, 1.0f64);
+        // Whether the last step was taken at the first try: a step that succeeds only after
+        // halving keeps its length for the next one instead of doubling (doubling there
+        // fails again: one wasted corrector run per step, each a few ms on strongly
+        // tensioned rods).
+        let mut first_try = true;
         while s < 1.0 {
             if crate::solver::deadline::expired() {
                 return Err(Stop::Deadline(current, s));
@@ -447,9 +495,13 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                 Some(next) => {
                     current = next;
                     s = s_new;
-                    ds = (2.0 * ds).min(1.0);
+                    if first_try {
+                        ds = (2.0 * ds).min(1.0);
+                    }
+                    first_try = true;
                 }
                 None => {
+                    first_try = false;
                     ds *= 0.5;
                     if ds < MIN_STEP {
                         return Err(Stop::Fold(current, s));
