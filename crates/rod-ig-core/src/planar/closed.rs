@@ -478,6 +478,17 @@ impl<T: Real> Closed<T> {
         self.a4.re().hypot(self.a5.re()).sqrt().exp()
     }
 
+    /// Whether the closed form's J(1) is within `j_tolerance` (relative) by its own estimate, in
+    /// the cases where that estimate is the cancellation one (I and II, m not tiny): a looser
+    /// bound than [`CLOSED_J_TOLERANCE`], for uses that need fewer digits.
+    pub(crate) fn accurate_within(&self, j_tolerance: f64) -> bool {
+        let (a3, a4, a5) = (self.a3.re(), self.a4.re(), self.a5.re());
+        (a3 * a3).max(a4.abs()).max(a5.abs()) <= REFERENCE_MAX_SCALE
+            && matches!(self.case, Case::I | Case::II)
+            && self.m.re() >= SMALL_M
+            && self.cancellation_loss(1.0) * f64::EPSILON <= j_tolerance
+    }
+
     fn needs_reference_by_estimate(&self) -> bool {
         let (a3, a4, a5) = (self.a3.re(), self.a4.re(), self.a5.re());
         if (a3 * a3).max(a4.abs()).max(a5.abs()) > REFERENCE_MAX_SCALE {

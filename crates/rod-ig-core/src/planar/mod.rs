@@ -566,6 +566,36 @@ pub(crate) fn tip_and_jacobian_for_iteration(
     )
 }
 
+/// Largest estimated relative error of the closed form's J (its cancellation estimate) for
+/// which a continuation's intermediate step uses it: 100× inside the steps' 1e-6 tolerance.
+/// Strongly tensioned rods (a4 ≈ 600) have estimates of 1e-8 to 2e-8, just past the 1e-8 of
+/// an answer ([`closed::CLOSED_J_TOLERANCE`]), and agree with the double-double series to
+/// 1e-14; the series costs 3 ms there, the closed form under 1 µs.
+const SUBSTEP_J_TOLERANCE: f64 = 1e-8 * 100.0;
+
+/// q(1) and J(1, a) for the intermediate poses of a continuation
+/// (`RodModel::tip_and_jacobian_for_substep`): the closed form wherever its error estimate is
+/// within [`SUBSTEP_J_TOLERANCE`] (cases I and II away from m → 0), else [`tip_and_jacobian`].
+pub(crate) fn tip_and_jacobian_for_substep(
+    a: &PlanarParams,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    check_params(a)?;
+    if series_first(a) {
+        return series_pose_and_jac(a, 1.0);
+    }
+    with_seeded(
+        a,
+        |c| {
+            if c.needs_series() != SeriesNeed::None && c.accurate_within(SUBSTEP_J_TOLERANCE) {
+                pose_jac_from(c.pose(1.0))
+            } else {
+                pose_and_jac_of(c, a, 1.0)
+            }
+        },
+        || series_pose_and_jac(a, 1.0),
+    )
+}
+
 /// Tip pose q(1, a) and J(1, a) (see [`pose_and_jacobian`]).
 pub fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     pose_and_jacobian(a, 1.0)
@@ -796,6 +826,53 @@ mod tests {
         assert!(
             worst_tip <= 1.0,
             "pose error {worst_tip} times its estimate"
+        );
+    }
+}
+
+#[cfg(test)]
+mod substep_tests {
+    use super::*;
+    use crate::rng::SplitMix64;
+
+    /// The substep evaluation agrees with the full-accuracy one far inside the continuation's
+    /// 1e-6 step tolerance on strongly tensioned rods, where it takes the closed form instead
+    /// of the double-double series (tolerances: 1e-9 on the tip, 1e-7 relative on J, 10×
+    /// inside the 1e-8 and 1e-6 that SUBSTEP_J_TOLERANCE's estimate allows).
+    #[test]
+    fn substep_evaluation_agrees_on_tensioned_rods() {
+        let mut rng = SplitMix64::new(0x5B57_E9);
+        let mut closed_used = 0;
+        for _ in 0..400 {
+            // Near the branch a tracked move follows through strong tension (the issue-20
+            // move from (0.4, 0.1, 0.5) to (0.875, 0, 0.3)), between two of its rods.
+            let (p, q) = ([0.0782, 496.5, -1.65], [0.179, 682.7, -4.675]);
+            let u = rng.range(0.0, 1.0);
+            let mut jitter = |k: usize| 1.0 + 1e-3 * rng.range(-1.0, 1.0) * (k as f64 + 1.0);
+            let a = PlanarParams::new(
+                (p[0] + u * (q[0] - p[0])) * jitter(0),
+                (p[1] + u * (q[1] - p[1])) * jitter(1),
+                (p[2] + u * (q[2] - p[2])) * jitter(2),
+            );
+            let (Ok(loose), Ok(full)) = (tip_and_jacobian_for_substep(&a), tip_and_jacobian(&a))
+            else {
+                continue;
+            };
+            let dq = (loose.0.x - full.0.x)
+                .abs()
+                .max((loose.0.y - full.0.y).abs())
+                .max((loose.0.theta - full.0.theta).abs());
+            let dj = (loose.1 - full.1).norm() / full.1.norm();
+            assert!(dq < 1e-9 && dj < 1e-7, "a = {a:?}: tip {dq:e}, J {dj:e}");
+            if let Some(c) = seeded_closed(&a) {
+                if c.needs_series() != SeriesNeed::None && c.accurate_within(SUBSTEP_J_TOLERANCE) {
+                    closed_used += 1;
+                }
+            }
+        }
+        assert!(
+            closed_used >= 10,
+            "the closed form stood in for the series {closed_used} times"
         );
     }
 }

@@ -233,6 +233,13 @@ impl RodModel<3> for PlanarClosedForm {
         crate::planar::tip_and_jacobian(a)
     }
 
+    fn tip_and_jacobian_for_substep(
+        &self,
+        a: &Vector3<f64>,
+    ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+        crate::planar::tip_and_jacobian_for_substep(a)
+    }
+
     fn evaluate(&self, a: &Vector3<f64>) -> Result<ModelEvaluation<3, PlanarPose>, RodError> {
         crate::planar::evaluate(a)
     }

@@ -491,7 +491,14 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
             } else {
                 SUBSTEP_TOLERANCE.max(self.options.tolerance)
             };
-            match self.correct(&current, &goal, tolerance, work) {
+            if last && s > 0.0 {
+                // The last step is corrected at full accuracy, from a rod re-evaluated so.
+                (current.tip, current.jacobian) = match self.model.tip_and_jacobian(&current.a) {
+                    Ok(q) => q,
+                    Err(_) => return Err(Stop::Fold(current, s)),
+                };
+            }
+            match self.correct(&current, &goal, tolerance, !last, work) {
                 Some(next) => {
                     current = next;
                     s = s_new;
@@ -520,6 +527,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         from: &Held<N, M::Pose>,
         goal: &M::Pose,
         tolerance: f64,
+        substep: bool,
         work: &mut Work,
     ) -> Option<Held<N, M::Pose>> {
         let side = self.model.jacobian_det(&from.jacobian);
@@ -545,7 +553,11 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
             x.a += d;
             work.iterations += 1;
             work.evaluations += 1;
-            (x.tip, x.jacobian) = self.model.tip_and_jacobian(&x.a).ok()?;
+            (x.tip, x.jacobian) = if substep {
+                self.model.tip_and_jacobian_for_substep(&x.a).ok()?
+            } else {
+                self.model.tip_and_jacobian(&x.a).ok()?
+            };
             // A sign change of det J(1, a) means the step crossed the fold.
             if self.model.jacobian_det(&x.jacobian) * side <= 0.0 {
                 return None;

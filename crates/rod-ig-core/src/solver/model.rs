@@ -48,6 +48,17 @@ pub trait RodModel<const N: usize> {
         self.evaluate(a).map(|e| (e.tip, e.jacobian))
     }
 
+    /// Υ(a) and J(1, a) for the intermediate poses of a continuation, whose tolerance is
+    /// [`crate::solver::continuation::SUBSTEP_TOLERANCE`] (1e-6): a model may use a cheaper
+    /// evaluation there when its error is certified far below that. The end of a move is
+    /// always verified with [`Self::tip_and_jacobian`] and [`Self::evaluate`].
+    fn tip_and_jacobian_for_substep(
+        &self,
+        a: &SVector<f64, N>,
+    ) -> Result<(Self::Pose, SMatrix<f64, N, N>), RodError> {
+        self.tip_and_jacobian(a)
+    }
+
     /// As [`Self::evaluate`], for an iterate of a run that began at `start`: a model may use a
     /// cheaper accuracy there (setting `full_accuracy` false).
     fn evaluate_iterate(
