@@ -841,7 +841,7 @@ mod substep_tests {
     /// inside the 1e-8 and 1e-6 that SUBSTEP_J_TOLERANCE's estimate allows).
     #[test]
     fn substep_evaluation_agrees_on_tensioned_rods() {
-        let mut rng = SplitMix64::new(0x5B57_E9);
+        let mut rng = SplitMix64::new(0x005B_57E9);
         let mut closed_used = 0;
         for _ in 0..400 {
             // Near the branch a tracked move follows through strong tension (the issue-20
