@@ -115,20 +115,9 @@ def first_target(starts, follow=100):
 
 def raw_path_times(samples, runs):
     """Target publish -> raw (serialized) /rod/path of `samples` poses at an rclpy subscriber."""
-    from nav_msgs.msg import Path as PathMsg
     domain = h.free_domain()
     node = h.NodeProcess(domain, ["-p", f"path_samples:={samples}"])
-    client = h.Client(domain, name="rod_ig_large_bench", path_only=True)
-    got = []
-    ready = threading.Event()
-
-    def on_raw(msg):
-        got.append((time.perf_counter(), msg))
-        ready.set()
-
-    client.node.create_subscription(PathMsg, "/rod/path", on_raw, h.topic_qos(), raw=True)
-    # Only the raw subscription: the harness's own /rod/path one would convert each message.
-    client.node.destroy_subscription(next(s for s in client.node.subscriptions if s.raw is False))
+    client, got, ready = h.raw_path_client(domain, name="rod_ig_large_bench")
     try:
         if not client.wait_connected_topics():
             raise SystemExit(f"no connection; log {node.log_path}")

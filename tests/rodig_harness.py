@@ -347,6 +347,23 @@ class Client:
         self._thread.join(timeout=2.0)
 
 
+def raw_path_client(domain: int, name: str = "rod_ig_large_client"):
+    """A client whose only /rod/path subscription is raw: the delivery time of the serialized
+    message, without rclpy's conversion to Python objects (~2 s for 100,000 poses here).
+    Returns (client, [(arrival time, bytes)], an Event set at each arrival)."""
+    c = Client(domain, name=name, path_only=True)
+    got: list = []
+    ready = threading.Event()
+
+    def on_raw(msg):
+        got.append((time.perf_counter(), msg))
+        ready.set()
+
+    c.node.create_subscription(PathMsg, "/rod/path", on_raw, topic_qos(), raw=True)
+    c.node.destroy_subscription(next(s for s in c.node.subscriptions if s.raw is False))
+    return c, got, ready
+
+
 def start_node_and_client(args: list[str] | None = None, name: str = "rod_ig_test_client"):
     """A fresh rod_ig_node on a free domain (with `args`) and a connected client."""
     domain = free_domain()

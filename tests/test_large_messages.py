@@ -9,7 +9,6 @@ fixes (40-60 s for 100,000 poses, small calls queued behind large ones for that 
 import math
 import subprocess
 import sys
-import threading
 import time
 
 from nav_msgs.msg import Path as PathMsg
@@ -20,27 +19,10 @@ import rodig_harness as h
 BIG = 100_000
 
 
-def raw_path_client(domain):
-    """A client with a raw /rod/path subscription: the delivery time of the serialized
-    message, without rclpy's conversion to Python objects (~1.8 s for 100,000 poses here)."""
-    c = h.Client(domain, name="rod_ig_large_client", path_only=True)
-    got = []
-    ready = threading.Event()
-
-    def on_raw(msg):
-        got.append((time.perf_counter(), msg))
-        ready.set()
-
-    c.node.create_subscription(PathMsg, "/rod/path", on_raw, h.topic_qos(), raw=True)
-    # Only the raw subscription: the harness's own would convert each path (~2 s apiece).
-    c.node.destroy_subscription(next(s for s in c.node.subscriptions if s.raw is False))
-    return c, got, ready
-
-
 def test_large_paths_arrive_whole_and_memory_stays_bounded():
     domain = h.free_domain()
     node = h.NodeProcess(domain, ["-p", f"path_samples:={BIG}"])
-    c, got, ready = raw_path_client(domain)
+    c, got, ready = h.raw_path_client(domain)
     try:
         assert c.wait_connected_topics(), node.log_text()[-2000:]
         rss = []

@@ -26,18 +26,22 @@ fn reachable_tips(n: usize, seed: u64) -> Vec<[f64; 3]> {
     out
 }
 
-#[test]
-fn every_move_ends_reached_kept_or_lost_and_a_deadline_keeps_the_rod() {
-    let tips = reachable_tips(40, 0x7A11);
-    let lines: String = tips
-        .iter()
+/// One `track` line per tip, with `extra` JSON fields after the target.
+fn track_lines(tips: &[[f64; 3]], extra: &str) -> String {
+    tips.iter()
         .map(|t| {
             format!(
-                "{{\"target\":{{\"x\":{},\"y\":{},\"theta\":{}}}}}\n",
+                "{{\"target\":{{\"x\":{},\"y\":{},\"theta\":{}}}{extra}}}\n",
                 t[0], t[1], t[2]
             )
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn every_move_ends_reached_kept_or_lost_and_a_deadline_keeps_the_rod() {
+    let tips = reachable_tips(40, 0x7A11);
+    let lines = track_lines(&tips, "");
     let answers = run(&["track"], &lines);
     assert_eq!(answers.len(), tips.len());
     let (mut reached, mut kept) = (0, 0);
@@ -77,15 +81,7 @@ fn every_move_ends_reached_kept_or_lost_and_a_deadline_keeps_the_rod() {
 #[test]
 fn given_the_time_no_move_between_stable_poses_is_lost() {
     let tips = reachable_tips(300, 0x5EED_2026);
-    let lines: String = tips
-        .iter()
-        .map(|t| {
-            format!(
-                "{{\"target\":{{\"x\":{},\"y\":{},\"theta\":{}}},\"deadline_ms\":10000}}\n",
-                t[0], t[1], t[2]
-            )
-        })
-        .collect();
+    let lines = track_lines(&tips, ",\"deadline_ms\":10000");
     let answers = run(&["track"], &lines);
     assert_eq!(answers.len(), tips.len());
     for (k, a) in answers.iter().enumerate() {
