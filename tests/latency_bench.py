@@ -159,7 +159,6 @@ def solve_call_times(samples, runs):
 
 def small_call_during_large(runs, delay):
     """A 5-pose /rod/solve call made `delay` s after a 100,000-pose one (from another process)."""
-    import subprocess
     domain = h.free_domain()
     node = h.NodeProcess(domain, [])
     client = h.Client(domain, name="rod_ig_small_caller")
@@ -169,29 +168,17 @@ def small_call_during_large(runs, delay):
             raise SystemExit(f"no connection; log {node.log_path}")
         client.solve(client.make_target(0.6, 0.3, 0.5, h.next_seq()), path_samples=8)
         for _ in range(runs):
-            big = subprocess.Popen([sys.executable, "-c", f"""
-import sys
-sys.path.insert(0, {str(h.REPO / 'tests')!r})
-import rodig_harness as h
-c = h.Client({domain}, name='rod_ig_big_caller')
-assert c.wait_connected()
-print('ready', flush=True)
-sys.stdin.readline()
-r = c.solve(c.make_target(0.6, 0.3, 0.5, 5), path_samples=100000, timeout=60)
-print('done', flush=True)
-c.close()
-"""], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-            big.stdout.readline()
-            big.stdin.write("\n")
-            big.stdin.flush()
+            big = h.LargeCaller(domain, 100_000)
+            if not big.start():
+                raise SystemExit("the large caller did not connect")
+            big.call()
             time.sleep(delay)
             t0 = time.perf_counter()
             r = client.solve(client.make_target(0.5, 0.3, 0.5, h.next_seq()), path_samples=5)
             times.append(time.perf_counter() - t0)
             if r is None:
                 raise SystemExit(f"small call unanswered; log {node.log_path}")
-            big.stdout.readline()
-            big.wait()
+            big.result()
         return times
     finally:
         h.stop_node_and_client(node, client)

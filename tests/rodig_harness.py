@@ -13,6 +13,7 @@ import os
 import random
 import signal
 import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -362,6 +363,44 @@ def raw_path_client(domain: int, name: str = "rod_ig_large_client"):
     c.node.create_subscription(PathMsg, "/rod/path", on_raw, topic_qos(), raw=True)
     c.node.destroy_subscription(next(s for s in c.node.subscriptions if s.raw is False))
     return c, got, ready
+
+
+class LargeCaller:
+    """A /rod/solve call of `samples` path poses from another process (rclpy holds the GIL
+    while it converts a large reply, ~2 s for 100,000 poses, which would delay this process's
+    calls too). start() waits until it is connected; call() sends the request; result() waits
+    for the answer and returns its number of path poses (None: no answer)."""
+
+    def __init__(self, domain: int, samples: int):
+        self.proc = subprocess.Popen([sys.executable, "-c", f"""
+import sys
+sys.path.insert(0, {str(REPO / 'tests')!r})
+import rodig_harness as h
+c = h.Client({domain}, name='rod_ig_large_caller')
+assert c.wait_connected()
+print('ready', flush=True)
+sys.stdin.readline()
+r = c.solve(c.make_target(0.6, 0.3, 0.5, 5), path_samples={samples}, timeout=60)
+print(len(r.path.poses) if r is not None else 'none', flush=True)
+c.close()
+"""], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+
+    def start(self) -> bool:
+        return self.proc.stdout.readline().strip() == "ready"
+
+    def call(self):
+        self.proc.stdin.write("\n")
+        self.proc.stdin.flush()
+
+    def result(self):
+        line = self.proc.stdout.readline().strip()
+        self.proc.wait()
+        return int(line) if line.isdigit() else None
+
+    def close(self):
+        if self.proc.poll() is None:
+            self.proc.kill()
+        self.proc.wait()
 
 
 def start_node_and_client(args: list[str] | None = None, name: str = "rod_ig_test_client"):

@@ -7,8 +7,6 @@ The figures themselves (medians and worst of several runs) are in tests/latency_
 so that a loaded CI machine does not fail them, yet far below what the node did before the
 fixes (40-60 s for 100,000 poses, small calls queued behind large ones for that long)."""
 import math
-import subprocess
-import sys
 import time
 
 from nav_msgs.msg import Path as PathMsg
@@ -52,28 +50,13 @@ def test_small_call_is_not_queued_behind_a_large_one():
     domain = h.free_domain()
     node = h.NodeProcess(domain, [])
     c = h.Client(domain)
-    # The large call comes from another process: rclpy holds the GIL while it converts a
-    # 100,000-pose reply (~1.8 s), which would delay this process's small call too.
-    big = subprocess.Popen([sys.executable, "-c", f"""
-import sys, time
-sys.path.insert(0, {str(h.REPO / 'tests')!r})
-import rodig_harness as h
-c = h.Client({domain}, name='rod_ig_big_caller')
-assert c.wait_connected()
-print('ready', flush=True)
-sys.stdin.readline()
-t = c.make_target(0.6, 0.3, 0.5, 5)
-r = c.solve(t, path_samples={BIG}, timeout=60)
-print('big', r is not None and len(r.path.poses), flush=True)
-c.close()
-"""], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    big = h.LargeCaller(domain, BIG)
     try:
         assert c.wait_connected(), node.log_text()[-2000:]
         warm = c.make_target(0.6, 0.3, 0.5, h.next_seq())
         assert c.solve(warm, path_samples=8) is not None
-        assert big.stdout.readline().strip() == "ready"
-        big.stdin.write("\n")
-        big.stdin.flush()
+        assert big.start()
+        big.call()
         time.sleep(0.2)  # the large call is in flight (its caller waits ~2 s in all)
         t = c.make_target(0.5, 0.3, 0.5, h.next_seq())
         t0 = time.perf_counter()
@@ -82,11 +65,9 @@ c.close()
         assert r is not None and r.solution.success and len(r.path.poses) == 5
         # Measured ~2 ms; it waited 40-60 s before.
         assert small < 1.0, f"the small call took {small:.3f} s"
-        assert big.stdout.readline().strip() == f"big {BIG}"
+        assert big.result() == BIG
     finally:
-        if big.poll() is None:
-            big.kill()
-        big.wait()
+        big.close()
         h.stop_node_and_client(node, c)
 
 
