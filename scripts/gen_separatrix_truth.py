@@ -19,7 +19,9 @@ Writes crates/rod-ig-core/tests/data/separatrix_truth.jsonl, one line per rod:
  t ≥ 0.05 of det J(t)/(t⁹(a3²/8640 + a5²t²/33600)), "first_conjugate" (first grid t with
  det J ≤ 0, or null)}.
 Run: python3 scripts/gen_separatrix_truth.py [N=600]   (needs python-flint; ≈ 1 s per rod, two
-processes). The sample is seeded: the same file every run.
+processes); `--extreme [N=160]` writes separatrix_truth_extreme.jsonl instead, issue 23's
+tiny-bending sample; `--verdicts IN OUT` writes only the verdicts of the rods listed in IN.
+The samples are seeded: the same files every run.
 """
 import json, math, pathlib, random, sys
 from multiprocessing import Pool
@@ -167,11 +169,53 @@ def sample(n):
     return out
 
 
-if __name__ == "__main__":
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 600
-    path = pathlib.Path(__file__).resolve().parent.parent / "crates/rod-ig-core/tests/data/separatrix_truth.jsonl"
+def sample_extreme(n):
+    """Issue 23's independent sample: axial force 1e3..1e4 of either sign, moment and transverse
+    force 1e-14..1e-6 with some exact zeros, and the rod issue 23 quotes (a 320-bit integration
+    calls it stable, det_min 2.73; it came back "unstable, uncertain", margin -2.1e39)."""
+    r = random.Random(2311)
+
+    def signed(lo, hi):
+        v = 10 ** r.uniform(lo, hi)
+        return -v if r.random() < 0.5 else v
+
+    def small():
+        return 0.0 if r.random() < 0.15 else signed(-14, -6)
+
+    out = [[0.0, 2473.289745880672, 2.3178627609785778e-14]]
+    while len(out) < n:
+        a = [small(), signed(3, 4), small()]
+        if a[0] != 0.0 or a[2] != 0.0:
+            out.append(a)
+    return out
+
+
+def verdicts(path_in, path_out):
+    """The reference verdict and det_min only, for the rods listed in path_in (one JSON array
+    [a3, a4, a5] per line): tests/data/stability_truth_tiny_bending.jsonl holds the 30 rods of
+    a seeded tiny-bending sample that the double-double stability scan called "unstable" with a
+    certain verdict (issue 23)."""
+    rods = [json.loads(line) for line in open(path_in) if line.strip()]
     with Pool(2) as pool:
-        rows = pool.map(reference, sample(n), chunksize=1)
+        rows = pool.map(reference, rods, chunksize=1)
+    with open(path_out, "w") as f:
+        for row in rows:
+            keep = {k: row[k] for k in ("a", "stable", "det_min", "first_conjugate")}
+            f.write(json.dumps(keep) + "\n")
+
+
+if __name__ == "__main__":
+    if "--verdicts" in sys.argv:
+        i = sys.argv.index("--verdicts")
+        verdicts(sys.argv[i + 1], sys.argv[i + 2])
+        sys.exit(0)
+    extreme = "--extreme" in sys.argv
+    args = [v for v in sys.argv[1:] if not v.startswith("--")]
+    n = int(args[0]) if args else (160 if extreme else 600)
+    name = "separatrix_truth_extreme.jsonl" if extreme else "separatrix_truth.jsonl"
+    path = pathlib.Path(__file__).resolve().parent.parent / "crates/rod-ig-core/tests/data" / name
+    with Pool(2) as pool:
+        rows = pool.map(reference, (sample_extreme if extreme else sample)(n), chunksize=1)
     with open(path, "w") as f:
         for row in rows:
             f.write(json.dumps(row) + "\n")

@@ -36,6 +36,94 @@ fn main() {
         println!("{:?}", planar::evaluate(&a));
         return;
     }
+    if args.get(1).map(String::as_str) == Some("calls") {
+        // `calls SAMPLE_INDEX`: per-rod time of stability and tip + J over the sample, split by
+        // the sign of a4, with the slowest stability calls.
+        let index: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(3);
+        let n = std::env::var("PROFILE_N")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(1000);
+        let sets = samples(n);
+        let (name, inputs) = &sets[index.min(sets.len() - 1)];
+        let time = |f: &dyn Fn()| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1e6
+        };
+        let mut rows: Vec<(f64, f64, rod_ig_core::PlanarParams, String)> = inputs
+            .iter()
+            .map(|a| {
+                let s = time(&|| {
+                    let _ = black_box(planar::stability(black_box(a)));
+                });
+                let j = time(&|| {
+                    let _ = black_box(planar::evaluate(black_box(a)));
+                });
+                let r = planar::stability(a);
+                let v = match r {
+                    Ok(r) => format!(
+                        "stable {} unc {} margin {:.3e}",
+                        r.stable, r.uncertain, r.margin
+                    ),
+                    Err(e) => format!("error {e}"),
+                };
+                (s, j, *a, v)
+            })
+            .collect();
+        for (label, pos) in [("a4 > 0", true), ("a4 < 0", false)] {
+            let mut s: Vec<f64> = rows
+                .iter()
+                .filter(|r| (r.2[1] > 0.0) == pos)
+                .map(|r| r.0)
+                .collect();
+            let mut j: Vec<f64> = rows
+                .iter()
+                .filter(|r| (r.2[1] > 0.0) == pos)
+                .map(|r| r.1)
+                .collect();
+            s.sort_by(f64::total_cmp);
+            j.sort_by(f64::total_cmp);
+            let q = |v: &[f64], p: f64| v[((v.len() - 1) as f64 * p) as usize];
+            let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+            println!(
+                "{name} {label}: {} rods; stability mean {:.1} p50 {:.1} p99 {:.1} µs; evaluate mean {:.1} p50 {:.1} p99 {:.1} µs",
+                s.len(), mean(&s), q(&s, 0.5), q(&s, 0.99), mean(&j), q(&j, 0.5), q(&j, 0.99)
+            );
+        }
+        rows.sort_by(|p, q| q.0.total_cmp(&p.0));
+        for r in rows.iter().take(12) {
+            println!("{:9.1} µs  {:?}  {}", r.0, r.2.as_slice(), r.3);
+        }
+        let uncertain = rows.iter().filter(|r| !r.3.contains("unc false")).count();
+        println!("{uncertain} rods uncertain or refused");
+        for r in rows.iter().filter(|r| !r.3.contains("unc false")).take(10) {
+            println!("{:9.1} µs  {:?}  {}", r.0, r.2.as_slice(), r.3);
+        }
+        return;
+    }
+    if args.get(1).map(String::as_str) == Some("file") {
+        // `file PATH`: evaluate every "a3 a4 a5" line, printing refusals and uncertain verdicts.
+        let text = std::fs::read_to_string(&args[2]).unwrap_or_default();
+        for line in text.lines() {
+            let v: Vec<f64> = line
+                .split_whitespace()
+                .filter_map(|s| s.parse().ok())
+                .collect();
+            let a = rod_ig_core::PlanarParams::new(v[0], v[1], v[2]);
+            let t = Instant::now();
+            let r = planar::evaluate(&a);
+            let us = t.elapsed().as_secs_f64() * 1e6;
+            match r {
+                Err(e) => println!("{us:9.1} µs {line}: {e}"),
+                Ok(e) if e.stability.uncertain => {
+                    println!("{us:9.1} µs {line}: uncertain {:?}", e.stability)
+                }
+                Ok(_) => {}
+            }
+        }
+        return;
+    }
     let what = args.get(1).map_or("forward", String::as_str);
     let index: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1);
     let rounds: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(20);

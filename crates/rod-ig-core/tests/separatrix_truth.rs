@@ -37,10 +37,111 @@ const MAX_REFUSED_SHARE: f64 = 0.03;
 
 #[test]
 fn separatrix_rods_match_the_rigorous_reference_or_are_refused() {
-    let text = include_str!("data/separatrix_truth.jsonl");
+    let report = check_reference(include_str!("data/separatrix_truth.jsonl"));
+    assert!(report.n >= 200, "only {} reference rods", report.n);
+    assert!(
+        report.failures.is_empty() && report.uncertain.is_empty(),
+        "{} failures, {} uncertain where the reference is clear:\n{}\n{}",
+        report.failures.len(),
+        report.uncertain.len(),
+        report.failures.join("\n"),
+        report.uncertain.join("\n")
+    );
+    assert!(
+        (report.refused as f64) <= MAX_REFUSED_SHARE * report.n as f64,
+        "{} of {} refused",
+        report.refused,
+        report.n
+    );
+}
+
+/// Largest shares of issue 23's tiny-bending sample left uncertain although the reference is
+/// clear, and refused. Measured 2 and 16 of 160: rods whose bending, grown from ~1e-12 by
+/// e^{√‖F‖ t}, loops late on the rod. There det J(t) is ~1e-40 of the products of its entries
+/// (beyond double-double), the closed form's J is off by up to 3.5e-4 (estimate 1e2) and the
+/// double-double series' by up to 100 %: neither certifies the other. A quad-double series
+/// would, at ~30× the double-double's cost (issue 23, item 2, still open).
+const MAX_EXTREME_UNCERTAIN_SHARE: f64 = 0.02;
+const MAX_EXTREME_REFUSED_SHARE: f64 = 0.11;
+
+/// Issue 23's independent sample (`scripts/gen_separatrix_truth.py --extreme`): axial force
+/// 1e3..1e4 of either sign, moment and transverse force 1e-14..1e-6 with exact zeros, and the
+/// rod the issue quotes. Before, the double-double scan called 30 of 1,429 such rods (stable,
+/// det_min 3..250) "unstable" with a certain verdict, its rounding bound blind to the e^{√‖F‖ t}
+/// growth. Now no verdict, tip or J is wrong, and refusals say why.
+#[test]
+fn tiny_bending_under_strong_force_is_never_wrong() {
+    let report = check_reference(include_str!("data/separatrix_truth_extreme.jsonl"));
+    assert!(report.n >= 150, "only {} reference rods", report.n);
+    assert!(
+        report.failures.is_empty(),
+        "{} failures:\n{}",
+        report.failures.len(),
+        report.failures.join("\n")
+    );
+    assert!(
+        (report.uncertain.len() as f64) <= MAX_EXTREME_UNCERTAIN_SHARE * report.n as f64,
+        "{} of {} uncertain where the reference is clear:\n{}",
+        report.uncertain.len(),
+        report.n,
+        report.uncertain.join("\n")
+    );
+    assert!(
+        (report.refused as f64) <= MAX_EXTREME_REFUSED_SHARE * report.n as f64,
+        "{} of {} refused",
+        report.refused,
+        report.n
+    );
+    // The rod issue 23 quotes (stable, det_min 2.73): never "unstable" with a certain verdict.
+    let quoted = PlanarParams::new(0.0, 2473.289745880672, 2.3178627609785778e-14);
+    let s = planar::stability(&quoted).expect("issue 23's rod");
+    assert!(s.stable || s.uncertain, "{s:?}");
+}
+
+/// 30 stable rods (det_min 3.8..250, 320-bit reference) of a seeded tiny-bending sample under
+/// tension 1e3..1e4 that the double-double stability scan called "unstable" with a certain
+/// verdict (margins down to -1e29): its rounding bound ignored the e^{√‖F‖ t} growth. Now each
+/// is stable with the reference's margin.
+#[test]
+fn stable_rods_the_double_double_scan_called_unstable() {
+    let text = include_str!("data/stability_truth_tiny_bending.jsonl");
+    let mut n = 0;
+    for line in text.lines().filter(|l| !l.trim().is_empty()) {
+        let v: serde_json::Value = serde_json::from_str(line).expect("reference line");
+        let a = numbers(&v["a"]);
+        let a = PlanarParams::new(a[0], a[1], a[2]);
+        let det_min = v["det_min"].as_f64().expect("det_min");
+        assert_eq!(v["stable"].as_bool(), Some(true), "{line}");
+        let s = planar::stability(&a).expect("a verdict");
+        // The margin is the scan's refined minimum, the reference's the minimum over a grid of
+        // 2000 points: both find the same minimum at t = 0.05 here.
+        assert!(
+            s.stable && !s.uncertain && (s.margin - det_min).abs() <= 1e-9 * det_min,
+            "{:?}: {s:?}, reference det_min {det_min}",
+            a.as_slice()
+        );
+        n += 1;
+    }
+    assert_eq!(n, 30);
+}
+
+/// What [`check_reference`] found.
+struct ReferenceReport {
+    n: usize,
+    refused: usize,
+    /// Wrong answers (tip, J, energy or a verdict different from a clear reference).
+    failures: Vec<String>,
+    /// Uncertain verdicts where the reference is clear.
+    uncertain: Vec<String>,
+}
+
+/// Every rod of a reference file against `planar::evaluate`: tips, J and energy within issue
+/// 9's tolerances, refusals only where no certified method exists, and the verdict wherever
+/// the reference's margin is clear.
+fn check_reference(text: &str) -> ReferenceReport {
     let (mut n, mut refused) = (0usize, 0usize);
     let (mut worst_tip, mut worst_jac, mut worst_energy) = (0.0f64, 0.0f64, 0.0f64);
-    let mut failures = Vec::new();
+    let (mut failures, mut uncertain) = (Vec::new(), Vec::new());
     for line in text.lines().filter(|l| !l.trim().is_empty()) {
         let v: serde_json::Value = serde_json::from_str(line).expect("reference line");
         let a = numbers(&v["a"]);
@@ -88,31 +189,30 @@ fn separatrix_rods_match_the_rigorous_reference_or_are_refused() {
             .as_f64()
             .is_some_and(|m| m.abs() > CLEAR_MARGIN);
         if let (Some(stable), true) = (v["stable"].as_bool(), clear) {
-            if eval.stability.uncertain || eval.stability.stable != stable {
-                failures.push(format!(
-                    "{:?}: verdict {:?}, reference stable = {stable} (det_min {})",
-                    a.as_slice(),
-                    eval.stability,
-                    v["det_min"]
-                ));
+            let line = format!(
+                "{:?}: verdict {:?}, reference stable = {stable} (det_min {})",
+                a.as_slice(),
+                eval.stability,
+                v["det_min"]
+            );
+            if eval.stability.uncertain {
+                uncertain.push(line);
+            } else if eval.stability.stable != stable {
+                failures.push(line);
             }
         }
     }
     eprintln!(
-        "{n} rods: {refused} refused, max |Δtip| {worst_tip:.2e}, max rel ‖ΔJ‖ {worst_jac:.2e}, \
-         max rel Δenergy {worst_energy:.2e}"
+        "{n} rods: {refused} refused, {} uncertain, max |Δtip| {worst_tip:.2e}, max rel ‖ΔJ‖ \
+         {worst_jac:.2e}, max rel Δenergy {worst_energy:.2e}",
+        uncertain.len()
     );
-    assert!(n >= 200, "only {n} reference rods");
-    assert!(
-        failures.is_empty(),
-        "{} failures:\n{}",
-        failures.len(),
-        failures.join("\n")
-    );
-    assert!(
-        (refused as f64) <= MAX_REFUSED_SHARE * n as f64,
-        "{refused} of {n} refused"
-    );
+    ReferenceReport {
+        n,
+        refused,
+        failures,
+        uncertain,
+    }
 }
 
 /// Rods of issue 9's strong-force family, against `scripts/gen_separatrix_truth.py`'s reference

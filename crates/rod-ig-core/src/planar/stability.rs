@@ -89,10 +89,29 @@ fn normalised_det(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64, norm_wise: bool) 
 /// by σ = max(|a3|, |a5|) (det scales by 1/σ², the normalisation is taken with a/σ): both are
 /// O(σ²) for a nearly straight rod, and the scaled quantities are O(1).
 fn normalised_det_series<T: Gradient>(rod: &TaylorRod<T>, a3: f64, a5: f64, t: f64) -> (f64, f64) {
+    normalised_det_series_amplified(rod, a3, a5, t, 0.0)
+}
+
+/// [`normalised_det_series`] with, besides the entries' own [`SERIES_ENTRY_REL`], an error of
+/// `amplified`·‖J‖ in every entry: rounding (or truncation) made near the hyperbolic straight
+/// equilibrium grows like e^{√‖F‖ t} and spreads over all entries.
+fn normalised_det_series_amplified<T: Gradient>(
+    rod: &TaylorRod<T>,
+    a3: f64,
+    a5: f64,
+    t: f64,
+    amplified: f64,
+) -> (f64, f64) {
     let Some(j) = scaled_series_jacobian(rod, a3, a5, t) else {
         return (f64::NAN, f64::INFINITY);
     };
-    let (det, err) = det_and_error(&j, SERIES_ENTRY_REL, 0.0);
+    normalised_det_of(&j, a3, a5, t, amplified)
+}
+
+/// g(t) and its bound from a scaled series J (see [`normalised_det_series_amplified`]).
+fn normalised_det_of(j: &[[f64; 3]; 3], a3: f64, a5: f64, t: f64, amplified: f64) -> (f64, f64) {
+    let size = amplified * j.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+    let (det, err) = det_and_error(j, SERIES_ENTRY_REL, size);
     let n = normalisation_scaled(a3, a5, t);
     (det / n, err / n)
 }
@@ -112,8 +131,14 @@ fn scaled_series_jacobian<T: Gradient>(
     a5: f64,
     t: f64,
 ) -> Option<[[f64; 3]; 3]> {
+    scaled_jacobian(rod.pose(t)?, a3, a5)
+}
+
+/// J from a pose in dual numbers, with the x row and the a4 column divided by σ = max(|a3|,
+/// |a5|) (see [`normalised_det_series`]).
+fn scaled_jacobian<T: Gradient>(pose: [T; 3], a3: f64, a5: f64) -> Option<[[f64; 3]; 3]> {
     let sigma = a3.abs().max(a5.abs());
-    let mut j = rod.pose(t)?.map(|v| v.gradient());
+    let mut j = pose.map(|v| v.gradient());
     for v in j[0].iter_mut() {
         *v /= sigma;
     }
@@ -158,13 +183,14 @@ fn verdict(scan: Scan, g_error: f64) -> StabilityReport {
 }
 
 /// Stability on the Taylor series of near-relaxed rods (`rod`, when given, is their dense
-/// dual-number series), or, with `precise`, on the double-double series of the rods where the
-/// closed form's error estimate fails. `wavelength` bounds the scan spacing.
+/// dual-number series), or, with `precise` (the rod's closed form), on the double-double
+/// series of the rods where the closed form's error estimate fails. `wavelength` bounds the
+/// scan spacing.
 pub(crate) fn stability_of_series(
     a: &PlanarParams,
     rod: Option<&TaylorRod<Dual3>>,
     wavelength: Option<f64>,
-    precise: bool,
+    precise: Option<&Closed<Dual3>>,
 ) -> Result<StabilityReport, RodError> {
     let (mut a3, a4, mut a5) = (a[0], a[1], a[2]);
     let sigma = a3.abs().max(a5.abs());
@@ -183,21 +209,50 @@ pub(crate) fn stability_of_series(
     let wavelength =
         wavelength.unwrap_or_else(|| std::f64::consts::TAU / super::curvature_scale(a));
     let spacing = (0.25 * wavelength).clamp(1e-3, SERIES_SPACING);
-    if precise {
+    if let Some(closed) = precise {
         let rod = super::series_dd::<false>(&b, true, super::STABILITY_DD_MAX_ROOT_F)?;
-        return scan_series(&rod, a3, a5, spacing);
+        let cross = CrossCheck {
+            root_f: a[1].hypot(a[2]).sqrt(),
+            closed: (!on_ray).then_some(closed),
+        };
+        return scan_series(&rod, a3, a5, spacing, Some(cross));
     }
     match rod {
-        Some(r) if !on_ray => scan_series(r, a3, a5, spacing),
-        _ => scan_series(&super::series_dual(&b, true)?, a3, a5, spacing),
+        Some(r) if !on_ray => scan_series(r, a3, a5, spacing, None),
+        _ => scan_series(&super::series_dual(&b, true)?, a3, a5, spacing, None),
     }
 }
 
+/// Relative error per step of the double-double series (its truncation, see
+/// `taylor::DoubleF64`): near the separatrix it grows like e^{√‖F‖ t} along the rod.
+const SERIES_DD_STEP_REL: f64 = 1e-22;
+
+/// How the double-double series' g is bounded near the separatrix (see [`scan_series`]).
+struct CrossCheck<'a> {
+    /// √‖F‖: the growth rate of rounding near the straight equilibrium.
+    root_f: f64,
+    /// The closed form of the same rod (not on the σ ray).
+    closed: Option<&'a Closed<Dual3>>,
+}
+
+/// Largest relative disagreement between the double-double series' g and the closed form's
+/// for which their agreement bounds both (their errors have unrelated causes: amplified
+/// truncation and cancellation in the elliptic derivatives, as for `cross_checked_tip`).
+const CROSS_CHECK_G: f64 = 0.1;
+
+/// The scan of g on a series. `cross`: near the separatrix the double-double series' entries
+/// are bounded norm-wise by [`SERIES_DD_STEP_REL`]·e^{√‖F‖ t} (rounding made near the straight
+/// equilibrium grows at that rate) — or, where that bound is too large to decide, by their
+/// disagreement with the closed form when both agree in sign within [`CROSS_CHECK_G`]; and an
+/// unstable verdict needs a sample past the first sign change where g < 0 beyond its bound
+/// (measured against the 320-bit reference: sign changes seen where the bound covers g were
+/// no conjugate points, and such "unstable" verdicts were wrong).
 fn scan_series<T: Gradient>(
     rod: &TaylorRod<T>,
     a3: f64,
     a5: f64,
     spacing: f64,
+    cross: Option<CrossCheck>,
 ) -> Result<StabilityReport, RodError> {
     let s = scan(
         &|t| normalised_det_series_value(rod, a3, a5, t),
@@ -206,7 +261,59 @@ fn scan_series<T: Gradient>(
         a3,
         a5,
     )?;
-    Ok(verdict(s, normalised_det_series(rod, a3, a5, s.t_margin).1))
+    let Some(cross) = cross else {
+        return Ok(verdict(s, normalised_det_series(rod, a3, a5, s.t_margin).1));
+    };
+    let g = |t: f64| {
+        let amplified = SERIES_DD_STEP_REL * (cross.root_f * t).exp();
+        let (v, e) = normalised_det_series_amplified(rod, a3, a5, t, amplified);
+        if v.abs() > e {
+            return (v, e);
+        }
+        let Some(c) = cross.closed else {
+            return (v, e);
+        };
+        let (vc, _) = normalised_det(c, a3, a5, t, true);
+        let gap = (v - vc).abs();
+        if v.signum() == vc.signum() && gap <= CROSS_CHECK_G * v.abs() {
+            (v, gap + normalised_det_series(rod, a3, a5, t).1)
+        } else {
+            (v, e)
+        }
+    };
+    Ok(certified_verdict(s, &g, (SERIES_T_MIN, spacing, a3, a5)))
+}
+
+/// The verdict of a scan whose samples' values may be far off where their bound is large: an
+/// unstable verdict needs a sample past the first sign change where g < 0 beyond its bound,
+/// a stable one a margin beyond its bound (else uncertain). `grid`: the scan's (t0, spacing,
+/// a3, a5).
+fn certified_verdict(
+    s: Scan,
+    g: &impl Fn(f64) -> (f64, f64),
+    (t0, spacing, a3, a5): (f64, f64, f64, f64),
+) -> StabilityReport {
+    let Some(first) = s.first else {
+        return verdict(s, g(s.t_margin).1);
+    };
+    // Just past the sign change g is small but its bound, where it comes from cancellation
+    // near the straight equilibrium, is smaller still: try a few points there first.
+    let (ts, np) = sample_times(t0, spacing, a3, a5);
+    let near = [0.05, 0.1, 0.2, 0.4].map(|f| first + f * spacing);
+    let certified = near
+        .iter()
+        .chain(ts[..np].iter().filter(|&&t| t >= first))
+        .filter(|&&t| t <= 1.0)
+        .any(|&t| {
+            let (v, e) = g(t);
+            v < -e
+        });
+    StabilityReport {
+        stable: false,
+        margin: s.margin,
+        first_conjugate_t: certified.then_some(first),
+        uncertain: !certified,
+    }
 }
 
 /// Stability on the closed form (FINDINGS §5), with the series where the closed form's own
@@ -224,20 +331,18 @@ pub(crate) fn stability_of(
     // rigorous reference (scripts/gen_separatrix_truth.py). The scan there bounds every entry
     // norm-wise and hands what it cannot decide to the double-double series.
     if c.needs_precise_series() {
-        if c.needs_series() == SeriesNeed::None {
-            let report = closed_scan(c, a, true)?;
-            if !report.uncertain {
-                return Ok(report);
-            }
+        let report = closed_scan(c, a, true)?;
+        if !report.uncertain {
+            return Ok(report);
         }
-        return stability_of_series(a, None, Some(c.wavelength()), true);
+        return stability_of_series(a, None, Some(c.wavelength()), Some(c));
     }
     match c.needs_series() {
         SeriesNeed::IllConditioned => {
-            return stability_of_series(a, None, Some(c.wavelength()), true)
+            return stability_of_series(a, None, Some(c.wavelength()), Some(c))
         }
         SeriesNeed::Cancellation => {
-            return stability_of_series(a, None, Some(c.wavelength()), false)
+            return stability_of_series(a, None, Some(c.wavelength()), None)
         }
         SeriesNeed::None => {}
     }
@@ -245,7 +350,7 @@ pub(crate) fn stability_of(
     if report.uncertain {
         // The closed form cannot decide: its error bound covers the margin. The series'
         // entries are accurate relative to themselves; ask it.
-        return stability_of_series(a, None, Some(c.wavelength()), false);
+        return stability_of_series(a, None, Some(c.wavelength()), None);
     }
     Ok(report)
 }
@@ -260,11 +365,19 @@ fn closed_scan(
     let (a3, a5) = (a[0], a[2]);
     // At small t the entries of J(t) are O(t)..O(t³) and the closed form's absolute error
     // floor swamps det J ∝ t⁹: there g comes from a short Taylor series from the base,
-    // which is accurate relative to itself (one low-order step for t ≲ 0.2).
-    let start = ShortSeries::new(a);
+    // which is accurate relative to itself (one low-order step for t ≲ 0.2). Norm-wise
+    // (near the separatrix under a force) g grows like e^{2√‖F‖ t}, and the closed form's
+    // value is taken where it is accurate relative to itself.
+    let start = ShortSeries::new(a, if norm_wise { 0.0 } else { 0.2 });
+    let root_f = a[1].hypot(a[2]).sqrt();
     let g = |t: f64| {
         let (v, e) = normalised_det(c, a3, a5, t, norm_wise);
-        if e <= CLOSED_G_ERROR {
+        let accepted = if norm_wise {
+            CLOSED_G_ERROR * v.abs().max(1.0)
+        } else {
+            CLOSED_G_ERROR
+        };
+        if e <= accepted || (norm_wise && root_f * t > SHORT_SERIES_REACH) {
             return (v, e);
         }
         start.normalised_det(t).unwrap_or((v, e))
@@ -273,14 +386,84 @@ fn closed_scan(
     // No conjugate point comes before a fraction of the half-wavelength, and there the
     // closed-form det J (≈ t⁹) is swamped by rounding: start the scan at t0.
     let t0 = (0.1 * wl).clamp(T_MIN, T_MARGIN);
-    let s = scan(&|t| g(t).0, t0, (0.25 * wl).clamp(0.01, 0.1), a3, a5)?;
-    Ok(verdict(s, g(s.t_margin).1))
+    let spacing = (0.25 * wl).clamp(0.01, 0.1);
+    let s = scan(&|t| g(t).0, t0, spacing, a3, a5)?;
+    if !norm_wise {
+        return Ok(verdict(s, g(s.t_margin).1));
+    }
+    // Norm-wise (near the separatrix under a strong force) the closed form's value is far
+    // off where its bound is large, and an unstable verdict needs a sample past the first sign
+    // change where g < 0 beyond its bound; the margin of a stable one is certified at t_margin
+    // (by the closed form's bound or the f64 series, [`certify_margin`]). Between, where the
+    // bound exceeds g by orders of magnitude, g ~ e^{2√‖F‖ t} is huge and the closed form's
+    // sign is kept: measured against the 320-bit references (tests/separatrix_truth.rs, 760
+    // rods) every verdict so reached is right, where the double-double scan called 30 of 1,429
+    // stable rods of issue 23's tiny-bending sample "unstable" with a certain verdict.
+    if s.first.is_some() {
+        return Ok(certified_verdict(s, &g, (t0, spacing, a3, a5)));
+    }
+    let report = verdict(s, g(s.t_margin).1);
+    if !report.uncertain {
+        return Ok(report);
+    }
+    Ok(certify_margin(a, s, &g).unwrap_or(report))
+}
+
+/// Step budget of the f64 series that certifies the margin of a rod near the separatrix
+/// ([`certify_margin`]): ≈ 3 µs per step.
+const MARGIN_SERIES_MAX_STEPS: usize = 60;
+/// Largest estimated relative error of that series' J entries for which its g is used (its
+/// rounding grows like e^{√‖F‖ t}, see [`certify_margin`]).
+const MARGIN_SERIES_MAX_REL: f64 = 1e-6;
+
+/// The margin of a stable rod near the separatrix under a strong force, certified by the f64
+/// series from the base to t_margin, its entries' errors bounded by [`SERIES_ENTRY_REL`] plus
+/// ε·e^{√‖F‖ t} norm-wise (rounding made near the hyperbolic straight equilibrium grows at
+/// that rate), where the closed form's norm-wise bound is too
+/// pessimistic. None where that bound, the step budget or the agreement of both values does
+/// not hold.
+fn certify_margin(
+    a: &PlanarParams,
+    s: Scan,
+    g: &impl Fn(f64) -> (f64, f64),
+) -> Option<StabilityReport> {
+    let (a3, a5) = (a[0], a[2]);
+    if a3.abs().max(a5.abs()) < SIGMA_RAY {
+        return None;
+    }
+    let amplified = f64::EPSILON * (a[1].hypot(a[2]).sqrt() * s.t_margin).exp();
+    if amplified.is_nan() || amplified > MARGIN_SERIES_MAX_REL {
+        return None;
+    }
+    let rod = TaylorRod::new_to(
+        Dual3::variable(a3, 0),
+        Dual3::variable(a[1], 1),
+        Dual3::variable(a5, 2),
+        s.t_margin,
+        MARGIN_SERIES_MAX_STEPS,
+        false,
+    )
+    .ok()?;
+    let j = scaled_jacobian(rod.tip(), a3, a5)?;
+    let (value, error) = normalised_det_of(&j, a3, a5, s.t_margin, amplified);
+    // The scan's value and the series' must agree within their bounds.
+    let (v, e) = g(s.t_margin);
+    if !(value.is_finite() && value.abs() > error && (value - v).abs() <= error + e) {
+        return None;
+    }
+    Some(verdict(Scan { margin: value, ..s }, error))
 }
 
 /// Largest error bound of the closed form's g(t) for which the scan takes its value (g is
 /// scale-free, ≈ 1 on a gently bent rod: a thousandth of that cannot decide a sign or the
 /// margin's verdict; near a root of g the bound is small and the closed form is kept).
 const CLOSED_G_ERROR: f64 = 1e-3;
+/// Near the separatrix (norm-wise scan) the short series stands in for the closed form up to
+/// √‖F‖·t = this only: beyond, g grows like e^{2√‖F‖ t} (the rod lingers by the straight
+/// equilibrium) and the closed form's value decides its sign, while the margin, found at
+/// small t or in a dip where the closed form is accurate, is certified separately
+/// ([`certify_margin`]).
+const SHORT_SERIES_REACH: f64 = 6.0;
 /// Step budget of the short series (≈ 3 µs per step): beyond, the rod is too strongly bent
 /// for a short start and the closed form's value stands (an uncertain verdict then goes to
 /// the full series, as without the short series).
@@ -290,6 +473,8 @@ const SHORT_SERIES_MAX_STEPS: usize = 24;
 /// (rebuilt to 2t) when asked beyond its end.
 struct ShortSeries {
     a: PlanarParams,
+    /// The first end (grown to 2t when asked at t beyond its end).
+    min_end: f64,
     rod: std::cell::RefCell<Start>,
 }
 
@@ -298,6 +483,8 @@ enum Start {
     NotBuilt,
     /// It could not be built or extended within its step budget.
     Failed,
+    /// Built to `rod.t_end()`; `steps_left` of the budget remain (0 once an extension failed:
+    /// the steps already taken stay valid and keep answering below their end).
     Built {
         rod: Box<TaylorRod<Dual3>>,
         steps_left: usize,
@@ -305,9 +492,10 @@ enum Start {
 }
 
 impl ShortSeries {
-    fn new(a: &PlanarParams) -> Self {
+    fn new(a: &PlanarParams, min_end: f64) -> Self {
         Self {
             a: *a,
+            min_end,
             rod: std::cell::RefCell::new(Start::NotBuilt),
         }
     }
@@ -321,38 +509,46 @@ impl ShortSeries {
             return None;
         }
         let mut slot = self.rod.borrow_mut();
-        let end = (2.0 * t).clamp(0.2, 1.0);
-        match &mut *slot {
-            Start::Failed => return None,
-            // Grown, not rebuilt: the steps to the old end are kept.
-            Start::Built { rod, steps_left } if rod.t_end() < t => {
-                match rod.extend_to(end, *steps_left) {
-                    Ok(steps) => *steps_left -= steps,
-                    Err(_) => *slot = Start::Failed,
+        if let Start::NotBuilt = *slot {
+            // Started empty and grown below: a budget that runs out before the first end
+            // still leaves the steps taken.
+            *slot = match TaylorRod::new_to(
+                Dual3::variable(a3, 0),
+                Dual3::variable(self.a[1], 1),
+                Dual3::variable(a5, 2),
+                0.0,
+                0,
+                true,
+            ) {
+                Ok(rod) => Start::Built {
+                    steps_left: SHORT_SERIES_MAX_STEPS,
+                    rod: Box::new(rod),
+                },
+                Err(_) => Start::Failed,
+            };
+        }
+        // Grown, not rebuilt: the steps to the old end are kept, and kept too when the budget
+        // runs out before the new end (they still answer up to where they reached).
+        if let Start::Built { rod, steps_left } = &mut *slot {
+            if rod.t_end() < t && *steps_left > 0 {
+                let end = (2.0 * t).clamp(self.min_end, 1.0);
+                let before = rod.steps();
+                let _ = rod.extend_to(end, *steps_left);
+                *steps_left -= rod.steps() - before;
+                if rod.t_end() < end {
+                    *steps_left = 0;
                 }
-            }
-            Start::Built { .. } => {}
-            Start::NotBuilt => {
-                *slot = match TaylorRod::new_to(
-                    Dual3::variable(a3, 0),
-                    Dual3::variable(self.a[1], 1),
-                    Dual3::variable(a5, 2),
-                    end,
-                    SHORT_SERIES_MAX_STEPS,
-                    true,
-                ) {
-                    Ok(rod) => Start::Built {
-                        steps_left: SHORT_SERIES_MAX_STEPS - rod.steps(),
-                        rod: Box::new(rod),
-                    },
-                    Err(_) => Start::Failed,
-                };
             }
         }
         let Start::Built { rod, .. } = &*slot else {
             return None;
         };
-        let (v, e) = normalised_det_series(rod, a3, a5, t);
+        if rod.t_end() < t {
+            return None;
+        }
+        let root_f = self.a[1].hypot(self.a[2]).sqrt();
+        let (v, e) =
+            normalised_det_series_amplified(rod, a3, a5, t, f64::EPSILON * (root_f * t).exp());
         v.is_finite().then_some((v, e))
     }
 }
