@@ -337,6 +337,9 @@ pub(crate) fn stability_of(
         }
         return stability_of_series(a, None, Some(c.wavelength()), Some(c));
     }
+    if c.det_needs_series() {
+        return stability_of_series(a, None, Some(c.wavelength()), None);
+    }
     match c.needs_series() {
         SeriesNeed::IllConditioned => {
             return stability_of_series(a, None, Some(c.wavelength()), Some(c))
