@@ -371,8 +371,12 @@ fn closed_scan(
     // which is accurate relative to itself (one low-order step for t ≲ 0.2). Norm-wise
     // (near the separatrix under a force) g grows like e^{2√‖F‖ t}, and the closed form's
     // value is taken where it is accurate relative to itself.
-    let start = ShortSeries::new(a, if norm_wise { 0.0 } else { 0.2 });
     let root_f = a[1].hypot(a[2]).sqrt();
+    let start = if norm_wise {
+        ShortSeries::new(a, 0.0, (SHORT_SERIES_REACH / root_f).min(1.0))
+    } else {
+        ShortSeries::new(a, 0.2, 1.0)
+    };
     let g = |t: f64| {
         let (v, e) = normalised_det(c, a3, a5, t, norm_wise);
         let accepted = if norm_wise {
@@ -476,8 +480,10 @@ const SHORT_SERIES_MAX_STEPS: usize = 24;
 /// (rebuilt to 2t) when asked beyond its end.
 struct ShortSeries {
     a: PlanarParams,
-    /// The first end (grown to 2t when asked at t beyond its end).
+    /// The ends it grows to when asked at t beyond its end: 2t within [min_end, max_end]
+    /// (at least t).
     min_end: f64,
+    max_end: f64,
     rod: std::cell::RefCell<Start>,
 }
 
@@ -495,10 +501,11 @@ enum Start {
 }
 
 impl ShortSeries {
-    fn new(a: &PlanarParams, min_end: f64) -> Self {
+    fn new(a: &PlanarParams, min_end: f64, max_end: f64) -> Self {
         Self {
             a: *a,
             min_end,
+            max_end,
             rod: std::cell::RefCell::new(Start::NotBuilt),
         }
     }
@@ -534,7 +541,7 @@ impl ShortSeries {
         // runs out before the new end (they still answer up to where they reached).
         if let Start::Built { rod, steps_left } = &mut *slot {
             if rod.t_end() < t && *steps_left > 0 {
-                let end = (2.0 * t).clamp(self.min_end, 1.0);
+                let end = (2.0 * t).clamp(self.min_end, self.max_end.max(t));
                 let before = rod.steps();
                 let _ = rod.extend_to(end, *steps_left);
                 *steps_left -= rod.steps() - before;
