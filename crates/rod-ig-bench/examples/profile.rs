@@ -170,7 +170,12 @@ fn main() {
             calls += targets.len();
         } else {
             for a in inputs {
-                let _ = black_box(planar::evaluate(black_box(a)));
+                match what {
+                    "tip" => drop(black_box(planar::tip(black_box(a)))),
+                    "tipj" => drop(black_box(planar::tip_and_jacobian(black_box(a)))),
+                    "stability" => drop(black_box(planar::stability(black_box(a)))),
+                    _ => drop(black_box(planar::evaluate(black_box(a)))),
+                }
             }
             calls += inputs.len();
         }

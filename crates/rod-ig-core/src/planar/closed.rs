@@ -429,7 +429,7 @@ impl<T: Real> Closed<T> {
         self.a3
             .re()
             .abs()
-            .max(self.a4.re().hypot(self.a5.re()).sqrt())
+            .max(crate::scalar::fast_hypot(self.a4.re(), self.a5.re()).sqrt())
     }
 
     /// A-priori bound on the absolute error of the pose (x, y, θ) at any t ∈ [0, 1]:
@@ -468,7 +468,7 @@ impl<T: Real> Closed<T> {
         if !self.needs_reference_by_estimate() {
             SeriesNeed::None
         } else if self.needs_precise_series() {
-            let root_f = self.a4.re().hypot(self.a5.re()).sqrt();
+            let root_f = crate::scalar::fast_hypot(self.a4.re(), self.a5.re()).sqrt();
             if root_f > SERIES_DD_MAX_ROOT_F
                 && matches!(self.case, Case::I | Case::II)
                 && self.cancellation_loss(1.0) * f64::EPSILON <= CLOSED_J_LAST_RESORT
@@ -493,7 +493,9 @@ impl<T: Real> Closed<T> {
     /// about the hyperbolic straight equilibrium grows like e^{√‖F‖ t}, so at most e^{√‖F‖}
     /// over the unit rod.
     fn rounding_amplification(&self) -> f64 {
-        self.a4.re().hypot(self.a5.re()).sqrt().exp()
+        crate::scalar::fast_hypot(self.a4.re(), self.a5.re())
+            .sqrt()
+            .exp()
     }
 
     /// Whether the closed form's J(1) is within `j_tolerance` (relative) by its own estimate, in

@@ -52,7 +52,7 @@ const LN_F64_MAX: f64 = 709.7;
 
 /// ρ = max(|a3|, √‖(a4, a5)‖): the rod's curvature scale (its Taylor terms grow like ρᵏ/k!).
 fn curvature_scale(a: &PlanarParams) -> f64 {
-    a[0].abs().max(a[1].hypot(a[2]).sqrt())
+    a[0].abs().max(crate::scalar::fast_hypot(a[1], a[2]).sqrt())
 }
 
 /// True when the series is chosen without building the closed form.
@@ -497,7 +497,9 @@ pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
     let [x, y, th] = if series_first(a) {
         series_f64(a, false)?.tip()
     } else {
-        let Some(closed) = Closed::<f64>::new(a[0], a[1], a[2]) else {
+        // Matched by reference: binding the rod out of the Option copied its ~600 bytes.
+        let closed = Closed::<f64>::new(a[0], a[1], a[2]);
+        let Some(closed) = &closed else {
             return finite_tip(series_f64(a, false)?.tip());
         };
         match closed.needs_series() {
