@@ -842,6 +842,22 @@ impl<T: Real> Closed<T> {
 
     /// Pose (x, y, θ)(t) with θ unwrapped (FINDINGS §1 position formulas, §3 integrals):
     /// x = −(a4/F)∫β1 + 2ε(a5/F)∫β2, y = −(a5/F)∫β1 − 2ε(a4/F)∫β2.
+    /// Case I: ½∫₀¹κ² = ½α3 ∫₀¹cn²(rt + φ|m) dt = ½α3 [(Z(Γ1) − Z(φ))/(m r) + (1 − q)/2], from
+    /// ∫cn² du = Z(u)/m + u(1 − D/K) (Z the Jacobi zeta, A&S 17.4.28 and 16.26.1; D/K =
+    /// (1 + q)/2): every term is free of cancellation as m → 0, where the identity
+    /// λ2/2 − a4 x − a5 y cancels (a nearly straight rod under compression). None in the other
+    /// cases.
+    pub fn energy_case_i(&self) -> Option<f64> {
+        if self.case != Case::I {
+            return None;
+        }
+        let r = self.r.re();
+        let zm1 = self.landen.eval(self.r + self.phi, false).zm.re();
+        let q = self.landen.q().re();
+        let alpha3 = self.sqa3.re() * self.sqa3.re();
+        Some(0.5 * alpha3 * ((zm1 - self.j0.zm.re()) / r + (1.0 - q) * 0.5))
+    }
+
     pub fn pose(&self, t: f64) -> [T; 3] {
         if t == 0.0 {
             // the base is clamped at the identity: q(0) = 0 and J(0) = 0 exactly
