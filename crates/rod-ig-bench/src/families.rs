@@ -16,7 +16,8 @@ pub fn signed_pow10(rng: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
 }
 
 /// `n` parameters per sample, seeded (the same every run): the uniform box
-/// (|a3| ≤ 10, |a4|, |a5| ≤ 100) and issue 9's log-scale families.
+/// (|a3| ≤ 10, |a4|, |a5| ≤ 100), issue 9's log-scale families and issue 23's near-circles
+/// (a moment with a tiny force) and nearly straight rods under a moderate force.
 pub fn samples(n: usize) -> Vec<(&'static str, Vec<PlanarParams>)> {
     let mut rng = SplitMix64::new(9);
     let mut gen = |f: &mut dyn FnMut(&mut SplitMix64) -> PlanarParams| {
@@ -60,6 +61,26 @@ pub fn samples(n: usize) -> Vec<(&'static str, Vec<PlanarParams>)> {
                     signed_pow10(r, -6.0, 0.0),
                     signed_pow10(r, 2.0, 4.0),
                     signed_pow10(r, -6.0, 0.0),
+                )
+            }),
+        ),
+        (
+            "near-circles (rho .3..2, F 1e-12..1e-2)",
+            gen(&mut |r| {
+                PlanarParams::new(
+                    signed_pow10(r, -0.52, 0.3),
+                    signed_pow10(r, -12.0, -2.0),
+                    signed_pow10(r, -12.0, -2.0),
+                )
+            }),
+        ),
+        (
+            "nearly straight (|a4| 15..30)",
+            gen(&mut |r| {
+                PlanarParams::new(
+                    signed_pow10(r, -8.0, -3.0),
+                    signed_pow10(r, 1.18, 1.48),
+                    signed_pow10(r, -8.0, -3.0),
                 )
             }),
         ),
