@@ -5,14 +5,9 @@
 use crate::SplitMix64;
 use rod_ig_core::PlanarParams;
 
-/// ±10^u with u uniform in [lo, hi] and a random sign.
+/// ±10^u with u uniform in [lo, hi] and a random sign ([`SplitMix64::signed_pow10`]).
 pub fn signed_pow10(rng: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
-    let v = 10f64.powf(rng.range(lo, hi));
-    if rng.range(0.0, 1.0) < 0.5 {
-        -v
-    } else {
-        v
-    }
+    rng.signed_pow10(lo, hi)
 }
 
 /// `n` parameters per sample, seeded (the same every run): the uniform box

@@ -30,6 +30,17 @@ impl SplitMix64 {
     pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.uniform()
     }
+
+    /// ±10^u with u uniform in [lo, hi) and a random sign: the log-scale magnitudes the tests
+    /// and benchmarks draw parameters with.
+    pub fn signed_pow10(&mut self, lo: f64, hi: f64) -> f64 {
+        let v = 10f64.powf(self.range(lo, hi));
+        if self.uniform() < 0.5 {
+            -v
+        } else {
+            v
+        }
+    }
 }
 
 #[cfg(test)]

@@ -37,21 +37,10 @@ const MAX_REFUSED_SHARE: f64 = 0.03;
 
 #[test]
 fn separatrix_rods_match_the_rigorous_reference_or_are_refused() {
-    let report = check_reference(include_str!("data/separatrix_truth.jsonl"));
-    assert!(report.n >= 200, "only {} reference rods", report.n);
-    assert!(
-        report.failures.is_empty() && report.uncertain.is_empty(),
-        "{} failures, {} uncertain where the reference is clear:\n{}\n{}",
-        report.failures.len(),
-        report.uncertain.len(),
-        report.failures.join("\n"),
-        report.uncertain.join("\n")
-    );
-    assert!(
-        (report.refused as f64) <= MAX_REFUSED_SHARE * report.n as f64,
-        "{} of {} refused",
-        report.refused,
-        report.n
+    check_reference(include_str!("data/separatrix_truth.jsonl")).assert_within(
+        200,
+        0.0,
+        MAX_REFUSED_SHARE,
     );
 }
 
@@ -71,26 +60,10 @@ const MAX_EXTREME_REFUSED_SHARE: f64 = 0.11;
 /// growth. Now no verdict, tip or J is wrong, and refusals say why.
 #[test]
 fn tiny_bending_under_strong_force_is_never_wrong() {
-    let report = check_reference(include_str!("data/separatrix_truth_extreme.jsonl"));
-    assert!(report.n >= 150, "only {} reference rods", report.n);
-    assert!(
-        report.failures.is_empty(),
-        "{} failures:\n{}",
-        report.failures.len(),
-        report.failures.join("\n")
-    );
-    assert!(
-        (report.uncertain.len() as f64) <= MAX_EXTREME_UNCERTAIN_SHARE * report.n as f64,
-        "{} of {} uncertain where the reference is clear:\n{}",
-        report.uncertain.len(),
-        report.n,
-        report.uncertain.join("\n")
-    );
-    assert!(
-        (report.refused as f64) <= MAX_EXTREME_REFUSED_SHARE * report.n as f64,
-        "{} of {} refused",
-        report.refused,
-        report.n
+    check_reference(include_str!("data/separatrix_truth_extreme.jsonl")).assert_within(
+        150,
+        MAX_EXTREME_UNCERTAIN_SHARE,
+        MAX_EXTREME_REFUSED_SHARE,
     );
     // The rod issue 23 quotes (stable, det_min 2.73): never "unstable" with a certain verdict.
     let quoted = PlanarParams::new(0.0, 2473.289745880672, 2.3178627609785778e-14);
@@ -133,6 +106,34 @@ struct ReferenceReport {
     failures: Vec<String>,
     /// Uncertain verdicts where the reference is clear.
     uncertain: Vec<String>,
+}
+
+impl ReferenceReport {
+    /// At least `min_n` rods, no wrong answer, and at most these shares of the rods uncertain
+    /// where the reference is clear, and refused.
+    fn assert_within(&self, min_n: usize, uncertain_share: f64, refused_share: f64) {
+        let n = self.n as f64;
+        assert!(self.n >= min_n, "only {} reference rods", self.n);
+        assert!(
+            self.failures.is_empty(),
+            "{} failures:\n{}",
+            self.failures.len(),
+            self.failures.join("\n")
+        );
+        assert!(
+            self.uncertain.len() as f64 <= uncertain_share * n,
+            "{} of {} uncertain where the reference is clear:\n{}",
+            self.uncertain.len(),
+            self.n,
+            self.uncertain.join("\n")
+        );
+        assert!(
+            self.refused as f64 <= refused_share * n,
+            "{} of {} refused",
+            self.refused,
+            self.n
+        );
+    }
 }
 
 /// Every rod of a reference file against `planar::evaluate`: tips, J and energy within issue

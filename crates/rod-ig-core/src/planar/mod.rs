@@ -725,16 +725,6 @@ mod tests {
     use super::*;
     use crate::rng::SplitMix64;
 
-    /// ±10^U(lo, hi), random sign.
-    fn signed_pow10(r: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
-        let v = 10f64.powf(r.range(lo, hi));
-        if r.range(0.0, 1.0) < 0.5 {
-            -v
-        } else {
-            v
-        }
-    }
-
     /// The closed form's errors against a reference tip and J, each divided by its a-priori
     /// estimate: (pose, J).
     fn error_ratios(c: &Closed<Dual3>, tip_ref: &PlanarPose, j_ref: &PlanarJacobian) -> (f64, f64) {
@@ -758,12 +748,12 @@ mod tests {
         let mut r = SplitMix64::new(23);
         let (mut used, mut n, mut worst, mut worst_energy) = (0usize, 0usize, 0.0f64, 0.0f64);
         for i in 0..600 {
-            let a3 = signed_pow10(&mut r, -6.0, 0.0);
+            let a3 = r.signed_pow10(-6.0, 0.0);
             let a4 = -10f64.powf(r.range(0.0, 4.0));
             let a5 = if i % 7 == 0 {
                 0.0
             } else {
-                signed_pow10(&mut r, -6.0, 0.0)
+                r.signed_pow10(-6.0, 0.0)
             };
             let a = PlanarParams::new(a3, a4, a5);
             let c = seeded_closed(&a).expect("closed form");
@@ -821,7 +811,7 @@ mod tests {
     #[test]
     fn closed_form_where_chosen_meets_its_error_estimates() {
         let mut r = SplitMix64::new(17);
-        let mut signed = |lo: f64, hi: f64| signed_pow10(&mut r, lo, hi);
+        let mut signed = |lo: f64, hi: f64| r.signed_pow10(lo, hi);
         let (mut closed_used, mut in_domain) = (0usize, 0usize);
         let (mut worst_j, mut worst_tip, mut worst_e) = (0.0f64, 0.0f64, 0.0f64);
         for _ in 0..40_000 {
@@ -868,7 +858,7 @@ mod tests {
     #[test]
     fn closed_form_near_the_separatrix_meets_its_error_estimates() {
         let mut r = SplitMix64::new(23);
-        let mut signed = |lo: f64, hi: f64| signed_pow10(&mut r, lo, hi);
+        let mut signed = |lo: f64, hi: f64| r.signed_pow10(lo, hi);
         let (mut closed_used, mut in_domain) = (0usize, 0usize);
         let (mut worst_j, mut worst_tip) = (0.0f64, 0.0f64);
         while in_domain < 1500 {
