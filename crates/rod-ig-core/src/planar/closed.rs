@@ -64,6 +64,12 @@ pub(crate) struct Closed<T: Real> {
     /// (a5² + a3²|a3²/4 + a4|)/|λ4| ≥ 1: how much the terms of λ4 cancel (≈ 1 for a rod with
     /// little bending near the separatrix, ~1/m1 for O(1) parameters tuned onto it).
     lambda4_spread: f64,
+    /// The error estimate's constants, computed once (they were a tenth of a stability scan):
+    /// ρ = max(|a3|, √F), and for cases I and II the m1 loss, 1/m and 1/√m.
+    rho: f64,
+    loss_m1: f64,
+    inv_m: f64,
+    inv_sqrt_m: f64,
     landen: Duplication<T>,
     /// Jacobi values at Γ0 = φ (cases I, II).
     j0: JacobiValues<T>,
@@ -370,13 +376,12 @@ impl<T: Real> Closed<T> {
 
     /// (1/m + L(m1))·s(ρt) for cases I and II, s(ρt) alone otherwise (in units of ε).
     fn cancellation_loss(&self, t: f64) -> f64 {
-        let m = self.m.re();
         let loss = match self.case {
             Case::I => {
-                let small_m = SMALL_M_I_ULPS * (self.curvature_scale() * t).max(1.0) / m.sqrt();
-                self.m1_loss_j() + m.recip().min(small_m)
+                let small_m = SMALL_M_I_ULPS * (self.rho * t).max(1.0) * self.inv_sqrt_m;
+                self.loss_m1 + self.inv_m.min(small_m)
             }
-            Case::II => self.m1_loss_j() + 1.0 / m,
+            Case::II => self.loss_m1 + self.inv_m,
             _ => 1.0,
         };
         loss * self.rho_spread(t)
@@ -426,10 +431,7 @@ impl<T: Real> Closed<T> {
 
     /// ρ = max(|a3|, √F), the rod's curvature scale.
     fn curvature_scale(&self) -> f64 {
-        self.a3
-            .re()
-            .abs()
-            .max(crate::scalar::fast_hypot(self.a4.re(), self.a5.re()).sqrt())
+        self.rho
     }
 
     /// A-priori bound on the absolute error of the pose (x, y, θ) at any t ∈ [0, 1]:
@@ -565,6 +567,13 @@ impl<T: Real> Closed<T> {
             lin: zero,
             m1: 1.0,
             lambda4_spread: 1.0,
+            rho: a3
+                .re()
+                .abs()
+                .max(crate::scalar::fast_hypot(a4.re(), a5.re()).sqrt()),
+            loss_m1: 0.0,
+            inv_m: 0.0,
+            inv_sqrt_m: 0.0,
             landen: dummy_landen,
             j0: dummy_j,
             th0: zero,
@@ -625,6 +634,12 @@ impl<T: Real> Closed<T> {
             }
         } else {
             s.init_case_iii(&invariants);
+        }
+        if matches!(s.case, Case::I | Case::II) {
+            let m = s.m.re();
+            s.loss_m1 = s.m1_loss_j();
+            s.inv_m = m.recip();
+            s.inv_sqrt_m = m.sqrt().recip();
         }
         s.checked()
     }
