@@ -46,6 +46,8 @@ pub struct BenchmarkReport3d {
     pub median_us: f64,
     /// 90th percentile wall time (µs).
     pub p90_us: f64,
+    /// 99th percentile wall time (µs).
+    pub p99_us: f64,
     /// Largest wall time (µs).
     pub max_us: f64,
     /// Mean Newton iterations of the successful solves.
@@ -126,6 +128,7 @@ pub fn benchmark_random_targets(n: usize, seed: u64) -> BenchmarkReport3d {
         },
         median_us: pct(0.5),
         p90_us: pct(0.9),
+        p99_us: pct(0.99),
         max_us: times.last().copied().unwrap_or(0.0),
         mean_iterations: if successes > 0 {
             iters as f64 / successes as f64

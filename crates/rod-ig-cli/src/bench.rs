@@ -321,11 +321,12 @@ pub fn spatial(quick: bool) {
     let targets = if quick { 50 } else { 500 };
     let r = ig3d::benchmark_random_targets(targets, 5);
     println!(
-        "robust 3-D solve, {} random stable targets: success {:.1} %, median {:.0} µs, p90 {:.0} µs, max {:.0} µs, {:.1} iterations, {:.1} integrations per solve (goals ≥ 99 %, median ≤ 1 ms)",
+        "robust 3-D solve, {} random stable targets: success {:.1} %, median {:.0} µs, p90 {:.0} µs, p99 {:.0} µs, max {:.0} µs, {:.1} iterations, {:.1} integrations per solve (goals ≥ 99 %, median ≤ 1 ms)",
         r.targets,
         100.0 * r.success_rate,
         r.median_us,
         r.p90_us,
+        r.p99_us,
         r.max_us,
         r.mean_iterations,
         r.mean_evaluations
