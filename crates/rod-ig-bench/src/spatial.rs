@@ -62,6 +62,14 @@ pub struct BenchmarkReport3d {
     pub work: Counters,
 }
 
+/// Counts one more `key` in `list` (first occurrence order kept).
+fn tally(list: &mut Vec<(String, usize)>, key: String) {
+    match list.iter_mut().find(|(k, _)| *k == key) {
+        Some(e) => e.1 += 1,
+        None => list.push((key, 1)),
+    }
+}
+
 /// Runs the robust solver (default options) on `n` random stable targets ([`random_targets`])
 /// and returns the success rate and timings (no I/O; the CLI prints them).
 pub fn benchmark_random_targets(n: usize, seed: u64) -> BenchmarkReport3d {
@@ -90,7 +98,7 @@ pub fn benchmark_random_targets(n: usize, seed: u64) -> BenchmarkReport3d {
                     restarts += 1;
                 }
             }
-            Ok(_) => failures.push(("unstable solution".into(), 1)),
+            Ok(_) => tally(&mut failures, "unstable solution".into()),
             Err(f) => {
                 let key = match &f.reason {
                     IgError::NoStableSolution {
@@ -98,15 +106,8 @@ pub fn benchmark_random_targets(n: usize, seed: u64) -> BenchmarkReport3d {
                     } => format!("no stable solution ({last})"),
                     other => other.to_string(),
                 };
-                failures.push((key, 1));
+                tally(&mut failures, key);
             }
-        }
-    }
-    let mut merged: Vec<(String, usize)> = Vec::new();
-    for (k, c) in failures {
-        match merged.iter_mut().find(|(m, _)| *m == k) {
-            Some(e) => e.1 += c,
-            None => merged.push((k, c)),
         }
     }
     times.sort_by(f64::total_cmp);
@@ -141,7 +142,7 @@ pub fn benchmark_random_targets(n: usize, seed: u64) -> BenchmarkReport3d {
             0.0
         },
         restarts_used: restarts,
-        failures: merged,
+        failures,
         work,
     }
 }
