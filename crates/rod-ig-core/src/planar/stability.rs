@@ -67,6 +67,11 @@ fn rows(p: &[Dual3; 3]) -> [[f64; 3]; 3] {
     [p[0].g, p[1].g, p[2].g]
 }
 
+/// g(t) alone from the dual-number closed form (scans that bound it elsewhere).
+fn normalised_det_value(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64) -> f64 {
+    det3(&rows(&c.pose(t))) / normalisation(a3, a5, t)
+}
+
 /// g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (FINDINGS §5) and its error bound, from the
 /// dual-number closed form.
 /// With `norm_wise`, every entry's error is bounded by rel·‖J(t)‖ (the Frobenius estimate
@@ -383,7 +388,7 @@ fn small_m_scan(c: &Closed<Dual3>, a: &PlanarParams) -> Result<Option<StabilityR
     let wl = c.wavelength();
     let t0 = (0.1 * wl).clamp(T_MIN, T_MARGIN);
     let spacing = (0.25 * wl).clamp(1e-3, SERIES_SPACING);
-    let closed = |t: f64| normalised_det(c, a3, a5, t, true).0;
+    let closed = |t: f64| normalised_det_value(c, a3, a5, t);
     let s = scan(&closed, t0, spacing, a3, a5)?;
     // The first sample past the sign change where g < 0: the unstable verdict's witness.
     let witness = match s.first {
