@@ -6,12 +6,13 @@
 use rod_ig_core::wrap_angle;
 use std::f64::consts::PI;
 
+mod common;
+
 #[test]
 fn reduction_matches_80_digit_values() {
     let text = include_str!("data/angle_reduction.jsonl");
     let mut worst = 0.0f64;
-    for line in text.lines().filter(|l| !l.trim().is_empty()) {
-        let v: serde_json::Value = serde_json::from_str(line).expect("json");
+    for v in common::json_lines(text) {
         let x = v["x"].as_f64().expect("x");
         let want = v["wrapped"].as_f64().expect("wrapped");
         let got = wrap_angle(x);

@@ -20,7 +20,7 @@ use rod_ig_core::planar;
 use rod_ig_core::{PlanarJacobian, PlanarParams};
 
 mod common;
-use common::numbers;
+use common::{json_lines, numbers};
 
 /// Issue 9's tolerances.
 const TIP_TOL: f64 = 1e-9;
@@ -79,12 +79,11 @@ fn tiny_bending_under_strong_force_is_never_wrong() {
 fn stable_rods_the_double_double_scan_called_unstable() {
     let text = include_str!("data/stability_truth_tiny_bending.jsonl");
     let mut n = 0;
-    for line in text.lines().filter(|l| !l.trim().is_empty()) {
-        let v: serde_json::Value = serde_json::from_str(line).expect("reference line");
+    for v in json_lines(text) {
         let a = numbers(&v["a"]);
         let a = PlanarParams::new(a[0], a[1], a[2]);
         let det_min = v["det_min"].as_f64().expect("det_min");
-        assert_eq!(v["stable"].as_bool(), Some(true), "{line}");
+        assert_eq!(v["stable"].as_bool(), Some(true), "{v}");
         let s = planar::stability(&a).expect("a verdict");
         // The margin is the scan's refined minimum, the reference's the minimum over a grid of
         // 2000 points: both find the same minimum at t = 0.05 here.
@@ -143,12 +142,11 @@ fn check_reference(text: &str) -> ReferenceReport {
     let (mut n, mut refused) = (0usize, 0usize);
     let (mut worst_tip, mut worst_jac, mut worst_energy) = (0.0f64, 0.0f64, 0.0f64);
     let (mut failures, mut uncertain) = (Vec::new(), Vec::new());
-    for line in text.lines().filter(|l| !l.trim().is_empty()) {
-        let v: serde_json::Value = serde_json::from_str(line).expect("reference line");
+    for v in json_lines(text) {
         let a = numbers(&v["a"]);
         let a = PlanarParams::new(a[0], a[1], a[2]);
         // the reference's own rounding bound is far below the tolerances checked here
-        assert!(v["radius"].as_f64().expect("radius") < 1e-20, "{line}");
+        assert!(v["radius"].as_f64().expect("radius") < 1e-20, "{v}");
         n += 1;
         let root_f = a[1].hypot(a[2]).sqrt();
         let eval = match planar::evaluate(&a) {

@@ -20,3 +20,12 @@ pub fn numbers(v: &serde_json::Value) -> Vec<f64> {
         .map(|x| x.as_f64().expect("number"))
         .collect()
 }
+
+/// The JSON values of a JSON-lines text, blank lines skipped (panics on a malformed line: test
+/// data).
+#[allow(dead_code)] // not every test binary that includes this module reads JSON lines
+pub fn json_lines(text: &str) -> impl Iterator<Item = serde_json::Value> + '_ {
+    text.lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}")))
+}
