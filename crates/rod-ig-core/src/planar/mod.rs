@@ -16,6 +16,7 @@
 mod closed;
 pub mod ig;
 pub mod model;
+mod small_angle;
 mod stability;
 mod taylor;
 
@@ -51,7 +52,7 @@ pub(crate) const STABILITY_DD_MAX_ROOT_F: f64 = 120.0;
 const LN_F64_MAX: f64 = 709.7;
 
 /// ρ = max(|a3|, √‖(a4, a5)‖): the rod's curvature scale (its Taylor terms grow like ρᵏ/k!).
-fn curvature_scale(a: &PlanarParams) -> f64 {
+pub(crate) fn curvature_scale(a: &PlanarParams) -> f64 {
     a[0].abs().max(crate::scalar::fast_hypot(a[1], a[2]).sqrt())
 }
 
@@ -64,7 +65,7 @@ fn series_f64(a: &PlanarParams, dense: bool) -> Result<TaylorRod<f64>, RodError>
     TaylorRod::new(a[0], a[1], a[2], SERIES_MAX_STEPS, dense)
 }
 
-fn series_dual(a: &PlanarParams, dense: bool) -> Result<TaylorRod<Dual3>, RodError> {
+pub(crate) fn series_dual(a: &PlanarParams, dense: bool) -> Result<TaylorRod<Dual3>, RodError> {
     TaylorRod::new(
         Dual3::variable(a[0], 0),
         Dual3::variable(a[1], 1),
@@ -714,7 +715,17 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
                 // A nearly straight rod under a force near the separatrix: its energy and
                 // det J(t) both need the series (the identity cancels, the x row of J is below
                 // the closed form's error floor); one dense series serves both. The tip and J
-                // stay the closed form's, identical to `tip_and_jacobian`'s.
+                // stay the closed form's, identical to `tip_and_jacobian`'s. Where the
+                // small-angle limit decides stability, the energy needs the series' values only.
+                if let Some(stability) = stability::small_angle_report(a)? {
+                    return Ok(Evaluation {
+                        tip,
+                        jacobian,
+                        energy: series_f64(a, false)?.energy(),
+                        stability,
+                        full_accuracy: true,
+                    });
+                }
                 let rod = series_dual(a, true)?;
                 return Ok(Evaluation {
                     tip,

@@ -1,0 +1,205 @@
+//! The small-angle limit of the stability function g(t) for nearly straight rods (issue 23).
+//!
+//! A rod with little bending, σ = max(|a3|, |a5|) → 0 under a force a4 of any size, is a
+//! perturbation of the straight rod. Linearised (FINDINGS §1 with θ, a3 and a5 small):
+//!
+//! ```text
+//! θ'' = a4 θ − a5,  θ(0) = 0,  θ'(0) = a3   ⇒   θ = a3 S1 − a5 S2,   y = ∫θ = a3 S2 − a5 S3,
+//! x = ∫cos θ = t − ½∫θ² + O(σ⁴),
+//! ```
+//!
+//! with S1 = sinh(wt)/w (sin for a4 = −w² < 0), S2 = ∫S1, S3 = ∫S2, as in the closed form's
+//! straight rod. The entries of J(t) = ∂(x, y, θ)/∂(a3, a4, a5) follow: the θ and y rows to
+//! O(σ²) relative, the x row from ½∫θ² = ½(a3² I11 − 2 a3 a5 I12 + a5² I22), Iij = ∫Si Sj, to
+//! O(σ²) relative as well. det J(t) is a quadratic form in (a3, a5) at leading order, and
+//! g(t) = det J(t)/(t⁹(a3²/8640 + a5² t²/33600)) (FINDINGS §5) depends on (a3, a5) only
+//! through their ratio: this module gives that limit g₀(t), accurate relative to itself (every
+//! quantity is a positive series or a hyperbolic/trigonometric closed form, no difference of
+//! O(1) elliptic quantities), where the closed form's x row, a difference of O(1) terms, is
+//! swamped by rounding and the series costs tens of µs.
+//!
+//! The neglected terms are O(Θ²) relative, Θ the largest bending angle (measured bound in
+//! [`truncation`]).
+
+use crate::scalar::{Dual3, Real};
+
+/// Terms of the Maclaurin series in z = a4 t² (|z| < [`SERIES_MAX_Z`]): the first neglected
+/// term is below 16²⁰/40! ≈ 1.5e-24 of the sum.
+const TERMS: usize = 20;
+/// Below this |a4 t²| the S and I functions come from their Maclaurin series (the closed forms
+/// cancel there: I22 = (sc/2 + 3wt/2 − 2s)/(w a4²) is O((wt)⁵) as a difference of O(wt) terms).
+/// At |z| = 4 the closed forms lose at most ~20 ulps.
+const SERIES_MAX_Z: f64 = 4.0;
+
+/// 1/k! for k < 64.
+const INV_FACTORIAL: [f64; 64] = {
+    let mut f = [1.0f64; 64];
+    let mut k = 1;
+    while k < 64 {
+        f[k] = f[k - 1] / k as f64;
+        k += 1;
+    }
+    f
+};
+
+/// Coefficients of Si = tⁱ Σ zᵏ/(2k + i)!.
+const fn s_coefficients(i: usize) -> [f64; TERMS] {
+    let mut c = [0.0; TERMS];
+    let mut k = 0;
+    while k < TERMS {
+        c[k] = INV_FACTORIAL[2 * k + i];
+        k += 1;
+    }
+    c
+}
+
+/// Coefficients of Iij = ∫₀ᵗ Si Sj = t^{i+j+1} Σ zⁿ (Σₖ 1/((2k + i)!(2(n − k) + j)!))/(2n + i +
+/// j + 1) (the Cauchy product of the two series, integrated term by term).
+const fn i_coefficients(i: usize, j: usize) -> [f64; TERMS] {
+    let mut c = [0.0; TERMS];
+    let mut n = 0;
+    while n < TERMS {
+        let mut sum = 0.0;
+        let mut k = 0;
+        while k <= n {
+            sum += INV_FACTORIAL[2 * k + i] * INV_FACTORIAL[2 * (n - k) + j];
+            k += 1;
+        }
+        c[n] = sum / (2 * n + i + j + 1) as f64;
+        n += 1;
+    }
+    c
+}
+
+const S1: [f64; TERMS] = s_coefficients(1);
+const S2: [f64; TERMS] = s_coefficients(2);
+const S3: [f64; TERMS] = s_coefficients(3);
+const I11: [f64; TERMS] = i_coefficients(1, 1);
+const I12: [f64; TERMS] = i_coefficients(1, 2);
+const I22: [f64; TERMS] = i_coefficients(2, 2);
+
+/// Σ cₖ zᵏ by Horner's rule.
+fn horner(c: &[f64; TERMS], z: Dual3) -> Dual3 {
+    let mut acc = Dual3::constant(c[TERMS - 1]);
+    for &ck in c[..TERMS - 1].iter().rev() {
+        acc = acc * z + ck;
+    }
+    acc
+}
+
+/// The straight rod's functions at t and their a4-derivatives (slot 0 of each [`Dual3`]):
+/// [S1, S2, S3, I11, I12, I22] (module docs).
+fn straight_jets(a4: f64, t: f64) -> [Dual3; 6] {
+    if (a4 * t * t).abs() < SERIES_MAX_Z {
+        series_jets(a4, t)
+    } else {
+        closed_jets(a4, t)
+    }
+}
+
+/// [`straight_jets`] by the Maclaurin series in z = a4 t².
+fn series_jets(a4: f64, t: f64) -> [Dual3; 6] {
+    let z = Dual3::variable(a4, 0) * (t * t);
+    let (t2, t3) = (t * t, t * t * t);
+    [
+        horner(&S1, z) * t,
+        horner(&S2, z) * t2,
+        horner(&S3, z) * t3,
+        horner(&I11, z) * t3,
+        horner(&I12, z) * (t2 * t2),
+        horner(&I22, z) * (t2 * t3),
+    ]
+}
+
+/// [`straight_jets`] by the hyperbolic (a4 > 0) or trigonometric (a4 < 0) closed forms.
+fn closed_jets(a4: f64, t: f64) -> [Dual3; 6] {
+    let f = Dual3::variable(a4, 0);
+    // a4 = ±w²: (s, c) = (sinh, cosh)(wt) or (sin, cos)(wt); the same formulas hold in both
+    // cases when written with a4 itself (I12 differs in the sign of its s² term).
+    let w = f.abs().sqrt();
+    let wt = w * t;
+    let (s, c, s2_sign) = if a4 > 0.0 {
+        (wt.sinh(), wt.cosh(), 1.0)
+    } else {
+        let (s, c) = wt.sin_cos();
+        (s, c, -1.0)
+    };
+    let wf = w * f;
+    let ff = f * f;
+    [
+        s / w,
+        (c - 1.0) / f,
+        (s - wt) / wf,
+        (s * c - wt) / (wf * 2.0),
+        (s * s * (0.5 * s2_sign) - c + 1.0) / ff,
+        (s * c * 0.5 + wt * 1.5 - s * 2.0) / (wf * f),
+    ]
+}
+
+/// g₀(t): the σ → 0 limit of g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (module docs), with
+/// (a3, a5) entering through their ratio only.
+pub(crate) fn normalised_det(a3: f64, a4: f64, a5: f64, t: f64) -> f64 {
+    let sigma = a3.abs().max(a5.abs());
+    let (u3, u5) = (a3 / sigma, a5 / sigma);
+    let [s1, s2, s3, i11, i12, i22] = straight_jets(a4, t);
+    let d = |v: Dual3| v.g[0];
+    // Rows (x, y, θ), columns (a3, a4, a5); the x row and the a4 column divided by σ.
+    let th = [s1.v, u3 * d(s1) - u5 * d(s2), -s2.v];
+    let y = [s2.v, u3 * d(s2) - u5 * d(s3), -s3.v];
+    let x = [
+        -(u3 * i11.v - u5 * i12.v),
+        -0.5 * (u3 * u3 * d(i11) - 2.0 * u3 * u5 * d(i12) + u5 * u5 * d(i22)),
+        u3 * i12.v - u5 * i22.v,
+    ];
+    let det = x[0] * (y[1] * th[2] - y[2] * th[1]) - x[1] * (y[0] * th[2] - y[2] * th[0])
+        + x[2] * (y[0] * th[1] - y[1] * th[0]);
+    det / crate::planar_det_leading_term(u3, u5, t)
+}
+
+/// Largest bending angle Θ of the linearised rod over [0, 1] (bounded above): |θ| ≤ |a3| S1 +
+/// |a5| S2 with S1, S2 ≥ 0 increasing under tension; under compression |S1| ≤ min(t, 1/w) and
+/// |S2| ≤ min(t²/2, 2/w²).
+pub(crate) fn max_angle(a3: f64, a4: f64, a5: f64) -> f64 {
+    let [s1, s2, ..] = straight_jets(a4, 1.0);
+    if a4 >= 0.0 {
+        a3.abs() * s1.v + a5.abs() * s2.v
+    } else {
+        let w = (-a4).sqrt();
+        a3.abs() * w.recip().min(1.0) + a5.abs() * (2.0 / (w * w)).min(0.5)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The series and closed-form branches of the straight rod's functions agree where they
+    /// meet (|z| = 4) and beyond (the series converges for every z), values and
+    /// a4-derivatives, to the closed forms' loss (≲ 20 ulps at |z| = 4, ×10 allowance).
+    #[test]
+    fn series_and_closed_forms_agree() {
+        for a4 in [4.0, -4.0, 7.5, -7.5, 12.0, -12.0] {
+            for t in [1.0, 0.9] {
+                let series = series_jets(a4, t);
+                let closed = closed_jets(a4, t);
+                for (s, c) in series.iter().zip(&closed) {
+                    let tol = 200.0 * f64::EPSILON;
+                    assert!((s.v - c.v).abs() <= tol * c.v.abs(), "{a4}: {s:?} vs {c:?}");
+                    assert!(
+                        (s.g[0] - c.g[0]).abs() <= tol * c.g[0].abs(),
+                        "{a4}: {s:?} vs {c:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// At t → 0 g → 1 by the normalisation (FINDINGS §5), for any ratio and force.
+    #[test]
+    fn leading_term_normalises_to_one() {
+        for (a3, a4, a5) in [(1e-6, 20.0, 3e-7), (0.0, -20.0, 1e-5), (1e-5, 0.3, 0.0)] {
+            let g = normalised_det(a3, a4, a5, 1e-5);
+            assert!((g - 1.0).abs() < 1e-4, "{a3} {a4} {a5}: {g}");
+        }
+    }
+}
