@@ -522,7 +522,11 @@ fn closed_scan(
     let start = if norm_wise {
         ShortSeries::new(a, 0.0, (SHORT_SERIES_REACH / root_f).min(1.0))
     } else {
-        ShortSeries::new(a, 0.2, 1.0)
+        // One low-order step reaches t ≈ 0.2 on a gently bent rod; on a strongly bent one
+        // (ρ = max(|a3|, √‖F‖) ≫ 1) the steps shrink like 1/ρ while the closed form is
+        // accurate from t ~ 1/ρ on: the first end is capped there (it still grows to 2t).
+        let rho = a3.abs().max(root_f);
+        ShortSeries::new(a, (SHORT_SERIES_FIRST_END_RHO / rho).min(0.2), 1.0)
     };
     let g = |t: f64| {
         let (v, e) = normalised_det(c, a3, a5, t, norm_wise);
@@ -618,6 +622,9 @@ const CLOSED_G_ERROR: f64 = 1e-3;
 /// small t or in a dip where the closed form is accurate, is certified separately
 /// ([`certify_margin`]).
 const SHORT_SERIES_REACH: f64 = 6.0;
+/// The short series' first end on a strongly bent rod is this over ρ = max(|a3|, √‖F‖) (a
+/// few steps; 0.2 for ρ ≤ 10, as for every rod before).
+const SHORT_SERIES_FIRST_END_RHO: f64 = 2.0;
 /// Step budget of the short series (≈ 3 µs per step): beyond, the rod is too strongly bent
 /// for a short start and the closed form's value stands (an uncertain verdict then goes to
 /// the full series, as without the short series).
