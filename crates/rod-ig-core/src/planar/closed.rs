@@ -855,24 +855,41 @@ impl<T: Real> Closed<T> {
         }
     }
 
-    /// Pose (x, y, θ)(t) with θ unwrapped (FINDINGS §1 position formulas, §3 integrals):
-    /// x = −(a4/F)∫β1 + 2ε(a5/F)∫β2, y = −(a5/F)∫β1 − 2ε(a4/F)∫β2.
-    /// Case I: ½∫₀¹κ² = ½α3 ∫₀¹cn²(rt + φ|m) dt = ½α3 [(Z(Γ1) − Z(φ))/(m r) + (1 − q)/2], from
-    /// ∫cn² du = Z(u)/m + u(1 − D/K) (Z the Jacobi zeta, A&S 17.4.28 and 16.26.1; D/K =
-    /// (1 + q)/2): every term is free of cancellation as m → 0, where the identity
-    /// λ2/2 − a4 x − a5 y cancels (a nearly straight rod under compression). None in the other
-    /// cases.
-    pub fn energy_case_i(&self) -> Option<f64> {
-        if self.case != Case::I {
-            return None;
-        }
+    /// ½∫₀¹κ² by the Jacobi zeta function, free of the cancellation of the identity
+    /// λ2/2 − a4 x − a5 y on nearly straight rods. Case I, κ = ε√α3 cn(rt + φ|m):
+    /// ½α3 [(Z(Γ1) − Z(φ))/(m r) + (1 − q)/2], from ∫cn² du = Z(u)/m + u(1 − D/K) (A&S 17.4.28,
+    /// 16.26.1; D/K = (1 + q)/2). Case II, κ = ε√α3 dn, r = √α3/2: ½α3 [(Z(Γ1) − Z(φ))/r + m1 +
+    /// m(1 − q)/2], from ∫dn² du = E(am u) = Z(u) + u E/K (A&S 17.4.28) with E/K = 1 − m D/K.
+    /// None in the other cases.
+    ///
+    /// Returned with the size of its terms, ½α3[(K + |Z(Γ1)/m| + |Z(φ)/m|)·s/r + 1] with
+    /// s = 1 (case I) or m (case II); Z/m is evaluated as u·D/K − D(u) with |u| ≲ K: its
+    /// rounding is a few ulps of that, which near m = 1 with little bending is far above the
+    /// energy itself (the terms cancel).
+    pub fn energy_by_zeta_bounded(&self) -> Option<(f64, f64)> {
+        let scale = match self.case {
+            Case::I => 1.0,
+            Case::II => self.m.re(),
+            _ => return None,
+        };
         let r = self.r.re();
         let zm1 = self.landen.eval(self.r + self.phi, false).zm.re();
+        let zm0 = self.j0.zm.re();
         let q = self.landen.q().re();
         let alpha3 = self.sqa3.re() * self.sqa3.re();
-        Some(0.5 * alpha3 * ((zm1 - self.j0.zm.re()) / r + (1.0 - q) * 0.5))
+        let linear = if self.case == Case::I {
+            (1.0 - q) * 0.5
+        } else {
+            self.m1 + scale * (1.0 - q) * 0.5
+        };
+        let energy = 0.5 * alpha3 * (scale * (zm1 - zm0) / r + linear);
+        let terms =
+            0.5 * alpha3 * ((self.landen.k().re() + zm1.abs() + zm0.abs()) * scale / r + 1.0);
+        Some((energy, terms))
     }
 
+    /// Pose (x, y, θ)(t) with θ unwrapped (FINDINGS §1 position formulas, §3 integrals):
+    /// x = −(a4/F)∫β1 + 2ε(a5/F)∫β2, y = −(a5/F)∫β1 − 2ε(a4/F)∫β2.
     pub fn pose(&self, t: f64) -> [T; 3] {
         if t == 0.0 {
             // the base is clamped at the identity: q(0) = 0 and J(0) = 0 exactly

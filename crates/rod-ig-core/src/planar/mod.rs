@@ -451,6 +451,11 @@ fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
 /// is itself ≥ 2× the measured error.
 const ENERGY_REL_TOLERANCE: f64 = 1e-9;
 
+/// Rounding of [`Closed::energy_by_zeta_bounded`] in ulps of its terms: measured ≤ 10.1 on
+/// 1,160 rods of cases I and II against the 320-bit references (tests/data/separatrix_truth*
+/// .jsonl) and the double-double series (`zeta_energy_meets_its_bound`), ×3.
+const ZETA_ENERGY_ULPS: f64 = 32.0;
+
 /// The energy by the identity λ2/2 − a4 x − a5 y of FINDINGS §1 where its error bound allows,
 /// else None. The identity subtracts a4·x + a5·y from λ2/2, both ≈ ‖F‖ on a nearly straight
 /// rod under force, whose energy is orders of magnitude smaller: its error is (|a4| + |a5|)
@@ -486,8 +491,12 @@ fn closed_energy<T: crate::scalar::Real>(
     // cancels): ∫cn² in closed form, within 2.2e-11 of the double-double series on 4,000
     // log-scale rods (1.7e-14 on those under compression; tests: see
     // `small_m_compression_closed_form_meets_its_estimate`); near m = 1 its Z/m terms cancel.
-    if c.m.re() < 0.5 {
-        if let Some(e) = c.energy_case_i() {
+    // Elsewhere (case I from m = ½ up to the separatrix, case II) it is taken where its
+    // rounding, a few ulps of its terms, is below the tolerance (a rod with some bending
+    // under a strong tension: the series there takes 100+ steps).
+    if let Some((e, terms)) = c.energy_by_zeta_bounded() {
+        let bound = ZETA_ENERGY_ULPS * f64::EPSILON * terms;
+        if (c.case == Case::I && c.m.re() < 0.5) || bound <= ENERGY_REL_TOLERANCE * e.abs() {
             return Ok(e);
         }
     }
@@ -716,12 +725,13 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
                 // det J(t) both need the series (the identity cancels, the x row of J is below
                 // the closed form's error floor); one dense series serves both. The tip and J
                 // stay the closed form's, identical to `tip_and_jacobian`'s. Where the
-                // small-angle limit decides stability, the energy needs the series' values only.
+                // small-angle limit decides stability, the energy needs no dense series (the
+                // zeta form, or the series' values only).
                 if let Some(stability) = stability::small_angle_report(a)? {
                     return Ok(Evaluation {
                         tip,
                         jacobian,
-                        energy: series_f64(a, false)?.energy(),
+                        energy: closed_energy(c, a, &tip)?,
                         stability,
                         full_accuracy: true,
                     });
@@ -768,6 +778,62 @@ mod tests {
         )
     }
 
+    /// The energy by the Jacobi zeta function (cases I and II, [`Closed::energy_by_zeta_bounded`])
+    /// against the 320-bit references (tests/data/separatrix_truth*.jsonl: rods near the
+    /// separatrix, √‖F‖ up to 100, bending from 1e-14 to 1) and against the double-double
+    /// series on tensioned rods with some bending (log-scale a3, a5 from 1e-4 to 1, a4 from 10
+    /// to 700): within [`ZETA_ENERGY_ULPS`] ulps of its terms on every rod (measured ≤ 10.1),
+    /// and within the energy tolerance on most of them, where `evaluate` takes it.
+    #[test]
+    fn zeta_energy_meets_its_bound() {
+        let (mut rods, mut taken, mut worst) = (0, 0, 0.0f64);
+        let mut check = |a: PlanarParams, reference: f64| {
+            let Some(c) = Closed::<f64>::new(a[0], a[1], a[2]) else {
+                return;
+            };
+            let Some((e, terms)) = c.energy_by_zeta_bounded() else {
+                return;
+            };
+            rods += 1;
+            let ulps = (e - reference).abs() / (f64::EPSILON * terms);
+            assert!(
+                ulps <= ZETA_ENERGY_ULPS,
+                "{a:?}: {e} vs {reference} ({ulps} ulps)"
+            );
+            worst = worst.max(ulps);
+            if ZETA_ENERGY_ULPS * f64::EPSILON * terms <= ENERGY_REL_TOLERANCE * e.abs() {
+                taken += 1;
+            }
+        };
+        let files = [
+            include_str!("../../tests/data/separatrix_truth.jsonl"),
+            include_str!("../../tests/data/separatrix_truth_extreme.jsonl"),
+        ];
+        for line in files.iter().flat_map(|f| f.lines()) {
+            let v: serde_json::Value = serde_json::from_str(line).expect("reference line");
+            let a: Vec<f64> = serde_json::from_value(v["a"].clone()).expect("a");
+            check(
+                PlanarParams::new(a[0], a[1], a[2]),
+                v["energy"].as_f64().expect("energy"),
+            );
+        }
+        let mut r = SplitMix64::new(23);
+        for _ in 0..400 {
+            let a = PlanarParams::new(
+                r.signed_pow10(-4.0, 0.0),
+                10f64.powf(r.range(1.0, 2.85)),
+                r.signed_pow10(-4.0, 0.0),
+            );
+            let reference = series_dd::<true>(&a, false, SERIES_DD_MAX_ROOT_F)
+                .expect("series")
+                .energy()
+                .value();
+            check(a, reference);
+        }
+        assert!(rods > 500 && taken > 300, "{taken} of {rods} taken");
+        assert!(worst > 1.0, "{worst}");
+    }
+
     /// Case I at small m (nearly straight rods under compression, |a4| from 1 to 1e4, |a3|, |a5|
     /// from 1e-6 to 1, a5 sometimes exactly 0): where the closed form now answers J
     /// ([`closed::SMALL_M_I_ULPS`]), its J is within its estimate of the double-double series'
@@ -795,7 +861,7 @@ mod tests {
                 .expect("series")
                 .energy()
                 .value();
-            let e = c.energy_case_i().expect("case I");
+            let (e, _) = c.energy_by_zeta_bounded().expect("case I");
             worst_energy = worst_energy.max((e - e_ref).abs() / e_ref);
             assert!(
                 (e - e_ref).abs() <= 1e-12 * e_ref,
