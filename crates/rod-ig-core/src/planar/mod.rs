@@ -535,16 +535,20 @@ const SMALL_ANGLE_TIP_TOLERANCE: f64 = 1e-13;
 /// form's x row (O(σ), O(σ²)) is swamped by rounding.
 fn small_angle_pose_and_jac(a: &PlanarParams, t: f64) -> Option<(PlanarPose, PlanarJacobian)> {
     let (a3, a4, a5) = (a[0], a[1], a[2]);
-    if small_angle::jacobian_rel_error(a3, a4, a5) > CLOSED_J_TOLERANCE
-        || small_angle::tip_abs_error(a3, a4, a5) > SMALL_ANGLE_TIP_TOLERANCE
+    let j_truncation = small_angle::jacobian_rel_error(a3, a4, a5);
+    let tip_truncation = small_angle::tip_abs_error(a3, a4, a5);
+    if j_truncation > CLOSED_J_TOLERANCE || tip_truncation > SMALL_ANGLE_TIP_TOLERANCE {
+        return None;
+    }
+    let lin = small_angle::pose_and_jacobian(a3, a4, a5, t);
+    if j_truncation + lin.jacobian_rounding > CLOSED_J_TOLERANCE
+        || tip_truncation + lin.pose_rounding > SMALL_ANGLE_TIP_TOLERANCE
     {
         return None;
     }
-    let ([x, y, th], j) = small_angle::pose_and_jacobian(a3, a4, a5, t);
+    let [x, y, th] = lin.pose;
     let pose = PlanarPose::new(x, y, th);
-    let j = PlanarJacobian::from_row_slice(&[
-        j[0][0], j[0][1], j[0][2], j[1][0], j[1][1], j[1][2], j[2][0], j[2][1], j[2][2],
-    ]);
+    let j = PlanarJacobian::from_row_slice(&lin.jacobian.concat());
     (pose.is_finite() && j.iter().all(|v| v.is_finite())).then_some((pose, j))
 }
 
@@ -552,18 +556,26 @@ fn small_angle_pose_and_jac(a: &PlanarParams, t: f64) -> Option<(PlanarPose, Pla
 /// [`SMALL_ANGLE_TIP_TOLERANCE`].
 fn small_angle_tip(a: &PlanarParams) -> Option<[f64; 3]> {
     let (a3, a4, a5) = (a[0], a[1], a[2]);
-    (small_angle::tip_abs_error(a3, a4, a5) <= SMALL_ANGLE_TIP_TOLERANCE)
-        .then(|| small_angle::pose_and_jacobian(a3, a4, a5, 1.0).0)
-        .filter(|p| p.iter().all(|v| v.is_finite()))
+    let truncation = small_angle::tip_abs_error(a3, a4, a5);
+    if truncation > SMALL_ANGLE_TIP_TOLERANCE {
+        return None;
+    }
+    let lin = small_angle::pose_and_jacobian(a3, a4, a5, 1.0);
+    (truncation + lin.pose_rounding <= SMALL_ANGLE_TIP_TOLERANCE
+        && lin.pose.iter().all(|v| v.is_finite()))
+    .then_some(lin.pose)
 }
 
 /// ½∫κ² of a nearly straight rod from the small-angle expansion, where its bound is within
 /// [`ENERGY_REL_TOLERANCE`].
 fn small_angle_energy(a: &PlanarParams) -> Option<f64> {
     let (a3, a4, a5) = (a[0], a[1], a[2]);
-    (small_angle::energy_rel_error(a3, a4, a5) <= ENERGY_REL_TOLERANCE)
-        .then(|| small_angle::energy(a3, a4, a5))
-        .filter(|e| e.is_finite())
+    let truncation = small_angle::energy_rel_error(a3, a4, a5);
+    if truncation > ENERGY_REL_TOLERANCE {
+        return None;
+    }
+    let (e, rounding) = small_angle::energy(a3, a4, a5);
+    (truncation + rounding <= ENERGY_REL_TOLERANCE && e.is_finite()).then_some(e)
 }
 
 fn finite_tip([x, y, th]: [f64; 3]) -> Result<PlanarPose, RodError> {
@@ -894,26 +906,22 @@ mod tests {
                 .expect("series")
                 .energy()
                 .value();
-            let ([x, y, th], js) = small_angle::pose_and_jacobian(a3, a4, a5, 1.0);
-            let js = PlanarJacobian::from_row_slice(&js.concat());
+            let lin = small_angle::pose_and_jacobian(a3, a4, a5, 1.0);
+            let [x, y, th] = lin.pose;
+            let js = PlanarJacobian::from_row_slice(&lin.jacobian.concat());
             let dj = (js - j).norm() / j.norm();
             let dtip = (x - tip.x)
                 .abs()
                 .max((y - tip.y).abs())
                 .max((th - tip.theta).abs());
-            let de = ((small_angle::energy(a3, a4, a5) - e_ref) / e_ref).abs();
-            assert!(
-                dj <= small_angle::jacobian_rel_error(a3, a4, a5),
-                "{a:?}: J {dj:e}"
-            );
-            assert!(
-                dtip <= small_angle::tip_abs_error(a3, a4, a5),
-                "{a:?}: tip {dtip:e}"
-            );
-            assert!(
-                de <= small_angle::energy_rel_error(a3, a4, a5),
-                "{a:?}: energy {de:e}"
-            );
+            let (e, e_rounding) = small_angle::energy(a3, a4, a5);
+            let de = ((e - e_ref) / e_ref).abs();
+            let j_bound = small_angle::jacobian_rel_error(a3, a4, a5) + lin.jacobian_rounding;
+            let tip_bound = small_angle::tip_abs_error(a3, a4, a5) + lin.pose_rounding;
+            let e_bound = small_angle::energy_rel_error(a3, a4, a5) + e_rounding;
+            assert!(dj <= j_bound, "{a:?}: J {dj:e} > {j_bound:e}");
+            assert!(dtip <= tip_bound, "{a:?}: tip {dtip:e} > {tip_bound:e}");
+            assert!(de <= e_bound, "{a:?}: energy {de:e} > {e_bound:e}");
             rods += 1;
             // Where the truncation is far above rounding.
             if theta > 1e-4 {

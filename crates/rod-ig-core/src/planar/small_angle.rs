@@ -138,35 +138,87 @@ fn closed_jets(a4: f64, t: f64) -> [Dual3; 6] {
     ]
 }
 
+/// Rounding of the straight rod's functions and of the combinations that make J's entries, in
+/// ulps of the sum of the combinations' absolute terms (the closed forms lose ≲ 20 ulps where
+/// they meet the series, `series_and_closed_forms_agree`; ×3).
+const ENTRY_ULPS: f64 = 64.0;
+
 /// g₀(t): the σ → 0 limit of g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (module docs), with
-/// (a3, a5) entering through their ratio only.
-pub(crate) fn normalised_det(a3: f64, a4: f64, a5: f64, t: f64) -> f64 {
+/// (a3, a5) entering through their ratio only, and a first-order bound on its rounding: each
+/// entry's error [`ENTRY_ULPS`]·ε times the sum of its terms' magnitudes, times the
+/// magnitude of its cofactor, plus the expansion's own rounding. Under a strong tension the
+/// entries grow like e^{√a4 t} (the x row like e^{2√a4 t}) while det J grows slower: the
+/// bound shows that cancellation.
+pub(crate) fn normalised_det(a3: f64, a4: f64, a5: f64, t: f64) -> (f64, f64) {
     let sigma = a3.abs().max(a5.abs());
     let (u3, u5) = (a3 / sigma, a5 / sigma);
     let [s1, s2, s3, i11, i12, i22] = straight_jets(a4, t);
     let d = |v: Dual3| v.g[0];
-    // Rows (x, y, θ), columns (a3, a4, a5); the x row and the a4 column divided by σ.
-    let th = [s1.v, u3 * d(s1) - u5 * d(s2), -s2.v];
-    let y = [s2.v, u3 * d(s2) - u5 * d(s3), -s3.v];
-    let x = [
-        -(u3 * i11.v - u5 * i12.v),
-        -0.5 * (u3 * u3 * d(i11) - 2.0 * u3 * u5 * d(i12) + u5 * u5 * d(i22)),
-        u3 * i12.v - u5 * i22.v,
+    // Rows (x, y, θ), columns (a3, a4, a5); the x row and the a4 column divided by σ. `size`
+    // holds each entry's sum of absolute terms.
+    let (p3, p5) = (u3.abs(), u5.abs());
+    let j = [
+        [
+            -(u3 * i11.v - u5 * i12.v),
+            -0.5 * (u3 * u3 * d(i11) - 2.0 * u3 * u5 * d(i12) + u5 * u5 * d(i22)),
+            u3 * i12.v - u5 * i22.v,
+        ],
+        [s2.v, u3 * d(s2) - u5 * d(s3), -s3.v],
+        [s1.v, u3 * d(s1) - u5 * d(s2), -s2.v],
     ];
-    let det = x[0] * (y[1] * th[2] - y[2] * th[1]) - x[1] * (y[0] * th[2] - y[2] * th[0])
-        + x[2] * (y[0] * th[1] - y[1] * th[0]);
-    det / crate::planar_det_leading_term(u3, u5, t)
+    let size = [
+        [
+            p3 * i11.v.abs() + p5 * i12.v.abs(),
+            0.5 * (p3 * p3 * d(i11).abs() + 2.0 * p3 * p5 * d(i12).abs() + p5 * p5 * d(i22).abs()),
+            p3 * i12.v.abs() + p5 * i22.v.abs(),
+        ],
+        [s2.v.abs(), p3 * d(s2).abs() + p5 * d(s3).abs(), s3.v.abs()],
+        [s1.v.abs(), p3 * d(s1).abs() + p5 * d(s2).abs(), s2.v.abs()],
+    ];
+    let mut det = 0.0;
+    let mut err = 0.0;
+    for c in 0..3 {
+        let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
+        let cof = j[1][c1] * j[2][c2] - j[1][c2] * j[2][c1];
+        det += j[0][c] * cof;
+        // First order in every entry's error: the x row's through its cofactor, the other rows'
+        // through the minors they share with the x row.
+        err += size[0][c] * cof.abs()
+            + j[0][c].abs()
+                * (size[1][c1] * j[2][c2].abs()
+                    + j[1][c1].abs() * size[2][c2]
+                    + size[1][c2] * j[2][c1].abs()
+                    + j[1][c2].abs() * size[2][c1]);
+    }
+    let n = crate::planar_det_leading_term(u3, u5, t);
+    (det / n, ENTRY_ULPS * f64::EPSILON * err / n)
+}
+
+/// The linearised rod at some t: pose, J and first-order bounds on their rounding.
+pub(crate) struct Linearised {
+    /// (x, y, θ).
+    pub pose: [f64; 3],
+    /// ∂(x, y, θ)/∂(a3, a4, a5), rows x, y, θ.
+    pub jacobian: [[f64; 3]; 3],
+    /// Absolute rounding bound of the pose.
+    pub pose_rounding: f64,
+    /// Relative (Frobenius) rounding bound of J.
+    pub jacobian_rounding: f64,
 }
 
 /// q(t) and J(t) = ∂(x, y, θ)/∂(a3, a4, a5) of the linearised rod (module docs): θ and y to
 /// first order in σ, x to second (relative truncation O(Θ²) in every entry and in θ, y; O(Θ⁴)
-/// absolute in x).
-pub(crate) fn pose_and_jacobian(a3: f64, a4: f64, a5: f64, t: f64) -> ([f64; 3], [[f64; 3]; 3]) {
+/// absolute in x); rounding bounded by [`ENTRY_ULPS`] ulps of each combination's terms (they
+/// cancel where the terms of a3 and a5 nearly balance).
+pub(crate) fn pose_and_jacobian(a3: f64, a4: f64, a5: f64, t: f64) -> Linearised {
     let [s1, s2, s3, i11, i12, i22] = straight_jets(a4, t);
     let d = |v: Dual3| v.g[0];
+    let (p3, p5) = (a3.abs(), a5.abs());
     let theta = a3 * s1.v - a5 * s2.v;
     let y = a3 * s2.v - a5 * s3.v;
     let half_q = 0.5 * (a3 * a3 * i11.v - 2.0 * a3 * a5 * i12.v + a5 * a5 * i22.v);
+    let half_q_size =
+        0.5 * (p3 * p3 * i11.v.abs() + 2.0 * p3 * p5 * i12.v.abs() + p5 * p5 * i22.v.abs());
     let jacobian = [
         [
             -(a3 * i11.v - a5 * i12.v),
@@ -176,12 +228,35 @@ pub(crate) fn pose_and_jacobian(a3: f64, a4: f64, a5: f64, t: f64) -> ([f64; 3],
         [s2.v, a3 * d(s2) - a5 * d(s3), -s3.v],
         [s1.v, a3 * d(s1) - a5 * d(s2), -s2.v],
     ];
-    ([t - half_q, y, theta], jacobian)
+    let size = [
+        p3 * i11.v.abs() + p5 * i12.v.abs(),
+        0.5 * (p3 * p3 * d(i11).abs() + 2.0 * p3 * p5 * d(i12).abs() + p5 * p5 * d(i22).abs()),
+        p3 * i12.v.abs() + p5 * i22.v.abs(),
+        s2.v.abs(),
+        p3 * d(s2).abs() + p5 * d(s3).abs(),
+        s3.v.abs(),
+        s1.v.abs(),
+        p3 * d(s1).abs() + p5 * d(s2).abs(),
+        s2.v.abs(),
+    ];
+    let norm = |v: &mut dyn Iterator<Item = f64>| v.map(|e| e * e).sum::<f64>().sqrt();
+    let ulp = ENTRY_ULPS * f64::EPSILON;
+    let pose_size = (p3 * s1.v.abs() + p5 * s2.v.abs())
+        .max(p3 * s2.v.abs() + p5 * s3.v.abs())
+        .max(t + half_q_size);
+    Linearised {
+        pose: [t - half_q, y, theta],
+        jacobian,
+        pose_rounding: ulp * pose_size,
+        jacobian_rounding: ulp * norm(&mut size.into_iter())
+            / norm(&mut jacobian.into_iter().flatten()),
+    }
 }
 
 /// ½∫₀¹κ² of the linearised rod, κ = θ' = a3 S0 − a5 S1 (S0 = cosh(wt) or cos(wt)):
-/// ½(a3² I00 − 2 a3 a5 I01 + a5² I11), relative truncation O(Θ²).
-pub(crate) fn energy(a3: f64, a4: f64, a5: f64) -> f64 {
+/// ½(a3² I00 − 2 a3 a5 I01 + a5² I11), relative truncation O(Θ²); with a bound on its
+/// relative rounding ([`ENTRY_ULPS`] ulps of its terms).
+pub(crate) fn energy(a3: f64, a4: f64, a5: f64) -> (f64, f64) {
     let [i00, i01, i11] = if a4.abs() < SERIES_MAX_Z {
         let z = Dual3::constant(a4);
         [horner(&I00, z).v, horner(&I01, z).v, horner(&I11, z).v]
@@ -199,7 +274,9 @@ pub(crate) fn energy(a3: f64, a4: f64, a5: f64) -> f64 {
             (s * c - w) / (2.0 * w * a4),
         ]
     };
-    0.5 * (a3 * a3 * i00 - 2.0 * a3 * a5 * i01 + a5 * a5 * i11)
+    let e = 0.5 * (a3 * a3 * i00 - 2.0 * a3 * a5 * i01 + a5 * a5 * i11);
+    let size = 0.5 * (a3 * a3 * i00.abs() + 2.0 * (a3 * a5 * i01).abs() + a5 * a5 * i11.abs());
+    (e, ENTRY_ULPS * f64::EPSILON * size / e.abs())
 }
 
 /// Constants of the a-priori bounds of the linearised rod's J (relative, Frobenius), tip
@@ -219,23 +296,32 @@ const ENERGY_ROUNDING: f64 = 1e-13;
 /// under compression the nonlinearity's O(Θ²) phase shift accumulates over the √|a4|/π
 /// wavelengths of the rod.
 pub(crate) fn effective_angle(a3: f64, a4: f64, a5: f64) -> f64 {
+    if a4 > MAX_TENSION {
+        return f64::INFINITY;
+    }
     max_angle(a3, a4, a5) * (1.0 + a4.abs().sqrt()).sqrt()
 }
 
-/// A-priori relative (Frobenius) error of [`pose_and_jacobian`]'s J.
+/// Largest tension a4 at which the truncation constants were measured (√a4 = 27, where the
+/// series that served as the reference is still accurate).
+const MAX_TENSION: f64 = 729.0;
+
+/// A-priori relative (Frobenius) truncation error of [`pose_and_jacobian`]'s J (add its
+/// `jacobian_rounding`); infinite beyond the tension where it was measured.
 pub(crate) fn jacobian_rel_error(a3: f64, a4: f64, a5: f64) -> f64 {
     let th = effective_angle(a3, a4, a5);
     J_C * th * th + J_ROUNDING
 }
 
-/// A-priori absolute error of [`pose_and_jacobian`]'s pose (in length units of the rod and
-/// radians).
+/// A-priori absolute truncation error of [`pose_and_jacobian`]'s pose (in length units of the
+/// rod and radians; add its `pose_rounding`); infinite beyond the measured tension.
 pub(crate) fn tip_abs_error(a3: f64, a4: f64, a5: f64) -> f64 {
     let th = effective_angle(a3, a4, a5);
     TIP_C * th * th * th + TIP_ROUNDING
 }
 
-/// A-priori relative error of [`energy`].
+/// A-priori relative truncation error of [`energy`] (add its rounding); infinite beyond the
+/// measured tension.
 pub(crate) fn energy_rel_error(a3: f64, a4: f64, a5: f64) -> f64 {
     let th = effective_angle(a3, a4, a5);
     ENERGY_C * th * th + ENERGY_ROUNDING
@@ -283,7 +369,7 @@ mod tests {
     #[test]
     fn leading_term_normalises_to_one() {
         for (a3, a4, a5) in [(1e-6, 20.0, 3e-7), (0.0, -20.0, 1e-5), (1e-5, 0.3, 0.0)] {
-            let g = normalised_det(a3, a4, a5, 1e-5);
+            let (g, _) = normalised_det(a3, a4, a5, 1e-5);
             assert!((g - 1.0).abs() < 1e-4, "{a3} {a4} {a5}: {g}");
         }
     }

@@ -189,23 +189,30 @@ fn verdict(scan: Scan, g_error: f64) -> StabilityReport {
 }
 
 /// Largest truncation bound Θ² of the small-angle g₀ (relative to max(|g|, 1)) for which
-/// [`small_angle_report`] answers: margins to 1e-8 relative, where the closed-form scan accepts
+/// [`small_angle_report`] answers: margins to 1e-6 relative, where the closed-form scan accepts
 /// g to 1e-3.
-const SMALL_ANGLE_MAX_TRUNCATION: f64 = 1e-8;
+const SMALL_ANGLE_MAX_TRUNCATION: f64 = 1e-6;
 /// Constant of the small-angle truncation bound C·Θ²·max(|g|, 1), Θ the largest bending
 /// angle ([`small_angle::max_angle`]): measured ≤ 0.16 against the series' g on 6,000 rods
 /// (a4 from 1e-6 to 1e4 and 0, either sign; a3, a5 log-scale 1e-20..0.1 and 0;
 /// `small_angle_agrees_with_the_series`), ×6.
 const SMALL_ANGLE_TRUNCATION_C: f64 = 1.0;
-/// Rounding of g₀ relative to max(|g₀|, 1): measured ≤ 2.1e-12 (with the series' own, where
-/// Θ < 1e-8), ×50.
+/// Rounding of g₀ relative to max(|g₀|, 1) beyond its first-order bound (the normalisation,
+/// the division): measured ≤ 2.1e-12 in all (with the series' own, where Θ < 1e-8), ×50.
 const SMALL_ANGLE_ROUNDING: f64 = 1e-10;
+/// Largest first-order rounding bound of g₀ at t = 1, relative to max(|g₀|, 1), for which
+/// [`small_angle_report`] answers: under a strong tension det J of the linearised rod is a
+/// difference of terms e^{2√a4} times larger than itself (rounding grows with t, so t = 1 is
+/// the worst point).
+const SMALL_ANGLE_MAX_ROUNDING: f64 = 1e-9;
 
 /// Stability of a nearly straight rod from the small-angle limit g₀ of g (FINDINGS §5 on the
 /// linearised straight rod, [`small_angle`]), where its truncation C·Θ² is below
-/// [`SMALL_ANGLE_MAX_TRUNCATION`]: no elliptic function, no series (the closed form's x row is
-/// swamped by rounding there, the series costs tens of µs). None where Θ is larger, σ is
-/// zero or denormal, or the verdict is not certain: the caller's scans decide.
+/// [`SMALL_ANGLE_MAX_TRUNCATION`] and its rounding below [`SMALL_ANGLE_MAX_ROUNDING`]: no
+/// elliptic function, no series (the closed form's x row is swamped by rounding there, the
+/// series costs tens of µs). An unstable verdict needs a sample past the sign change with
+/// g₀ < 0 beyond its bound. None where Θ or the rounding is larger, σ is zero or denormal, or
+/// the verdict is not certain: the caller's scans decide.
 pub(crate) fn small_angle_report(a: &PlanarParams) -> Result<Option<StabilityReport>, RodError> {
     let (a3, a4, a5) = (a[0], a[1], a[2]);
     let sigma = a3.abs().max(a5.abs());
@@ -218,13 +225,26 @@ pub(crate) fn small_angle_report(a: &PlanarParams) -> Result<Option<StabilityRep
     if truncation.is_nan() || truncation > SMALL_ANGLE_MAX_TRUNCATION {
         return Ok(None);
     }
+    let (g1, rounding1) = small_angle::normalised_det(a3, a4, a5, 1.0);
+    if rounding1.is_nan() || rounding1 > SMALL_ANGLE_MAX_ROUNDING * g1.abs().max(1.0) {
+        return Ok(None);
+    }
     // g varies on the rod's own scale, as on the series (same quarter-wavelength rule).
     let wavelength = std::f64::consts::TAU / sigma.max(a4.abs().sqrt());
     let spacing = (0.25 * wavelength).clamp(1e-3, SERIES_SPACING);
-    let g = |t: f64| small_angle::normalised_det(a3, a4, a5, t);
-    let s = scan(&g, SERIES_T_MIN, spacing, a3, a5)?;
-    let bound = (truncation + SMALL_ANGLE_ROUNDING) * g(s.t_margin).abs().max(1.0);
-    let report = verdict(s, bound);
+    let s = scan(
+        &|t| small_angle::normalised_det(a3, a4, a5, t).0,
+        SERIES_T_MIN,
+        spacing,
+        a3,
+        a5,
+    )?;
+    let bounded = |t: f64| {
+        let (v, rounding) = small_angle::normalised_det(a3, a4, a5, t);
+        let bound = (truncation + SMALL_ANGLE_ROUNDING) * v.abs().max(1.0) + rounding;
+        (v, bound)
+    };
+    let report = certified_verdict(s, &bounded, (SERIES_T_MIN, spacing, a3, a5));
     Ok((!report.uncertain).then_some(report))
 }
 
@@ -1001,7 +1021,8 @@ mod tests {
                 if e.is_nan() || e > 1e-9 * g.abs() {
                     continue;
                 }
-                let dev = (g - small_angle::normalised_det(a3, a4, a5, t)).abs() / g.abs().max(1.0);
+                let dev =
+                    (g - small_angle::normalised_det(a3, a4, a5, t).0).abs() / g.abs().max(1.0);
                 let bound = SMALL_ANGLE_TRUNCATION_C * theta * theta + SMALL_ANGLE_ROUNDING;
                 assert!(
                     dev <= bound,
@@ -1020,9 +1041,35 @@ mod tests {
         assert!(worst_rounding <= 5e-12, "{worst_rounding}");
     }
 
+    /// Under tension a nearly straight rod is stable (the straight rod is, and stability is
+    /// open): wherever [`small_angle_report`] answers on tensioned rods up to a4 = 1e4 with
+    /// bending down to 1e-300, it says stable with a positive margin. Under a strong tension
+    /// g₀'s determinant cancels by e^{2√a4}: without its rounding bound it called
+    /// (1e-22, 1433.68, 1e-23) unstable with a certain verdict and margin −2.2e39.
+    #[test]
+    fn small_angle_never_calls_a_tensioned_rod_unstable() {
+        let mut r = SplitMix64::new(8);
+        let mut answered = 0;
+        let quoted = PlanarParams::new(1e-22, 1433.68, 1e-23);
+        let rods = (0..4000).map(|_| {
+            let a4 = 10f64.powf(r.range(0.0, 4.0));
+            let sigma = 10f64.powf(r.range(-300.0, -3.0));
+            PlanarParams::new(sigma * r.range(-1.0, 1.0), a4, sigma * r.range(-1.0, 1.0))
+        });
+        for a in std::iter::once(quoted).chain(rods) {
+            if let Some(s) = small_angle_report(&a).unwrap() {
+                answered += 1;
+                assert!(s.stable && s.margin > 0.0, "{a:?}: {s:?}");
+            }
+        }
+        assert!(answered > 1000, "{answered}");
+    }
+
     /// Where [`small_angle_report`] answers, it gives the series scan's verdict, first
-    /// conjugate point and margin (to 1e-6: both refine the same minimum from slightly
-    /// different samples), on the sample above; and it answers most of it.
+    /// conjugate point (to 1e-5) and margin (to 2e-6 relative: its truncation bound is ≤ 1e-6,
+    /// and both refine the same minimum from slightly different samples), on the sample above
+    /// (tension up to a4 = 289, where the f64 series is the reference); and it answers most of
+    /// it.
     #[test]
     fn small_angle_report_matches_the_series_scan() {
         let mut r = SplitMix64::new(6);
@@ -1031,6 +1078,11 @@ mod tests {
             let Some(a) = nearly_straight_sample(&mut r, i) else {
                 continue;
             };
+            // The f64 series is the reference up to √a4 = 17 under tension (beyond, its
+            // rounding grows like ε·e^{√a4}).
+            if a[1] > 289.0 {
+                continue;
+            }
             let Ok(rod) = crate::planar::series_dual(&a, true) else {
                 continue;
             };
@@ -1044,7 +1096,7 @@ mod tests {
             let slow = scan_series(&rod, a[0], a[2], spacing, None).unwrap();
             assert!(!slow.uncertain, "{a:?}: {slow:?}");
             assert_eq!(fast.stable, slow.stable, "{a:?}: {fast:?} vs {slow:?}");
-            let tol = 1e-6 * slow.margin.abs().max(1.0);
+            let tol = 2e-6 * slow.margin.abs().max(1.0);
             assert!(
                 (fast.margin - slow.margin).abs() <= tol,
                 "{a:?}: {fast:?} vs {slow:?}"
@@ -1053,7 +1105,7 @@ mod tests {
                 (None, None) => {}
                 (Some(f), Some(s)) => {
                     unstable += 1;
-                    assert!((f - s).abs() <= 1e-6, "{a:?}: {fast:?} vs {slow:?}")
+                    assert!((f - s).abs() <= 1e-5, "{a:?}: {fast:?} vs {slow:?}")
                 }
                 _ => panic!("{a:?}: {fast:?} vs {slow:?}"),
             }
