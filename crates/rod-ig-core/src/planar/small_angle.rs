@@ -21,7 +21,130 @@
 //! The neglected terms are O(Θ²) relative, Θ the largest bending angle (measured bound in
 //! [`truncation`]).
 
-use crate::scalar::{Dual3, Real};
+/// A value and its derivative with respect to a4 (a one-variable dual number: the straight
+/// rod's functions need no other derivative, and Horner's rule in it costs a third of
+/// [`crate::scalar::Dual3`]'s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Jet {
+    v: f64,
+    d: f64,
+}
+
+impl Jet {
+    const fn constant(v: f64) -> Self {
+        Self { v, d: 0.0 }
+    }
+
+    fn sqrt(self) -> Self {
+        let r = self.v.sqrt();
+        Self {
+            v: r,
+            d: 0.5 * self.d / r,
+        }
+    }
+
+    fn abs(self) -> Self {
+        if self.v < 0.0 {
+            Self {
+                v: -self.v,
+                d: -self.d,
+            }
+        } else {
+            self
+        }
+    }
+
+    /// (sinh, cosh) or (sin, cos) of self, by `hyperbolic`.
+    fn sin_cos(self, hyperbolic: bool) -> (Self, Self) {
+        let (s, c) = if hyperbolic {
+            (self.v.sinh(), self.v.cosh())
+        } else {
+            self.v.sin_cos()
+        };
+        let sign = if hyperbolic { 1.0 } else { -1.0 };
+        (
+            Self {
+                v: s,
+                d: c * self.d,
+            },
+            Self {
+                v: c,
+                d: sign * s * self.d,
+            },
+        )
+    }
+}
+
+impl std::ops::Add for Jet {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        Self {
+            v: self.v + o.v,
+            d: self.d + o.d,
+        }
+    }
+}
+
+impl std::ops::Sub for Jet {
+    type Output = Self;
+    fn sub(self, o: Self) -> Self {
+        Self {
+            v: self.v - o.v,
+            d: self.d - o.d,
+        }
+    }
+}
+
+impl std::ops::Mul for Jet {
+    type Output = Self;
+    fn mul(self, o: Self) -> Self {
+        Self {
+            v: self.v * o.v,
+            d: self.v * o.d + self.d * o.v,
+        }
+    }
+}
+
+impl std::ops::Div for Jet {
+    type Output = Self;
+    fn div(self, o: Self) -> Self {
+        let q = self.v / o.v;
+        Self {
+            v: q,
+            d: (self.d - q * o.d) / o.v,
+        }
+    }
+}
+
+impl std::ops::Add<f64> for Jet {
+    type Output = Self;
+    fn add(self, o: f64) -> Self {
+        Self {
+            v: self.v + o,
+            d: self.d,
+        }
+    }
+}
+
+impl std::ops::Sub<f64> for Jet {
+    type Output = Self;
+    fn sub(self, o: f64) -> Self {
+        Self {
+            v: self.v - o,
+            d: self.d,
+        }
+    }
+}
+
+impl std::ops::Mul<f64> for Jet {
+    type Output = Self;
+    fn mul(self, o: f64) -> Self {
+        Self {
+            v: self.v * o,
+            d: self.d * o,
+        }
+    }
+}
 
 /// Terms of the Maclaurin series in z = a4 t² (|z| < [`SERIES_MAX_Z`]): the first neglected
 /// term is below 16²⁰/40! ≈ 1.5e-24 of the sum.
@@ -81,17 +204,17 @@ const I12: [f64; TERMS] = i_coefficients(1, 2);
 const I22: [f64; TERMS] = i_coefficients(2, 2);
 
 /// Σ cₖ zᵏ by Horner's rule.
-fn horner(c: &[f64; TERMS], z: Dual3) -> Dual3 {
-    let mut acc = Dual3::constant(c[TERMS - 1]);
+fn horner(c: &[f64; TERMS], z: Jet) -> Jet {
+    let mut acc = Jet::constant(c[TERMS - 1]);
     for &ck in c[..TERMS - 1].iter().rev() {
         acc = acc * z + ck;
     }
     acc
 }
 
-/// The straight rod's functions at t and their a4-derivatives (slot 0 of each [`Dual3`]):
+/// The straight rod's functions at t and their a4-derivatives:
 /// [S1, S2, S3, I11, I12, I22] (module docs).
-fn straight_jets(a4: f64, t: f64) -> [Dual3; 6] {
+fn straight_jets(a4: f64, t: f64) -> [Jet; 6] {
     if (a4 * t * t).abs() < SERIES_MAX_Z {
         series_jets(a4, t)
     } else {
@@ -100,8 +223,8 @@ fn straight_jets(a4: f64, t: f64) -> [Dual3; 6] {
 }
 
 /// [`straight_jets`] by the Maclaurin series in z = a4 t².
-fn series_jets(a4: f64, t: f64) -> [Dual3; 6] {
-    let z = Dual3::variable(a4, 0) * (t * t);
+fn series_jets(a4: f64, t: f64) -> [Jet; 6] {
+    let z = Jet { v: a4, d: 1.0 } * (t * t);
     let (t2, t3) = (t * t, t * t * t);
     [
         horner(&S1, z) * t,
@@ -114,18 +237,14 @@ fn series_jets(a4: f64, t: f64) -> [Dual3; 6] {
 }
 
 /// [`straight_jets`] by the hyperbolic (a4 > 0) or trigonometric (a4 < 0) closed forms.
-fn closed_jets(a4: f64, t: f64) -> [Dual3; 6] {
-    let f = Dual3::variable(a4, 0);
+fn closed_jets(a4: f64, t: f64) -> [Jet; 6] {
+    let f = Jet { v: a4, d: 1.0 };
     // a4 = ±w²: (s, c) = (sinh, cosh)(wt) or (sin, cos)(wt); the same formulas hold in both
     // cases when written with a4 itself (I12 differs in the sign of its s² term).
     let w = f.abs().sqrt();
     let wt = w * t;
-    let (s, c, s2_sign) = if a4 > 0.0 {
-        (wt.sinh(), wt.cosh(), 1.0)
-    } else {
-        let (s, c) = wt.sin_cos();
-        (s, c, -1.0)
-    };
+    let (s, c) = wt.sin_cos(a4 > 0.0);
+    let s2_sign = if a4 > 0.0 { 1.0 } else { -1.0 };
     let wf = w * f;
     let ff = f * f;
     [
@@ -153,7 +272,7 @@ pub(crate) fn normalised_det(a3: f64, a4: f64, a5: f64, t: f64) -> (f64, f64) {
     let sigma = a3.abs().max(a5.abs());
     let (u3, u5) = (a3 / sigma, a5 / sigma);
     let [s1, s2, s3, i11, i12, i22] = straight_jets(a4, t);
-    let d = |v: Dual3| v.g[0];
+    let d = |v: Jet| v.d;
     // Rows (x, y, θ), columns (a3, a4, a5); the x row and the a4 column divided by σ. `size`
     // holds each entry's sum of absolute terms.
     let (p3, p5) = (u3.abs(), u5.abs());
@@ -212,7 +331,7 @@ pub(crate) struct Linearised {
 /// cancel where the terms of a3 and a5 nearly balance).
 pub(crate) fn pose_and_jacobian(a3: f64, a4: f64, a5: f64, t: f64) -> Linearised {
     let [s1, s2, s3, i11, i12, i22] = straight_jets(a4, t);
-    let d = |v: Dual3| v.g[0];
+    let d = |v: Jet| v.d;
     let (p3, p5) = (a3.abs(), a5.abs());
     let theta = a3 * s1.v - a5 * s2.v;
     let y = a3 * s2.v - a5 * s3.v;
@@ -258,7 +377,7 @@ pub(crate) fn pose_and_jacobian(a3: f64, a4: f64, a5: f64, t: f64) -> Linearised
 /// relative rounding ([`ENTRY_ULPS`] ulps of its terms).
 pub(crate) fn energy(a3: f64, a4: f64, a5: f64) -> (f64, f64) {
     let [i00, i01, i11] = if a4.abs() < SERIES_MAX_Z {
-        let z = Dual3::constant(a4);
+        let z = Jet::constant(a4);
         [horner(&I00, z).v, horner(&I01, z).v, horner(&I11, z).v]
     } else {
         let w = a4.abs().sqrt();
@@ -356,10 +475,7 @@ mod tests {
                 for (s, c) in series.iter().zip(&closed) {
                     let tol = 200.0 * f64::EPSILON;
                     assert!((s.v - c.v).abs() <= tol * c.v.abs(), "{a4}: {s:?} vs {c:?}");
-                    assert!(
-                        (s.g[0] - c.g[0]).abs() <= tol * c.g[0].abs(),
-                        "{a4}: {s:?} vs {c:?}"
-                    );
+                    assert!((s.d - c.d).abs() <= tol * c.d.abs(), "{a4}: {s:?} vs {c:?}");
                 }
             }
         }
