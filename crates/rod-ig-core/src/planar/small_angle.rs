@@ -448,10 +448,14 @@ pub(crate) fn energy_rel_error(a3: f64, a4: f64, a5: f64) -> f64 {
 
 /// Largest bending angle Θ of the linearised rod over [0, 1] (bounded above): |θ| ≤ |a3| S1 +
 /// |a5| S2 with S1, S2 ≥ 0 increasing under tension; under compression |S1| ≤ min(t, 1/w) and
-/// |S2| ≤ min(t²/2, 2/w²).
+/// |S2| ≤ min(t²/2, 2/w²). Infinite (beyond the expansion) when already |a3| + |a5|/2 > 0.01
+/// under tension (S1 ≥ 1, S2 ≥ ½), so that a bent rod pays no more than that test.
 pub(crate) fn max_angle(a3: f64, a4: f64, a5: f64) -> f64 {
-    let [s1, s2, ..] = straight_jets(a4, 1.0);
     if a4 >= 0.0 {
+        if a3.abs() + 0.5 * a5.abs() > 0.01 {
+            return f64::INFINITY;
+        }
+        let [s1, s2, ..] = straight_jets(a4, 1.0);
         a3.abs() * s1.v + a5.abs() * s2.v
     } else {
         let w = (-a4).sqrt();
