@@ -746,10 +746,15 @@ pub type Evaluation = crate::solver::ModelEvaluation<3, PlanarPose>;
 
 /// [`evaluate`] on the Taylor series (one dense integration serves all four quantities).
 fn evaluate_series(a: &PlanarParams) -> Result<Evaluation, RodError> {
-    let rod = series_dual(a, true)?;
+    // Where the small-angle limit decides stability, the scan needs no dense output.
+    let small_angle = stability::small_angle_report(a)?;
+    let rod = series_dual(a, small_angle.is_none())?;
     let (tip, jacobian) = pose_jac_from(rod.tip())?;
     let energy = rod.energy().v;
-    let stability = stability::stability_of_series(a, Some(&rod), None, None)?;
+    let stability = match small_angle {
+        Some(report) => report,
+        None => stability::stability_of_dense_series(a, &rod)?,
+    };
     Ok(Evaluation {
         tip,
         jacobian,
