@@ -257,6 +257,34 @@ fn closed_jets(a4: f64, t: f64) -> [Jet; 6] {
     ]
 }
 
+/// J(t) of the linearised rod from the straight rod's functions at t, with (b3, b5) in place
+/// of (a3, a5) (the bending itself, or its direction (a3, a5)/σ, which scales the x row and
+/// the a4 column by 1/σ), and each entry's sum of absolute terms (its rounding is a few ulps
+/// of that). Rows (x, y, θ), columns (a3, a4, a5).
+fn jacobian_and_sizes(b3: f64, b5: f64, jets: &[Jet; 6]) -> ([[f64; 3]; 3], [[f64; 3]; 3]) {
+    let [s1, s2, s3, i11, i12, i22] = *jets;
+    let (p3, p5) = (b3.abs(), b5.abs());
+    let j = [
+        [
+            -(b3 * i11.v - b5 * i12.v),
+            -0.5 * (b3 * b3 * i11.d - 2.0 * b3 * b5 * i12.d + b5 * b5 * i22.d),
+            b3 * i12.v - b5 * i22.v,
+        ],
+        [s2.v, b3 * s2.d - b5 * s3.d, -s3.v],
+        [s1.v, b3 * s1.d - b5 * s2.d, -s2.v],
+    ];
+    let size = [
+        [
+            p3 * i11.v.abs() + p5 * i12.v.abs(),
+            0.5 * (p3 * p3 * i11.d.abs() + 2.0 * p3 * p5 * i12.d.abs() + p5 * p5 * i22.d.abs()),
+            p3 * i12.v.abs() + p5 * i22.v.abs(),
+        ],
+        [s2.v.abs(), p3 * s2.d.abs() + p5 * s3.d.abs(), s3.v.abs()],
+        [s1.v.abs(), p3 * s1.d.abs() + p5 * s2.d.abs(), s2.v.abs()],
+    ];
+    (j, size)
+}
+
 /// Rounding of the straight rod's functions and of the combinations that make J's entries, in
 /// ulps of the sum of the combinations' absolute terms (the closed forms lose ≲ 20 ulps where
 /// they meet the series, `series_and_closed_forms_agree`; ×3).
@@ -271,29 +299,8 @@ const ENTRY_ULPS: f64 = 64.0;
 pub(crate) fn normalised_det(a3: f64, a4: f64, a5: f64, t: f64) -> (f64, f64) {
     let sigma = a3.abs().max(a5.abs());
     let (u3, u5) = (a3 / sigma, a5 / sigma);
-    let [s1, s2, s3, i11, i12, i22] = straight_jets(a4, t);
-    let d = |v: Jet| v.d;
-    // Rows (x, y, θ), columns (a3, a4, a5); the x row and the a4 column divided by σ. `size`
-    // holds each entry's sum of absolute terms.
-    let (p3, p5) = (u3.abs(), u5.abs());
-    let j = [
-        [
-            -(u3 * i11.v - u5 * i12.v),
-            -0.5 * (u3 * u3 * d(i11) - 2.0 * u3 * u5 * d(i12) + u5 * u5 * d(i22)),
-            u3 * i12.v - u5 * i22.v,
-        ],
-        [s2.v, u3 * d(s2) - u5 * d(s3), -s3.v],
-        [s1.v, u3 * d(s1) - u5 * d(s2), -s2.v],
-    ];
-    let size = [
-        [
-            p3 * i11.v.abs() + p5 * i12.v.abs(),
-            0.5 * (p3 * p3 * d(i11).abs() + 2.0 * p3 * p5 * d(i12).abs() + p5 * p5 * d(i22).abs()),
-            p3 * i12.v.abs() + p5 * i22.v.abs(),
-        ],
-        [s2.v.abs(), p3 * d(s2).abs() + p5 * d(s3).abs(), s3.v.abs()],
-        [s1.v.abs(), p3 * d(s1).abs() + p5 * d(s2).abs(), s2.v.abs()],
-    ];
+    // The x row and the a4 column divided by σ.
+    let (j, size) = jacobian_and_sizes(u3, u5, &straight_jets(a4, t));
     let mut det = 0.0;
     let mut err = 0.0;
     for c in 0..3 {
@@ -330,34 +337,15 @@ pub(crate) struct Linearised {
 /// absolute in x); rounding bounded by [`ENTRY_ULPS`] ulps of each combination's terms (they
 /// cancel where the terms of a3 and a5 nearly balance).
 pub(crate) fn pose_and_jacobian(a3: f64, a4: f64, a5: f64, t: f64) -> Linearised {
-    let [s1, s2, s3, i11, i12, i22] = straight_jets(a4, t);
-    let d = |v: Jet| v.d;
+    let jets = straight_jets(a4, t);
+    let [s1, s2, s3, i11, i12, i22] = jets;
     let (p3, p5) = (a3.abs(), a5.abs());
     let theta = a3 * s1.v - a5 * s2.v;
     let y = a3 * s2.v - a5 * s3.v;
     let half_q = 0.5 * (a3 * a3 * i11.v - 2.0 * a3 * a5 * i12.v + a5 * a5 * i22.v);
     let half_q_size =
         0.5 * (p3 * p3 * i11.v.abs() + 2.0 * p3 * p5 * i12.v.abs() + p5 * p5 * i22.v.abs());
-    let jacobian = [
-        [
-            -(a3 * i11.v - a5 * i12.v),
-            -0.5 * (a3 * a3 * d(i11) - 2.0 * a3 * a5 * d(i12) + a5 * a5 * d(i22)),
-            a3 * i12.v - a5 * i22.v,
-        ],
-        [s2.v, a3 * d(s2) - a5 * d(s3), -s3.v],
-        [s1.v, a3 * d(s1) - a5 * d(s2), -s2.v],
-    ];
-    let size = [
-        p3 * i11.v.abs() + p5 * i12.v.abs(),
-        0.5 * (p3 * p3 * d(i11).abs() + 2.0 * p3 * p5 * d(i12).abs() + p5 * p5 * d(i22).abs()),
-        p3 * i12.v.abs() + p5 * i22.v.abs(),
-        s2.v.abs(),
-        p3 * d(s2).abs() + p5 * d(s3).abs(),
-        s3.v.abs(),
-        s1.v.abs(),
-        p3 * d(s1).abs() + p5 * d(s2).abs(),
-        s2.v.abs(),
-    ];
+    let (jacobian, size) = jacobian_and_sizes(a3, a5, &jets);
     let norm = |v: &mut dyn Iterator<Item = f64>| v.map(|e| e * e).sum::<f64>().sqrt();
     let ulp = ENTRY_ULPS * f64::EPSILON;
     let pose_size = (p3 * s1.v.abs() + p5 * s2.v.abs())
@@ -367,7 +355,7 @@ pub(crate) fn pose_and_jacobian(a3: f64, a4: f64, a5: f64, t: f64) -> Linearised
         pose: [t - half_q, y, theta],
         jacobian,
         pose_rounding: ulp * pose_size,
-        jacobian_rounding: ulp * norm(&mut size.into_iter())
+        jacobian_rounding: ulp * norm(&mut size.into_iter().flatten())
             / norm(&mut jacobian.into_iter().flatten()),
     }
 }
@@ -464,8 +452,31 @@ pub(crate) fn max_angle(a3: f64, a4: f64, a5: f64) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+    use crate::rng::SplitMix64;
+    use crate::PlanarParams;
+
+    /// Nearly straight rods the way users give them: a4 log-scale 1e-6..1e4 of either sign
+    /// and exact 0, a3 and a5 log-scale 1e-20..0.1 and exact zeros.
+    pub(crate) fn nearly_straight_sample(r: &mut SplitMix64, i: usize) -> Option<PlanarParams> {
+        let a4 = if i.is_multiple_of(11) {
+            0.0
+        } else {
+            r.signed_pow10(-6.0, 4.0)
+        };
+        let a3 = if i.is_multiple_of(7) {
+            0.0
+        } else {
+            r.signed_pow10(-20.0, -1.0)
+        };
+        let a5 = if i.is_multiple_of(5) {
+            0.0
+        } else {
+            r.signed_pow10(-20.0, -1.0)
+        };
+        (a3 != 0.0 || a5 != 0.0).then(|| PlanarParams::new(a3, a4, a5))
+    }
 
     /// The series and closed-form branches of the straight rod's functions agree where they
     /// meet (|z| = 4) and beyond (the series converges for every z), values and

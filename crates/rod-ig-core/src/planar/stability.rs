@@ -985,26 +985,7 @@ mod tests {
     use super::*;
     use crate::rng::SplitMix64;
 
-    /// Nearly straight rods the way users give them: a4 log-scale 1e-6..1e4 of either sign
-    /// and exact 0, a3 and a5 log-scale 1e-20..0.1 and exact zeros.
-    fn nearly_straight_sample(r: &mut SplitMix64, i: usize) -> Option<PlanarParams> {
-        let a4 = if i.is_multiple_of(11) {
-            0.0
-        } else {
-            r.signed_pow10(-6.0, 4.0)
-        };
-        let a3 = if i.is_multiple_of(7) {
-            0.0
-        } else {
-            r.signed_pow10(-20.0, -1.0)
-        };
-        let a5 = if i.is_multiple_of(5) {
-            0.0
-        } else {
-            r.signed_pow10(-20.0, -1.0)
-        };
-        (a3 != 0.0 || a5 != 0.0).then(|| PlanarParams::new(a3, a4, a5))
-    }
+    use crate::planar::small_angle::tests::nearly_straight_sample;
 
     /// The small-angle g₀ against g on the dual-number Taylor series (an independent
     /// computation of the full nonlinear rod, entries accurate to 1e-14 relative): on 6,000
