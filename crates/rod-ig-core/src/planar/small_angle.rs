@@ -222,6 +222,12 @@ fn straight_jets(a4: f64, t: f64) -> [Jet; 6] {
     }
 }
 
+/// [S1, S2, S3, I11, I12, I22] of the straight rod under a4 at t (module docs), values only
+/// (also the small-angle starts of the inverse geometry, `ig/straight.rs`).
+pub(crate) fn straight_functions(a4: f64, t: f64) -> [f64; 6] {
+    straight_jets(a4, t).map(|j| j.v)
+}
+
 /// [`straight_jets`] by the Maclaurin series in z = a4 t².
 fn series_jets(a4: f64, t: f64) -> [Jet; 6] {
     let z = Jet { v: a4, d: 1.0 } * (t * t);

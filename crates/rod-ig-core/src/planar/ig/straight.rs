@@ -17,6 +17,7 @@
 //! bounded exponentials e^{k(t−1)}, e^{−kt} (`Basis::fit_exponential`): sinh and cosh would
 //! cancel terms of size e^{2k}.
 
+use crate::planar::small_angle;
 use crate::{wrap_angle, PlanarParams, PlanarPose};
 use std::sync::OnceLock;
 
@@ -37,64 +38,18 @@ struct Basis {
     int_cc: f64,
 }
 
-/// Terms of the power series in T of the coefficients (|T| ≤ [`SERIES_BELOW`]: the n-th term
-/// is below 4ⁿ/(2n)!, < 1e-17 of the first beyond n = 16).
-const SERIES_TERMS: usize = 18;
-
-/// Below this |T| the coefficients come from their power series in T; above it from their
-/// closed forms in sinh/cosh or sin/cos, whose cancellation costs at most ~1.5 digits at k = 2.
+/// Beyond this tension the fit works in bounded exponentials ([`Basis::fit_exponential`]): in
+/// sinh/cosh it cancels terms of size e^{2k}.
 const SERIES_BELOW: f64 = 4.0;
 
-/// Power-series coefficients (in T) of [S1, C1, ∫S, ∫C, ∫S², ∫SC, ∫C²]. With
-/// S(t) = Σ Tⁿ t^{2n+1}/(2n+1)! and C(t) = Σ Tⁿ t^{2n+2}/(2n+2)!, a product of two terms
-/// Tⁿ t^p and Tᵐ t^q integrates to T^{n+m}/(p + q + 1).
-fn series() -> &'static [[f64; SERIES_TERMS]; 7] {
-    static SERIES: OnceLock<[[f64; SERIES_TERMS]; 7]> = OnceLock::new();
-    SERIES.get_or_init(|| {
-        let mut fact = [1.0f64; 2 * SERIES_TERMS + 4];
-        for i in 1..fact.len() {
-            fact[i] = fact[i - 1] * i as f64;
-        }
-        let mut c = [[0.0; SERIES_TERMS]; 7];
-        for n in 0..SERIES_TERMS {
-            c[0][n] = 1.0 / fact[2 * n + 1];
-            c[1][n] = 1.0 / fact[2 * n + 2];
-            c[2][n] = 1.0 / fact[2 * n + 2];
-            c[3][n] = 1.0 / fact[2 * n + 3];
-            for i in 0..=n {
-                let j = n - i;
-                c[4][n] += 1.0 / (fact[2 * i + 1] * fact[2 * j + 1]) / (2 * n + 3) as f64;
-                c[5][n] += 1.0 / (fact[2 * i + 1] * fact[2 * j + 2]) / (2 * n + 4) as f64;
-                c[6][n] += 1.0 / (fact[2 * i + 2] * fact[2 * j + 2]) / (2 * n + 5) as f64;
-            }
-        }
-        c
-    })
-}
-
 impl Basis {
-    /// The coefficients at T = `t` (series or closed form).
+    /// The coefficients at T = `t` (the straight rod's functions of [`small_angle`]).
     fn at(t: f64) -> Basis {
-        if t.abs() <= SERIES_BELOW {
-            let v = series().map(|c| c.iter().rev().fold(0.0, |acc, &cn| acc * t + cn));
-            return Basis {
-                t,
-                exponential: None,
-                s1: v[0],
-                c1: v[1],
-                int_s: v[2],
-                int_c: v[3],
-                int_ss: v[4],
-                int_sc: v[5],
-                int_cc: v[6],
-            };
-        }
-        let k = t.abs().sqrt();
-        let (k2, k3, k4) = (k * k, k * k * k, k * k * k * k);
-        if t > 0.0 {
+        if t > SERIES_BELOW {
             // sinh and cosh grow like e^k while the answer is O(1): the fit works in bounded
             // exponentials instead, and these coefficients are not used.
-            Basis {
+            let k = t.sqrt();
+            return Basis {
                 t,
                 exponential: Some((k, (-k).exp())),
                 s1: f64::NAN,
@@ -104,20 +59,20 @@ impl Basis {
                 int_ss: f64::NAN,
                 int_sc: f64::NAN,
                 int_cc: f64::NAN,
-            }
-        } else {
-            let (sn, cs, sn2) = (k.sin(), k.cos(), (2.0 * k).sin());
-            Basis {
-                t,
-                exponential: None,
-                s1: sn / k,
-                c1: (1.0 - cs) / k2,
-                int_s: (1.0 - cs) / k2,
-                int_c: (k - sn) / k3,
-                int_ss: (0.5 - sn2 / (4.0 * k)) / k2,
-                int_sc: ((1.0 - cs) / k - sn * sn / (2.0 * k)) / k3,
-                int_cc: (1.5 - 2.0 * sn / k + sn2 / (4.0 * k)) / k4,
-            }
+            };
+        }
+        // S = S1, C = S2 = ∫S, ∫C = S3 and the Iij of the small-angle expansion, at t = 1.
+        let [s1, s2, s3, i11, i12, i22] = small_angle::straight_functions(t, 1.0);
+        Basis {
+            t,
+            exponential: None,
+            s1,
+            c1: s2,
+            int_s: s2,
+            int_c: s3,
+            int_ss: i11,
+            int_sc: i12,
+            int_cc: i22,
         }
     }
 
