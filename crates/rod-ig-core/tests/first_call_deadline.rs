@@ -1,6 +1,11 @@
 //! Deadlines hold from a process's first call (issue 24): the atlas of stable rods, built on
 //! first use, is charged to the calls that need it, in pieces that poll their deadline. This
 //! binary holds one test so that nothing else builds the atlas first.
+//!
+//! Each attempt runs in a fresh process (the test re-runs its own binary), and the test passes
+//! when one of [`ATTEMPTS`] does: on a shared virtual machine a pause of the whole VM can
+//! exceed the 10 ms slack once in a while (measured: pieces of 0.6 ms that took 10–12 ms in
+//! one run in three), while a call that does not poll its deadline overruns on every attempt.
 
 use rod_ig_core::plan::{PlanError, PlanRequest, Planner};
 use rod_ig_core::planar::ig::{self, SolveOptions, Termination};
@@ -20,8 +25,39 @@ fn check(what: &str, deadline: Duration, took: Duration) {
     );
 }
 
+/// Fresh processes tried before the test fails (see the module docs).
+const ATTEMPTS: usize = 3;
+/// Set in the child processes: they run the checks themselves.
+const CHILD: &str = "ROD_IG_FIRST_CALL_CHILD";
+
 #[test]
 fn first_calls_answer_within_their_deadline() {
+    if std::env::var_os(CHILD).is_some() {
+        first_calls();
+        return;
+    }
+    let exe = std::env::current_exe().expect("test binary");
+    let mut failures = Vec::new();
+    for _ in 0..ATTEMPTS {
+        let out = std::process::Command::new(&exe)
+            .args([
+                "first_calls_answer_within_their_deadline",
+                "--exact",
+                "--test-threads=1",
+            ])
+            .env(CHILD, "1")
+            .output()
+            .expect("re-run of the test binary");
+        if out.status.success() {
+            return;
+        }
+        failures.push(String::from_utf8_lossy(&out.stdout).into_owned());
+    }
+    panic!("every attempt overran:\n{}", failures.join("\n"));
+}
+
+/// A process's first calls, each within its deadline plus the slack.
+fn first_calls() {
     let target = PlanarPose::new(0.9, 0.1, 3.0);
     for ms in [1u64, 10, 100] {
         let deadline = Duration::from_millis(ms);
