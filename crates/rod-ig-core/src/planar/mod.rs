@@ -534,9 +534,19 @@ const SMALL_ANGLE_TIP_TOLERANCE: f64 = 1e-13;
 /// [`SMALL_ANGLE_TIP_TOLERANCE`]); None elsewhere. It replaces the series where the closed
 /// form's x row (O(σ), O(σ²)) is swamped by rounding.
 fn small_angle_pose_and_jac(a: &PlanarParams, t: f64) -> Option<(PlanarPose, PlanarJacobian)> {
+    small_angle_pose_and_jac_at(a, t, small_angle::effective_angle(a[0], a[1], a[2]))
+}
+
+/// [`small_angle_pose_and_jac`] for the rod's effective angle `th`
+/// ([`small_angle::effective_angle`], computed once by callers that need several answers).
+fn small_angle_pose_and_jac_at(
+    a: &PlanarParams,
+    t: f64,
+    th: f64,
+) -> Option<(PlanarPose, PlanarJacobian)> {
     let (a3, a4, a5) = (a[0], a[1], a[2]);
-    let j_truncation = small_angle::jacobian_rel_error(a3, a4, a5);
-    let tip_truncation = small_angle::tip_abs_error(a3, a4, a5);
+    let j_truncation = small_angle::jacobian_rel_error(th);
+    let tip_truncation = small_angle::tip_abs_error(th);
     if j_truncation > CLOSED_J_TOLERANCE || tip_truncation > SMALL_ANGLE_TIP_TOLERANCE {
         return None;
     }
@@ -546,8 +556,8 @@ fn small_angle_pose_and_jac(a: &PlanarParams, t: f64) -> Option<(PlanarPose, Pla
     {
         return None;
     }
-    let [x, y, th] = lin.pose;
-    let pose = PlanarPose::new(x, y, th);
+    let [x, y, theta] = lin.pose;
+    let pose = PlanarPose::new(x, y, theta);
     let j = PlanarJacobian::from_row_slice(&lin.jacobian.concat());
     (pose.is_finite() && j.iter().all(|v| v.is_finite())).then_some((pose, j))
 }
@@ -556,7 +566,7 @@ fn small_angle_pose_and_jac(a: &PlanarParams, t: f64) -> Option<(PlanarPose, Pla
 /// [`SMALL_ANGLE_TIP_TOLERANCE`].
 fn small_angle_tip(a: &PlanarParams) -> Option<[f64; 3]> {
     let (a3, a4, a5) = (a[0], a[1], a[2]);
-    let truncation = small_angle::tip_abs_error(a3, a4, a5);
+    let truncation = small_angle::tip_abs_error(small_angle::effective_angle(a3, a4, a5));
     if truncation > SMALL_ANGLE_TIP_TOLERANCE {
         return None;
     }
@@ -569,12 +579,16 @@ fn small_angle_tip(a: &PlanarParams) -> Option<[f64; 3]> {
 /// ½∫κ² of a nearly straight rod from the small-angle expansion, where its bound is within
 /// [`ENERGY_REL_TOLERANCE`].
 fn small_angle_energy(a: &PlanarParams) -> Option<f64> {
-    let (a3, a4, a5) = (a[0], a[1], a[2]);
-    let truncation = small_angle::energy_rel_error(a3, a4, a5);
+    small_angle_energy_at(a, small_angle::effective_angle(a[0], a[1], a[2]))
+}
+
+/// [`small_angle_energy`] for the rod's effective angle `th`.
+fn small_angle_energy_at(a: &PlanarParams, th: f64) -> Option<f64> {
+    let truncation = small_angle::energy_rel_error(th);
     if truncation > ENERGY_REL_TOLERANCE {
         return None;
     }
-    let (e, rounding) = small_angle::energy(a3, a4, a5);
+    let (e, rounding) = small_angle::energy(a[0], a[1], a[2]);
     (truncation + rounding <= ENERGY_REL_TOLERANCE && e.is_finite()).then_some(e)
 }
 
@@ -767,10 +781,11 @@ fn evaluate_series(a: &PlanarParams) -> Result<Evaluation, RodError> {
 /// [`evaluate`] of a nearly straight rod by the small-angle expansion, where every part of it
 /// is within its tolerance; None elsewhere.
 fn evaluate_small_angle(a: &PlanarParams) -> Result<Option<Evaluation>, RodError> {
-    let Some((tip, jacobian)) = small_angle_pose_and_jac(a, 1.0) else {
+    let th = small_angle::effective_angle(a[0], a[1], a[2]);
+    let Some((tip, jacobian)) = small_angle_pose_and_jac_at(a, 1.0, th) else {
         return Ok(None);
     };
-    let Some(energy) = small_angle_energy(a) else {
+    let Some(energy) = small_angle_energy_at(a, th) else {
         return Ok(None);
     };
     let Some(stability) = stability::small_angle_report(a)? else {
@@ -909,9 +924,9 @@ mod tests {
                 .max((th - tip.theta).abs());
             let (e, e_rounding) = small_angle::energy(a3, a4, a5);
             let de = ((e - e_ref) / e_ref).abs();
-            let j_bound = small_angle::jacobian_rel_error(a3, a4, a5) + lin.jacobian_rounding;
-            let tip_bound = small_angle::tip_abs_error(a3, a4, a5) + lin.pose_rounding;
-            let e_bound = small_angle::energy_rel_error(a3, a4, a5) + e_rounding;
+            let j_bound = small_angle::jacobian_rel_error(theta) + lin.jacobian_rounding;
+            let tip_bound = small_angle::tip_abs_error(theta) + lin.pose_rounding;
+            let e_bound = small_angle::energy_rel_error(theta) + e_rounding;
             assert!(dj <= j_bound, "{a:?}: J {dj:e} > {j_bound:e}");
             assert!(dtip <= tip_bound, "{a:?}: tip {dtip:e} > {tip_bound:e}");
             assert!(de <= e_bound, "{a:?}: energy {de:e} > {e_bound:e}");

@@ -419,24 +419,24 @@ pub(crate) fn effective_angle(a3: f64, a4: f64, a5: f64) -> f64 {
 /// series that served as the reference is still accurate).
 const MAX_TENSION: f64 = 729.0;
 
-/// A-priori relative (Frobenius) truncation error of [`pose_and_jacobian`]'s J (add its
+/// A-priori relative (Frobenius) truncation error of [`pose_and_jacobian`]'s J at the
+/// effective angle `th` ([`effective_angle`]; add its
 /// `jacobian_rounding`); infinite beyond the tension where it was measured.
-pub(crate) fn jacobian_rel_error(a3: f64, a4: f64, a5: f64) -> f64 {
-    let th = effective_angle(a3, a4, a5);
+pub(crate) fn jacobian_rel_error(th: f64) -> f64 {
     J_C * th * th + J_ROUNDING
 }
 
-/// A-priori absolute truncation error of [`pose_and_jacobian`]'s pose (in length units of the
+/// A-priori absolute truncation error of [`pose_and_jacobian`]'s pose at the effective angle
+/// `th` (in length units of the
 /// rod and radians; add its `pose_rounding`); infinite beyond the measured tension.
-pub(crate) fn tip_abs_error(a3: f64, a4: f64, a5: f64) -> f64 {
-    let th = effective_angle(a3, a4, a5);
+pub(crate) fn tip_abs_error(th: f64) -> f64 {
     TIP_C * th * th * th + TIP_ROUNDING
 }
 
-/// A-priori relative truncation error of [`energy`] (add its rounding); infinite beyond the
+/// A-priori relative truncation error of [`energy`] at the effective angle `th` (add its
+/// rounding); infinite beyond the
 /// measured tension.
-pub(crate) fn energy_rel_error(a3: f64, a4: f64, a5: f64) -> f64 {
-    let th = effective_angle(a3, a4, a5);
+pub(crate) fn energy_rel_error(th: f64) -> f64 {
     ENERGY_C * th * th + ENERGY_ROUNDING
 }
 
