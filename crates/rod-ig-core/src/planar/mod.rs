@@ -853,7 +853,7 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
                     tip,
                     jacobian,
                     energy: rod.energy().v,
-                    stability: stability::stability_of_series(a, Some(&rod), None, None)?,
+                    stability: stability::stability_of_dense_series(a, &rod)?,
                     full_accuracy: true,
                 });
             }

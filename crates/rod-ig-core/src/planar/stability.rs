@@ -274,10 +274,21 @@ pub(crate) fn stability_of_dense_series(
     a: &PlanarParams,
     rod: &TaylorRod<Dual3>,
 ) -> Result<StabilityReport, RodError> {
+    series_after_small_angle(a, Some(rod), None, None)
+}
+
+/// [`stability_of_series`] for a caller that has already asked [`small_angle_report`] (it
+/// would ask again).
+fn series_after_small_angle(
+    a: &PlanarParams,
+    rod: Option<&TaylorRod<Dual3>>,
+    wavelength: Option<f64>,
+    precise: Option<&Closed<Dual3>>,
+) -> Result<StabilityReport, RodError> {
     if a[0] == 0.0 && a[2] == 0.0 {
         return Ok(straight_report());
     }
-    whole_series_scan(a, Some(rod), None, None)
+    whole_series_scan(a, rod, wavelength, precise)
 }
 
 /// [`stability_of_series`] without the small-angle shortcut: the scan on the whole rod's series.
@@ -430,20 +441,20 @@ pub(crate) fn stability_of(
         if !report.uncertain {
             return Ok(report);
         }
-        return stability_of_series(a, None, Some(c.wavelength()), Some(c));
+        return series_after_small_angle(a, None, Some(c.wavelength()), Some(c));
     }
     if c.det_needs_series() {
         if let Some(report) = small_m_scan(c, a)? {
             return Ok(report);
         }
-        return stability_of_series(a, None, Some(c.wavelength()), None);
+        return series_after_small_angle(a, None, Some(c.wavelength()), None);
     }
     match c.needs_series() {
         SeriesNeed::IllConditioned => {
-            return stability_of_series(a, None, Some(c.wavelength()), Some(c))
+            return series_after_small_angle(a, None, Some(c.wavelength()), Some(c))
         }
         SeriesNeed::Cancellation => {
-            return stability_of_series(a, None, Some(c.wavelength()), None)
+            return series_after_small_angle(a, None, Some(c.wavelength()), None)
         }
         SeriesNeed::None => {}
     }
@@ -451,7 +462,7 @@ pub(crate) fn stability_of(
     if report.uncertain {
         // The closed form cannot decide: its error bound covers the margin. The series'
         // entries are accurate relative to themselves; ask it.
-        return stability_of_series(a, None, Some(c.wavelength()), None);
+        return series_after_small_angle(a, None, Some(c.wavelength()), None);
     }
     Ok(report)
 }
