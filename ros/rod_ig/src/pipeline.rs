@@ -391,6 +391,14 @@ mod tests {
     use crate::convert::yaw_to_quaternion;
     use crate::messages::{Header, Point, Pose, Quaternion, Time};
 
+    /// A processor as the node builds one: the solver's tables first (the node builds them
+    /// before it reads its first target, so that no target pays for them against its
+    /// deadline; built here inside a 250 ms deadline, on a slow machine they were not ready).
+    fn warm_processor(params: &Params) -> Processor {
+        RodSolver::warm_up();
+        Processor::new(params)
+    }
+
     fn target(x: f64, y: f64, yaw: f64, frame: &str) -> PoseStamped {
         PoseStamped {
             header: Header {
@@ -432,7 +440,7 @@ mod tests {
             path_samples: 33,
             ..Params::default()
         };
-        let mut p = Processor::new(&params);
+        let mut p = warm_processor(&params);
         let t = target(1.2, 0.6, 0.5, "left");
         let o = p.process(&t, &params, &Overrides::default());
         assert!(o.solution.success, "{}", o.solution.message);
@@ -448,7 +456,7 @@ mod tests {
     #[test]
     fn warm_started_sequence() {
         let params = Params::default();
-        let mut p = Processor::new(&params);
+        let mut p = warm_processor(&params);
         for i in 0..20 {
             let s = i as f64 / 20.0;
             let t = target(0.8 - 0.2 * s, 0.1 + 0.3 * s, 0.8 * s, "");
@@ -462,7 +470,7 @@ mod tests {
     #[test]
     fn bad_targets_answered_without_path() {
         let params = Params::default();
-        let mut p = Processor::new(&params);
+        let mut p = warm_processor(&params);
         let mut nonfinite = target(0.5, 0.0, 0.0, "");
         nonfinite.pose.position.y = f64::NAN;
         let mut offplane = target(0.5, 0.0, 0.0, "");
@@ -519,7 +527,7 @@ mod tests {
     #[test]
     fn non_planar_target_solved_in_3d_when_enabled() {
         let off = Params::default();
-        let mut p = Processor::new(&off);
+        let mut p = warm_processor(&off);
         let t = tilted_target();
         let o = p.process(&t, &off, &Overrides::default());
         assert!(!o.solution.success && o.path.is_none());
@@ -602,7 +610,7 @@ mod tests {
             publish_marker: false,
             ..Params::default()
         };
-        let mut p = Processor::new(&params);
+        let mut p = warm_processor(&params);
         let o = p.process(&target(0.6, 0.2, 0.1, ""), &params, &Overrides::default());
         assert!(o.path.is_some() && o.marker.is_none());
     }
@@ -649,7 +657,7 @@ mod tests {
             deadline_ms: 20.0,
             ..Params::default()
         };
-        let mut processor = Processor::new(&params);
+        let mut processor = warm_processor(&params);
         let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
         let mut next = move || {
             state ^= state << 13;
