@@ -202,14 +202,15 @@ const FAC_MAX: f64 = 6.0;
 /// `y + h·Σ cᵢ kᵢ` for a fixed list of (coefficient, stage) pairs, expanded inline so that
 /// the component loop vectorises.
 macro_rules! combine {
-    ($y:expr, $h:expr; $(($c:expr, $k:expr)),+ $(,)?) => {{
+    ($out:expr; $y:expr, $h:expr; ($c0:expr, $k0:expr) $(, ($c:expr, $k:expr))* $(,)?) => {{
+        // Written into the stepper's scratch vector: a fresh array per stage cost a zero-fill.
+        let out: &mut [f64; N] = $out;
         let y = $y;
         let h = $h;
-        let mut out = [0.0; N];
         for i in 0..N {
-            out[i] = y[i] + h * (0.0 $(+ $c * $k[i])+);
+            out[i] = y[i] + h * ($c0 * $k0[i] $(+ $c * $k[i])*);
         }
-        out
+        &*out
     }};
 }
 
@@ -258,7 +259,14 @@ pub struct Dop853<const N: usize> {
     opts: OdeOptions,
     t: f64,
     y: [f64; N],
-    k1: [f64; N],
+    /// The stages of the current step; `k[0]` is the derivative at (t, y) (first same as last:
+    /// the previous step's final evaluation). Kept here so that a step neither zero-fills nor
+    /// copies 12 state vectors.
+    k: [[f64; N]; 12],
+    /// The argument of the stage being evaluated.
+    scratch: [f64; N],
+    /// The solution at the end of the step being attempted.
+    y_next: [f64; N],
     t_end: f64,
     dir: f64,
     h: f64,
@@ -300,11 +308,15 @@ impl<const N: usize> Dop853<N> {
             return Err(OdeError::NonFinite { t: t0 });
         }
         let dir = if t_end >= t0 { 1.0 } else { -1.0 };
+        let mut k = [[0.0; N]; 12];
+        k[0] = k1;
         let mut s = Self {
             opts,
             t: t0,
             y: y0,
-            k1,
+            k,
+            scratch: [0.0; N],
+            y_next: [0.0; N],
             t_end,
             dir,
             h: 0.0,
@@ -362,7 +374,7 @@ impl<const N: usize> Dop853<N> {
         let mut dny = 0.0;
         for i in 0..ne {
             let sk = self.weight(self.y[i], self.y[i]);
-            dnf += (self.k1[i] / sk).powi(2);
+            dnf += (self.k[0][i] / sk).powi(2);
             dny += (self.y[i] / sk).powi(2);
         }
         let mut h = if dnf <= 1e-10 || dny <= 1e-10 {
@@ -374,14 +386,14 @@ impl<const N: usize> Dop853<N> {
             h = 1e-6;
         }
         h = h.min(hmax);
-        let y1: [f64; N] = std::array::from_fn(|i| self.y[i] + self.dir * h * self.k1[i]);
+        let y1: [f64; N] = std::array::from_fn(|i| self.y[i] + self.dir * h * self.k[0][i]);
         let mut f1 = [0.0; N];
         f(self.t + self.dir * h, &y1, &mut f1);
         self.stats.evaluations += 1;
         let mut der2 = 0.0;
         for i in 0..ne {
             let sk = self.weight(self.y[i], self.y[i]);
-            der2 += ((f1[i] - self.k1[i]) / sk).powi(2);
+            der2 += ((f1[i] - self.k[0][i]) / sk).powi(2);
         }
         let der2 = der2.sqrt() / h;
         let der12 = der2.max(dnf.sqrt());
@@ -402,48 +414,47 @@ impl<const N: usize> Dop853<N> {
     /// a coefficient table; k1 is the stored FSAL derivative), the last evaluated at
     /// `t_new` = t + h exactly.
     #[inline(always)]
-    fn stages<F>(&self, f: &mut F, t: f64, h: f64, t_new: f64, k: &mut [[f64; N]; 12])
+    fn stages<F>(&mut self, f: &mut F, t: f64, h: f64, t_new: f64)
     where
         F: FnMut(f64, &[f64; N], &mut [f64; N]),
     {
-        let y = &self.y;
-        let k1 = &self.k1;
-        k[0] = *k1;
-        f(t + C2 * h, &combine!(y, h; (A21, k1)), &mut k[1]);
+        let Self { y, k, scratch, .. } = self;
+        let y = &*y;
+        f(t + C2 * h, combine!(scratch; y, h; (A21, &k[0])), &mut k[1]);
         f(
             t + C3 * h,
-            &combine!(y, h; (A31, k1), (A32, &k[1])),
+            combine!(scratch; y, h; (A31, &k[0]), (A32, &k[1])),
             &mut k[2],
         );
         f(
             t + C4 * h,
-            &combine!(y, h; (A41, k1), (A43, &k[2])),
+            combine!(scratch; y, h; (A41, &k[0]), (A43, &k[2])),
             &mut k[3],
         );
         f(
             t + C5 * h,
-            &combine!(y, h; (A51, k1), (A53, &k[2]), (A54, &k[3])),
+            combine!(scratch; y, h; (A51, &k[0]), (A53, &k[2]), (A54, &k[3])),
             &mut k[4],
         );
         f(
             t + C6 * h,
-            &combine!(y, h; (A61, k1), (A64, &k[3]), (A65, &k[4])),
+            combine!(scratch; y, h; (A61, &k[0]), (A64, &k[3]), (A65, &k[4])),
             &mut k[5],
         );
         f(
             t + C7 * h,
-            &combine!(y, h; (A71, k1), (A74, &k[3]), (A75, &k[4]), (A76, &k[5])),
+            combine!(scratch; y, h; (A71, &k[0]), (A74, &k[3]), (A75, &k[4]), (A76, &k[5])),
             &mut k[6],
         );
         f(
             t + C8 * h,
-            &combine!(y, h; (A81, k1), (A84, &k[3]), (A85, &k[4]), (A86, &k[5]), (A87, &k[6])),
+            combine!(scratch; y, h; (A81, &k[0]), (A84, &k[3]), (A85, &k[4]), (A86, &k[5]), (A87, &k[6])),
             &mut k[7],
         );
         f(
             t + C9 * h,
-            &combine!(y, h;
-                (A91, k1),
+            combine!(scratch; y, h;
+                (A91, &k[0]),
                 (A94, &k[3]),
                 (A95, &k[4]),
                 (A96, &k[5]),
@@ -454,8 +465,8 @@ impl<const N: usize> Dop853<N> {
         );
         f(
             t + C10 * h,
-            &combine!(y, h;
-                (A101, k1),
+            combine!(scratch; y, h;
+                (A101, &k[0]),
                 (A104, &k[3]),
                 (A105, &k[4]),
                 (A106, &k[5]),
@@ -467,8 +478,8 @@ impl<const N: usize> Dop853<N> {
         );
         f(
             t + C11 * h,
-            &combine!(y, h;
-                (A111, k1),
+            combine!(scratch; y, h;
+                (A111, &k[0]),
                 (A114, &k[3]),
                 (A115, &k[4]),
                 (A116, &k[5]),
@@ -481,8 +492,8 @@ impl<const N: usize> Dop853<N> {
         );
         f(
             t_new,
-            &combine!(y, h;
-                (A121, k1),
+            combine!(scratch; y, h;
+                (A121, &k[0]),
                 (A124, &k[3]),
                 (A125, &k[4]),
                 (A126, &k[5]),
@@ -499,15 +510,19 @@ impl<const N: usize> Dop853<N> {
     /// The 8th-order solution of the step and its scaled error norm (Hairer's combination of
     /// the 5th- and 3rd-order estimates: err = |h| err5 / √(n (err5² + 0.01 err3²))).
     #[inline(always)]
-    fn solution_and_error(&self, h: f64, habs: f64, k: &[[f64; N]; 12]) -> ([f64; N], f64) {
-        let y = &self.y;
-        let [k1, _, _, _, _, k6, k7, k8, k9, k10, k11, k12] = k;
-        let mut y_new = [0.0; N];
-        let mut err5 = 0.0;
-        let mut err3 = 0.0;
-        let ne = self.opts.error_components.min(N).max(1);
+    fn solution_and_error(&mut self, h: f64, habs: f64) -> f64 {
+        let Self {
+            y,
+            k,
+            scratch,
+            y_next,
+            opts,
+            ..
+        } = self;
+        let [k1, _, _, _, _, k6, k7, k8, k9, k10, k11, k12] = &*k;
+        // Σ bᵢkᵢ is kept in `scratch` for the error estimate; both loops vectorise.
         for i in 0..N {
-            let bk = B1 * k1[i]
+            scratch[i] = B1 * k1[i]
                 + B6 * k6[i]
                 + B7 * k7[i]
                 + B8 * k8[i]
@@ -515,12 +530,14 @@ impl<const N: usize> Dop853<N> {
                 + B10 * k10[i]
                 + B11 * k11[i]
                 + B12 * k12[i];
-            y_new[i] = y[i] + h * bk;
-            if i >= ne {
-                continue;
-            }
-            let inv = 1.0 / self.weight(y[i], y_new[i]);
-            let e3 = bk - BHH1 * k1[i] - BHH2 * k9[i] - BHH3 * k12[i];
+            y_next[i] = y[i] + h * scratch[i];
+        }
+        let mut err5 = 0.0;
+        let mut err3 = 0.0;
+        let ne = opts.error_components.min(N).max(1);
+        for i in 0..ne {
+            let inv = 1.0 / (opts.atol + opts.rtol * y[i].abs().max(y_next[i].abs()));
+            let e3 = scratch[i] - BHH1 * k1[i] - BHH2 * k9[i] - BHH3 * k12[i];
             let e5 = ER1 * k1[i]
                 + ER6 * k6[i]
                 + ER7 * k7[i]
@@ -536,32 +553,31 @@ impl<const N: usize> Dop853<N> {
         if deno <= 0.0 {
             deno = 1.0;
         }
-        (y_new, habs * err5 * (1.0 / (ne as f64 * deno)).sqrt())
+        habs * err5 * (1.0 / (ne as f64 * deno)).sqrt()
     }
 
     /// The 7th-order continuous extension of an accepted step (Hairer's `CONTD8`): three more
     /// stages k14..k16 and the coefficients r₁..r₈ of [`DenseStep`].
     #[inline(always)]
-    fn dense_output<F>(
-        &self,
-        f: &mut F,
-        t: f64,
-        h: f64,
-        k: &[[f64; N]; 12],
-        k13: &[f64; N],
-        y_new: &[f64; N],
-    ) -> DenseStep<N>
+    fn dense_output<F>(&mut self, f: &mut F, t: f64, h: f64, k13: &[f64; N]) -> DenseStep<N>
     where
         F: FnMut(f64, &[f64; N], &mut [f64; N]),
     {
-        let y = &self.y;
+        let Self {
+            y,
+            k,
+            scratch,
+            y_next,
+            ..
+        } = self;
+        let (y, k, y_new) = (&*y, &*k, &*y_next);
         let [k1, _, _, _, _, k6, k7, k8, k9, k10, k11, k12] = k;
         let mut k14 = [0.0; N];
         let mut k15 = [0.0; N];
         let mut k16 = [0.0; N];
         f(
             t + C14 * h,
-            &combine!(y, h;
+            combine!(scratch; y, h;
                 (A141, k1),
                 (A147, &k7),
                 (A148, &k8),
@@ -575,7 +591,7 @@ impl<const N: usize> Dop853<N> {
         );
         f(
             t + C15 * h,
-            &combine!(y, h;
+            combine!(scratch; y, h;
                 (A151, k1),
                 (A156, &k6),
                 (A157, &k7),
@@ -589,7 +605,7 @@ impl<const N: usize> Dop853<N> {
         );
         f(
             t + C16 * h,
-            &combine!(y, h;
+            combine!(scratch; y, h;
                 (A161, k1),
                 (A166, &k6),
                 (A167, &k7),
@@ -603,22 +619,25 @@ impl<const N: usize> Dop853<N> {
         );
         let ks: [&[f64; N]; 12] = [k1, k6, k7, k8, k9, k10, k11, k12, k13, &k14, &k15, &k16];
         debug_assert_eq!(DSTAGE.len(), ks.len());
-        let mut r = [[0.0; N]; 8];
-        for i in 0..N {
-            let ydiff = y_new[i] - y[i];
-            let bspl = h * k1[i] - ydiff;
-            r[0][i] = y[i];
-            r[1][i] = ydiff;
-            r[2][i] = bspl;
-            r[3][i] = ydiff - h * k13[i] - bspl;
-            for (row, drow) in D.iter().enumerate() {
-                let mut s = 0.0;
-                for (c, k) in drow.iter().zip(ks.iter()) {
-                    s += c * k[i];
+        let r: [[f64; N]; 8] = std::array::from_fn(|row| {
+            std::array::from_fn(|i| {
+                let ydiff = y_new[i] - y[i];
+                let bspl = h * k1[i] - ydiff;
+                match row {
+                    0 => y[i],
+                    1 => ydiff,
+                    2 => bspl,
+                    3 => ydiff - h * k13[i] - bspl,
+                    _ => {
+                        let mut s = 0.0;
+                        for (c, k) in D[row - 4].iter().zip(ks.iter()) {
+                            s += c * k[i];
+                        }
+                        h * s
+                    }
                 }
-                r[4 + row][i] = h * s;
-            }
-        }
+            })
+        });
         DenseStep { t0: t, h, r }
     }
 
@@ -634,7 +653,6 @@ impl<const N: usize> Dop853<N> {
         if self.finished() {
             return Ok(());
         }
-        let mut k = [[0.0; N]; 12];
         loop {
             if self.stats.attempts >= self.opts.max_steps {
                 return Err(OdeError::StepBudget {
@@ -655,10 +673,10 @@ impl<const N: usize> Dop853<N> {
             let h = self.dir * habs;
             let t = self.t;
             let t_new = if last { self.t_end } else { t + h };
-            self.stages(f, t, h, t_new, &mut k);
+            self.stages(f, t, h, t_new);
             self.stats.evaluations += 11;
-            let (y_new, err) = self.solution_and_error(h, habs, &k);
-            if !err.is_finite() || y_new.iter().any(|v| !v.is_finite()) {
+            let err = self.solution_and_error(h, habs);
+            if !err.is_finite() || self.y_next.iter().any(|v| !v.is_finite()) {
                 // Treat as a hard rejection: shrink and retry (bounded by the budget).
                 self.stats.rejected += 1;
                 self.h = habs * 0.25;
@@ -667,7 +685,7 @@ impl<const N: usize> Dop853<N> {
             }
             if err <= 1.0 {
                 let mut k13 = [0.0; N];
-                f(t_new, &y_new, &mut k13);
+                f(t_new, &self.y_next, &mut k13);
                 self.stats.evaluations += 1;
                 if k13.iter().any(|v| !v.is_finite()) {
                     self.stats.rejected += 1;
@@ -676,7 +694,7 @@ impl<const N: usize> Dop853<N> {
                     continue;
                 }
                 if self.want_dense {
-                    self.dense = Some(self.dense_output(f, t, h, &k, &k13, &y_new));
+                    self.dense = Some(self.dense_output(f, t, h, &k13));
                     self.stats.evaluations += 3;
                 }
                 // Accept.
@@ -689,8 +707,8 @@ impl<const N: usize> Dop853<N> {
                 self.reject = false;
                 self.h = habs * fac;
                 self.t = t_new;
-                self.y = y_new;
-                self.k1 = k13;
+                self.y = self.y_next;
+                self.k[0] = k13;
                 self.stats.accepted += 1;
                 return Ok(());
             } else {
