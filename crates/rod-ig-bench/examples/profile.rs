@@ -16,6 +16,7 @@ fn main() {
         Some("one") => one(&args),
         Some("calls") => calls(&args),
         Some("file") => file(&args),
+        Some("tipj3d" | "evaluate3d" | "solve3d") => spatial_rounds(&args),
         _ => rounds(&args),
     }
 }
@@ -44,6 +45,44 @@ fn one(args: &[String]) {
         per_call(|| planar::energy(black_box(&a))),
     );
     println!("{:?}", planar::evaluate(&a));
+}
+
+/// `tipj3d|evaluate3d|solve3d N ROUNDS`: the 3-D forward map with J, the evaluation with the
+/// stability scan, or the robust 3-D solve, on the benchmark's N stable rods (seed 3).
+fn spatial_rounds(args: &[String]) {
+    use rod_ig_core::spatial::{self, StabilityOptions, Stiffness, PRODUCTION_RTOL};
+    let n: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(64);
+    let rounds: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(20);
+    let k = Stiffness::default();
+    let rods = rod_ig_bench::spatial::random_targets(n, 3, &k);
+    let opts = StabilityOptions::production();
+    let solve_opts = rod_ig_core::solver::SolveOptions::default();
+    let model = spatial::Spatial::with_stiffness(k);
+    let t0 = Instant::now();
+    for _ in 0..rounds {
+        for (a, tip) in &rods {
+            match args[1].as_str() {
+                "tipj3d" => drop(black_box(spatial::tip_and_jacobian(
+                    black_box(a),
+                    &k,
+                    PRODUCTION_RTOL,
+                ))),
+                "evaluate3d" => drop(black_box(spatial::evaluate(black_box(a), &k, &opts))),
+                _ => drop(black_box(rod_ig_core::solver::solve(
+                    &model,
+                    black_box(tip),
+                    &solve_opts,
+                ))),
+            }
+        }
+    }
+    let calls = (rounds * rods.len()).max(1);
+    let us = t0.elapsed().as_secs_f64() * 1e6 / calls as f64;
+    println!(
+        "{} on {} rods: {calls} calls, {us:.2} µs per call",
+        args[1],
+        rods.len()
+    );
 }
 
 /// `calls SAMPLE_INDEX`: per-rod time of stability and evaluate over the sample, split by the

@@ -7,8 +7,8 @@
 //! Differentiating with δR = R[η_ω]×, δp = R η_v (η = q⁻¹ δq, the columns of J):
 //! δm = −η_ω × m − η_v × f + Rᵀ δa_m − Rᵀ(p × δa_f), δω = δm / c, and
 //! η' = δξ − ad_ξ η, i.e. η_ω' = δω − ω × η_ω, η_v' = −ω × η_v + η_ω × e1 (δf is not needed).
-//! State: q (w, x, y, z), p, energy, then η for a1..a6: 8 + 36 = 44 values (the literal
-//! μ-form of [`super`] needs 86).
+//! State: q (w, x, y, z), p, energy, then η for a1..a6, row-major (component r of column c
+//! at 8 + 6 r + c): 8 + 36 = 44 values (the literal μ-form of [`super`] needs 86).
 
 use super::{SpatialJacobian, SpatialParams, SpatialPose};
 
@@ -89,34 +89,42 @@ pub(crate) fn rhs<const N: usize, const VAR: bool>(
     if !VAR {
         return;
     }
-    // g_j = Rᵀ δa_m − Rᵀ (p × δa_f) for δa = e_j: rows of R for j < 3, −Rᵀ(p × e_k) after.
-    let pe = [[0.0, p[2], -p[1]], [-p[2], 0.0, p[0]], [p[1], -p[0], 0.0]]; // p × e_k
-    let mut g = [[0.0; 3]; 6];
-    for k in 0..3 {
-        g[k] = r[k];
-        let v = rt_mul(&r, pe[k]);
-        g[k + 3] = [-v[0], -v[1], -v[2]];
+    // The variational block is stored row-major (component r of every column c at
+    // NRB + 6 r + c) so that each line below is one operation on 6 columns at once: the loops
+    // over c vectorise.
+    //
+    // g_c = Rᵀ δa_m − Rᵀ (p × δa_f) for δa = e_c, component i: R[c][i] for c < 3, and
+    // (p × u_i) for c = 3, 4, 5, where u_i is column i of R.
+    let mut g = [[0.0; 6]; 3];
+    for (i, gi) in g.iter_mut().enumerate() {
+        let u = [r[0][i], r[1][i], r[2][i]];
+        let pu = cross(p, u);
+        *gi = [u[0], u[1], u[2], pu[0], pu[1], pu[2]];
     }
     let (_, var) = s.split_at(NRB);
     let (_, dvar) = ds.split_at_mut(NRB);
-    for ((col, dcol), gj) in var
-        .chunks_exact(6)
-        .zip(dvar.chunks_exact_mut(6))
-        .zip(g.iter())
-    {
-        let eo = [col[0], col[1], col[2]];
-        let ev = [col[3], col[4], col[5]];
-        let c1 = cross(eo, m);
-        let c2 = cross(ev, f);
-        let we = cross(om, eo);
-        let wv = cross(om, ev);
-        dcol[0] = (gj[0] - c1[0] - c2[0]) * ci[0] - we[0];
-        dcol[1] = (gj[1] - c1[1] - c2[1]) * ci[1] - we[1];
-        dcol[2] = (gj[2] - c1[2] - c2[2]) * ci[2] - we[2];
+    let row = |k: usize| -> [f64; 6] { std::array::from_fn(|c| var[6 * k + c]) };
+    let (e0, e1, e2) = (row(0), row(1), row(2));
+    let (v0, v1, v2) = (row(3), row(4), row(5));
+    for c in 0..6 {
+        // δm = −η_ω × m − η_v × f + g; η_ω' = δm / c − ω × η_ω.
+        let c1 = [
+            e1[c] * m[2] - e2[c] * m[1],
+            e2[c] * m[0] - e0[c] * m[2],
+            e0[c] * m[1] - e1[c] * m[0],
+        ];
+        let c2 = [
+            v1[c] * f[2] - v2[c] * f[1],
+            v2[c] * f[0] - v0[c] * f[2],
+            v0[c] * f[1] - v1[c] * f[0],
+        ];
+        dvar[c] = (g[0][c] - c1[0] - c2[0]) * ci[0] - (om[1] * e2[c] - om[2] * e1[c]);
+        dvar[6 + c] = (g[1][c] - c1[1] - c2[1]) * ci[1] - (om[2] * e0[c] - om[0] * e2[c]);
+        dvar[12 + c] = (g[2][c] - c1[2] - c2[2]) * ci[2] - (om[0] * e1[c] - om[1] * e0[c]);
         // η_v' = −ω × η_v + η_ω × e1, with η_ω × e1 = (0, η_ω3, −η_ω2).
-        dcol[3] = -wv[0];
-        dcol[4] = -wv[1] + eo[2];
-        dcol[5] = -wv[2] - eo[1];
+        dvar[18 + c] = -(om[1] * v2[c] - om[2] * v1[c]);
+        dvar[24 + c] = -(om[2] * v0[c] - om[0] * v2[c]) + e2[c];
+        dvar[30 + c] = -(om[0] * v1[c] - om[1] * v0[c]) - e1[c];
     }
 }
 
@@ -136,7 +144,13 @@ pub(crate) fn pose(s: &[f64]) -> SpatialPose {
     super::pose_from_parts([s[0], s[1], s[2], s[3]], [s[4], s[5], s[6]])
 }
 
+/// Entry (r, c) of J in a reduced state (the variational block is row-major).
+#[inline(always)]
+pub(crate) fn jac_entry(s: &[f64], r: usize, c: usize) -> f64 {
+    s[NRB + 6 * r + c]
+}
+
 /// J from a reduced state.
 pub(crate) fn jac(s: &[f64]) -> SpatialJacobian {
-    SpatialJacobian::from_fn(|r, c| s[NRB + 6 * c + r])
+    SpatialJacobian::from_fn(|r, c| jac_entry(s, r, c))
 }

@@ -162,8 +162,8 @@ fn sample(planar: Option<&nalgebra::Matrix6<f64>>, s: &[f64]) -> (f64, f64) {
         let dout = det3(&j, [0, 1, 5], [0, 1, 5]);
         (din.min(dout), din * dout)
     } else {
-        let o = reduced::NRB;
-        let m: [[f64; 6]; 6] = std::array::from_fn(|c| std::array::from_fn(|r| s[o + 6 * c + r]));
+        let m: [[f64; 6]; 6] =
+            std::array::from_fn(|c| std::array::from_fn(|r| reduced::jac_entry(s, r, c)));
         let d = det6(m);
         (d, d)
     }
