@@ -272,7 +272,10 @@ pub struct Dop853<const N: usize> {
     h: f64,
     reject: bool,
     stats: OdeStats,
-    dense: Option<DenseStep<N>>,
+    /// The continuous extension of the last accepted step, written in place (valid when
+    /// `has_dense`).
+    dense: DenseStep<N>,
+    has_dense: bool,
     want_dense: bool,
 }
 
@@ -322,7 +325,12 @@ impl<const N: usize> Dop853<N> {
             h: 0.0,
             reject: false,
             stats,
-            dense: None,
+            dense: DenseStep {
+                t0,
+                h: 0.0,
+                r: [[0.0; N]; 8],
+            },
+            has_dense: false,
             want_dense: dense,
         };
         s.h = match opts.initial_step {
@@ -351,7 +359,7 @@ impl<const N: usize> Dop853<N> {
     /// Continuous extension of the last accepted step (None before the first step or
     /// when the stepper was created without dense output).
     pub fn dense(&self) -> Option<&DenseStep<N>> {
-        self.dense.as_ref()
+        self.has_dense.then_some(&self.dense)
     }
 
     fn weight(&self, a: f64, b: f64) -> f64 {
@@ -559,7 +567,7 @@ impl<const N: usize> Dop853<N> {
     /// The 7th-order continuous extension of an accepted step (Hairer's `CONTD8`): three more
     /// stages k14..k16 and the coefficients r₁..r₈ of [`DenseStep`].
     #[inline(always)]
-    fn dense_output<F>(&mut self, f: &mut F, t: f64, h: f64, k13: &[f64; N]) -> DenseStep<N>
+    fn dense_output<F>(&mut self, f: &mut F, t: f64, h: f64, k13: &[f64; N])
     where
         F: FnMut(f64, &[f64; N], &mut [f64; N]),
     {
@@ -568,6 +576,7 @@ impl<const N: usize> Dop853<N> {
             k,
             scratch,
             y_next,
+            dense,
             ..
         } = self;
         let (y, k, y_new) = (&*y, &*k, &*y_next);
@@ -619,26 +628,28 @@ impl<const N: usize> Dop853<N> {
         );
         let ks: [&[f64; N]; 12] = [k1, k6, k7, k8, k9, k10, k11, k12, k13, &k14, &k15, &k16];
         debug_assert_eq!(DSTAGE.len(), ks.len());
-        let r: [[f64; N]; 8] = std::array::from_fn(|row| {
-            std::array::from_fn(|i| {
-                let ydiff = y_new[i] - y[i];
-                let bspl = h * k1[i] - ydiff;
-                match row {
-                    0 => y[i],
-                    1 => ydiff,
-                    2 => bspl,
-                    3 => ydiff - h * k13[i] - bspl,
-                    _ => {
-                        let mut s = 0.0;
-                        for (c, k) in D[row - 4].iter().zip(ks.iter()) {
-                            s += c * k[i];
-                        }
-                        h * s
-                    }
+        // Row by row, so that each loop runs over the components and vectorises.
+        let r = &mut dense.r;
+        for i in 0..N {
+            let ydiff = y_new[i] - y[i];
+            let bspl = h * k1[i] - ydiff;
+            r[0][i] = y[i];
+            r[1][i] = ydiff;
+            r[2][i] = bspl;
+            r[3][i] = ydiff - h * k13[i] - bspl;
+        }
+        for (row, d) in D.iter().enumerate() {
+            let out = &mut r[4 + row];
+            for i in 0..N {
+                let mut s = d[0] * ks[0][i];
+                for c in 1..12 {
+                    s += d[c] * ks[c][i];
                 }
-            })
-        });
-        DenseStep { t0: t, h, r }
+                out[i] = h * s;
+            }
+        }
+        dense.t0 = t;
+        dense.h = h;
     }
 
     /// Performs one accepted step towards `t_end` (a no-op once there).
@@ -694,7 +705,8 @@ impl<const N: usize> Dop853<N> {
                     continue;
                 }
                 if self.want_dense {
-                    self.dense = Some(self.dense_output(f, t, h, &k13));
+                    self.dense_output(f, t, h, &k13);
+                    self.has_dense = true;
                     self.stats.evaluations += 3;
                 }
                 // Accept.
@@ -789,7 +801,7 @@ where
             let y = if t == t_now {
                 st.y
             } else {
-                match st.dense.as_ref() {
+                match st.dense() {
                     Some(d) => d.eval(t),
                     None => st.y,
                 }
