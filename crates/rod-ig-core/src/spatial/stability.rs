@@ -116,16 +116,16 @@ fn det3(j: &super::SpatialJacobian, rows: [usize; 3], cols: [usize; 3]) -> f64 {
     m.determinant()
 }
 
-/// Determinant of a 6×6 matrix (columns given as arrays) by Gaussian elimination with partial
-/// pivoting, on the stack.
+/// Determinant of a 6×6 matrix (given as its rows) by Gaussian elimination with partial
+/// pivoting, on the stack: each row operation runs over a contiguous array.
 fn det6(mut m: [[f64; 6]; 6]) -> f64 {
-    // m[c][r]: column-major, as stored in the state.
     let mut det = 1.0;
     for k in 0..6 {
+        // Pivot: the largest entry of column k of Jᵀ at or below the diagonal.
         let mut p = k;
         let mut best = m[k][k].abs();
-        for r in k + 1..6 {
-            let v = m[k][r].abs();
+        for (r, row) in m.iter().enumerate().skip(k + 1) {
+            let v = row[k].abs();
             if v > best {
                 best = v;
                 p = r;
@@ -135,19 +135,18 @@ fn det6(mut m: [[f64; 6]; 6]) -> f64 {
             return if best == 0.0 { 0.0 } else { f64::NAN };
         }
         if p != k {
-            for col in m.iter_mut() {
-                col.swap(k, p);
-            }
+            m.swap(k, p);
             det = -det;
         }
-        let piv = m[k][k];
+        let pivot_row = m[k];
+        let piv = pivot_row[k];
         det *= piv;
-        for c in k + 1..6 {
-            let f = m[c][k] / piv;
-            if f != 0.0 {
-                for r in k + 1..6 {
-                    m[c][r] -= f * m[k][r];
-                }
+        for row in m.iter_mut().skip(k + 1) {
+            let f = row[k] / piv;
+            // All six columns: a fixed-length loop vectorises; the columns ≤ k are not read
+            // again.
+            for (v, pv) in row.iter_mut().zip(pivot_row) {
+                *v -= f * pv;
             }
         }
     }
@@ -163,7 +162,7 @@ fn sample(planar: Option<&nalgebra::Matrix6<f64>>, s: &[f64]) -> (f64, f64) {
         (din.min(dout), din * dout)
     } else {
         let m: [[f64; 6]; 6] =
-            std::array::from_fn(|c| std::array::from_fn(|r| reduced::jac_entry(s, r, c)));
+            std::array::from_fn(|r| std::array::from_fn(|c| reduced::jac_entry(s, r, c)));
         let d = det6(m);
         (d, d)
     }
@@ -467,7 +466,7 @@ mod tests {
                     x - 0.5
                 })
             });
-            let n = nalgebra::Matrix6::from_fn(|r, c| m[c][r]);
+            let n = nalgebra::Matrix6::from_fn(|r, c| m[r][c]);
             let (a, b) = (super::det6(m), n.determinant());
             assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()), "{a} {b}");
         }
