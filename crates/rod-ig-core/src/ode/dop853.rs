@@ -225,6 +225,42 @@ pub struct DenseStep<const N: usize> {
 }
 
 impl<const N: usize> DenseStep<N> {
+    /// Writes the coefficients r₁..r₈ of the step (t, t + h) from y(t), y(t + h), the FSAL
+    /// derivative k13 and the stages `ks` (in the order of [`DSTAGE`]; `ks[0]` is k1). Row by
+    /// row, so that each loop runs over the components and vectorises.
+    #[inline(always)]
+    fn fill(
+        &mut self,
+        t: f64,
+        h: f64,
+        y: &[f64; N],
+        y_new: &[f64; N],
+        k13: &[f64; N],
+        ks: &[&[f64; N]; 12],
+    ) {
+        let r = &mut self.r;
+        for i in 0..N {
+            let ydiff = y_new[i] - y[i];
+            let bspl = h * ks[0][i] - ydiff;
+            r[0][i] = y[i];
+            r[1][i] = ydiff;
+            r[2][i] = bspl;
+            r[3][i] = ydiff - h * k13[i] - bspl;
+        }
+        for (row, d) in D.iter().enumerate() {
+            let out = &mut r[4 + row];
+            for i in 0..N {
+                let mut s = d[0] * ks[0][i];
+                for c in 1..12 {
+                    s += d[c] * ks[c][i];
+                }
+                out[i] = h * s;
+            }
+        }
+        self.t0 = t;
+        self.h = h;
+    }
+
     /// Start of the step.
     pub fn t_start(&self) -> f64 {
         self.t0
@@ -628,28 +664,7 @@ impl<const N: usize> Dop853<N> {
         );
         let ks: [&[f64; N]; 12] = [k1, k6, k7, k8, k9, k10, k11, k12, k13, &k14, &k15, &k16];
         debug_assert_eq!(DSTAGE.len(), ks.len());
-        // Row by row, so that each loop runs over the components and vectorises.
-        let r = &mut dense.r;
-        for i in 0..N {
-            let ydiff = y_new[i] - y[i];
-            let bspl = h * k1[i] - ydiff;
-            r[0][i] = y[i];
-            r[1][i] = ydiff;
-            r[2][i] = bspl;
-            r[3][i] = ydiff - h * k13[i] - bspl;
-        }
-        for (row, d) in D.iter().enumerate() {
-            let out = &mut r[4 + row];
-            for i in 0..N {
-                let mut s = d[0] * ks[0][i];
-                for c in 1..12 {
-                    s += d[c] * ks[c][i];
-                }
-                out[i] = h * s;
-            }
-        }
-        dense.t0 = t;
-        dense.h = h;
+        dense.fill(t, h, y, y_new, k13, &ks);
     }
 
     /// Performs one accepted step towards `t_end` (a no-op once there).
