@@ -36,6 +36,7 @@ pub mod plan;
 pub mod planar;
 pub mod rng;
 pub mod scalar;
+mod simd;
 pub mod solver;
 pub mod spatial;
 mod types;

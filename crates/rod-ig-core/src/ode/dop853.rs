@@ -270,6 +270,7 @@ impl<const N: usize> DenseStep<N> {
         self.t0 + self.h
     }
     /// The interpolated state at `t` (meant for t within the step; extrapolates otherwise).
+    #[inline(always)] // into the 3-D scan's AVX2 build (crate::simd)
     pub fn eval(&self, t: f64) -> [f64; N] {
         let s = if self.h != 0.0 {
             (t - self.t0) / self.h
@@ -320,6 +321,7 @@ impl<const N: usize> Dop853<N> {
     /// accepted step also builds its continuous extension (3 extra evaluations per step).
     ///
     /// Errors: non-finite t0, t_end, y0, invalid tolerances, or a non-finite f(t0, y0).
+    #[inline(always)] // so that a caller compiled for wider vectors (crate::simd) gets it all
     pub fn new<F>(
         f: &mut F,
         t0: f64,
@@ -672,6 +674,7 @@ impl<const N: usize> Dop853<N> {
     /// Errors: [`OdeError::StepBudget`] when `max_steps` attempts are used up,
     /// [`OdeError::StepSizeUnderflow`] when h falls below the resolution of t (e.g. a state that
     /// keeps turning non-finite).
+    #[inline(always)] // so that a caller compiled for wider vectors (crate::simd) gets it all
     pub fn step<F>(&mut self, f: &mut F) -> Result<(), OdeError>
     where
         F: FnMut(f64, &[f64; N], &mut [f64; N]),
@@ -749,6 +752,7 @@ impl<const N: usize> Dop853<N> {
 }
 
 /// Integrates y' = f(t, y), y(t0) = y0 to `t1` with DOP853 and returns y(t1).
+#[inline(always)] // so that a caller compiled for wider vectors (crate::simd) gets it all
 pub fn solve<const N: usize, F>(
     mut f: F,
     t0: f64,
@@ -771,6 +775,7 @@ where
 /// the step's 8th-order value). `ts` must be monotone in the direction of integration and lie on
 /// the same side of `t0`; integration stops at the last requested time, or early when the
 /// observer returns `ControlFlow::Break`.
+#[inline(always)] // so that a caller compiled for wider vectors (crate::simd) gets it all
 pub fn solve_dense<const N: usize, F, O>(
     mut f: F,
     t0: f64,

@@ -414,13 +414,8 @@ pub fn tip(a: &SpatialParams, k: &Stiffness, rtol: f64) -> Result<SpatialPose, R
     let ci = k.inv();
     let ap = reduced::params(a);
     const M: usize = reduced::NRB;
-    let (s, _) = solve(
-        |_, s: &[f64; M], ds: &mut [f64; M]| reduced::rhs::<M, false>(&ci, &ap, s, ds),
-        0.0,
-        reduced::initial::<M>(),
-        1.0,
-        &options_for(a, rtol, default_atol(rtol)),
-    )?;
+    let s =
+        reduced::integrate::<M, false>(&ci, &ap, 1.0, &options_for(a, rtol, default_atol(rtol)))?;
     finite(&s)?;
     Ok(reduced::pose(&s))
 }
@@ -445,13 +440,7 @@ pub fn pose_and_jacobian(
     }
     let ci = k.inv();
     let ap = reduced::params(a);
-    let (s, _) = solve(
-        |_, s: &[f64; M], ds: &mut [f64; M]| reduced::rhs::<M, true>(&ci, &ap, s, ds),
-        0.0,
-        s0,
-        t,
-        &options_for(a, rtol, default_atol(rtol)),
-    )?;
+    let s = reduced::integrate::<M, true>(&ci, &ap, t, &options_for(a, rtol, default_atol(rtol)))?;
     finite(&s)?;
     Ok((reduced::pose(&s), reduced::jac(&s)))
 }

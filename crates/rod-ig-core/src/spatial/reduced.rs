@@ -11,6 +11,7 @@
 //! at 8 + 6 r + c): 8 + 36 = 44 values (the literal μ-form of [`super`] needs 86).
 
 use super::{SpatialJacobian, SpatialParams, SpatialPose};
+use crate::ode::{solve, OdeError, OdeOptions};
 
 /// Base state size (q, p, energy).
 pub(crate) const NRB: usize = 8;
@@ -153,4 +154,46 @@ pub(crate) fn jac_entry(s: &[f64], r: usize, c: usize) -> f64 {
 /// J from a reduced state.
 pub(crate) fn jac(s: &[f64]) -> SpatialJacobian {
     SpatialJacobian::from_fn(|r, c| jac_entry(s, r, c))
+}
+
+/// The reduced rod (with its variational equations when `VAR`) integrated from the base to t:
+/// the final state. Compiled twice (see [`crate::simd`]); the AVX2 build where the CPU has it.
+pub(crate) fn integrate<const N: usize, const VAR: bool>(
+    ci: &[f64; 3],
+    a: &[f64; 6],
+    t: f64,
+    opts: &OdeOptions,
+) -> Result<[f64; N], OdeError> {
+    #[cfg(target_arch = "x86_64")]
+    if crate::simd::has_avx2() {
+        // SAFETY: integrate_avx2 needs AVX2 only, and this CPU has it (checked just above).
+        return unsafe { integrate_avx2::<N, VAR>(ci, a, t, opts) };
+    }
+    integrate_baseline::<N, VAR>(ci, a, t, opts)
+}
+
+/// [`integrate`] as the crate is built.
+pub(super) fn integrate_baseline<const N: usize, const VAR: bool>(
+    ci: &[f64; 3],
+    a: &[f64; 6],
+    t: f64,
+    opts: &OdeOptions,
+) -> Result<[f64; N], OdeError> {
+    let f = |_: f64, s: &[f64; N], ds: &mut [f64; N]| rhs::<N, VAR>(ci, a, s, ds);
+    Ok(solve(f, 0.0, initial::<N>(), t, opts)?.0)
+}
+
+/// [`integrate`] compiled for AVX2. The closure is written here, not taken from
+/// [`integrate_baseline`], because a closure inherits the target features of the function it
+/// is written in.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+pub(super) fn integrate_avx2<const N: usize, const VAR: bool>(
+    ci: &[f64; 3],
+    a: &[f64; 6],
+    t: f64,
+    opts: &OdeOptions,
+) -> Result<[f64; N], OdeError> {
+    let f = |_: f64, s: &[f64; N], ds: &mut [f64; N]| rhs::<N, VAR>(ci, a, s, ds);
+    Ok(solve(f, 0.0, initial::<N>(), t, opts)?.0)
 }
