@@ -172,28 +172,31 @@ pub(crate) fn integrate<const N: usize, const VAR: bool>(
     integrate_baseline::<N, VAR>(ci, a, t, opts)
 }
 
-/// [`integrate`] as the crate is built.
-pub(super) fn integrate_baseline<const N: usize, const VAR: bool>(
-    ci: &[f64; 3],
-    a: &[f64; 6],
-    t: f64,
-    opts: &OdeOptions,
-) -> Result<[f64; N], OdeError> {
-    let f = |_: f64, s: &[f64; N], ds: &mut [f64; N]| rhs::<N, VAR>(ci, a, s, ds);
-    Ok(solve(f, 0.0, initial::<N>(), t, opts)?.0)
+/// Defines one build of [`integrate`]'s work. The right-hand side's closure must be written
+/// inside the function whose target features it is to inherit ([`crate::simd`]), so both
+/// builds are generated from this one text.
+macro_rules! integrator {
+    ($(#[$attr:meta])* fn $name:ident) => {
+        $(#[$attr])*
+        pub(super) fn $name<const N: usize, const VAR: bool>(
+            ci: &[f64; 3],
+            a: &[f64; 6],
+            t: f64,
+            opts: &OdeOptions,
+        ) -> Result<[f64; N], OdeError> {
+            let f = |_: f64, s: &[f64; N], ds: &mut [f64; N]| rhs::<N, VAR>(ci, a, s, ds);
+            Ok(solve(f, 0.0, initial::<N>(), t, opts)?.0)
+        }
+    };
 }
 
-/// [`integrate`] compiled for AVX2. The closure is written here, not taken from
-/// [`integrate_baseline`], because a closure inherits the target features of the function it
-/// is written in.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-pub(super) fn integrate_avx2<const N: usize, const VAR: bool>(
-    ci: &[f64; 3],
-    a: &[f64; 6],
-    t: f64,
-    opts: &OdeOptions,
-) -> Result<[f64; N], OdeError> {
-    let f = |_: f64, s: &[f64; N], ds: &mut [f64; N]| rhs::<N, VAR>(ci, a, s, ds);
-    Ok(solve(f, 0.0, initial::<N>(), t, opts)?.0)
-}
+integrator!(
+    /// [`integrate`] as the crate is built.
+    fn integrate_baseline
+);
+integrator!(
+    /// [`integrate`] compiled for AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn integrate_avx2
+);
