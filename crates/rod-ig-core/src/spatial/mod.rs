@@ -406,6 +406,12 @@ fn check_t(t: f64) -> Result<(), RodError> {
     }
 }
 
+/// True when this CPU runs the AVX2 build of the 3-D integrations (same results, about a
+/// third fewer instructions; `crate::simd`).
+pub fn uses_avx2() -> bool {
+    crate::simd::has_avx2()
+}
+
 /// Tip pose q(1), by DOP853 at relative tolerance `rtol` (atol = max(1e-3·rtol, 1e-16)),
 /// integrating (q, p) with μ recovered from the conserved world wrench (see `reduced`).
 pub fn tip(a: &SpatialParams, k: &Stiffness, rtol: f64) -> Result<SpatialPose, RodError> {
