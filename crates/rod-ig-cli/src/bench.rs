@@ -33,9 +33,10 @@ fn row(name: &str, closed: Timing, rk4: Option<Timing>, goal: &str) {
         ),
         None => (format!("{:>12}", "—"), format!("{:>10}", "—")),
     };
-    println!(
+    outln!(
         "{name:<28} {:>10.0} {:>10.0} {rk4_text} {ratio}   {goal}",
-        closed.median_ns, closed.mean_ns
+        closed.median_ns,
+        closed.mean_ns
     );
 }
 
@@ -58,10 +59,14 @@ pub fn planar_forward(quick: bool) {
     };
     let inputs = sample_box(n, 1);
     let rk4_inputs = &inputs[..rk4_n];
-    println!("## Planar forward map (box a3 ∈ [−10, 10], a4, a5 ∈ [−100, 100]; {n} parameter sets, {rounds} rounds; single thread)");
-    println!(
+    outln!("## Planar forward map (box a3 ∈ [−10, 10], a4, a5 ∈ [−100, 100]; {n} parameter sets, {rounds} rounds; single thread)");
+    outln!(
         "{:<28} {:>10} {:>10} {:>12} {:>10}   goal",
-        "ns per call", "median", "mean", "RK4 median", "ratio"
+        "ns per call",
+        "median",
+        "mean",
+        "RK4 median",
+        "ratio"
     );
     let tip = measure(&inputs, rounds, |a| planar::tip(a).map(|p| p.x));
     let rk4_tip = measure(rk4_inputs, rk4_rounds, |a| {
@@ -97,7 +102,7 @@ pub fn planar_forward(quick: bool) {
     );
     let energy = measure(&inputs, rounds, planar::energy);
     row("elastic energy", energy, None, "");
-    println!();
+    outln!();
 }
 
 /// The paper's Table 1 (α, success %, µs per solve, iterations), for comparison.
@@ -132,7 +137,7 @@ pub fn read_cases(path: &Path) -> Result<Vec<IgCase>, String> {
 }
 
 fn robust_header() {
-    println!(
+    outln!(
         "{:<72} {:>6} {:>8} {:>9} {:>8} {:>6} {:>9} {:>9}",
         "## Robust solver",
         "runs",
@@ -146,7 +151,7 @@ fn robust_header() {
 }
 
 fn robust_row(r: &ig_bench::RobustRow) {
-    println!(
+    outln!(
         "{:<72} {:>6} {:>8.2} {:>9.1} {:>8.2} {:>6} {:>9.2} {:>9.2}",
         r.label,
         r.runs,
@@ -158,9 +163,11 @@ fn robust_row(r: &ig_bench::RobustRow) {
         r.mean_us
     );
     for (target, why) in r.failures.iter().take(5) {
-        println!(
+        outln!(
             "    failed: x = {:.6}, y = {:.6}, θ = {:.6}: {why}",
-            target.x, target.y, target.theta
+            target.x,
+            target.y,
+            target.theta
         );
     }
 }
@@ -171,12 +178,12 @@ pub fn inverse_geometry(quick: bool, cases_path: &Path) {
     match read_cases(cases_path) {
         Ok(cases) => {
             let runs: usize = cases.iter().map(|c| c.a0_list.len()).sum();
-            println!(
+            outln!(
                 "## Inverse geometry: the paper's Newton (Table 1 protocol) on {} ({} targets, {runs} solves per α, ≤ 100 iterations, tolerance 1e-6)",
                 cases_path.display(),
                 cases.len()
             );
-            println!(
+            outln!(
                 "{:>5} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>9} | {:>9} {:>9} | {:>9} {:>8} {:>9}",
                 "α",
                 "success%",
@@ -195,37 +202,37 @@ pub fn inverse_geometry(quick: bool, cases_path: &Path) {
             let alphas: Vec<f64> = PAPER_TABLE1.iter().map(|r| r.0).collect();
             let rows = ig_bench::table1(&cases, &alphas, 100, 1e-6);
             for ((row, paper), reference) in rows.iter().zip(PAPER_TABLE1).zip(FINDINGS_TABLE1) {
-                println!(
+                outln!(
                     "{:>5.1} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>8.1} {:>9.2} {:>9.2} | {:>9.1} {:>9.1} | {:>9.1} {:>8.1} {:>9.1}",
                     row.alpha, row.success_pct, row.instability_pct, row.max_iterations_pct,
                     row.singular_pct, row.mean_iterations, row.median_us, row.mean_us,
                     reference.0, reference.1, paper.1, paper.3, paper.2
                 );
             }
-            println!("(ref = the independent reference of FINDINGS §8 on this file; paper = its Table 1, on its own unstated box and test)");
-            println!();
+            outln!("(ref = the independent reference of FINDINGS §8 on this file; paper = its Table 1, on its own unstated box and test)");
+            outln!();
             robust_header();
             robust_row(&ig_bench::robust_from_starts(&cases, &options));
             robust_row(&ig_bench::robust_no_start(&cases, &options));
         }
         Err(e) => {
-            println!("## Inverse geometry: Table 1 skipped ({e}); pass --ig-cases FILE");
+            outln!("## Inverse geometry: Table 1 skipped ({e}); pass --ig-cases FILE");
             robust_header();
         }
     }
     let n = if quick { 200 } else { 2000 };
     robust_row(&ig_bench::robust_random(n, 7, ParamBox::PAPER, &options));
     robust_row(&ig_bench::robust_random(n, 8, ParamBox::PUBLIC, &options));
-    println!(
+    outln!(
         "(verified% = solutions re-checked independently: forward map within tolerance and stable)"
     );
-    println!();
+    outln!();
     tracking(quick, &options);
 }
 
 /// Tracking rows: the warm-started tracker along two paths of targets.
 fn tracking(quick: bool, options: &SolveOptions) {
-    println!(
+    outln!(
         "{:<60} {:>6} {:>8} {:>9} {:>10} {:>6} {:>9} {:>9}",
         "## Tracking (warm start from the previous solution)",
         "steps",
@@ -249,7 +256,7 @@ fn tracking(quick: bool, options: &SolveOptions) {
     ];
     for (label, path) in paths {
         let t = ig_bench::tracking(&label, &path, options);
-        println!(
+        outln!(
             "{:<60} {:>6} {:>8.2} {:>9.1} {:>10.2} {:>6} {:>9.2} {:>9.2}",
             t.label,
             t.steps,
@@ -261,8 +268,8 @@ fn tracking(quick: bool, options: &SolveOptions) {
             t.mean_us
         );
     }
-    println!("(goals: robust ≥ 99.9 % success, every success stable, median ≤ 10 µs, ≤ 4 µs by issue 23; tracking ≤ 3 iterations per step)");
-    println!();
+    outln!("(goals: robust ≥ 99.9 % success, every success stable, median ≤ 10 µs, ≤ 4 µs by issue 23; tracking ≤ 3 iterations per step)");
+    outln!();
 }
 
 /// The 3-D per-call tails (issue 23 asks for them, and for both to be halved).
@@ -281,7 +288,7 @@ fn spatial_tails(
         ("forward3d + J + stability", t_ev, (48.0, 100.0)),
     ] {
         let met = t.p50 <= 0.5 * p50 && t.p99 <= 0.5 * p99;
-        println!(
+        outln!(
             "{name:<28} per call: p50 {:.1} µs, p99 {:.1} µs, max {:.1} µs, mean {:.1} µs   \
              goal (issue 23): p50 ≤ {:.1}, p99 ≤ {:.1} µs: {}",
             t.p50,
@@ -307,18 +314,21 @@ pub fn spatial(quick: bool) {
         .into_iter()
         .map(|(a, _)| a)
         .collect();
-    println!(
-        "## 3-D rod (numerical integration, rtol {PRODUCTION_RTOL:e}; {} stable rods from |a1..3| ≤ {a_box}, |a4..6| ≤ {f_box}, {rounds} rounds)",
-        inputs.len()
+    outln!(
+        "## 3-D rod (numerical integration, rtol {PRODUCTION_RTOL:e}; {} stable rods from |a1..3| ≤ {a_box}, |a4..6| ≤ {f_box}, {rounds} rounds; {} build of the integrations)",
+        inputs.len(),
+        if spatial::uses_avx2() { "AVX2" } else { "baseline (SSE2)" }
     );
-    println!(
+    outln!(
         "{:<28} {:>10} {:>10}   goal",
-        "µs per call", "median", "mean"
+        "µs per call",
+        "median",
+        "mean"
     );
     let tj = measure(&inputs, rounds, |a| {
         spatial::tip_and_jacobian(a, &k, PRODUCTION_RTOL).map(|(p, _)| p.position.x)
     });
-    println!(
+    outln!(
         "{:<28} {:>10.2} {:>10.2}   ≤ 50 µs",
         "forward + J(1)",
         tj.median_ns / 1e3,
@@ -328,7 +338,7 @@ pub fn spatial(quick: bool) {
     let ev = measure(&inputs, rounds, |a| {
         spatial::evaluate(a, &k, &opts).map(|e| e.stability.stable)
     });
-    println!(
+    outln!(
         "{:<28} {:>10.2} {:>10.2}",
         "forward + J + stability",
         ev.median_ns / 1e3,
@@ -337,7 +347,7 @@ pub fn spatial(quick: bool) {
     spatial_tails(&inputs, &k, &opts);
     let targets = if quick { 50 } else { 500 };
     let r = ig3d::benchmark_random_targets(targets, 5);
-    println!(
+    outln!(
         "robust 3-D solve, {} random stable targets: success {:.1} %, median {:.0} µs, p90 {:.0} µs, p99 {:.0} µs, max {:.0} µs, {:.1} iterations, {:.1} integrations per solve (goals ≥ 99 %, median ≤ 1 ms)",
         r.targets,
         100.0 * r.success_rate,
@@ -349,14 +359,14 @@ pub fn spatial(quick: bool) {
         r.mean_evaluations
     );
     let solves = r.work.solves.max(1) as f64;
-    println!(
+    outln!(
         "    solver observer: {:.2} starts per solve (at most {}), {} deadline hits",
         r.work.starts as f64 / solves,
         r.work.max_starts_per_solve,
         r.work.deadlines
     );
     for (why, count) in &r.failures {
-        println!("    failed ×{count}: {why}");
+        outln!("    failed ×{count}: {why}");
     }
-    println!();
+    outln!();
 }

@@ -59,7 +59,7 @@ pub fn tails<T, R, E>(inputs: &[T], mut f: impl FnMut(&T) -> Result<R, E>) -> Ta
 }
 
 fn print_row(what: &str, sample: &str, t: &Tails, box_mean: f64) {
-    println!(
+    outln!(
         "{what:<8} {sample:<30} {:>9.2} {:>9.2} {:>9.2} {:>10.2} {:>10.2} {:>7.2}× {:>7}",
         t.mean,
         t.p50,
@@ -75,10 +75,18 @@ fn print_row(what: &str, sample: &str, t: &Tails, box_mean: f64) {
 pub fn run(quick: bool) {
     let n = if quick { 300 } else { 4000 };
     let sets = samples(n);
-    println!("## Latency tails (per call, µs; {n} inputs per sample; single thread)");
-    println!(
+    outln!("## Latency tails (per call, µs; {n} inputs per sample; single thread)");
+    outln!(
         "{:<8} {:<30} {:>9} {:>9} {:>9} {:>10} {:>10} {:>8} {:>7}",
-        "call", "sample", "mean", "p50", "p99", "p99.9", "max", "vs box", "errors"
+        "call",
+        "sample",
+        "mean",
+        "p50",
+        "p99",
+        "p99.9",
+        "max",
+        "vs box",
+        "errors"
     );
     let mut box_mean = f64::NAN;
     let mut strong_forward = None;
@@ -114,14 +122,14 @@ pub fn run(quick: bool) {
         }
         print_row("solve", name, &t, box_mean);
     }
-    println!("goal (issue 9): the log-scale sample within 1.5× the box per call");
+    outln!("goal (issue 9): the log-scale sample within 1.5× the box per call");
     for (name, ratio) in within_twice {
         let verdict = if ratio <= 2.0 { "met" } else { "NOT met" };
-        println!(
+        outln!(
             "goal (issue 23): {name} within 2× the box per forward call: {ratio:.2}×, {verdict}"
         );
     }
-    println!(
+    outln!(
         "goal (issue 23): strong force mean ≤ 20 µs and p99 ≤ 200 µs per forward call, ≤ 2× the box through the CLI: {}",
         match strong_forward {
             Some(t) if t.mean <= 20.0 && t.p99 <= 200.0 => "met".to_string(),

@@ -1,6 +1,21 @@
 //! `rod-ig`: the command-line face of rod-ig-core. JSON lines in, JSON lines out; benchmarks;
 //! SVG pictures. A thin adapter: every number comes from the solver crate.
 
+/// `println!` for the benchmark's report, except that a closed stdout (`rod-ig bench | head`)
+/// ends the program quietly instead of panicking: std ignores SIGPIPE, so each write would
+/// fail with BrokenPipe.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout(), $($arg)*) {
+            if e.kind() == std::io::ErrorKind::BrokenPipe {
+                std::process::exit(0);
+            }
+            panic!("cannot write the report to stdout: {e}");
+        }
+    }};
+}
+
 mod answer;
 mod bench;
 mod bench_tails;

@@ -206,3 +206,29 @@ fn streamed_shape_equals_the_rods_samples() {
         assert_eq!(line["a"], serde_json::json!(a));
     }
 }
+
+/// `rod-ig bench | head -1`: the report stops quietly when its reader goes away (std ignores
+/// SIGPIPE, so each write fails with BrokenPipe; println! used to panic with a backtrace).
+#[test]
+fn bench_stops_quietly_when_its_reader_goes_away() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
+        .args(["bench", "--only", "spatial", "--quick"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("rod-ig starts");
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().expect("stdout"))
+        .read_line(&mut first)
+        .expect("the report's first line");
+    assert!(first.starts_with("## 3-D rod"), "{first}");
+    // The reader is dropped here: the pipe closes with the report unfinished.
+    let out = child.wait_with_output().expect("rod-ig exits");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success(),
+        "exit status {:?}: {stderr}",
+        out.status
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
