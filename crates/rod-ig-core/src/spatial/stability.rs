@@ -369,7 +369,7 @@ fn run(
     let options = options_for(a, opts.rtol, opts.atol);
     let dense = !straight && opts.coarse_stride != 0;
     let mut scan = Scan::new(a, opts);
-    let run = Run {
+    let integration = Integration {
         ci,
         a: ap,
         options,
@@ -380,12 +380,12 @@ fn run(
     #[cfg(target_arch = "x86_64")]
     let y = if crate::simd::has_avx2() {
         // SAFETY: scan_avx2 needs AVX2 only, and this CPU has it (checked just above).
-        unsafe { scan_avx2(&run, &mut scan) }
+        unsafe { scan_avx2(&integration, &mut scan) }
     } else {
-        scan_baseline(&run, &mut scan)
+        scan_baseline(&integration, &mut scan)
     };
     #[cfg(not(target_arch = "x86_64"))]
-    let y = scan_baseline(&run, &mut scan);
+    let y = scan_baseline(&integration, &mut scan);
     let y = y?;
     let Some(y) = y else {
         return Ok((None, scan.report()));
@@ -402,7 +402,7 @@ fn run(
 }
 
 /// What [`run`] integrates: the rod's stiffness inverses and parameters, and how.
-struct Run {
+struct Integration {
     ci: [f64; 3],
     a: [f64; 6],
     options: crate::ode::OdeOptions,
@@ -412,22 +412,25 @@ struct Run {
 }
 
 /// [`integrate_scanning`] as the crate is built.
-fn scan_baseline(run: &Run, scan: &mut Scan) -> Result<Option<[f64; NV]>, RodError> {
+fn scan_baseline(
+    integration: &Integration,
+    scan: &mut Scan,
+) -> Result<Option<[f64; NV]>, RodError> {
     let mut f = |_: f64, s: &[f64; NV], ds: &mut [f64; NV]| {
-        reduced::rhs::<NV, true>(&run.ci, &run.a, s, ds)
+        reduced::rhs::<NV, true>(&integration.ci, &integration.a, s, ds)
     };
-    integrate_scanning(&mut f, run, scan)
+    integrate_scanning(&mut f, integration, scan)
 }
 
 /// [`integrate_scanning`] compiled for AVX2 ([`crate::simd`]); the closure is written here so
 /// that it inherits the feature.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn scan_avx2(run: &Run, scan: &mut Scan) -> Result<Option<[f64; NV]>, RodError> {
+fn scan_avx2(integration: &Integration, scan: &mut Scan) -> Result<Option<[f64; NV]>, RodError> {
     let mut f = |_: f64, s: &[f64; NV], ds: &mut [f64; NV]| {
-        reduced::rhs::<NV, true>(&run.ci, &run.a, s, ds)
+        reduced::rhs::<NV, true>(&integration.ci, &integration.a, s, ds)
     };
-    integrate_scanning(&mut f, run, scan)
+    integrate_scanning(&mut f, integration, scan)
 }
 
 /// The integration of [`run`] with the scan of each accepted step: the final state, or None
@@ -435,14 +438,25 @@ fn scan_avx2(run: &Run, scan: &mut Scan) -> Result<Option<[f64; NV]>, RodError> 
 #[inline(always)]
 fn integrate_scanning<F>(
     f: &mut F,
-    run: &Run,
+    integration: &Integration,
     scan: &mut Scan,
 ) -> Result<Option<[f64; NV]>, RodError>
 where
     F: FnMut(f64, &[f64; NV], &mut [f64; NV]),
 {
-    let (dense, straight, early_exit) = (run.dense, run.straight, run.early_exit);
-    let mut st = Dop853::new(f, 0.0, reduced::initial::<NV>(), 1.0, &run.options, dense)?;
+    let (dense, straight, early_exit) = (
+        integration.dense,
+        integration.straight,
+        integration.early_exit,
+    );
+    let mut st = Dop853::new(
+        f,
+        0.0,
+        reduced::initial::<NV>(),
+        1.0,
+        &integration.options,
+        dense,
+    )?;
     while !st.finished() {
         st.step(f)?;
         if !straight {
@@ -548,7 +562,7 @@ mod tests {
     #[test]
     fn avx2_build_is_bit_identical() {
         use super::super::{options_for, reduced, SpatialParams};
-        use super::{Run, Scan, StabilityOptions, NV};
+        use super::{Integration, Scan, StabilityOptions, NV};
         if !crate::simd::has_avx2() {
             eprintln!("this CPU has no AVX2: only the baseline build runs here");
             return;
@@ -578,7 +592,7 @@ mod tests {
             let avx = unsafe { reduced::integrate_avx2::<NV, true>(&ci, &a, 1.0, &opts) };
             assert_eq!(bits(&base), bits(&avx.expect("avx2")), "{a:?}");
             let so = StabilityOptions::production();
-            let run = Run {
+            let integration = Integration {
                 ci,
                 a,
                 options: options_for(&p, so.rtol, so.atol),
@@ -587,11 +601,11 @@ mod tests {
                 early_exit: false,
             };
             let (mut s1, mut s2) = (Scan::new(&p, &so), Scan::new(&p, &so));
-            let y1 = super::scan_baseline(&run, &mut s1)
+            let y1 = super::scan_baseline(&integration, &mut s1)
                 .expect("base")
                 .expect("state");
             // SAFETY: as above.
-            let y2 = unsafe { super::scan_avx2(&run, &mut s2) }
+            let y2 = unsafe { super::scan_avx2(&integration, &mut s2) }
                 .expect("avx2")
                 .expect("state");
             assert_eq!(bits(&y1), bits(&y2), "{a:?}");
