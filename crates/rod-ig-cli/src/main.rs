@@ -11,7 +11,8 @@ macro_rules! outln {
             if e.kind() == std::io::ErrorKind::BrokenPipe {
                 std::process::exit(0);
             }
-            panic!("cannot write the report to stdout: {e}");
+            eprintln!("rod-ig: cannot write the report to stdout: {e}");
+            std::process::exit(1);
         }
     }};
 }
