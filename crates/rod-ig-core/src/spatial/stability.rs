@@ -122,7 +122,7 @@ fn det3(j: &super::SpatialJacobian, rows: [usize; 3], cols: [usize; 3]) -> f64 {
 fn det6(mut m: [[f64; 6]; 6]) -> f64 {
     let mut det = 1.0;
     for k in 0..6 {
-        // Pivot: the largest entry of column k of Jᵀ at or below the diagonal.
+        // Pivot: the largest entry of column k at or below the diagonal.
         let mut p = k;
         let mut best = m[k][k].abs();
         for (r, row) in m.iter().enumerate().skip(k + 1) {
