@@ -400,10 +400,6 @@ impl<const N: usize> Dop853<N> {
         self.has_dense.then_some(&self.dense)
     }
 
-    fn weight(&self, a: f64, b: f64) -> f64 {
-        self.opts.atol + self.opts.rtol * a.abs().max(b.abs())
-    }
-
     /// Hairer's starting-step heuristic (HNW I, §II.4): h such that an explicit Euler step
     /// would have local error ≈ 0.01 in the weighted norm, corrected by a second evaluation.
     fn initial_step<F>(&mut self, f: &mut F) -> f64
@@ -419,7 +415,7 @@ impl<const N: usize> Dop853<N> {
         let mut dnf = 0.0;
         let mut dny = 0.0;
         for i in 0..ne {
-            let sk = self.weight(self.y[i], self.y[i]);
+            let sk = self.opts.weight(self.y[i], self.y[i]);
             dnf += (self.k[0][i] / sk).powi(2);
             dny += (self.y[i] / sk).powi(2);
         }
@@ -438,7 +434,7 @@ impl<const N: usize> Dop853<N> {
         self.stats.evaluations += 1;
         let mut der2 = 0.0;
         for i in 0..ne {
-            let sk = self.weight(self.y[i], self.y[i]);
+            let sk = self.opts.weight(self.y[i], self.y[i]);
             der2 += ((f1[i] - self.k[0][i]) / sk).powi(2);
         }
         let der2 = der2.sqrt() / h;
@@ -582,7 +578,7 @@ impl<const N: usize> Dop853<N> {
         let mut err3 = 0.0;
         let ne = opts.error_components.min(N).max(1);
         for i in 0..ne {
-            let inv = 1.0 / (opts.atol + opts.rtol * y[i].abs().max(y_next[i].abs()));
+            let inv = 1.0 / opts.weight(y[i], y_next[i]);
             let e3 = scratch[i] - BHH1 * k1[i] - BHH2 * k9[i] - BHH3 * k12[i];
             let e5 = ER1 * k1[i]
                 + ER6 * k6[i]

@@ -121,6 +121,13 @@ impl OdeOptions {
         Ok(())
     }
 
+    /// The error weight of a component whose value goes from `a` to `b` over a step:
+    /// atol + rtol·max(|a|, |b|).
+    #[inline(always)]
+    pub(crate) fn weight(&self, a: f64, b: f64) -> f64 {
+        self.atol + self.rtol * a.abs().max(b.abs())
+    }
+
     pub(crate) fn sanitized(mut self) -> Self {
         if self.rtol.is_finite() && self.rtol > 0.0 && self.rtol < 1e-15 {
             self.rtol = 1e-15;
