@@ -164,12 +164,14 @@ pub(crate) fn integrate<const N: usize, const VAR: bool>(
     t: f64,
     opts: &OdeOptions,
 ) -> Result<[f64; N], OdeError> {
-    #[cfg(target_arch = "x86_64")]
-    if crate::simd::has_avx2() {
-        // SAFETY: integrate_avx2 needs AVX2 only, and this CPU has it (checked just above).
-        return unsafe { integrate_avx2::<N, VAR>(ci, a, t, opts) };
-    }
-    integrate_baseline::<N, VAR>(ci, a, t, opts)
+    crate::simd::pick_build!(
+        integrate_avx2::<N, VAR>,
+        integrate_baseline::<N, VAR>,
+        ci,
+        a,
+        t,
+        opts
+    )
 }
 
 /// Defines one build of [`integrate`]'s work. The right-hand side's closure must be written

@@ -377,16 +377,7 @@ fn run(
         straight,
         early_exit,
     };
-    #[cfg(target_arch = "x86_64")]
-    let y = if crate::simd::has_avx2() {
-        // SAFETY: scan_avx2 needs AVX2 only, and this CPU has it (checked just above).
-        unsafe { scan_avx2(&integration, &mut scan) }
-    } else {
-        scan_baseline(&integration, &mut scan)
-    };
-    #[cfg(not(target_arch = "x86_64"))]
-    let y = scan_baseline(&integration, &mut scan);
-    let y = y?;
+    let y = crate::simd::pick_build!(scan_avx2, scan_baseline, &integration, &mut scan)?;
     let Some(y) = y else {
         return Ok((None, scan.report()));
     };
