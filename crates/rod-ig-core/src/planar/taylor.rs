@@ -121,6 +121,81 @@ impl Measured for Dual3 {
     }
 }
 
+/// Truncation per step of [`CoarseDual3`]'s series: each series (value and every derivative)
+/// to 1e-10 of its own scale.
+pub(crate) const COARSE_TAIL_TOL: f64 = 1e-10;
+
+/// A [`Dual3`] whose series are truncated at [`COARSE_TAIL_TOL`] instead of one unit roundoff:
+/// longer steps (about 1.4× at order 32) for the short series of the stability scan, whose g
+/// is taken to 1e-3 (see `stability::ShortSeries`); its entries carry a correspondingly larger
+/// error bound there.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct CoarseDual3(pub(crate) Dual3);
+
+impl std::ops::Add for CoarseDual3 {
+    type Output = Self;
+    #[inline]
+    fn add(self, o: Self) -> Self {
+        Self(self.0 + o.0)
+    }
+}
+
+impl std::ops::Sub for CoarseDual3 {
+    type Output = Self;
+    #[inline]
+    fn sub(self, o: Self) -> Self {
+        Self(self.0 - o.0)
+    }
+}
+
+impl std::ops::Mul for CoarseDual3 {
+    type Output = Self;
+    #[inline]
+    fn mul(self, o: Self) -> Self {
+        Self(self.0 * o.0)
+    }
+}
+
+impl std::ops::Neg for CoarseDual3 {
+    type Output = Self;
+    #[inline]
+    fn neg(self) -> Self {
+        Self(-self.0)
+    }
+}
+
+impl std::ops::AddAssign for CoarseDual3 {
+    #[inline]
+    fn add_assign(&mut self, o: Self) {
+        self.0 += o.0;
+    }
+}
+
+impl Measured for CoarseDual3 {
+    const PARTS: usize = 4;
+    const TAIL_TOL: f64 = COARSE_TAIL_TOL;
+    #[inline]
+    fn constant(v: f64) -> Self {
+        Self(Dual3::constant(v))
+    }
+    #[inline]
+    fn part(self, i: usize) -> f64 {
+        self.0.part(i)
+    }
+    #[inline]
+    fn div_n(self, n: f64) -> Self {
+        Self(self.0.div_n(n))
+    }
+    #[inline]
+    fn mul_f(self, h: f64) -> Self {
+        Self(self.0.mul_f(h))
+    }
+    #[inline]
+    fn mul_values(self, o: Self) -> Self {
+        Self(self.0.mul_values(o.0))
+    }
+}
+
 /// A double-double number hi + lo (|lo| ≤ ulp(hi)/2), ≈ 106-bit significand, by the error-free
 /// transformations of Dekker (1971) and Knuth (TwoSum). Used for the tip of rods whose f64
 /// integration is ill-conditioned (strong axial force: rounding made while the rod loops grows
@@ -345,6 +420,15 @@ impl Gradient for Dual3 {
     }
     fn gradient(self) -> [f64; 3] {
         self.g
+    }
+}
+
+impl Gradient for CoarseDual3 {
+    fn value(self) -> f64 {
+        self.0.v
+    }
+    fn gradient(self) -> [f64; 3] {
+        self.0.g
     }
 }
 
