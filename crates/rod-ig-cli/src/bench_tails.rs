@@ -2,9 +2,11 @@
 //! forward map and of the robust solve on the uniform box next to log-scale samples of the
 //! regime a cable lives in (issue 9), with the ratio log-scale / box.
 
+use crate::planar_cmds::forward_line;
 use rod_ig_bench::families::samples;
 use rod_ig_core::planar::ig::{self, SolveOptions};
-use rod_ig_core::{planar, PlanarPose};
+use rod_ig_core::rng::SplitMix64;
+use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -130,11 +132,58 @@ pub fn run(quick: bool) {
         );
     }
     outln!(
-        "goal (issue 23): strong force mean ≤ 20 µs and p99 ≤ 200 µs per forward call, ≤ 2× the box through the CLI: {}",
+        "goal (issue 23): strong force mean ≤ 20 µs and p99 ≤ 200 µs per forward call: {}",
         match strong_forward {
             Some(t) if t.mean <= 20.0 && t.p99 <= 200.0 => "met".to_string(),
             Some(t) => format!("NOT met (mean {:.1} µs, p99 {:.1} µs)", t.mean, t.p99),
             None => "no strong-force sample".to_string(),
         }
     );
+    through_the_cli(&sets[0].1, n);
+}
+
+/// Mean µs per line of `rod-ig forward`'s work (parse, evaluate, JSON answer), after one
+/// untimed pass.
+fn per_line(lines: &[String]) -> f64 {
+    for l in lines {
+        let _ = black_box(forward_line(black_box(l)));
+    }
+    let t0 = Instant::now();
+    for l in lines {
+        let _ = black_box(forward_line(black_box(l)));
+    }
+    t0.elapsed().as_secs_f64() * 1e6 / lines.len().max(1) as f64
+}
+
+/// Issue 23's measure through the CLI: on a log-scale sample (|a3| 1e-8..5, |a4|, |a5|
+/// 1e-9..3e3, random signs), the rods within the box's magnitudes and those with |a4| or |a5|
+/// in [1e2, 3e3] against the uniform box, per line of `rod-ig forward`.
+fn through_the_cli(box_rods: &[PlanarParams], n: usize) {
+    let line = |a: &PlanarParams| format!("{{\"a\": [{:e}, {:e}, {:e}]}}", a[0], a[1], a[2]);
+    let mut rng = SplitMix64::new(23);
+    let (mut in_box, mut strong) = (Vec::new(), Vec::new());
+    // Draw until both groups are full (about a third of the draws are strong).
+    while in_box.len() < n || strong.len() < n {
+        let a = PlanarParams::new(
+            rng.signed_pow10(-8.0, 0.7),
+            rng.signed_pow10(-9.0, 3.5),
+            rng.signed_pow10(-9.0, 3.5),
+        );
+        let force = a[1].abs().max(a[2].abs());
+        if (1e2..=3e3).contains(&force) && strong.len() < n {
+            strong.push(line(&a));
+        } else if force <= 1e2 && a[0].abs() <= 10.0 && in_box.len() < n {
+            in_box.push(line(&a));
+        }
+    }
+    let box_lines: Vec<String> = box_rods.iter().map(line).collect();
+    let (b, i, s) = (per_line(&box_lines), per_line(&in_box), per_line(&strong));
+    outln!(
+        "through the CLI (rod-ig forward, per line: parse, evaluate, JSON; {n} lines each): box {b:.2} µs, \
+         log-scale within the box's magnitudes {i:.2} µs ({:.2}×), log-scale with |a4| or |a5| 1e2..3e3 {s:.2} µs ({:.2}×)",
+        i / b,
+        s / b
+    );
+    let verdict = if s <= 2.0 * b { "met" } else { "NOT met" };
+    outln!("goal (issue 23): strong-force rods ≤ 2× the box per rod through the CLI: {:.2}×, {verdict}", s / b);
 }
