@@ -151,6 +151,16 @@ fn in_measured_amplitude(m: f64) -> bool {
     (0.0..=MAX_M).contains(&m)
 }
 
+/// The rod's pendulum and its m where the constants were measured (see
+/// [`in_measured_compression`], [`in_measured_amplitude`]); None elsewhere.
+fn measured_pendulum<T: Real>(a3: T, a4: T, a5: T) -> Option<(Pendulum<T>, f64)> {
+    if !in_measured_compression(a4.re()) {
+        return None;
+    }
+    let (p, m) = pendulum_of(a3, a4, a5);
+    in_measured_amplitude(m).then_some((p, m))
+}
+
 /// q(t) and J(t) of a compressed nearly straight rod by its pendulum, with a-priori bounds.
 pub(crate) struct PoseAndJacobian {
     /// (x, y, θ).
@@ -166,17 +176,11 @@ pub(crate) struct PoseAndJacobian {
 /// Pose q(t), J(t) and their a-priori error bounds of a compressed nearly straight rod
 /// (module docs); None outside the measured domain or where a value is not finite.
 pub(crate) fn pose_and_jacobian(a3: f64, a4: f64, a5: f64, t: f64) -> Option<PoseAndJacobian> {
-    if !in_measured_compression(a4) {
-        return None;
-    }
-    let (p, m) = pendulum_of(
+    let (p, m) = measured_pendulum(
         Dual3::variable(a3, 0),
         Dual3::variable(a4, 1),
         Dual3::variable(a5, 2),
-    );
-    if !in_measured_amplitude(m) {
-        return None;
-    }
+    )?;
     let (pose, _) = pose_of(&p, t);
     let phase = p.omega.v * t.abs().max(1.0);
     let values = pose.map(|q| q.v);
@@ -195,13 +199,7 @@ pub(crate) fn pose_and_jacobian(a3: f64, a4: f64, a5: f64, t: f64) -> Option<Pos
 
 /// The tip q(1) and its a-priori absolute error bound (see [`pose_and_jacobian`]).
 pub(crate) fn tip(a3: f64, a4: f64, a5: f64) -> Option<([f64; 3], f64)> {
-    if !in_measured_compression(a4) {
-        return None;
-    }
-    let (p, m) = pendulum_of(a3, a4, a5);
-    if !in_measured_amplitude(m) {
-        return None;
-    }
+    let (p, m) = measured_pendulum(a3, a4, a5)?;
     let (pose, _) = pose_of(&p, 1.0);
     let error = TIP_C * m * m.sqrt() + TIP_ROUNDING * (1.0 + p.omega);
     pose.iter().all(|v| v.is_finite()).then_some((pose, error))
@@ -209,13 +207,7 @@ pub(crate) fn tip(a3: f64, a4: f64, a5: f64) -> Option<([f64; 3], f64)> {
 
 /// ½∫₀¹κ² = ½P(1) and its a-priori relative error bound (see [`pose_and_jacobian`]).
 pub(crate) fn energy(a3: f64, a4: f64, a5: f64) -> Option<(f64, f64)> {
-    if !in_measured_compression(a4) {
-        return None;
-    }
-    let (p, m) = pendulum_of(a3, a4, a5);
-    if !in_measured_amplitude(m) {
-        return None;
-    }
+    let (p, m) = measured_pendulum(a3, a4, a5)?;
     let (_, big_p) = pose_of(&p, 1.0);
     let e = 0.5 * big_p;
     let error = ENERGY_C * m + ENERGY_ROUNDING * (1.0 + p.omega);
