@@ -364,6 +364,15 @@ struct Invariants<T> {
     lambda4: T,
 }
 
+/// A J error estimate floored at the base accuracy [`CLOSED_J_REL`] (infinite when not finite).
+fn floored_j_error(e: f64) -> f64 {
+    if e.is_finite() {
+        e.max(CLOSED_J_REL)
+    } else {
+        f64::INFINITY
+    }
+}
+
 impl<T: Real> Closed<T> {
     /// A-priori estimate of the relative error (Frobenius) of J(t, a): the base accuracy
     /// [`CLOSED_J_REL`], or, when larger, the cancellation loss ε·(1/m + L(m1))·s(ρ) of cases I
@@ -380,11 +389,7 @@ impl<T: Real> Closed<T> {
             Case::SmallForce => self.rho_spread(t) * f64::EPSILON + self.m.re(),
             _ => 0.0,
         };
-        if e.is_finite() {
-            e.max(CLOSED_J_REL)
-        } else {
-            f64::INFINITY
-        }
+        floored_j_error(e)
     }
 
     /// The estimate of J(1)'s relative error that decides whether the closed form answers it:
@@ -393,14 +398,7 @@ impl<T: Real> Closed<T> {
     #[cfg(test)]
     pub(crate) fn end_jacobian_rel_error(&self) -> f64 {
         match self.case {
-            Case::I | Case::II => {
-                let e = self.end_cancellation_loss() * f64::EPSILON;
-                if e.is_finite() {
-                    e.max(CLOSED_J_REL)
-                } else {
-                    f64::INFINITY
-                }
-            }
+            Case::I | Case::II => floored_j_error(self.end_cancellation_loss() * f64::EPSILON),
             _ => self.jacobian_rel_error_at(1.0),
         }
     }
@@ -416,10 +414,11 @@ impl<T: Real> Closed<T> {
     /// det J(t) cancels beyond J's own error, and the phase factor was measured on J(1) only.
     fn end_cancellation_loss(&self) -> f64 {
         let blind = self.cancellation_loss(1.0);
-        let root_f = crate::scalar::fast_hypot(self.a4.re(), self.a5.re()).sqrt();
+        // Tested cheapest first: every closed-form rod asks this (`needs_series`).
         if self.near_separatrix_weakly_bent()
-            && root_f <= SEPARATRIX_PHASE_MAX_ROOT_F
             && blind * f64::EPSILON <= SEPARATRIX_PHASE_MAX_BLIND
+            && crate::scalar::fast_hypot(self.a4.re(), self.a5.re()).sqrt()
+                <= SEPARATRIX_PHASE_MAX_ROOT_F
         {
             self.cancellation_loss_with(1.0, self.loss_m1 * self.separatrix_phase_factor(1.0))
         } else {
