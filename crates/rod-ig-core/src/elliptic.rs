@@ -33,6 +33,35 @@ const ZETA_TOL: f64 = 1.0e-17;
 /// truncation error below 1e-17 for both R_F and R_D).
 const CARLSON_TOL: f64 = 1.2e-3;
 
+/// The tolerances for double-double scalars ([`Real::EXTENDED`]): the series' truncation and
+/// their f64 coefficients (1/24, 0.1, …, rounded to ε) then act on terms ≤ 1e-16, below 1e-32.
+const CARLSON_TOL_DD: f64 = 1e-8;
+/// See [`CARLSON_TOL_DD`]: the neglected arcsine term ≤ 2.5e-35, the Z/m term ≤ 1e-33.
+const AGM_TOL_DD: f64 = 1.0e-17;
+const ZETA_TOL_DD: f64 = 1.0e-33;
+
+/// Carlson's deviation tolerance for the scalar's precision.
+#[inline]
+fn carlson_tol<T: Real>() -> f64 {
+    if T::EXTENDED {
+        CARLSON_TOL_DD
+    } else {
+        CARLSON_TOL
+    }
+}
+
+/// True when the AGM has converged at ratio = |cₙ/aₙ| (see [`AGM_TOL`]) for the scalar's
+/// precision.
+#[inline]
+fn agm_done<T: Real>(ratio: f64, cr: f64, ar: f64, mr: f64) -> bool {
+    let (agm, zeta) = if T::EXTENDED {
+        (AGM_TOL_DD, ZETA_TOL_DD)
+    } else {
+        (AGM_TOL, ZETA_TOL)
+    };
+    ratio <= agm && ratio * cr.abs() <= 4.0 * zeta * ar.abs() * mr.abs()
+}
+
 /// Carlson's R_F(x, y, z) = ½∫₀^∞ dt / √((t+x)(t+y)(t+z)), x, y, z ≥ 0, at most one zero.
 ///
 /// Duplication theorem and the 5th-order Taylor series of Carlson (1995), eq. (2.2)–(2.3).
@@ -48,7 +77,7 @@ pub fn carlson_rf<T: Real>(x: T, y: T, z: T) -> T {
             .max((m - y.re()).abs())
             .max((m - z.re()).abs());
         // written so that NaN also ends the loop
-        if dev.partial_cmp(&(CARLSON_TOL * m.abs())) != Some(std::cmp::Ordering::Greater) {
+        if dev.partial_cmp(&(carlson_tol::<T>() * m.abs())) != Some(std::cmp::Ordering::Greater) {
             break;
         }
         let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
@@ -88,7 +117,8 @@ pub fn carlson_rf_rd<T: Real>(x: T, y: T, z: T) -> (T, T) {
         let md = (xr + yr + 3.0 * zr) / 5.0;
         let dev = (mf - xr).abs().max((mf - yr).abs()).max((mf - zr).abs());
         let devd = (md - xr).abs().max((md - yr).abs()).max((md - zr).abs());
-        if !(dev > CARLSON_TOL * mf.abs() || devd > CARLSON_TOL * md.abs()) {
+        let tol = carlson_tol::<T>();
+        if !(dev > tol * mf.abs() || devd > tol * md.abs()) {
             break;
         }
         let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
@@ -185,7 +215,7 @@ pub fn legendre_sc<T: Real>(s: T, c: T, m: T, m1: T) -> (T, T, T) {
 #[inline]
 fn reduce<T: Real>(phi: T) -> (T, f64) {
     let k = (phi.re() / PI).round();
-    (phi - k * PI, k)
+    (phi - T::pi() * k, k)
 }
 
 /// Incomplete integral of the first kind F(φ|m) for any real φ (quasi-periodic extension
@@ -261,7 +291,7 @@ pub fn inverse_phase<T: Real>(s: T, c: T, _m: T, m1: T, kk: T) -> T {
 /// the derivatives are carried through the Carlson duplications instead.
 #[inline]
 pub fn inverse_phase_zeta<T: Real>(s: T, c: T, m1: T, kk: T, dk: T) -> (T, T) {
-    if T::HAS_DERIVATIVES && m1.re() <= 0.99 {
+    if T::HAS_DERIVATIVES && !T::EXTENDED && m1.re() <= 0.99 {
         let (sr, cr, m1r) = (s.re(), c.re(), m1.re());
         let (phi, zm0) = inverse_phase_zeta::<f64>(sr, cr, m1r, kk.re(), dk.re());
         let m = 1.0 - m1r;
@@ -371,12 +401,12 @@ impl<T: Real> Landen<T> {
             levels = n;
             let (cr, ar, mr) = (c.re(), a.re(), m.re());
             let ratio = cr.abs() / ar.abs();
-            if ratio <= AGM_TOL && ratio * cr.abs() <= 4.0 * ZETA_TOL * ar.abs() * mr.abs() {
+            if agm_done::<T>(ratio, cr, ar, mr) {
                 converged = ar.is_finite() && ar > 0.0;
                 break;
             }
         }
-        let k = a.recip() * FRAC_PI_2;
+        let k = a.recip() * T::pi() * 0.5;
         Self {
             m,
             m1,
@@ -463,6 +493,20 @@ impl<T: Real> Landen<T> {
 /// Largest argument at which the Maclaurin series of [`Duplication`] are used: with terms
 /// through z⁹ (sn) and z⁸ (cn, dn) the first neglected term is ≤ 0.014·z¹⁰ ≤ 1.3e-17.
 const SERIES_MAX: f64 = 1.0 / 32.0;
+/// [`SERIES_MAX`] for double-double scalars: the first neglected term ≤ 0.014·z¹⁰ ≤ 2e-35
+/// (the coefficients are then divided exactly, see [`over`]).
+const SERIES_MAX_DD: f64 = 1.0 / 2048.0;
+
+/// x/d: an exact division for double-double scalars, a product by the rounded reciprocal
+/// (folded at compile time) otherwise.
+#[inline]
+fn over<U: Real>(x: U, d: f64) -> U {
+    if U::EXTENDED {
+        x / d
+    } else {
+        x * (1.0 / d)
+    }
+}
 
 /// Below this m, [`Duplication::eval`] carries dual numbers through the duplications instead of
 /// attaching the analytic derivatives (whose ∂D/∂m cancels like 1e-16/m).
@@ -494,12 +538,12 @@ fn agm_kq<T: Real>(m: T, m1: T) -> (T, T, bool) {
         q += m * d * d * pow2;
         let (cr, ar, mr) = (c.re(), a.re(), m.re());
         let ratio = cr.abs() / ar.abs();
-        if ratio <= AGM_TOL && ratio * cr.abs() <= 4.0 * ZETA_TOL * ar.abs() * mr.abs() {
+        if agm_done::<T>(ratio, cr, ar, mr) {
             converged = ar.is_finite() && ar > 0.0;
             break;
         }
     }
-    (a.recip() * FRAC_PI_2, q, converged)
+    (a.recip() * T::pi() * 0.5, q, converged)
 }
 
 /// Jacobi functions by argument reduction, Maclaurin series and duplication (no sines, no
@@ -549,33 +593,28 @@ pub struct Duplication<T> {
 fn series_coefficients<U: Real>(m: U) -> [[U; 4]; 4] {
     let m2 = m * m;
     let m3 = m2 * m;
-    let s3 = -(m + 1.0) * (1.0 / 6.0);
-    let s5 = (m * 14.0 + m2 + 1.0) * (1.0 / 120.0);
-    let s7 = -((m + m2) * 135.0 + m3 + 1.0) * (1.0 / 5040.0);
-    let s9 = ((m + m3) * 1228.0 + m2 * 5478.0 + m2 * m2 + 1.0) * (1.0 / 362_880.0);
+    let s3 = over(-(m + 1.0), 6.0);
+    let s5 = over(m * 14.0 + m2 + 1.0, 120.0);
+    let s7 = over(-((m + m2) * 135.0 + m3 + 1.0), 5040.0);
+    let s9 = over((m + m3) * 1228.0 + m2 * 5478.0 + m2 * m2 + 1.0, 362_880.0);
     let cc = [
         U::from_f64(-0.5),
-        (m * 4.0 + 1.0) * (1.0 / 24.0),
-        -(m * 44.0 + m2 * 16.0 + 1.0) * (1.0 / 720.0),
-        (m * 408.0 + m2 * 912.0 + m3 * 64.0 + 1.0) * (1.0 / 40_320.0),
+        over(m * 4.0 + 1.0, 24.0),
+        over(-(m * 44.0 + m2 * 16.0 + 1.0), 720.0),
+        over(m * 408.0 + m2 * 912.0 + m3 * 64.0 + 1.0, 40_320.0),
     ];
     let dc = [
         m * -0.5,
-        m * (m + 4.0) * (1.0 / 24.0),
-        -m * (m * 44.0 + m2 + 16.0) * (1.0 / 720.0),
-        m * (m * 912.0 + m2 * 408.0 + m3 + 64.0) * (1.0 / 40_320.0),
+        over(m * (m + 4.0), 24.0),
+        over(-m * (m * 44.0 + m2 + 16.0), 720.0),
+        over(m * (m * 912.0 + m2 * 408.0 + m3 + 64.0), 40_320.0),
     ];
     // sn² = z² + e4 z⁴ + e6 z⁶ + e8 z⁸ + e10 z¹⁰ + …, D = ∫ sn²
     let e4 = s3 * 2.0;
     let e6 = s5 * 2.0 + s3 * s3;
     let e8 = (s7 + s3 * s5) * 2.0;
     let e10 = (s9 + s3 * s7) * 2.0 + s5 * s5;
-    let pc = [
-        e4 * 0.2,
-        e6 * (1.0 / 7.0),
-        e8 * (1.0 / 9.0),
-        e10 * (1.0 / 11.0),
-    ];
+    let pc = [over(e4, 5.0), over(e6, 7.0), over(e8, 9.0), over(e10, 11.0)];
     [[s3, s5, s7, s9], cc, dc, pc]
 }
 
@@ -611,7 +650,7 @@ impl<T: Real> Duplication<T> {
     #[inline]
     pub fn new(m: T, m1: T) -> Self {
         let b0 = m1.sqrt();
-        let (k, q, converged) = if T::HAS_DERIVATIVES && m.re() >= ANALYTIC_MIN_M {
+        let (k, q, converged) = if T::HAS_DERIVATIVES && !T::EXTENDED && m.re() >= ANALYTIC_MIN_M {
             let (mr, m1r) = (m.re(), m1.re());
             let (k, q, conv) = agm_kq(mr, m1r);
             let d = k * (q + 1.0) * 0.5;
@@ -729,7 +768,8 @@ impl<T: Real> Duplication<T> {
 
     /// (sn, cn, dn, D) at v ∈ [−K, K] with the derivatives carried through every operation
     /// (series coefficients included). Used for dual numbers when m < [`ANALYTIC_MIN_M`],
-    /// where the analytic ∂D/∂m = −(dn A + D/2)/m would cancel like 1e-16/m.
+    /// where the analytic ∂D/∂m = −(dn A + D/2)/m would cancel like 1e-16/m, and for
+    /// double-double scalars (series to z ≤ [`SERIES_MAX_DD`], coefficients divided exactly).
     fn core_generic(&self, v: T) -> (T, T, T, T) {
         let (m, m1) = (self.m, self.m1);
         let kr = self.kr;
@@ -740,7 +780,12 @@ impl<T: Real> Duplication<T> {
         let mut zr = w.re();
         let mut scale = 1.0;
         let mut n = 0u32;
-        while zr > SERIES_MAX && n < 1100 {
+        let series_max = if T::EXTENDED {
+            SERIES_MAX_DD
+        } else {
+            SERIES_MAX
+        };
+        while zr > series_max && n < 1100 {
             zr *= 0.5;
             scale *= 0.5;
             n += 1;
@@ -751,7 +796,8 @@ impl<T: Real> Duplication<T> {
         let mut s = z + z * z2 * (sc[0] + z2 * (sc[1] + z2 * (sc[2] + z2 * sc[3])));
         let mut c = z2 * (cc[0] + z2 * (cc[1] + z2 * (cc[2] + z2 * cc[3]))) + 1.0;
         let mut d = z2 * (dc[0] + z2 * (dc[1] + z2 * (dc[2] + z2 * dc[3]))) + 1.0;
-        let mut dd = z * z2 * (z2 * (pc[0] + z2 * (pc[1] + z2 * (pc[2] + z2 * pc[3]))) + 1.0 / 3.0);
+        let third = over(T::from_f64(1.0), 3.0);
+        let mut dd = z * z2 * (z2 * (pc[0] + z2 * (pc[1] + z2 * (pc[2] + z2 * pc[3]))) + third);
         for _ in 0..n {
             let s2 = s * s;
             let c2 = c * c;
@@ -785,10 +831,10 @@ impl<T: Real> Duplication<T> {
         let j = (u.re() / (2.0 * kr)).round();
         let v = if j != 0.0 { u - self.k * (2.0 * j) } else { u };
         let vr = v.re();
-        if T::HAS_DERIVATIVES && self.mr < ANALYTIC_MIN_M {
+        if T::EXTENDED || (T::HAS_DERIVATIVES && self.mr < ANALYTIC_MIN_M) {
             let (mut sn, mut cn, dn, dv) = self.core_generic(v);
             let am = if with_am {
-                sn.atan2_fast(cn) + j * PI
+                sn.atan2_fast(cn) + T::pi() * j
             } else {
                 T::from_f64(0.0)
             };

@@ -28,6 +28,7 @@
 #![warn(missing_docs)]
 
 mod angle;
+pub mod dd;
 mod eft;
 pub mod elliptic;
 mod error;

@@ -31,8 +31,18 @@ pub trait Real:
 {
     /// True for scalars that carry derivatives (dual numbers), false for `f64`.
     const HAS_DERIVATIVES: bool;
+    /// True for arithmetic beyond f64 ([`crate::dd::DualDd`]): generic code then skips its
+    /// f64 shortcuts (values computed in f64 with derivatives attached, f64 constants that are
+    /// not exact) and runs its generic path with tolerances for that precision.
+    const EXTENDED: bool = false;
+    /// Unit roundoff of the arithmetic, for error estimates (`f64::EPSILON` unless extended).
+    const EPSILON: f64 = f64::EPSILON;
     /// A constant (zero derivative).
     fn from_f64(v: f64) -> Self;
+    /// π to the scalar's precision.
+    fn pi() -> Self {
+        Self::from_f64(std::f64::consts::PI)
+    }
     /// The f64 value (the real part of a dual number).
     fn re(self) -> f64;
     /// The same number with its value replaced by `v` (derivatives kept): for a value computed

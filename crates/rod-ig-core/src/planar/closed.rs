@@ -403,6 +403,13 @@ impl<T: Real> Closed<T> {
         }
     }
 
+    /// The phase-blind estimate of J(1)'s relative error in the scalar's own unit roundoff
+    /// ([`Real::EPSILON`]): for the double-double closed form, whose rounding follows the same
+    /// cancellation model at 2⁻¹⁰⁴ (measured in `planar::extended`).
+    pub(crate) fn end_jacobian_rel_error_own(&self) -> f64 {
+        floored_j_error(self.cancellation_loss(1.0) * T::EPSILON)
+    }
+
     /// (1/m + L(m1))·s(ρt) for cases I and II, s(ρt) alone otherwise (in units of ε).
     fn cancellation_loss(&self, t: f64) -> f64 {
         self.cancellation_loss_with(t, self.loss_m1)
@@ -513,7 +520,7 @@ impl<T: Real> Closed<T> {
             Case::I | Case::II => self.m1_loss_pose() + 1.0 / self.m.re(),
             _ => 0.0,
         };
-        CLOSED_POSE_ULPS * f64::EPSILON * (1.0 + loss) * rho.recip().max(1.0)
+        CLOSED_POSE_ULPS * T::EPSILON * (1.0 + loss) * rho.recip().max(1.0)
     }
 
     /// True when J (and det J) from this closed form may be off by more than
@@ -678,7 +685,13 @@ impl<T: Real> Closed<T> {
         };
         let a3s = a3 * a3;
         let alpha3 = a3s + fp * 2.0;
-        let lambda4 = (a5 * a5 - a3s * (a3s * 0.25 + a4)).with_re(lambda4_value(a3r, a4r, a5r));
+        let lambda4 = a5 * a5 - a3s * (a3s * 0.25 + a4);
+        // Double-double arithmetic already carries λ4 to ~2⁻¹⁰⁴ of its terms.
+        let lambda4 = if T::EXTENDED {
+            lambda4
+        } else {
+            lambda4.with_re(lambda4_value(a3r, a4r, a5r))
+        };
         s.chat = a4 / f;
         s.shat = a5 / f;
         s.sqa3 = alpha3.sqrt();

@@ -438,6 +438,8 @@ fn scan_series<T: Gradient>(
         // agree, the measured rule stands: every such verdict on the 320-bit references is
         // right.
         return Ok(StabilityReport {
+            stable: false,
+            first_conjugate_t: None,
             uncertain: true,
             ..verdict(s, g(s.t_margin).1)
         });
