@@ -515,6 +515,10 @@ fn closed_energy<T: crate::scalar::Real>(
     if let Some(e) = small_angle_energy(a) {
         return Ok(e);
     }
+    // The identity in double-double (tens of µs; the series below takes ms under a force).
+    if let Some(e) = extended::energy(a) {
+        return Ok(e);
+    }
     // Near the separatrix under a strong force the f64 series' rounding grows like e^{√‖F‖}
     // (measured far less: see [`SERIES_F64_TIP_MAX_ROOT_F`]).
     let root_f = a[1].hypot(a[2]).sqrt();
