@@ -8,10 +8,10 @@
 //! microseconds, where the double-double Taylor series took milliseconds and still had to be
 //! cross-checked beyond √‖F‖ = 27.
 //!
-//! The algorithms are the classical ones: Knuth's TwoSum and Dekker's product
-//! ([`crate::eft`]), Dekker's division and Karp's square root, and for the elementary
-//! functions an f64 first guess refined by one Newton step (atan2, ln, asinh) or argument
-//! reduction and a Taylor series (sin/cos, exp). Accuracy: a few units of 2⁻¹⁰⁴ relative for
+//! The algorithms are the classical ones: Knuth's TwoSum and Dekker's product (error-free
+//! transformations), Dekker's division and Karp's square root, and for the elementary functions
+//! an f64 first guess refined by one Newton step (atan2, ln, asinh) or argument reduction and a
+//! Taylor series (sin/cos, exp). Accuracy: a few units of 2⁻¹⁰⁴ relative for
 //! the arithmetic and of 2⁻¹⁰⁰ for the functions (tested below against identities and
 //! constants known to 32 digits). Overflow of the Dekker split (|x| ≳ 1e300) gives NaN, which
 //! the closed form reports as overflow.

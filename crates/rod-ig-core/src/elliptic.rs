@@ -13,7 +13,9 @@
 //!   quasi-periodicity F(φ + kπ) = F(φ) + 2kK (same for E, D).
 //!
 //! When the scalar is [`crate::scalar::Dual3`] the derivatives flow through every iteration;
-//! iteration counts and branches are decided on the f64 values ([`Real::re`]).
+//! iteration counts and branches are decided on the f64 values ([`Real::re`]). With a
+//! double-double scalar ([`crate::dd::DualDd`], [`Real::EXTENDED`]) the generic paths run with
+//! tolerances for 2⁻¹⁰⁴ and π to that precision.
 
 use crate::scalar::{fast_atan2, Real};
 use std::f64::consts::{FRAC_PI_2, PI};

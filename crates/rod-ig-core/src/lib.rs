@@ -12,6 +12,8 @@
 //! Modules:
 //! - [`scalar`]: the [`scalar::Real`] trait and forward-mode dual numbers, so the closed forms
 //!   give exact derivatives.
+//! - [`dd`]: double-double numbers and their dual numbers, on which the same closed forms run
+//!   where f64 cancels (near the separatrix).
 //! - [`elliptic`]: Jacobi elliptic functions and Legendre/Carlson integrals, accurate when the
 //!   complementary parameter m1 = 1 − m is passed directly.
 //! - [`planar`]: closed-form shape q(t), sensitivity J(t, a), stability and energy.
