@@ -33,9 +33,16 @@ def main() -> int:
     target.header.stamp = node.get_clock().now().to_msg()
     target.pose.position.x, target.pose.position.y = x, y
     target.pose.orientation.z, target.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
-    pub.publish(target)
-
+    # Discovery is asynchronous: the node may see our publisher before its writer has matched
+    # our subscription, and a volatile answer sent then is lost. Resend each second until one
+    # arrives (the node answers every target; a repeat is harmless).
+    resend_ns = 1_000_000_000
+    last_sent = 0
     while "solution" not in replies and node.get_clock().now().nanoseconds < deadline:
+        now = node.get_clock().now().nanoseconds
+        if now - last_sent >= resend_ns:
+            pub.publish(target)
+            last_sent = now
         rclpy.spin_once(node, timeout_sec=0.1)
     solution = replies.get("solution")
     if solution is None:
