@@ -445,15 +445,21 @@ pub(crate) fn energy_rel_error(th: f64) -> f64 {
 /// |S2| ≤ min(t²/2, 2/w²). Infinite (beyond the expansion) when already |a3| + |a5|/2 > 0.01
 /// under tension (S1 ≥ 1, S2 ≥ ½), so that a bent rod pays no more than that test.
 pub(crate) fn max_angle(a3: f64, a4: f64, a5: f64) -> f64 {
+    if a4 >= 0.0 && a3.abs() + 0.5 * a5.abs() > 0.01 {
+        return f64::INFINITY;
+    }
+    max_angle_to(a3, a4, a5, 1.0)
+}
+
+/// Largest bending angle of the linearised rod over [0, t] (bounded above, as
+/// [`max_angle`] over [0, 1]): the part [0, t] of the rod is a rod of length t.
+pub(crate) fn max_angle_to(a3: f64, a4: f64, a5: f64, t: f64) -> f64 {
     if a4 >= 0.0 {
-        if a3.abs() + 0.5 * a5.abs() > 0.01 {
-            return f64::INFINITY;
-        }
-        let [s1, s2, ..] = straight_jets(a4, 1.0);
+        let [s1, s2, ..] = straight_jets(a4, t);
         a3.abs() * s1.v + a5.abs() * s2.v
     } else {
         let w = (-a4).sqrt();
-        a3.abs() * w.recip().min(1.0) + a5.abs() * (2.0 / (w * w)).min(0.5)
+        a3.abs() * w.recip().min(t) + a5.abs() * (2.0 / (w * w)).min(0.5 * t * t)
     }
 }
 
