@@ -410,6 +410,19 @@ impl<T: Real> Closed<T> {
         floored_j_error(self.cancellation_loss(1.0) * T::EPSILON)
     }
 
+    /// The phase-blind estimate of J(t)'s relative error (Frobenius) in the scalar's own unit
+    /// roundoff, floored at [`CLOSED_J_REL`] scaled to it (the double-double closed form's
+    /// stability scan).
+    pub(crate) fn jacobian_rel_error_own_at(&self, t: f64) -> f64 {
+        let floor = CLOSED_J_REL * (T::EPSILON / f64::EPSILON);
+        let e = self.cancellation_loss(t) * T::EPSILON;
+        if e.is_finite() {
+            e.max(floor)
+        } else {
+            f64::INFINITY
+        }
+    }
+
     /// (1/m + L(m1))·s(ρt) for cases I and II, s(ρt) alone otherwise (in units of ε).
     fn cancellation_loss(&self, t: f64) -> f64 {
         self.cancellation_loss_with(t, self.loss_m1)

@@ -36,6 +36,15 @@ pub(crate) fn seeded(a: &PlanarParams) -> Option<Closed<DualDd>> {
     matches!(c.case, Case::I | Case::II).then_some(c)
 }
 
+/// The double-double closed form for the second pass of the norm-wise stability scan
+/// (`stability::closed_scan`), within the measured reach (√‖F‖ ≤ [`EXTENDED_MAX_ROOT_F`]).
+pub(crate) fn seeded_for_scan(a: &PlanarParams) -> Option<Closed<DualDd>> {
+    if a[1].hypot(a[2]).sqrt() > EXTENDED_MAX_ROOT_F {
+        return None;
+    }
+    seeded(a)
+}
+
 /// q(1), J(1) and the energy from the double-double closed form, where its error estimates
 /// hold (√‖F‖ ≤ [`EXTENDED_MAX_ROOT_F`]): J's relative error estimate ([`Closed::end_jacobian_rel_error_own`], the f64 model at
 /// 2⁻¹⁰⁴) within [`CLOSED_J_TOLERANCE`], the tip's within [`EXTENDED_TIP_TOLERANCE`], and the
