@@ -20,7 +20,8 @@ Writes crates/rod-ig-core/tests/data/separatrix_truth.jsonl, one line per rod:
  det J ≤ 0, or null)}.
 Run: python3 scripts/gen_separatrix_truth.py [N=600]   (needs python-flint; ≈ 1 s per rod, two
 processes); `--extreme [N=160]` writes separatrix_truth_extreme.jsonl instead, issue 23's
-tiny-bending sample; `--verdicts IN OUT` writes only the verdicts of the rods listed in IN.
+tiny-bending sample; `--strong [N=48]` writes separatrix_truth_strong.jsonl, tension beyond the
+double-double series' reach (√‖F‖ 100..500) at up to ~925 bits; `--verdicts IN OUT` writes only the verdicts of the rods listed in IN.
 The samples are seeded: the same files every run.
 """
 import json, math, pathlib, random, sys
@@ -38,8 +39,8 @@ def dmul(u, w):
             u[0] * w[3] + u[3] * w[0]]
 
 
-def reference(a):
-    flint.ctx.prec = PREC
+def reference(a, prec=PREC):
+    flint.ctx.prec = prec
     a3, a4, a5 = a
     Z = arb(0)
 
@@ -169,6 +170,38 @@ def sample(n):
     return out
 
 
+def strong_precision(a):
+    """Bits for a rod under tension beyond √‖F‖ = 100: rounding made near the straight
+    equilibrium grows like e^{√‖F‖} (1.44·√‖F‖ bits), plus 200 bits for the 1e-60 truncation
+    and the answer's own digits; 320 at least."""
+    return max(PREC, int(1.45 * math.sqrt(math.hypot(a[1], a[2]))) + 200)
+
+
+def reference_strong(a):
+    return reference(a, strong_precision(a))
+
+
+def sample_strong(n):
+    """Beyond the double-double series' reach: tension 1e4..2.5e5 (√‖F‖ 100..500), moment and
+    transverse force 1e-14..1e-3 with some exact zeros (`--strong`; each rod at
+    `strong_precision` bits, ~10–40 s)."""
+    r = random.Random(4005)
+
+    def signed(lo, hi):
+        v = 10 ** r.uniform(lo, hi)
+        return -v if r.random() < 0.5 else v
+
+    def small():
+        return 0.0 if r.random() < 0.15 else signed(-14, -3)
+
+    out = []
+    while len(out) < n:
+        a = [small(), 10 ** r.uniform(4, 5.4), small()]
+        if a[0] != 0.0 or a[2] != 0.0:
+            out.append(a)
+    return out
+
+
 def sample_extreme(n):
     """Issue 23's independent sample: axial force 1e3..1e4 of either sign, moment and transverse
     force 1e-14..1e-6 with some exact zeros, and the rod issue 23 quotes (a 320-bit integration
@@ -210,12 +243,17 @@ if __name__ == "__main__":
         verdicts(sys.argv[i + 1], sys.argv[i + 2])
         sys.exit(0)
     extreme = "--extreme" in sys.argv
+    strong = "--strong" in sys.argv
     args = [v for v in sys.argv[1:] if not v.startswith("--")]
-    n = int(args[0]) if args else (160 if extreme else 600)
-    name = "separatrix_truth_extreme.jsonl" if extreme else "separatrix_truth.jsonl"
+    n = int(args[0]) if args else (160 if extreme else 48 if strong else 600)
+    name = ("separatrix_truth_extreme.jsonl" if extreme else
+            "separatrix_truth_strong.jsonl" if strong else "separatrix_truth.jsonl")
     path = pathlib.Path(__file__).resolve().parent.parent / "crates/rod-ig-core/tests/data" / name
     with Pool(2) as pool:
-        rows = pool.map(reference, (sample_extreme if extreme else sample)(n), chunksize=1)
+        if strong:
+            rows = pool.map(reference_strong, sample_strong(n), chunksize=1)
+        else:
+            rows = pool.map(reference, (sample_extreme if extreme else sample)(n), chunksize=1)
     with open(path, "w") as f:
         for row in rows:
             f.write(json.dumps(row) + "\n")

@@ -234,7 +234,9 @@ fn check_reference(text: &str) -> ReferenceReport {
             Err(e) => {
                 refused += 1;
                 let msg = e.to_string();
-                if root_f <= CERTIFIED_ROOT_F || !msg.contains("cannot be certified") {
+                let certified_refusal =
+                    msg.contains("cannot be certified") || msg.contains("bounded time");
+                if root_f <= CERTIFIED_ROOT_F || !certified_refusal {
                     failures.push(format!("{:?}: refused: {msg}", a.as_slice()));
                 }
                 continue;
@@ -336,4 +338,17 @@ fn strong_tension_with_tiny_bending_is_right_or_refused() {
             ),
         }
     }
+}
+
+/// Tension beyond the double-double series' reach (`scripts/gen_separatrix_truth.py --strong`:
+/// 48 rods, √‖F‖ 101..470, moment and transverse force 1e-14..1e-3 with exact zeros, each at
+/// up to 880 bits): every answer right, none refused, at most 5 % uncertain. Measured: tips
+/// within 1.4e-14, J 1.2e-10, energies 7.5e-15, every verdict given right, 1 uncertain (its
+/// margin equal to the reference's to 1e-10). Before the closed form in double-double was
+/// measured here (it stopped at √‖F‖ = 100), most such rods were refused ("bounded time":
+/// 276 of 400 in a sample like this one).
+#[test]
+fn tension_beyond_the_series_reach() {
+    check_reference(include_str!("data/separatrix_truth_strong.jsonl"))
+        .assert_within(45, 0.05, 0.0);
 }
