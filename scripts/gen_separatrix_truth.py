@@ -21,7 +21,8 @@ Writes crates/rod-ig-core/tests/data/separatrix_truth.jsonl, one line per rod:
 Run: python3 scripts/gen_separatrix_truth.py [N=600]   (needs python-flint; ≈ 1 s per rod, two
 processes); `--extreme [N=160]` writes separatrix_truth_extreme.jsonl instead, issue 23's
 tiny-bending sample; `--strong [N=48]` writes separatrix_truth_strong.jsonl, tension beyond the
-double-double series' reach (√‖F‖ 100..500) at up to ~925 bits; `--verdicts IN OUT` writes only the verdicts of the rods listed in IN.
+double-double series' reach (√‖F‖ 100..500) at up to ~925 bits; `--edge [N=16]`
+separatrix_truth_edge.jsonl, √‖F‖ 500..700 at up to ~1215 bits; `--verdicts IN OUT` writes only the verdicts of the rods listed in IN.
 The samples are seeded: the same files every run.
 """
 import json, math, pathlib, random, sys
@@ -181,11 +182,12 @@ def reference_strong(a):
     return reference(a, strong_precision(a))
 
 
-def sample_strong(n):
-    """Beyond the double-double series' reach: tension 1e4..2.5e5 (√‖F‖ 100..500), moment and
-    transverse force 1e-14..1e-3 with some exact zeros (`--strong`; each rod at
-    `strong_precision` bits, ~10–40 s)."""
-    r = random.Random(4005)
+def sample_strong(n, seed=4005, lo=4.0, hi=5.4):
+    """Beyond the double-double series' reach: tension 10^lo..10^hi (√‖F‖ 100..500), moment
+    and transverse force 1e-14..1e-3 with some exact zeros (`--strong`; each rod at
+    `strong_precision` bits, ~10–40 s). `--edge`: tension 2.5e5..5e5 (√‖F‖ 500..707, up to
+    where J ≈ e^{√‖F‖} overflows f64), ~1 minute per rod."""
+    r = random.Random(seed)
 
     def signed(lo, hi):
         v = 10 ** r.uniform(lo, hi)
@@ -196,7 +198,7 @@ def sample_strong(n):
 
     out = []
     while len(out) < n:
-        a = [small(), 10 ** r.uniform(4, 5.4), small()]
+        a = [small(), 10 ** r.uniform(lo, hi), small()]
         if a[0] != 0.0 or a[2] != 0.0:
             out.append(a)
     return out
@@ -244,14 +246,18 @@ if __name__ == "__main__":
         sys.exit(0)
     extreme = "--extreme" in sys.argv
     strong = "--strong" in sys.argv
+    edge = "--edge" in sys.argv
     args = [v for v in sys.argv[1:] if not v.startswith("--")]
-    n = int(args[0]) if args else (160 if extreme else 48 if strong else 600)
+    n = int(args[0]) if args else (160 if extreme else 48 if strong else 16 if edge else 600)
     name = ("separatrix_truth_extreme.jsonl" if extreme else
-            "separatrix_truth_strong.jsonl" if strong else "separatrix_truth.jsonl")
+            "separatrix_truth_strong.jsonl" if strong else
+            "separatrix_truth_edge.jsonl" if edge else "separatrix_truth.jsonl")
     path = pathlib.Path(__file__).resolve().parent.parent / "crates/rod-ig-core/tests/data" / name
     with Pool(2) as pool:
         if strong:
             rows = pool.map(reference_strong, sample_strong(n), chunksize=1)
+        elif edge:
+            rows = pool.map(reference_strong, sample_strong(n, 4006, 5.4, 5.69), chunksize=1)
         else:
             rows = pool.map(reference, (sample_extreme if extreme else sample)(n), chunksize=1)
     with open(path, "w") as f:
