@@ -37,25 +37,31 @@ pub(crate) fn seeded(a: &PlanarParams) -> Option<Closed<DualDd>> {
     matches!(c.case, Case::I | Case::II).then_some(c)
 }
 
-/// The double-double closed form for the second pass of the norm-wise stability scan
-/// (`stability::closed_scan`), within the measured reach (√‖F‖ ≤ [`EXTENDED_MAX_ROOT_F`]).
-pub(crate) fn seeded_for_scan(a: &PlanarParams) -> Option<Closed<DualDd>> {
+/// The double-double closed form within its measured reach (√‖F‖ ≤ [`EXTENDED_MAX_ROOT_F`]):
+/// built once per rod, it serves the forward map ([`answer`]), the energy and the second pass
+/// of the norm-wise stability scan (`stability::closed_scan`).
+pub(crate) fn seeded_within_reach(a: &PlanarParams) -> Option<Closed<DualDd>> {
     if a[1].hypot(a[2]).sqrt() > EXTENDED_MAX_ROOT_F {
         return None;
     }
     seeded(a)
 }
 
-/// q(1), J(1) and the energy from the double-double closed form, where its error estimates
-/// hold (√‖F‖ ≤ [`EXTENDED_MAX_ROOT_F`]): J's relative error estimate ([`Closed::end_jacobian_rel_error_own`], the f64 model at
-/// 2⁻¹⁰⁴) within [`CLOSED_J_TOLERANCE`], the tip's within [`EXTENDED_TIP_TOLERANCE`], and the
-/// energy λ2/2 − a4 x − a5 y (FINDINGS §1, in double-double) within 1e-9 of itself. None
-/// elsewhere.
+/// [`answer`] on the rod's double-double closed form, built here.
+#[cfg(test)]
 pub(crate) fn tip_jacobian_energy(a: &PlanarParams) -> Option<(PlanarPose, PlanarJacobian, f64)> {
-    if a[1].hypot(a[2]).sqrt() > EXTENDED_MAX_ROOT_F {
-        return None;
-    }
-    let c = seeded(a)?;
+    answer(&seeded_within_reach(a)?, a)
+}
+
+/// q(1), J(1) and the energy from the double-double closed form `c` of the rod a, where its
+/// error estimates hold: J's relative error estimate ([`Closed::end_jacobian_rel_error_own`],
+/// the f64 model at 2⁻¹⁰⁴) within [`CLOSED_J_TOLERANCE`], the tip's within
+/// [`EXTENDED_TIP_TOLERANCE`], and the energy λ2/2 − a4 x − a5 y (FINDINGS §1, in
+/// double-double) within 1e-9 of itself. None elsewhere.
+pub(crate) fn answer(
+    c: &Closed<DualDd>,
+    a: &PlanarParams,
+) -> Option<(PlanarPose, PlanarJacobian, f64)> {
     let pose_error = EXTENDED_POSE_FACTOR * c.pose_abs_error();
     if c.end_jacobian_rel_error_own() > CLOSED_J_TOLERANCE || pose_error > EXTENDED_TIP_TOLERANCE {
         return None;
@@ -73,10 +79,7 @@ pub(crate) fn tip_jacobian_energy(a: &PlanarParams) -> Option<(PlanarPose, Plana
 /// The energy alone from the double-double closed form ([`identity_energy`]), where the f64
 /// identity cancels and its bound holds (√‖F‖ ≤ [`EXTENDED_MAX_ROOT_F`]); None elsewhere.
 pub(crate) fn energy(a: &PlanarParams) -> Option<f64> {
-    if a[1].hypot(a[2]).sqrt() > EXTENDED_MAX_ROOT_F {
-        return None;
-    }
-    let c = seeded(a)?;
+    let c = seeded_within_reach(a)?;
     let pose_error = EXTENDED_POSE_FACTOR * c.pose_abs_error();
     if pose_error > EXTENDED_TIP_TOLERANCE {
         return None;

@@ -129,8 +129,16 @@ const SERIES_F64_TIP_MAX_ROOT_F: f64 = 17.0;
 /// to √‖F‖ = [`SERIES_F64_TIP_MAX_ROOT_F`], the double-double series where it is certified
 /// (√‖F‖ ≤ [`SERIES_DD_MAX_ROOT_F`]), else [`cross_checked_tip`].
 fn ill_conditioned_tip(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian, f64), RodError> {
+    ill_conditioned_tip_with(a, extended::seeded_within_reach(a).as_ref())
+}
+
+/// [`ill_conditioned_tip`] with the rod's closed form in double-double, if within its reach.
+fn ill_conditioned_tip_with(
+    a: &PlanarParams,
+    extended: Option<&Closed<crate::dd::DualDd>>,
+) -> Result<(PlanarPose, PlanarJacobian, f64), RodError> {
     // The closed form in double-double first: tens of µs where the series takes ms.
-    if let Some(answer) = extended::tip_jacobian_energy(a) {
+    if let Some(answer) = extended.and_then(|c| extended::answer(c, a)) {
         return Ok(answer);
     }
     let root_f = a[1].hypot(a[2]).sqrt();
@@ -853,8 +861,10 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
                 return evaluate_series(a);
             }
             if c.needs_series() == SeriesNeed::IllConditioned {
-                let (tip, jacobian, energy) = ill_conditioned_tip(a)?;
-                let stability = stability::stability_of(c, a)?;
+                // One double-double closed form for the forward map and the stability scan.
+                let dd = extended::seeded_within_reach(a);
+                let (tip, jacobian, energy) = ill_conditioned_tip_with(a, dd.as_ref())?;
+                let stability = stability::stability_of_with(c, a, dd.as_ref())?;
                 return Ok(Evaluation {
                     tip,
                     jacobian,

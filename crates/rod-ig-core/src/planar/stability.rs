@@ -102,12 +102,6 @@ fn normalised_det(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64, norm_wise: bool) 
     (det / n, err / n)
 }
 
-/// The closed form in double-double for the norm-wise scan's second pass, where it applies
-/// (`planar::extended`).
-fn extended_for_scan(a: &PlanarParams) -> Option<Closed<DualDd>> {
-    super::extended::seeded_for_scan(a)
-}
-
 /// g(t) and its bound from the closed form in double-double: every entry of J(t) off by its
 /// norm-wise estimate ([`Closed::jacobian_rel_error_own_at`], the f64 model at 2⁻¹⁰⁴) times
 /// ‖J‖, plus its rounding to f64 (ε of itself).
@@ -542,6 +536,16 @@ pub(crate) fn stability_of(
     c: &Closed<Dual3>,
     a: &PlanarParams,
 ) -> Result<StabilityReport, RodError> {
+    stability_of_with(c, a, None)
+}
+
+/// [`stability_of`] with the rod's closed form in double-double when the caller has built it
+/// already (`planar::extended::seeded_within_reach`; built here when needed otherwise).
+pub(crate) fn stability_of_with(
+    c: &Closed<Dual3>,
+    a: &PlanarParams,
+    extended: Option<&Closed<DualDd>>,
+) -> Result<StabilityReport, RodError> {
     if c.case == Case::Straight {
         return Ok(straight_report());
     }
@@ -563,8 +567,16 @@ pub(crate) fn stability_of(
         // lingering by the straight equilibrium before its loop, where the f64 values are noise
         // of either sign): 150–480 µs where the double-double series takes 3–9 ms.
         let mut undecided = None;
-        if let Some(dd) = extended_for_scan(a) {
-            let report = closed_scan(c, a, true, Some(&dd))?;
+        let built;
+        let dd = match extended {
+            Some(dd) => Some(dd),
+            None => {
+                built = super::extended::seeded_within_reach(a);
+                built.as_ref()
+            }
+        };
+        if let Some(dd) = dd {
+            let report = closed_scan(c, a, true, Some(dd))?;
             if !report.uncertain {
                 return Ok(report);
             }
@@ -1308,7 +1320,7 @@ mod tests {
             if !closed_scan(&c, &a, true, None).expect("finite").uncertain {
                 continue;
             }
-            let Some(dd) = extended_for_scan(&a) else {
+            let Some(dd) = super::super::extended::seeded_within_reach(&a) else {
                 continue;
             };
             used += 1;
