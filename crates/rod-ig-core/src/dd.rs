@@ -310,16 +310,22 @@ pub struct DualDd {
 }
 
 impl DualDd {
+    /// A constant (zero gradient).
+    #[inline]
+    pub const fn constant(v: Dd) -> Self {
+        Self {
+            v,
+            g: [Dd::from_f64(0.0); 3],
+        }
+    }
+
     /// The i-th independent variable at value v (gradient = i-th unit vector).
     pub fn variable(v: f64, i: usize) -> Self {
-        let mut g = [Dd::default(); 3];
-        if let Some(gi) = g.get_mut(i) {
+        let mut d = Self::constant(Dd::from_f64(v));
+        if let Some(gi) = d.g.get_mut(i) {
             *gi = Dd::from_f64(1.0);
         }
-        Self {
-            v: Dd::from_f64(v),
-            g,
-        }
+        d
     }
 
     /// f with value `v` and derivative `d` (chain rule).
@@ -460,17 +466,11 @@ impl Real for DualDd {
     const EPSILON: f64 = DD_EPSILON;
     #[inline]
     fn from_f64(v: f64) -> Self {
-        Self {
-            v: Dd::from_f64(v),
-            g: [Dd::default(); 3],
-        }
+        Self::constant(Dd::from_f64(v))
     }
     #[inline]
     fn pi() -> Self {
-        Self {
-            v: PI_DD,
-            g: [Dd::default(); 3],
-        }
+        Self::constant(PI_DD)
     }
     #[inline]
     fn re(self) -> f64 {

@@ -92,13 +92,18 @@ pub(crate) fn energy(a: &PlanarParams) -> Option<f64> {
 /// error times (|a4| + |a5|) plus the rounding of the sum — is within
 /// [`ENERGY_REL_TOLERANCE`] of E.
 fn identity_energy(a: &PlanarParams, x: Dd, y: Dd, pose_error: f64) -> Option<f64> {
+    let (e, bound) = identity_energy_and_bound(a, x, y, pose_error);
+    (e.is_finite() && bound <= ENERGY_REL_TOLERANCE * e.abs()).then_some(e)
+}
+
+/// The identity's value (rounded to f64) and its bound (see [`identity_energy`]).
+fn identity_energy_and_bound(a: &PlanarParams, x: Dd, y: Dd, pose_error: f64) -> (f64, f64) {
     let (a3, a4, a5) = (Dd::from_f64(a[0]), Dd::from_f64(a[1]), Dd::from_f64(a[2]));
     let half_a3_sq = a3 * a3 * Dd::from_f64(0.5);
     let e = half_a3_sq + a4 - a4 * x - a5 * y;
     let terms = half_a3_sq.hi.abs() + 2.0 * a[1].abs() + a[2].abs();
     let bound = (a[1].abs() + a[2].abs()) * pose_error + 8.0 * DD_EPSILON * terms;
-    let e = e.to_f64();
-    (e.is_finite() && bound <= ENERGY_REL_TOLERANCE * e.abs()).then_some(e)
+    (e.to_f64(), bound)
 }
 
 #[cfg(test)]
@@ -147,11 +152,7 @@ mod tests {
             let pose_error = EXTENDED_POSE_FACTOR * c.pose_abs_error();
             let [x, y, _] = c.pose(1.0);
             // The identity's bound, on every rod.
-            let (a3, a4, a5) = (Dd::from_f64(a[0]), Dd::from_f64(a[1]), Dd::from_f64(a[2]));
-            let half_a3_sq = a3 * a3 * Dd::from_f64(0.5);
-            let e = (half_a3_sq + a4 - a4 * x.v - a5 * y.v).to_f64();
-            let terms = half_a3_sq.hi.abs() + 2.0 * a[1].abs() + a[2].abs();
-            let bound = (a[1].abs() + a[2].abs()) * pose_error + 8.0 * DD_EPSILON * terms;
+            let (e, bound) = identity_energy_and_bound(a, x.v, y.v, pose_error);
             let off = ((e - e_ref).abs() - 1.2e-16 * e_ref.abs()).max(0.0);
             assert!(
                 off <= bound,
