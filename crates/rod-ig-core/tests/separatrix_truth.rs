@@ -28,6 +28,11 @@ const JAC_TOL: f64 = 1e-6;
 const ENERGY_TOL: f64 = 1e-8;
 /// A clear verdict: |det_min| above this.
 const CLEAR_MARGIN: f64 = 1e-3;
+/// The references' det J grid spacing in t (`GRID` = 2000 in the script): their first
+/// conjugate point is the first grid point where det J ≤ 0 (or its ball contains 0).
+const CONJUGATE_GRID: f64 = 1.0 / 2000.0;
+/// Allowance on our conjugate point beyond that grid cell (regula falsi stops at 1e-7).
+const CONJUGATE_TOL: f64 = 1e-4;
 /// √‖F‖ up to which every rod must be answered (the double-double series is certified there).
 const CERTIFIED_ROOT_F: f64 = 27.0;
 /// Largest share of the sample whose stability may come back uncertain although the reference
@@ -221,6 +226,7 @@ impl ReferenceReport {
 fn check_reference(text: &str) -> ReferenceReport {
     let (mut n, mut refused) = (0usize, 0usize);
     let (mut worst_tip, mut worst_jac, mut worst_energy) = (0.0f64, 0.0f64, 0.0f64);
+    let mut worst_conjugate = 0.0f64;
     let (mut failures, mut uncertain) = (Vec::new(), Vec::new());
     for v in json_lines(text) {
         let a = numbers(&v["a"]);
@@ -280,12 +286,24 @@ fn check_reference(text: &str) -> ReferenceReport {
                 uncertain.push(line);
             } else if eval.stability.stable != stable {
                 failures.push(line);
+            } else if let (Some(tc), Some(tc_ref)) = (
+                eval.stability.first_conjugate_t,
+                v["first_conjugate"].as_f64(),
+            ) {
+                // The reference's first grid point (spacing 1/2000) with det J ≤ 0 lies at or
+                // just after the root.
+                let dev = tc - tc_ref;
+                worst_conjugate = worst_conjugate.max(dev.abs());
+                if !(-CONJUGATE_GRID - CONJUGATE_TOL..=CONJUGATE_TOL).contains(&dev) {
+                    failures.push(format!("{line}: conjugate point {tc}, reference {tc_ref}"));
+                }
             }
         }
     }
     eprintln!(
         "{n} rods: {refused} refused, {} uncertain, max |Δtip| {worst_tip:.2e}, max rel ‖ΔJ‖ \
-         {worst_jac:.2e}, max rel Δenergy {worst_energy:.2e}",
+         {worst_jac:.2e}, max rel Δenergy {worst_energy:.2e}, max |Δ conjugate point| \
+         {worst_conjugate:.1e}",
         uncertain.len()
     );
     ReferenceReport {

@@ -770,8 +770,19 @@ pub fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian)
 /// refined. The margin is FINDINGS §5 `det_min`, min over t ∈ [0.05, 1] of g; the report is
 /// `uncertain` when it lies within its error bound (the closed form first hands such rods to
 /// the series). The straight rod (a3 = a5 = 0) has det J ≡ 0: uncertain, margin 0.
+///
+/// Theory settles what rounding cannot (Sachkov, "Conjugate points in Euler's elastic
+/// problem", 2008): a rod whose curvature keeps its sign (λ4 < 0, circles, or λ4 > 0 with no
+/// inflection point on (0, 1]) has no conjugate point, so it is reported stable and certain,
+/// its margin the scan's (floored at 0). Negative values of g within their error bound
+/// before the first conjugate point can come are rounding and carry no sign in the scan.
 pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
     check_params(a)?;
+    Ok(stability::with_theorem(stability_scanned(a)?, a))
+}
+
+/// [`stability`] with the verdict of the scans alone (no theorem).
+pub(crate) fn stability_scanned(a: &PlanarParams) -> Result<StabilityReport, RodError> {
     if series_first(a) {
         return stability::stability_of_series(a, None, None, None);
     }
@@ -846,6 +857,15 @@ fn evaluate_small_angle(a: &PlanarParams) -> Result<Option<Evaluation>, RodError
 /// Tip, J(1, a), energy and stability in one call (one precomputation shared by all).
 pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
     check_params(a)?;
+    let e = evaluate_scanned(a)?;
+    Ok(Evaluation {
+        stability: stability::with_theorem(e.stability, a),
+        ..e
+    })
+}
+
+/// [`evaluate`] with the stability verdict of the scans alone.
+fn evaluate_scanned(a: &PlanarParams) -> Result<Evaluation, RodError> {
     if series_first(a) {
         return evaluate_series(a);
     }
