@@ -778,19 +778,27 @@ pub fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian)
 /// before the first conjugate point can come are rounding and carry no sign in the scan.
 pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
     check_params(a)?;
-    Ok(stability::with_theorem(stability_scanned(a)?, a))
-}
-
-/// [`stability`] with the verdict of the scans alone (no theorem).
-pub(crate) fn stability_scanned(a: &PlanarParams) -> Result<StabilityReport, RodError> {
     if series_first(a) {
-        return stability::stability_of_series(a, None, None, None);
+        let report = stability::stability_of_series(a, None, None, None)?;
+        return Ok(stability::with_theorem(report, || conjugate_free(a)));
     }
     with_seeded(
         a,
-        |c| stability::stability_of(c, a),
-        || stability::stability_of_series(a, None, None, None),
+        |c| {
+            let report = stability::stability_of(c, a)?;
+            Ok(stability::with_theorem(report, || c.conjugate_free()))
+        },
+        || {
+            let report = stability::stability_of_series(a, None, None, None)?;
+            Ok(stability::with_theorem(report, || conjugate_free(a)))
+        },
     )
+}
+
+/// [`Closed::conjugate_free`] of a rod whose closed form was not built (false where it
+/// cannot be).
+fn conjugate_free(a: &PlanarParams) -> bool {
+    Closed::<f64>::new(a[0], a[1], a[2]).is_some_and(|c| c.conjugate_free())
 }
 
 /// Elastic energy ½∫₀¹κ² (FINDINGS §1 identity λ2/2 − a4 x(1) − a5 y(1)).
@@ -859,7 +867,7 @@ pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
     check_params(a)?;
     let e = evaluate_scanned(a)?;
     Ok(Evaluation {
-        stability: stability::with_theorem(e.stability, a),
+        stability: stability::with_theorem(e.stability, || conjugate_free(a)),
         ..e
     })
 }

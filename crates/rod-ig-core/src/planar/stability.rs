@@ -211,12 +211,11 @@ fn straight_report() -> StabilityReport {
 /// curvature keeps its sign): stable and certain there, whatever the scan could decide. The
 /// margin stays the scan's value (floored at 0: where the scan's bound covered zero, its sign
 /// was rounding). Elsewhere, or where the scan already established stability, unchanged.
-pub(crate) fn with_theorem(report: StabilityReport, a: &PlanarParams) -> StabilityReport {
-    if report.stable && !report.uncertain {
-        return report;
-    }
-    let free = Closed::<f64>::new(a[0], a[1], a[2]).is_some_and(|c| c.conjugate_free());
-    if !free {
+pub(crate) fn with_theorem(
+    report: StabilityReport,
+    conjugate_free: impl FnOnce() -> bool,
+) -> StabilityReport {
+    if report.stable && !report.uncertain || !conjugate_free() {
         return report;
     }
     StabilityReport {
@@ -1127,17 +1126,12 @@ const MAX_SAMPLES: usize = 112;
 fn regula_falsi(g: &impl Fn(f64) -> f64, t0: f64, g0: f64, t1: f64, g1: f64) -> f64 {
     let (mut lo, mut glo, mut hi, mut ghi) = (t0, g0, t1, g1);
     let mut side = 0i8;
-    let mut width = 2.0 * (hi - lo);
-    for _ in 0..48 {
+    for _ in 0..24 {
         if hi - lo <= 1e-7 {
             break;
         }
-        // A step that did not halve the bracket is followed by a bisection: g growing like
-        // e^{2√‖F‖ t} under a strong tension stalled Illinois 0.003 past the root.
-        let stalled = hi - lo > 0.5 * width;
-        width = hi - lo;
         let mut t = (lo * ghi - hi * glo) / (ghi - glo);
-        if stalled || !(t > lo && t < hi) {
+        if !(t > lo && t < hi) {
             t = 0.5 * (lo + hi);
         }
         let gt = g(t);
@@ -1159,6 +1153,20 @@ fn regula_falsi(g: &impl Fn(f64) -> f64, t0: f64, g0: f64, t1: f64, g1: f64) -> 
         }
         if gt == 0.0 {
             return t;
+        }
+    }
+    // Illinois stalls on a g growing like e^{2√‖F‖ t} (under a tension of 71,306 it stopped
+    // 0.003 past the root): bisection finishes the bracket.
+    for _ in 0..32 {
+        if hi - lo <= 1e-7 {
+            break;
+        }
+        let t = 0.5 * (lo + hi);
+        let gt = g(t);
+        if gt > 0.0 || gt.is_nan() {
+            lo = t;
+        } else {
+            hi = t;
         }
     }
     hi
