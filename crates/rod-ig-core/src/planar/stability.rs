@@ -713,6 +713,22 @@ fn small_m_scan(c: &Closed<Dual3>, a: &PlanarParams) -> Result<Option<StabilityR
     }))
 }
 
+/// g's value for [`scan`], but NaN (no sign: the scan drops it) where g ≤ 0 lies within its
+/// error bound before `t_free`, where no conjugate point can come yet
+/// (`Closed::conjugate_span_bound`): that sign is rounding. Under a strong tension the
+/// norm-wise scan's noise there put "conjugate points" at t ≈ 0.1 on rods whose first one is
+/// at 0.8 (320-bit references).
+fn signs_where_possible(g: &impl Fn(f64) -> (f64, f64), t_free: f64) -> impl Fn(f64) -> f64 + '_ {
+    move |t| {
+        let (v, e) = g(t);
+        if t < t_free && v <= 0.0 && -v <= e {
+            f64::NAN
+        } else {
+            v
+        }
+    }
+}
+
 /// The scan of g on the closed form (a short series near the base); the report, uncertain
 /// where the error bound covers the margin (`norm_wise`: see [`normalised_det`]).
 fn closed_scan(
@@ -728,15 +744,7 @@ fn closed_scan(
     // (near the separatrix under a force) g grows like e^{2√‖F‖ t}, and the closed form's
     // value is taken where it is accurate relative to itself.
     let root_f = a[1].hypot(a[2]).sqrt();
-    let start = if norm_wise {
-        ShortSeries::new(a, 0.0, (SHORT_SERIES_REACH / root_f).min(1.0))
-    } else {
-        // One low-order step reaches t ≈ 0.2 on a gently bent rod; on a strongly bent one
-        // (ρ = max(|a3|, √‖F‖) ≫ 1) the steps shrink like 1/ρ while the closed form is
-        // accurate from t ~ 1/ρ on: the first end is capped there (it still grows to 2t).
-        let rho = a3.abs().max(root_f);
-        ShortSeries::new(a, (SHORT_SERIES_FIRST_END_RHO / rho).min(0.2), 1.0)
-    };
+    let start = ShortSeries::for_scan(a, norm_wise);
     let g = |t: f64| {
         let (v, e) = normalised_det(c, a3, a5, t, norm_wise);
         // Relative to |g| where g is large: under a strong tension g reaches 1e4 between the
@@ -773,20 +781,12 @@ fn closed_scan(
     // closed-form det J (≈ t⁹) is swamped by rounding: start the scan at t0.
     let t0 = (0.1 * wl).clamp(T_MIN, T_MARGIN);
     let spacing = (0.25 * wl).clamp(0.01, 0.1);
-    // Before the first conjugate point can come (`Closed::conjugate_span_bound`), a g ≤ 0
-    // within its error bound is rounding, not a sign change: under a strong tension the
-    // norm-wise scan's noise put "conjugate points" at t ≈ 0.1 on rods whose first one is at
-    // 0.8 (320-bit references). Such samples carry no sign (NaN, dropped by the scan).
-    let t_noise = c.conjugate_span_bound();
-    let g_scan = |t: f64| {
-        let (v, e) = g(t);
-        if t < t_noise && v <= 0.0 && -v <= e {
-            f64::NAN
-        } else {
-            v
-        }
-    };
-    let s = scan(&g_scan, t0, spacing, (a3, a5))?;
+    let s = scan(
+        &signs_where_possible(&g, c.conjugate_span_bound()),
+        t0,
+        spacing,
+        (a3, a5),
+    )?;
     if !norm_wise {
         return Ok(verdict(s, g(s.t_margin).1));
     }
@@ -905,6 +905,20 @@ impl ShortSeries {
             min_end,
             max_end,
             rod: std::cell::RefCell::new(Start::NotBuilt),
+        }
+    }
+
+    /// The short series of [`closed_scan`]: norm-wise up to √‖F‖·t = [`SHORT_SERIES_REACH`];
+    /// otherwise one low-order step reaches t ≈ 0.2 on a gently bent rod, and on a strongly
+    /// bent one (ρ = max(|a3|, √‖F‖) ≫ 1) the steps shrink like 1/ρ while the closed form is
+    /// accurate from t ~ 1/ρ on: the first end is capped there (it still grows to 2t).
+    fn for_scan(a: &PlanarParams, norm_wise: bool) -> Self {
+        let root_f = a[1].hypot(a[2]).sqrt();
+        if norm_wise {
+            Self::new(a, 0.0, (SHORT_SERIES_REACH / root_f).min(1.0))
+        } else {
+            let rho = a[0].abs().max(root_f);
+            Self::new(a, (SHORT_SERIES_FIRST_END_RHO / rho).min(0.2), 1.0)
         }
     }
 
