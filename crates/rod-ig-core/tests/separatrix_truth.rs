@@ -122,9 +122,10 @@ fn stability_alone_is_never_wrong_on_the_references() {
     );
     assert_eq!(n, 643);
     assert!(uncertain <= 2, "{uncertain} uncertain");
-    // The scan samples narrow dips of g coarsely: its stable margins can sit above the
-    // reference's grid minimum (measured 0.74 relative, 0.72 before the double-double pass).
-    assert!(worst_margin <= 0.8, "{worst_margin}");
+    // g's narrow dips under a strong tension (~1/√‖F‖ wide) sit at Γ = K(2j + 1) or at the
+    // window's ends, where the scan samples and probes them: stable margins within 5.0e-3 of
+    // the reference's grid minimum (0.74 when the grid alone sampled them).
+    assert!(worst_margin <= 0.02, "{worst_margin}");
 }
 
 /// The 110 rods of a seeded tiny-bending sample (a4 ±1e2..1e4, a3 and a5 ±1e-14..1e-6 with

@@ -315,6 +315,7 @@ pub(crate) fn small_angle_report(a: &PlanarParams) -> Result<Option<StabilityRep
         SERIES_T_MIN,
         spacing,
         (a3, a5),
+        &[],
     )?;
     let bounded = |t: f64| {
         let (v, rounding) = small_angle::normalised_det(a3, a4, a5, t);
@@ -459,6 +460,7 @@ fn scan_series<T: Gradient>(
         SERIES_T_MIN,
         spacing,
         (a3, a5),
+        &[],
     )?;
     let Some(cross) = cross else {
         return Ok(verdict(s, normalised_det_series(rod, a3, a5, s.t_margin).1));
@@ -508,7 +510,7 @@ fn every_sample_positive(
     g: &impl Fn(f64) -> (f64, f64),
     (t0, spacing, a3, a5): (f64, f64, f64, f64),
 ) -> bool {
-    let (ts, np) = sample_times(t0, spacing, a3, a5);
+    let (ts, np) = sample_times(t0, spacing, (a3, a5), &[]);
     ts[..np].iter().all(|&t| {
         let (v, e) = g(t);
         v > e
@@ -529,7 +531,7 @@ fn certified_verdict(
     };
     // Just past the sign change g is small but its bound, where it comes from cancellation
     // near the straight equilibrium, is smaller still: try a few points there first.
-    let (ts, np) = sample_times(t0, spacing, a3, a5);
+    let (ts, np) = sample_times(t0, spacing, (a3, a5), &[]);
     let near = [0.05, 0.1, 0.2, 0.4].map(|f| first + f * spacing);
     let certified = near
         .iter()
@@ -655,12 +657,12 @@ fn small_m_scan(c: &Closed<Dual3>, a: &PlanarParams) -> Result<Option<StabilityR
     let t0 = (0.1 * wl).clamp(T_MIN, T_MARGIN);
     let spacing = (0.25 * wl).clamp(1e-3, SERIES_SPACING);
     let closed = |t: f64| normalised_det_value(c, a3, a5, t);
-    let s = scan(&closed, t0, spacing, (a3, a5))?;
+    let s = scan(&closed, t0, spacing, (a3, a5), &[])?;
     // The first sample past the sign change where g < 0: the unstable verdict's witness.
     let witness = match s.first {
         None => None,
         Some(first) => {
-            let (ts, np) = sample_times(t0, spacing, a3, a5);
+            let (ts, np) = sample_times(t0, spacing, (a3, a5), &[]);
             let t = ts[..np]
                 .iter()
                 .copied()
@@ -786,6 +788,7 @@ fn closed_scan(
         t0,
         spacing,
         (a3, a5),
+        &c.dip_times(spacing),
     )?;
     if !norm_wise {
         return Ok(verdict(s, g(s.t_margin).1));
@@ -1001,8 +1004,9 @@ fn scan(
     t0: f64,
     h_target: f64,
     (a3, a5): (f64, f64),
+    extra: &[f64],
 ) -> Result<Scan, RodError> {
-    let (mut ts, np) = sample_times(t0, h_target, a3, a5);
+    let (mut ts, np) = sample_times(t0, h_target, (a3, a5), extra);
     let mut gs = [0.0f64; MAX_SAMPLES];
     // NaN: g's sign there is rounding where det J > 0 is known ([`closed_scan`]); dropped.
     let mut kept = 0;
@@ -1039,11 +1043,17 @@ fn scan(
     })
 }
 
-/// The sample times: a grid of spacing ≈ `h_target` on [t0, 1], and T_MARGIN and three times
-/// around t* = √(33600/8640)|a3/a5|, sorted; returns them and their number.
-fn sample_times(t0: f64, h_target: f64, a3: f64, a5: f64) -> ([f64; MAX_SAMPLES], usize) {
+/// The sample times: a grid of spacing ≈ `h_target` on [t0, 1], T_MARGIN, three times
+/// around t* = √(33600/8640)|a3/a5|, and `extra` (at most [`MAX_EXTRA_SAMPLES`]), sorted;
+/// returns them and their number.
+fn sample_times(
+    t0: f64,
+    h_target: f64,
+    (a3, a5): (f64, f64),
+    extra: &[f64],
+) -> ([f64; MAX_SAMPLES], usize) {
     let n = ((1.0 - t0) / h_target).ceil().max(1.0) as usize;
-    let n = n.min(MAX_SAMPLES - 4);
+    let n = n.min(MAX_SAMPLES - 4 - MAX_EXTRA_SAMPLES);
     let h = (1.0 - t0) / n as f64;
     let mut ts = [0.0f64; MAX_SAMPLES];
     let mut np = n + 1;
@@ -1058,7 +1068,8 @@ fn sample_times(t0: f64, h_target: f64, a3: f64, a5: f64) -> ([f64; MAX_SAMPLES]
     } else {
         f64::NAN
     };
-    for t in [T_MARGIN, ts_star * 0.7, ts_star, ts_star * 1.4] {
+    let fixed = [T_MARGIN, ts_star * 0.7, ts_star, ts_star * 1.4];
+    for &t in fixed.iter().chain(extra.iter().take(MAX_EXTRA_SAMPLES)) {
         if t > t0 && t < 1.0 && np < ts.len() {
             // insert keeping ts sorted
             let mut k = np;
@@ -1130,11 +1141,60 @@ fn refine_margin(
             *first = Some((tc, gm, tm));
         }
     }
+    if first.is_none() {
+        (margin, t_margin) = refine_window_ends(g, ts, gs, (margin, t_margin), first);
+    }
     (margin, t_margin)
 }
 
-/// Sample budget of one scan (coarse grid plus three samples around t*).
+/// The margin's window ends (T_MARGIN, 1) where the lowest sample lies there: g may dip
+/// between it and the next sample (under a strong force the dips are ~1/√‖F‖ wide, the grid
+/// 0.1). One probe a quarter of the way in; if it is lower, a parabolic refinement of the
+/// bracket it makes (a dip found below zero becomes the first sign change).
+fn refine_window_ends(
+    g: &impl Fn(f64) -> f64,
+    ts: &[f64],
+    gs: &[f64],
+    (mut margin, mut t_margin): (f64, f64),
+    first: &mut Option<(f64, f64, f64)>,
+) -> (f64, f64) {
+    let n = ts.len();
+    let Some(lo) = ts.iter().position(|&t| t >= T_MARGIN) else {
+        return (margin, t_margin);
+    };
+    for (end, inner) in [(lo, lo + 1), (n - 1, n.wrapping_sub(2))] {
+        if inner >= n || inner < lo || gs[end] != margin || gs[inner] <= gs[end] {
+            continue;
+        }
+        let tp = ts[end] + 0.25 * (ts[inner] - ts[end]);
+        let gp = g(tp);
+        if !(gp < gs[end]) {
+            continue;
+        }
+        let (a, c, fa, fc) = if end < inner {
+            (ts[end], ts[inner], gs[end], gs[inner])
+        } else {
+            (ts[inner], ts[end], gs[inner], gs[end])
+        };
+        let (tm, gm) = refine_min(g, a, tp, c, fa, gp, fc);
+        (margin, t_margin) = if gm < gp { (gm, tm) } else { (gp, tp) };
+        if margin <= 0.0 && first.is_none() {
+            let tc = if fa > 0.0 {
+                regula_falsi(g, a, fa, t_margin, margin)
+            } else {
+                t_margin
+            };
+            *first = Some((tc, margin, t_margin));
+        }
+    }
+    (margin, t_margin)
+}
+
+/// Sample budget of one scan (coarse grid, T_MARGIN, three samples around t* and the extra
+/// ones).
 const MAX_SAMPLES: usize = 112;
+/// Most extra sample times a scan takes (`Closed::dip_times`).
+const MAX_EXTRA_SAMPLES: usize = 8;
 
 /// Illinois regula falsi for the root of g in (t0, t1) with g(t0) > 0 ≥ g(t1).
 fn regula_falsi(g: &impl Fn(f64) -> f64, t0: f64, g0: f64, t1: f64, g1: f64) -> f64 {
