@@ -995,11 +995,6 @@ impl<T: Real> Closed<T> {
         }
     }
 
-    #[cfg(test)]
-    pub(crate) fn phase_data(&self) -> (f64, f64, f64) {
-        (self.landen.k().re(), self.phi.re(), self.r.re())
-    }
-
     /// The t ∈ (0, 1) where Γ = K(2j + 1) (cases I and II; at most 8, from the base): the
     /// inflection points (κ ∝ cn) or the straightest points between loops (κ ∝ dn), where
     /// they are needed: where a scan of this `spacing` in t samples Γ more coarsely than 1.
@@ -1015,7 +1010,8 @@ impl<T: Real> Closed<T> {
         let mut out = Vec::new();
         while out.len() < 8 {
             let t = (gamma - phi) / r;
-            if !(t < 1.0) {
+            // NaN ends the loop too.
+            if t.partial_cmp(&1.0) != Some(std::cmp::Ordering::Less) {
                 break;
             }
             out.push(t);

@@ -1168,7 +1168,8 @@ fn refine_window_ends(
         }
         let tp = ts[end] + 0.25 * (ts[inner] - ts[end]);
         let gp = g(tp);
-        if !(gp < gs[end]) {
+        // (NaN, no sign, is not lower.)
+        if gp.is_nan() || gp >= gs[end] {
             continue;
         }
         let (a, c, fa, fc) = if end < inner {
