@@ -40,6 +40,9 @@ const THEOREM_PHASE_MARGIN: f64 = 1e-9;
 /// Smallest size of λ4's terms for which [`Closed::conjugate_free`] trusts its sign: below,
 /// the squares lose digits to underflow.
 const THEOREM_MIN_TERMS: f64 = 1e-280;
+/// Most sample times [`Closed::dip_times`] gives, from the base (a share of the scan's sample
+/// budget; a rod with more periods has the grid alone beyond the eighth).
+pub(crate) const MAX_DIP_TIMES: usize = 8;
 
 /// Everything that depends on a only.
 #[derive(Clone, Copy, Debug)]
@@ -940,8 +943,7 @@ impl<T: Real> Closed<T> {
             Case::II | Case::SmallForce if sign_sure => f64::INFINITY,
             Case::Circle => f64::INFINITY,
             Case::I if sign_sure => {
-                let (k, phi, r) = (self.landen.k().re(), self.phi.re(), self.r.re());
-                let margin = THEOREM_PHASE_MARGIN * (phi.abs() + r + k);
+                let (k, phi, r, margin) = self.phase_and_margin();
                 let (below, above) = self.inflections_around_base();
                 // a3 = 0: φ is an inflection, rounded to either side of it.
                 let next = if a3 == 0.0 && phi - below > margin {
@@ -958,6 +960,13 @@ impl<T: Real> Closed<T> {
             }
             _ => 0.0,
         }
+    }
+
+    /// K, φ, r (f64 values) and the margin [`THEOREM_PHASE_MARGIN`]·(|φ| + r + K) by which a
+    /// bound on Γ is taken early for their rounding.
+    fn phase_and_margin(&self) -> (f64, f64, f64, f64) {
+        let (k, phi, r) = (self.landen.k().re(), self.phi.re(), self.r.re());
+        (k, phi, r, THEOREM_PHASE_MARGIN * (phi.abs() + r + k))
     }
 
     /// True when λ4's sign, and so the case, is sure: its terms' squares of normal size
@@ -985,8 +994,7 @@ impl<T: Real> Closed<T> {
         if self.case != Case::I || !self.case_is_sure() {
             return proven;
         }
-        let (k, phi, r) = (self.landen.k().re(), self.phi.re(), self.r.re());
-        let margin = THEOREM_PHASE_MARGIN * (phi.abs() + r + k);
+        let (k, _, r, margin) = self.phase_and_margin();
         let t = (2.0 * k - margin) / r;
         if t.is_finite() {
             proven.max(t)
@@ -995,7 +1003,7 @@ impl<T: Real> Closed<T> {
         }
     }
 
-    /// The t ∈ (0, 1) where Γ = K(2j + 1) (cases I and II; at most 8, from the base): the
+    /// The t ∈ (0, 1) where Γ = K(2j + 1) (cases I and II; at most [`MAX_DIP_TIMES`], from the base): the
     /// inflection points (κ ∝ cn) or the straightest points between loops (κ ∝ dn), where
     /// they are needed: where a scan of this `spacing` in t samples Γ more coarsely than 1.
     /// Near the separatrix g has narrow dips there (width ~1 in Γ, the loops' scale, where the
@@ -1008,7 +1016,7 @@ impl<T: Real> Closed<T> {
         }
         let (_, mut gamma) = self.inflections_around_base();
         let mut out = Vec::new();
-        while out.len() < 8 {
+        while out.len() < MAX_DIP_TIMES {
             let t = (gamma - phi) / r;
             // NaN ends the loop too.
             if t.partial_cmp(&1.0) != Some(std::cmp::Ordering::Less) {

@@ -778,9 +778,12 @@ pub fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian)
 /// before the first conjugate point can come are rounding and carry no sign in the scan.
 pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
     check_params(a)?;
-    if series_first(a) {
+    let series = || {
         let report = stability::stability_of_series(a, None, None, None)?;
-        return Ok(stability::with_theorem(report, || conjugate_free(a)));
+        Ok(stability::with_theorem(report, || conjugate_free(a)))
+    };
+    if series_first(a) {
+        return series();
     }
     with_seeded(
         a,
@@ -788,10 +791,7 @@ pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
             let report = stability::stability_of(c, a)?;
             Ok(stability::with_theorem(report, || c.conjugate_free()))
         },
-        || {
-            let report = stability::stability_of_series(a, None, None, None)?;
-            Ok(stability::with_theorem(report, || conjugate_free(a)))
-        },
+        series,
     )
 }
 
@@ -865,83 +865,88 @@ fn evaluate_small_angle(a: &PlanarParams) -> Result<Option<Evaluation>, RodError
 /// Tip, J(1, a), energy and stability in one call (one precomputation shared by all).
 pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
     check_params(a)?;
-    let e = evaluate_scanned(a)?;
-    Ok(Evaluation {
-        stability: stability::with_theorem(e.stability, || conjugate_free(a)),
-        ..e
-    })
-}
-
-/// [`evaluate`] with the stability verdict of the scans alone.
-fn evaluate_scanned(a: &PlanarParams) -> Result<Evaluation, RodError> {
+    let series = || Ok(with_theorem(evaluate_series(a)?, || conjugate_free(a)));
     if series_first(a) {
-        return evaluate_series(a);
+        return series();
     }
     with_seeded(
         a,
-        |c| {
-            if c.needs_series() != SeriesNeed::None {
-                if let Some(e) = evaluate_small_angle(a)? {
-                    return Ok(e);
-                }
-            }
-            if c.needs_series() == SeriesNeed::Cancellation {
-                return evaluate_series(a);
-            }
-            if c.needs_series() == SeriesNeed::IllConditioned {
-                // One double-double closed form for the forward map and the stability scan.
-                let dd = extended::seeded_within_reach(a);
-                let (tip, jacobian, energy) = ill_conditioned_tip_with(a, dd.as_ref())?;
-                let stability = stability::stability_of_with(c, a, dd.as_ref())?;
-                return Ok(Evaluation {
-                    tip,
-                    jacobian,
-                    energy,
-                    stability,
-                    full_accuracy: true,
-                });
-            }
-            let (tip, jacobian) = pose_and_jac_of(c, a, 1.0)?;
-            let near_separatrix = c.m1 < SEPARATRIX_M1
-                && !c.needs_precise_series()
-                && energy_by_identity(c, a, &tip)?.is_none();
-            if near_separatrix {
-                // A nearly straight rod under a force near the separatrix: its energy and
-                // det J(t) both need the series (the identity cancels, the x row of J is below
-                // the closed form's error floor); one dense series serves both. The tip and J
-                // stay the closed form's, identical to `tip_and_jacobian`'s. Where the
-                // small-angle limit decides stability, the energy needs no dense series (the
-                // zeta form, or the series' values only).
-                if let Some(stability) = stability::small_angle_report(a)? {
-                    return Ok(Evaluation {
-                        tip,
-                        jacobian,
-                        energy: closed_energy(c, a, &tip)?,
-                        stability,
-                        full_accuracy: true,
-                    });
-                }
-                let rod = series_dual(a, true)?;
-                return Ok(Evaluation {
-                    tip,
-                    jacobian,
-                    energy: rod.energy().v,
-                    stability: stability::stability_of_dense_series(a, &rod)?,
-                    full_accuracy: true,
-                });
-            }
-            let energy = closed_energy(c, a, &tip)?;
-            let stability = stability::stability_of(c, a)?;
-            Ok(Evaluation {
+        |c| Ok(with_theorem(evaluate_closed(c, a)?, || c.conjugate_free())),
+        series,
+    )
+}
+
+/// The evaluation with the stability verdict a theorem gives where one applies
+/// ([`stability::with_theorem`]).
+fn with_theorem(e: Evaluation, conjugate_free: impl FnOnce() -> bool) -> Evaluation {
+    Evaluation {
+        stability: stability::with_theorem(e.stability, conjugate_free),
+        ..e
+    }
+}
+
+/// [`evaluate`] on the closed form (handing to the small-angle expansion or the series where
+/// its estimates say so), with the stability verdict of the scans alone.
+fn evaluate_closed(c: &Closed<Dual3>, a: &PlanarParams) -> Result<Evaluation, RodError> {
+    if c.needs_series() != SeriesNeed::None {
+        if let Some(e) = evaluate_small_angle(a)? {
+            return Ok(e);
+        }
+    }
+    if c.needs_series() == SeriesNeed::Cancellation {
+        return evaluate_series(a);
+    }
+    if c.needs_series() == SeriesNeed::IllConditioned {
+        // One double-double closed form for the forward map and the stability scan.
+        let dd = extended::seeded_within_reach(a);
+        let (tip, jacobian, energy) = ill_conditioned_tip_with(a, dd.as_ref())?;
+        let stability = stability::stability_of_with(c, a, dd.as_ref())?;
+        return Ok(Evaluation {
+            tip,
+            jacobian,
+            energy,
+            stability,
+            full_accuracy: true,
+        });
+    }
+    let (tip, jacobian) = pose_and_jac_of(c, a, 1.0)?;
+    let near_separatrix = c.m1 < SEPARATRIX_M1
+        && !c.needs_precise_series()
+        && energy_by_identity(c, a, &tip)?.is_none();
+    if near_separatrix {
+        // A nearly straight rod under a force near the separatrix: its energy and
+        // det J(t) both need the series (the identity cancels, the x row of J is below
+        // the closed form's error floor); one dense series serves both. The tip and J
+        // stay the closed form's, identical to `tip_and_jacobian`'s. Where the
+        // small-angle limit decides stability, the energy needs no dense series (the
+        // zeta form, or the series' values only).
+        if let Some(stability) = stability::small_angle_report(a)? {
+            return Ok(Evaluation {
                 tip,
                 jacobian,
-                energy,
+                energy: closed_energy(c, a, &tip)?,
                 stability,
                 full_accuracy: true,
-            })
-        },
-        || evaluate_series(a),
-    )
+            });
+        }
+        let rod = series_dual(a, true)?;
+        return Ok(Evaluation {
+            tip,
+            jacobian,
+            energy: rod.energy().v,
+            stability: stability::stability_of_dense_series(a, &rod)?,
+            full_accuracy: true,
+        });
+    }
+    let energy = closed_energy(c, a, &tip)?;
+    let stability = stability::stability_of(c, a)?;
+    Ok(Evaluation {
+        tip,
+        jacobian,
+        energy,
+        stability,
+        full_accuracy: true,
+    })
 }
 
 #[cfg(test)]

@@ -1195,7 +1195,7 @@ fn refine_window_ends(
 /// ones).
 const MAX_SAMPLES: usize = 112;
 /// Most extra sample times a scan takes (`Closed::dip_times`).
-const MAX_EXTRA_SAMPLES: usize = 8;
+const MAX_EXTRA_SAMPLES: usize = super::closed::MAX_DIP_TIMES;
 
 /// Illinois regula falsi for the root of g in (t0, t1) with g(t0) > 0 ≥ g(t1).
 fn regula_falsi(g: &impl Fn(f64) -> f64, t0: f64, g0: f64, t1: f64, g1: f64) -> f64 {
