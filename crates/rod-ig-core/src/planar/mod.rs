@@ -820,6 +820,22 @@ pub fn energy(a: &PlanarParams) -> Result<f64, RodError> {
 /// planar rod.
 pub type Evaluation = crate::solver::ModelEvaluation<3, PlanarPose>;
 
+/// An evaluation whose every part is at full accuracy.
+fn full_accuracy(
+    tip: PlanarPose,
+    jacobian: PlanarJacobian,
+    energy: f64,
+    stability: StabilityReport,
+) -> Evaluation {
+    Evaluation {
+        tip,
+        jacobian,
+        energy,
+        stability,
+        full_accuracy: true,
+    }
+}
+
 /// [`evaluate`] on the Taylor series (one dense integration serves all four quantities).
 fn evaluate_series(a: &PlanarParams) -> Result<Evaluation, RodError> {
     // Where the small-angle limit decides stability, the scan needs no dense output.
@@ -831,13 +847,7 @@ fn evaluate_series(a: &PlanarParams) -> Result<Evaluation, RodError> {
         Some(report) => report,
         None => stability::stability_of_dense_series(a, &rod)?,
     };
-    Ok(Evaluation {
-        tip,
-        jacobian,
-        energy,
-        stability,
-        full_accuracy: true,
-    })
+    Ok(full_accuracy(tip, jacobian, energy, stability))
 }
 
 /// [`evaluate`] of a nearly straight rod by the small-angle expansion, where every part of it
@@ -853,13 +863,7 @@ fn evaluate_small_angle(a: &PlanarParams) -> Result<Option<Evaluation>, RodError
     let Some(stability) = stability::small_angle_report(a)? else {
         return Ok(None);
     };
-    Ok(Some(Evaluation {
-        tip,
-        jacobian,
-        energy,
-        stability,
-        full_accuracy: true,
-    }))
+    Ok(Some(full_accuracy(tip, jacobian, energy, stability)))
 }
 
 /// Tip, J(1, a), energy and stability in one call (one precomputation shared by all).
@@ -901,13 +905,7 @@ fn evaluate_closed(c: &Closed<Dual3>, a: &PlanarParams) -> Result<Evaluation, Ro
         let dd = extended::seeded_within_reach(a);
         let (tip, jacobian, energy) = ill_conditioned_tip_with(a, dd.as_ref())?;
         let stability = stability::stability_of_with(c, a, dd.as_ref())?;
-        return Ok(Evaluation {
-            tip,
-            jacobian,
-            energy,
-            stability,
-            full_accuracy: true,
-        });
+        return Ok(full_accuracy(tip, jacobian, energy, stability));
     }
     let (tip, jacobian) = pose_and_jac_of(c, a, 1.0)?;
     let near_separatrix = c.m1 < SEPARATRIX_M1
@@ -921,32 +919,24 @@ fn evaluate_closed(c: &Closed<Dual3>, a: &PlanarParams) -> Result<Evaluation, Ro
         // small-angle limit decides stability, the energy needs no dense series (the
         // zeta form, or the series' values only).
         if let Some(stability) = stability::small_angle_report(a)? {
-            return Ok(Evaluation {
+            return Ok(full_accuracy(
                 tip,
                 jacobian,
-                energy: closed_energy(c, a, &tip)?,
+                closed_energy(c, a, &tip)?,
                 stability,
-                full_accuracy: true,
-            });
+            ));
         }
         let rod = series_dual(a, true)?;
-        return Ok(Evaluation {
+        return Ok(full_accuracy(
             tip,
             jacobian,
-            energy: rod.energy().v,
-            stability: stability::stability_of_dense_series(a, &rod)?,
-            full_accuracy: true,
-        });
+            rod.energy().v,
+            stability::stability_of_dense_series(a, &rod)?,
+        ));
     }
     let energy = closed_energy(c, a, &tip)?;
     let stability = stability::stability_of(c, a)?;
-    Ok(Evaluation {
-        tip,
-        jacobian,
-        energy,
-        stability,
-        full_accuracy: true,
-    })
+    Ok(full_accuracy(tip, jacobian, energy, stability))
 }
 
 #[cfg(test)]
