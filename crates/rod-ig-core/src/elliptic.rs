@@ -17,7 +17,7 @@
 //! double-double scalar ([`crate::dd::DualDd`], [`Real::EXTENDED`]) the generic paths run with
 //! tolerances for 2⁻¹⁰⁴ and π to that precision.
 
-use crate::scalar::{fast_atan2, Real};
+use crate::scalar::{fast_atan2, fast_round, Real};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Maximum number of Landen (AGM) levels. The AGM started at b0 = √m1 converges in ≤ 12 levels
@@ -830,7 +830,7 @@ impl<T: Real> Duplication<T> {
     #[inline]
     pub fn eval(&self, u: T, with_am: bool) -> JacobiValues<T> {
         let kr = self.kr;
-        let j = (u.re() / (2.0 * kr)).round();
+        let j = fast_round(u.re() / (2.0 * kr));
         let v = if j != 0.0 { u - self.k * (2.0 * j) } else { u };
         let vr = v.re();
         if T::EXTENDED || (T::HAS_DERIVATIVES && self.mr < ANALYTIC_MIN_M) {
