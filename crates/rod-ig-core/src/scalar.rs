@@ -215,7 +215,7 @@ pub fn fast_hypot(x: f64, y: f64) -> f64 {
 #[inline]
 pub fn fast_round(x: f64) -> f64 {
     const EXACT: f64 = 4_503_599_627_370_496.0; // 2⁵²: every f64 from here on is an integer
-    if !(x.abs() < EXACT) {
+    if x.is_nan() || x.abs() >= EXACT {
         return x;
     }
     let t = x as i64 as f64;

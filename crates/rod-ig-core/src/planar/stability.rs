@@ -818,8 +818,11 @@ fn closed_scan(
 /// pose in dual numbers (~1.2k instructions, 4 % of a scan on the box).
 struct Recorded<G> {
     g: G,
-    seen: std::cell::RefCell<([(f64, f64, f64); RECORDED], usize)>,
+    seen: std::cell::RefCell<Evaluations>,
 }
+
+/// Up to [`RECORDED`] (t, g, its bound), and how many are filled.
+type Evaluations = ([(f64, f64, f64); RECORDED], usize);
 
 /// Evaluations a [`Recorded`] keeps (a box scan makes ~22; later ones are recomputed).
 const RECORDED: usize = 48;
