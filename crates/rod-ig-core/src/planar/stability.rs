@@ -1263,18 +1263,18 @@ fn regula_falsi(g: &impl Fn(f64) -> f64, t0: f64, g0: f64, t1: f64, g1: f64) -> 
         let gt = g(t);
         // NaN: a sign known positive ([`scan`]).
         if gt > 0.0 || gt.is_nan() {
+            if side == -1 {
+                ghi *= anderson_bjorck(gt, glo);
+            }
             lo = t;
             glo = gt;
-            if side == -1 {
-                ghi *= 0.5;
-            }
             side = -1;
         } else {
+            if side == 1 {
+                glo *= anderson_bjorck(gt, ghi);
+            }
             hi = t;
             ghi = gt;
-            if side == 1 {
-                glo *= 0.5;
-            }
             side = 1;
         }
         if gt == 0.0 {
@@ -1296,6 +1296,18 @@ fn regula_falsi(g: &impl Fn(f64) -> f64, t0: f64, g0: f64, t1: f64, g1: f64) -> 
         }
     }
     hi
+}
+
+/// The factor on the value kept at the end of the bracket that did not move twice in a row
+/// (Anderson & Björck 1973): 1 − g_new/g_old for the end that moved, ½ (Illinois) where that
+/// is not in (0, 1).
+fn anderson_bjorck(g_new: f64, g_old: f64) -> f64 {
+    let m = 1.0 - g_new / g_old;
+    if m > 0.0 && m < 1.0 {
+        m
+    } else {
+        0.5
+    }
 }
 
 /// A few parabolic steps towards the minimum of g bracketed by (t0, t1, t2).
