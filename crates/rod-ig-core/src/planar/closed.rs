@@ -752,7 +752,7 @@ impl<T: Real> Closed<T> {
             s.inv_m = m.recip();
             s.inv_sqrt_m = m.sqrt().recip();
         }
-        s.checked()
+        s.is_valid().then_some(s)
     }
 
     /// Phase pair (sn φ, cn φ) of cases I and III: cn φ = |a3|/√α3,
@@ -905,22 +905,23 @@ impl<T: Real> Closed<T> {
         self.e0 = e0;
     }
 
-    /// The constructed rod, or `None` when a field is not finite or the phase is lost.
-    fn checked(self) -> Option<Self> {
+    /// False when a field of the constructed rod is not finite or the phase is lost. (Takes
+    /// `&self`: a by-value check copied the ~1 kB dual-number form once more per construction.)
+    fn is_valid(&self) -> bool {
         let s = self;
         let fields = [
             s.phi, s.r, s.sqa3, s.chat, s.shat, s.lin, s.sqm, s.th0, s.e0, s.j0.sn, s.j0.cn,
             s.j0.dn, s.j0.zm,
         ];
         if s.r.re() + s.phi.re().abs() > MAX_PHASE {
-            return None;
+            return false;
         }
         if !fields.iter().all(|v| v.re().is_finite())
             || s.r.re().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
         {
-            return None;
+            return false;
         }
-        Some(s)
+        true
     }
 
     /// A t_free such that a theorem rules out any conjugate point on (0, t_free), so that det J
