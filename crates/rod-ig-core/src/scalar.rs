@@ -631,7 +631,8 @@ mod tests {
     }
 
     /// Bit for bit `f64::round` on the edges (halves, the last fractional ulps, 2⁵², signed
-    /// zeros, infinities, NaN) and on 200,000 log-scale values of both signs.
+    /// zeros, infinities, NaN) and on 200,000 log-scale values of both signs with the half
+    /// nearest each.
     #[test]
     fn fast_round_is_round() {
         let two52 = 4_503_599_627_370_496.0f64;
