@@ -44,6 +44,24 @@ const THEOREM_MIN_TERMS: f64 = 1e-280;
 /// budget; a rod with more periods has the grid alone beyond the eighth).
 pub(crate) const MAX_DIP_TIMES: usize = 8;
 
+/// Smallest m for which [`Closed::new_phase_free`] leaves out the phase: the small-m regimes
+/// (nearly straight rods under compression, near-circles) keep the form their error estimates
+/// were measured on.
+const PHASE_FREE_MIN_M: f64 = 0.01;
+/// Smallest m1 = 1 − m for which [`Closed::new_phase_free`] leaves out the phase: the
+/// addition theorems' numerators cancel as m → 1, and case II's amplitude is unwrapped by its
+/// mean slope π/(2K), which is unambiguous while 3·max|am(x) − πx/(2K)| < π (0.63π at
+/// m = 0.999, by quadrature).
+const PHASE_FREE_MIN_M1: f64 = 1e-3;
+
+/// Whether a case I or II rod of parameter m (m1 = 1 − m) may leave out its phase: in f64
+/// only. In dual numbers the addition theorems cost about as much as the phase they save
+/// (q + J: −3 % instructions on the box), and the forms that carry J must answer bit for bit
+/// alike (`evaluate` needs φ for its stability scan and energy).
+fn phase_free_allowed<T: Real>(m: f64, m1: f64) -> bool {
+    !T::HAS_DERIVATIVES && !T::EXTENDED && m >= PHASE_FREE_MIN_M && m1 >= PHASE_FREE_MIN_M1
+}
+
 /// Everything that depends on a only.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Closed<T: Real> {
@@ -92,6 +110,10 @@ pub(crate) struct Closed<T: Real> {
     th0: T,
     /// Case III: E(am φ) and cn φ (first order in δ).
     e0: T,
+    /// φ and Z(φ) were left out ([`Closed::new_phase_free`]; then both 0): `pose` places
+    /// Γ = r t + φ by the addition theorems ([`Closed::integrals_additive`]), and nothing that
+    /// needs φ itself (stability, energy, curvature, the theorem) may be asked.
+    phase_unknown: bool,
     /// Straight rod / circle: nothing else needed.
     _p: (),
 }
@@ -683,6 +705,7 @@ impl<T: Real> Closed<T> {
             j0: dummy_j,
             th0: zero,
             e0: zero,
+            phase_unknown: false,
             _p: (),
         }
     }
@@ -690,6 +713,25 @@ impl<T: Real> Closed<T> {
     /// Precomputes the closed form for a = (a3, a4, a5) (FINDINGS §2 table and phase).
     /// Returns None when an intermediate quantity is not finite (overflow).
     pub fn new(a3: T, a4: T, a5: T) -> Option<Self> {
+        Self::build(a3, a4, a5, true)
+    }
+
+    /// As [`Self::new`], for the pose alone (no stability scan, energy, curvature or theorem,
+    /// which need φ): in f64, where m ∈ [[`PHASE_FREE_MIN_M`], 1 − [`PHASE_FREE_MIN_M1`]]
+    /// (cases I and II), the phase φ = F(am φ | m) is not computed (Carlson's R_F and R_D,
+    /// ~20 % of q(1)) and `pose` places Γ = r t + φ by the addition theorems from the base's
+    /// sn, cn, dn, which are algebraic in a. Elsewhere the same as [`Self::new`].
+    pub fn new_phase_free(a3: T, a4: T, a5: T) -> Option<Self> {
+        Self::build(a3, a4, a5, false)
+    }
+
+    /// Whether this form was built without its phase ([`Self::new_phase_free`]).
+    #[cfg(test)]
+    pub(crate) fn phase_unknown(&self) -> bool {
+        self.phase_unknown
+    }
+
+    fn build(a3: T, a4: T, a5: T, with_phase: bool) -> Option<Self> {
         let (a3r, a4r, a5r) = (a3.re(), a4.re(), a5.re());
         let mut s = Self::straight(a3, a4, a5);
         if a3r == 0.0 && a5r == 0.0 {
@@ -737,9 +779,9 @@ impl<T: Real> Closed<T> {
             lambda4,
         };
         if l4 > 0.0 {
-            s.init_case_i(&invariants)?;
+            s.init_case_i(&invariants, with_phase)?;
         } else if l4 < 0.0 {
-            s.init_case_ii(&invariants)?;
+            s.init_case_ii(&invariants, with_phase)?;
             if s.case == Case::SmallForce {
                 return Some(s);
             }
@@ -770,7 +812,7 @@ impl<T: Real> Closed<T> {
     }
 
     /// Case I (λ4 > 0, FINDINGS §2): parameter m = α3/(4F), r = √F.
-    fn init_case_i(&mut self, inv: &Invariants<T>) -> Option<()> {
+    fn init_case_i(&mut self, inv: &Invariants<T>, with_phase: bool) -> Option<()> {
         let Invariants {
             f,
             fp,
@@ -787,7 +829,12 @@ impl<T: Real> Closed<T> {
             return None;
         }
         let (sn, cn) = self.phase_i(fp, fm, alpha3);
-        let (phi, zm0) = inverse_phase_zeta(sn, cn, m1, landen.k(), landen.d_over_k());
+        self.phase_unknown = !with_phase && phase_free_allowed::<T>(m.re(), m1.re());
+        let (phi, zm0) = if self.phase_unknown {
+            (zero, zero)
+        } else {
+            inverse_phase_zeta(sn, cn, m1, landen.k(), landen.d_over_k())
+        };
         self.r = f.sqrt();
         self.phi = phi;
         self.m = m;
@@ -813,7 +860,7 @@ impl<T: Real> Closed<T> {
 
     /// Case II (λ4 < 0, FINDINGS §2): parameter m = 4F/α3, r = √α3 / 2; tiny m is the
     /// small-force series ([`Case::SmallForce`]).
-    fn init_case_ii(&mut self, inv: &Invariants<T>) -> Option<()> {
+    fn init_case_ii(&mut self, inv: &Invariants<T>, with_phase: bool) -> Option<()> {
         let Invariants {
             f,
             fp,
@@ -845,7 +892,13 @@ impl<T: Real> Closed<T> {
         } else {
             ((fp / two_f).sqrt(), a5 * eps / (two_f * fp).sqrt())
         };
-        let (phi, zm0) = inverse_phase_zeta(sn, cn, m1, landen.k(), landen.d_over_k());
+        self.phase_unknown = !with_phase && phase_free_allowed::<T>(m.re(), m1.re());
+        let (phi, zm0) = if self.phase_unknown {
+            let zero = T::from_f64(0.0);
+            (zero, zero)
+        } else {
+            inverse_phase_zeta(sn, cn, m1, landen.k(), landen.d_over_k())
+        };
         self.r = sqa3 * 0.5;
         self.phi = phi;
         self.m = m;
@@ -1113,8 +1166,47 @@ impl<T: Real> Closed<T> {
         Some((energy, terms))
     }
 
+    /// (∫β1, ∫β2, θ/(2ε)) at t of a form built without its phase (cases I and II,
+    /// [`Self::new_phase_free`]): with u = r t and v = φ, the Jacobi functions at Γ = u + v by
+    /// the addition theorems (A&S 16.17.1–3), with the cancellation-free denominator
+    /// Δ = 1 − m sn²u sn²v = cn²u + sn²u dn²v, from those at u and the base's sn v, cn v,
+    /// dn v (algebraic in a); Z(u + v) − Z(v) = Z(u) − m sn u sn v sn(u + v) (A&S 17.4.35).
+    /// Case II's am(Γ) − am(v) is am(u) plus the principal angle of
+    /// e^{i am Γ} e^{−i am u} e^{−i am v} (that sum lies in (−π, π), see [`PHASE_FREE_MIN_M1`]).
+    fn integrals_additive(&self, t: f64) -> (T, T, T) {
+        let ii = self.case == Case::II;
+        let ju = self.landen.eval(self.r * t, ii);
+        let (su, cu, du) = (ju.sn, ju.cn, ju.dn);
+        let (sv, cv, dv) = (self.j0.sn, self.j0.cn, self.j0.dn);
+        let inv = (cu * cu + su * su * dv * dv).recip();
+        let sg = (su * cv * dv + sv * cu * du) * inv;
+        let cg = (cu * cv - su * sv * du * dv) * inv;
+        let dg = (du * dv - self.m * su * sv * cu * cv) * inv;
+        let ib1 = self.lin * t + (ju.zm - su * sv * sg) * self.zcoef;
+        if !ii {
+            let ib2 = (cg - cv) * self.b2coef;
+            // As in `pose`: one atan2 of the rotated pair (both angles in (−π/2, π/2)).
+            let (y1, x1) = (self.sqm * sg, dg);
+            let (y0, x0) = (self.y0, dv);
+            return (ib1, ib2, (y1 * x0 - x1 * y0).atan2_fast(x1 * x0 + y1 * y0));
+        }
+        // As in `pose`, −(dn − dn0)/(m r) in the form that does not cancel.
+        let ib2 = if self.m.re() >= 0.5 {
+            (dv - dg) * self.b2coef
+        } else {
+            (sg * sg - sv * sv) * self.inv_r / (dg + dv)
+        };
+        // e^{i am Γ}·conj(e^{i am u})·conj(e^{i am v}), with e^{i am x} = cn x + i sn x.
+        let (re1, im1) = (cg * cu + sg * su, sg * cu - cg * su);
+        let (re2, im2) = (re1 * cv + im1 * sv, im1 * cv - re1 * sv);
+        (ib1, ib2, ju.am + im2.atan2_fast(re2))
+    }
+
     /// Pose (x, y, θ)(t) with θ unwrapped (FINDINGS §1 position formulas, §3 integrals):
     /// x = −(a4/F)∫β1 + 2ε(a5/F)∫β2, y = −(a5/F)∫β1 − 2ε(a4/F)∫β2.
+    ///
+    /// A form built without its phase ([`Self::new_phase_free`]) places Γ by the addition
+    /// theorems instead ([`Self::integrals_additive`]).
     pub fn pose(&self, t: f64) -> [T; 3] {
         if t == 0.0 {
             // the base is clamped at the identity: q(0) = 0 and J(0) = 0 exactly
@@ -1154,6 +1246,7 @@ impl<T: Real> Closed<T> {
                 }
                 return [x, y, th];
             }
+            Case::I | Case::II if self.phase_unknown => self.integrals_additive(t),
             Case::I => {
                 let j = self.landen.eval(self.r * t + self.phi, false);
                 let ib1 = self.lin * t + (j.zm - self.j0.zm) * self.zcoef;
