@@ -548,6 +548,18 @@ fn agm_kq<T: Real>(m: T, m1: T) -> (T, T, bool) {
     (a.recip() * T::pi() * 0.5, q, converged)
 }
 
+/// What [`Duplication::eval_amplitude`] computes of the amplitude am(u).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Amplitude {
+    /// Not at all (am = 0).
+    None,
+    /// Its value and derivatives.
+    Value,
+    /// Its derivatives alone (dual numbers; the value is left out, not meaningful): what a
+    /// Jacobian needs, without the arctangent of the value.
+    SlopeOnly,
+}
+
 /// Jacobi functions by argument reduction, Maclaurin series and duplication (no sines, no
 /// arcsines). Per m: K(m) and D(m)/K(m) by the AGM (same recurrences as [`Landen`], nothing
 /// stored per level) and the series coefficients. Per u:
@@ -829,6 +841,20 @@ impl<T: Real> Duplication<T> {
     /// sn, cn, dn, Z/m at u, and the continuous amplitude am(u) if `with_am` (else am = 0).
     #[inline]
     pub fn eval(&self, u: T, with_am: bool) -> JacobiValues<T> {
+        self.eval_amplitude(
+            u,
+            if with_am {
+                Amplitude::Value
+            } else {
+                Amplitude::None
+            },
+        )
+    }
+
+    /// [`Self::eval`] with the amplitude as `amp` asks.
+    #[inline]
+    pub fn eval_amplitude(&self, u: T, amp: Amplitude) -> JacobiValues<T> {
+        let with_am = amp != Amplitude::None;
         let kr = self.kr;
         let j = fast_round(u.re() / (2.0 * kr));
         let v = if j != 0.0 { u - self.k * (2.0 * j) } else { u };
@@ -848,7 +874,12 @@ impl<T: Real> Duplication<T> {
             return JacobiValues { sn, cn, dn, am, zm };
         }
         let (s, c, d, dd) = self.core(vr);
-        let am_v = if with_am { fast_atan2(s, c) } else { 0.0 };
+        // The amplitude's value only where it is asked for (its slope is attached below).
+        let am_v = if with_am && (amp == Amplitude::Value || !T::HAS_DERIVATIVES) {
+            fast_atan2(s, c)
+        } else {
+            0.0
+        };
         let (mut sn, mut cn, dn, dv, am) = if T::HAS_DERIVATIVES {
             let (m, m1) = (self.mr, self.m1r);
             let a = (s * c - d * (vr - dd)) / (2.0 * m1);

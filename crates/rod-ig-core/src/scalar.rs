@@ -69,6 +69,11 @@ pub trait Real:
     fn atan2_fast(self, x: Self) -> Self {
         self.atan2(x)
     }
+    /// atan2 where only its derivatives are wanted (a Jacobian's entries, not the angle): dual
+    /// numbers leave the value out (0), every other scalar computes [`Real::atan2_fast`].
+    fn atan2_slope(self, x: Self) -> Self {
+        self.atan2_fast(x)
+    }
     /// Exponential.
     fn exp(self) -> Self;
     /// Natural logarithm.
@@ -282,6 +287,22 @@ pub struct Dual3 {
 }
 
 impl Dual3 {
+    /// atan2(self, x) with the given value: d atan2(y, x) = (x dy − y dx)/(x² + y²).
+    #[inline]
+    fn atan2_with(self, x: Self, value: f64) -> Self {
+        let y = self;
+        let r2 = x.v * x.v + y.v * y.v;
+        let inv = if r2 > 0.0 { 1.0 / r2 } else { 0.0 };
+        Self {
+            v: value,
+            g: [
+                (x.v * y.g[0] - y.v * x.g[0]) * inv,
+                (x.v * y.g[1] - y.v * x.g[1]) * inv,
+                (x.v * y.g[2] - y.v * x.g[2]) * inv,
+            ],
+        }
+    }
+
     /// A dual number from its value and gradient.
     #[inline]
     pub const fn new(v: f64, g: [f64; 3]) -> Self {
@@ -490,18 +511,12 @@ impl Real for Dual3 {
         }
     }
     #[inline]
+    fn atan2_slope(self, x: Self) -> Self {
+        self.atan2_with(x, 0.0)
+    }
+    #[inline]
     fn atan2_fast(self, x: Self) -> Self {
-        let y = self;
-        let r2 = x.v * x.v + y.v * y.v;
-        let inv = if r2 > 0.0 { 1.0 / r2 } else { 0.0 };
-        Self {
-            v: fast_atan2(y.v, x.v),
-            g: [
-                (x.v * y.g[0] - y.v * x.g[0]) * inv,
-                (x.v * y.g[1] - y.v * x.g[1]) * inv,
-                (x.v * y.g[2] - y.v * x.g[2]) * inv,
-            ],
-        }
+        self.atan2_with(x, fast_atan2(self.v, x.v))
     }
     #[inline]
     fn exp(self) -> Self {

@@ -4,7 +4,7 @@
 //! Landen sequence, values at Γ0 = φ); [`Closed::pose`] then costs one descending-Landen
 //! evaluation. With `T = Dual3` seeded with the identity on a, the same code yields J(t, a).
 
-use crate::elliptic::{inverse_phase_zeta, Duplication, JacobiValues};
+use crate::elliptic::{inverse_phase_zeta, Amplitude, Duplication, JacobiValues};
 use crate::scalar::Real;
 
 /// Which closed form applies (decided on f64 values).
@@ -1208,6 +1208,17 @@ impl<T: Real> Closed<T> {
     /// A form built without its phase ([`Self::new_phase_free`]) places Γ by the addition
     /// theorems instead ([`Self::integrals_additive`]).
     pub fn pose(&self, t: f64) -> [T; 3] {
+        self.pose_with(t, true)
+    }
+
+    /// [`Self::pose`] for its derivatives alone (J(t)): θ's value is left out in cases I and
+    /// II (an arctangent per call, ~5 % of a stability scan's sample), every derivative the
+    /// same bit for bit. x and y keep their values.
+    pub fn pose_for_jacobian(&self, t: f64) -> [T; 3] {
+        self.pose_with(t, false)
+    }
+
+    fn pose_with(&self, t: f64, theta_value: bool) -> [T; 3] {
         if t == 0.0 {
             // the base is clamped at the identity: q(0) = 0 and J(0) = 0 exactly
             let zero = T::from_f64(0.0);
@@ -1255,11 +1266,21 @@ impl<T: Real> Closed<T> {
                 // (−π/2, π/2), so one atan2 of the rotated pair gives the difference exactly.
                 let (y1, x1) = (self.sqm * j.sn, j.dn);
                 let (y0, x0) = (self.y0, self.j0.dn);
-                let ht = (y1 * x0 - x1 * y0).atan2_fast(x1 * x0 + y1 * y0);
+                let (y, x) = (y1 * x0 - x1 * y0, x1 * x0 + y1 * y0);
+                let ht = if theta_value {
+                    y.atan2_fast(x)
+                } else {
+                    y.atan2_slope(x)
+                };
                 (ib1, ib2, ht)
             }
             Case::II => {
-                let j = self.landen.eval(self.r * t + self.phi, true);
+                let amp = if theta_value {
+                    Amplitude::Value
+                } else {
+                    Amplitude::SlopeOnly
+                };
+                let j = self.landen.eval_amplitude(self.r * t + self.phi, amp);
                 let ib1 = self.lin * t + (j.zm - self.j0.zm) * self.zcoef;
                 // −(dn − dn0)/(m r) (FINDINGS §3), in the form that does not cancel: through
                 // sn² − sn0² = (dn0² − dn²)/m for small m, directly for m ≥ ½ (dn, computed

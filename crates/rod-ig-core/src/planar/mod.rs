@@ -963,6 +963,63 @@ mod tests {
         )
     }
 
+    /// `Closed::pose_for_jacobian` (the stability scans' samples) gives J(t) bit for bit as
+    /// `pose` does, and x, y too, on 3,000 rods of cases I and II (box, log-scale, looped) at
+    /// 8 times each; only θ's value is left out.
+    #[test]
+    fn pose_for_jacobian_is_pose_without_theta() {
+        let mut r = SplitMix64::new(31);
+        let mut compared = [0usize; 2];
+        for i in 0..3000usize {
+            let a = match i % 3 {
+                0 => PlanarParams::new(
+                    r.range(-10.0, 10.0),
+                    r.range(-100.0, 100.0),
+                    r.range(-100.0, 100.0),
+                ),
+                1 => PlanarParams::new(
+                    r.signed_pow10(-6.0, 1.0),
+                    r.signed_pow10(-6.0, 3.0),
+                    r.signed_pow10(-6.0, 3.0),
+                ),
+                _ => {
+                    PlanarParams::new(r.range(-40.0, 40.0), r.range(-5.0, 5.0), r.range(-5.0, 5.0))
+                }
+            };
+            let Some(c) = seeded_closed(&a) else {
+                continue;
+            };
+            let case = match c.case {
+                closed::Case::I => 0,
+                closed::Case::II => 1,
+                _ => continue,
+            };
+            for k in 1..=8 {
+                let t = f64::from(k) / 8.0;
+                let (full, slope) = (c.pose(t), c.pose_for_jacobian(t));
+                for row in 0..3 {
+                    let same = full[row]
+                        .g
+                        .iter()
+                        .zip(&slope[row].g)
+                        .all(|(p, q)| p.to_bits() == q.to_bits());
+                    assert!(
+                        same,
+                        "{a:?} t {t} row {row}: {:?} vs {:?}",
+                        full[row].g, slope[row].g
+                    );
+                }
+                assert_eq!(
+                    (full[0].v.to_bits(), full[1].v.to_bits()),
+                    (slope[0].v.to_bits(), slope[1].v.to_bits()),
+                    "{a:?} t {t}"
+                );
+            }
+            compared[case] += 1;
+        }
+        assert!(compared[0] > 500 && compared[1] > 500, "{compared:?}");
+    }
+
     /// q(1) of the form built without its phase (the addition theorems, `planar::tip`) and of
     /// the one built with it, against the double-double series (exact to ~1e-30 here), on
     /// 5,000 rods the way users give them: the paper's box, log-scale magnitudes with exact

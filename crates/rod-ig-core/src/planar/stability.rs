@@ -81,7 +81,7 @@ fn rows(p: &[Dual3; 3]) -> [[f64; 3]; 3] {
 
 /// g(t) alone from the dual-number closed form (scans that bound it elsewhere).
 fn normalised_det_value(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64) -> f64 {
-    det3(&rows(&c.pose(t))) / normalisation(a3, a5, t)
+    det3(&rows(&c.pose_for_jacobian(t))) / normalisation(a3, a5, t)
 }
 
 /// g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (FINDINGS §5) and its error bound, from the
@@ -90,7 +90,7 @@ fn normalised_det_value(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64) -> f64 {
 /// itself) instead of rel·|entry|: near the separatrix an entry far below ‖J‖ (the x row while
 /// the rod lingers by the straight equilibrium) can be off by that much.
 fn normalised_det(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64, norm_wise: bool) -> (f64, f64) {
-    let j = rows(&c.pose(t));
+    let j = rows(&c.pose_for_jacobian(t));
     let rel = c.jacobian_rel_error_at(t);
     let abs = if norm_wise {
         CLOSED_J_ABS.max(rel * j.iter().flatten().map(|v| v * v).sum::<f64>().sqrt())
@@ -106,7 +106,7 @@ fn normalised_det(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64, norm_wise: bool) 
 /// norm-wise estimate ([`Closed::jacobian_rel_error_own_at`], the f64 model at 2⁻¹⁰⁴) times
 /// ‖J‖, plus its rounding to f64 (ε of itself).
 fn normalised_det_extended(c: &Closed<DualDd>, a3: f64, a5: f64, t: f64) -> (f64, f64) {
-    let p = c.pose(t);
+    let p = c.pose_for_jacobian(t);
     let j = [0, 1, 2].map(|r| p[r].g.map(|v| v.to_f64()));
     let rel = c.jacobian_rel_error_own_at(t);
     let abs = rel * j.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
