@@ -852,7 +852,7 @@ impl<T: Real> Duplication<T> {
     }
 
     /// [`Self::eval`] with the amplitude as `amp` asks.
-    #[inline]
+    #[inline(always)]
     pub fn eval_amplitude(&self, u: T, amp: Amplitude) -> JacobiValues<T> {
         let with_am = amp != Amplitude::None;
         let kr = self.kr;

@@ -1208,17 +1208,20 @@ impl<T: Real> Closed<T> {
     /// A form built without its phase ([`Self::new_phase_free`]) places Γ by the addition
     /// theorems instead ([`Self::integrals_additive`]).
     pub fn pose(&self, t: f64) -> [T; 3] {
-        self.pose_with(t, true)
+        self.pose_with::<true>(t)
     }
 
     /// [`Self::pose`] for its derivatives alone (J(t)): θ's value is left out in cases I and
     /// II (an arctangent per call, ~5 % of a stability scan's sample), every derivative the
     /// same bit for bit. x and y keep their values.
     pub fn pose_for_jacobian(&self, t: f64) -> [T; 3] {
-        self.pose_with(t, false)
+        self.pose_with::<false>(t)
     }
 
-    fn pose_with(&self, t: f64, theta_value: bool) -> [T; 3] {
+    /// [`Self::pose`] with θ's value (`THETA_VALUE`) or its derivatives alone; a constant so
+    /// that each build folds the choice away.
+    #[inline(always)]
+    fn pose_with<const THETA_VALUE: bool>(&self, t: f64) -> [T; 3] {
         if t == 0.0 {
             // the base is clamped at the identity: q(0) = 0 and J(0) = 0 exactly
             let zero = T::from_f64(0.0);
@@ -1267,7 +1270,7 @@ impl<T: Real> Closed<T> {
                 let (y1, x1) = (self.sqm * j.sn, j.dn);
                 let (y0, x0) = (self.y0, self.j0.dn);
                 let (y, x) = (y1 * x0 - x1 * y0, x1 * x0 + y1 * y0);
-                let ht = if theta_value {
+                let ht = if THETA_VALUE {
                     y.atan2_fast(x)
                 } else {
                     y.atan2_slope(x)
@@ -1275,7 +1278,7 @@ impl<T: Real> Closed<T> {
                 (ib1, ib2, ht)
             }
             Case::II => {
-                let amp = if theta_value {
+                let amp = if THETA_VALUE {
                     Amplitude::Value
                 } else {
                     Amplitude::SlopeOnly
