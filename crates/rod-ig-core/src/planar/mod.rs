@@ -963,6 +963,15 @@ mod tests {
         )
     }
 
+    /// A rod of the paper's box: a3 ∈ [−10, 10], a4, a5 ∈ [−100, 100].
+    fn paper_box_rod(r: &mut SplitMix64) -> PlanarParams {
+        PlanarParams::new(
+            r.range(-10.0, 10.0),
+            r.range(-100.0, 100.0),
+            r.range(-100.0, 100.0),
+        )
+    }
+
     /// `Closed::pose_for_jacobian` (the stability scans' samples) gives J(t) bit for bit as
     /// `pose` does, and x, y too, on 3,000 rods of cases I and II (box, log-scale, looped) at
     /// 8 times each; only θ's value is left out.
@@ -972,11 +981,7 @@ mod tests {
         let mut compared = [0usize; 2];
         for i in 0..3000usize {
             let a = match i % 3 {
-                0 => PlanarParams::new(
-                    r.range(-10.0, 10.0),
-                    r.range(-100.0, 100.0),
-                    r.range(-100.0, 100.0),
-                ),
+                0 => paper_box_rod(&mut r),
                 1 => PlanarParams::new(
                     r.signed_pow10(-6.0, 1.0),
                     r.signed_pow10(-6.0, 3.0),
@@ -1034,11 +1039,7 @@ mod tests {
         let (mut taken, mut worst_free, mut worst_phase) = (0, 0.0f64, 0.0f64);
         for i in 0..5000usize {
             let a = match i % 5 {
-                0 => PlanarParams::new(
-                    r.range(-10.0, 10.0),
-                    r.range(-100.0, 100.0),
-                    r.range(-100.0, 100.0),
-                ),
+                0 => paper_box_rod(&mut r),
                 1 => {
                     let mut v = [
                         r.signed_pow10(-3.0, 1.0),
