@@ -203,13 +203,44 @@ const I11: [f64; TERMS] = i_coefficients(1, 1);
 const I12: [f64; TERMS] = i_coefficients(1, 2);
 const I22: [f64; TERMS] = i_coefficients(2, 2);
 
-/// Σ cₖ zᵏ by Horner's rule.
-fn horner(c: &[f64; TERMS], z: Jet) -> Jet {
-    let mut acc = Jet::constant(c[TERMS - 1]);
-    for &ck in c[..TERMS - 1].iter().rev() {
+/// Σ cₖ zᵏ by Horner's rule, over the first n terms.
+fn horner(c: &[f64; TERMS], z: Jet, n: usize) -> Jet {
+    let mut acc = Jet::constant(c[n - 1]);
+    for &ck in c[..n - 1].iter().rev() {
         acc = acc * z + ck;
     }
     acc
+}
+
+/// (n, z_max): n terms of every series of [`series_jets`] (S1, S2, S3, I11, I12, I22) leave
+/// tails in value and in z-derivative below 2⁻⁶⁴ of the sums' lower bounds c₀ − c₁|z| and
+/// c₁ − 2c₂|z| for |z| ≤ z_max (bisected with exact rational coefficients, rounded down;
+/// `series_terms_leave_no_tail` checks it). Beyond the last entry all [`TERMS`] are used (17
+/// suffice at |z| = [`SERIES_MAX_Z`]): most samples of a scan sit at small z, where 9–12
+/// terms do.
+const TERMS_FOR_Z: [(usize, f64); 13] = [
+    (4, 4.1e-6),
+    (5, 2.1e-4),
+    (6, 2.4e-3),
+    (7, 1.3e-2),
+    (8, 4.5e-2),
+    (9, 0.118),
+    (10, 0.252),
+    (11, 0.472),
+    (12, 0.797),
+    (13, 1.245),
+    (14, 1.828),
+    (15, 2.551),
+    (16, 3.401),
+];
+
+/// Terms [`series_jets`] needs at |z| (see [`TERMS_FOR_Z`]).
+fn terms_for(z: f64) -> usize {
+    let z = z.abs();
+    TERMS_FOR_Z
+        .iter()
+        .find(|&&(_, z_max)| z <= z_max)
+        .map_or(TERMS, |&(n, _)| n)
 }
 
 /// The straight rod's functions at t and their a4-derivatives:
@@ -231,14 +262,15 @@ pub(crate) fn straight_functions(a4: f64, t: f64) -> [f64; 6] {
 /// [`straight_jets`] by the Maclaurin series in z = a4 t².
 fn series_jets(a4: f64, t: f64) -> [Jet; 6] {
     let z = Jet { v: a4, d: 1.0 } * (t * t);
+    let n = terms_for(z.v);
     let (t2, t3) = (t * t, t * t * t);
     [
-        horner(&S1, z) * t,
-        horner(&S2, z) * t2,
-        horner(&S3, z) * t3,
-        horner(&I11, z) * t3,
-        horner(&I12, z) * (t2 * t2),
-        horner(&I22, z) * (t2 * t3),
+        horner(&S1, z, n) * t,
+        horner(&S2, z, n) * t2,
+        horner(&S3, z, n) * t3,
+        horner(&I11, z, n) * t3,
+        horner(&I12, z, n) * (t2 * t2),
+        horner(&I22, z, n) * (t2 * t3),
     ]
 }
 
@@ -372,7 +404,11 @@ pub(crate) fn pose_and_jacobian(a3: f64, a4: f64, a5: f64, t: f64) -> Linearised
 pub(crate) fn energy(a3: f64, a4: f64, a5: f64) -> (f64, f64) {
     let [i00, i01, i11] = if a4.abs() < SERIES_MAX_Z {
         let z = Jet::constant(a4);
-        [horner(&I00, z).v, horner(&I01, z).v, horner(&I11, z).v]
+        [
+            horner(&I00, z, TERMS).v,
+            horner(&I01, z, TERMS).v,
+            horner(&I11, z, TERMS).v,
+        ]
     } else {
         let w = a4.abs().sqrt();
         let (s, c, sign) = if a4 > 0.0 {
@@ -488,6 +524,36 @@ pub(crate) mod tests {
             r.signed_pow10(-20.0, -1.0)
         };
         (a3 != 0.0 || a5 != 0.0).then(|| PlanarParams::new(a3, a4, a5))
+    }
+
+    /// [`TERMS_FOR_Z`]: at each z_max, the neglected terms of every series of `series_jets`
+    /// (value and z-derivative) stay below 2⁻⁶³ of the sums' lower bounds c₀ − c₁z and
+    /// c₁ − 2c₂z (the table was bisected at 2⁻⁶⁴ in exact arithmetic), and all [`TERMS`] do
+    /// at |z| = [`SERIES_MAX_Z`].
+    #[test]
+    fn series_terms_leave_no_tail() {
+        let check = |n: usize, z: f64| {
+            for c in [&S1, &S2, &S3, &I11, &I12, &I22] {
+                let (mut tail_v, mut tail_d) = (0.0f64, 0.0f64);
+                for (k, ck) in c.iter().enumerate().skip(n) {
+                    tail_v += ck.abs() * z.powi(k as i32);
+                    tail_d += k as f64 * ck.abs() * z.powi(k as i32 - 1);
+                }
+                let (lower_v, lower_d) = (c[0] - c[1] * z, c[1] - 2.0 * c[2] * z);
+                assert!(lower_v > 0.0 && lower_d > 0.0, "n {n} z {z}");
+                assert!(
+                    tail_v <= 2f64.powi(-63) * lower_v && tail_d <= 2f64.powi(-63) * lower_d,
+                    "n {n} z {z}: tails {tail_v:e} {tail_d:e}"
+                );
+            }
+        };
+        let mut previous = 0.0;
+        for &(n, z_max) in &TERMS_FOR_Z {
+            assert!(z_max > previous);
+            previous = z_max;
+            check(n, z_max);
+        }
+        check(TERMS, SERIES_MAX_Z);
     }
 
     /// The series and closed-form branches of the straight rod's functions agree where they
