@@ -497,18 +497,7 @@ impl Real for Dual3 {
     }
     #[inline]
     fn atan2(self, x: Self) -> Self {
-        // d atan2(y, x) = (x dy − y dx) / (x² + y²)
-        let y = self;
-        let r2 = x.v * x.v + y.v * y.v;
-        let inv = if r2 > 0.0 { 1.0 / r2 } else { 0.0 };
-        Self {
-            v: y.v.atan2(x.v),
-            g: [
-                (x.v * y.g[0] - y.v * x.g[0]) * inv,
-                (x.v * y.g[1] - y.v * x.g[1]) * inv,
-                (x.v * y.g[2] - y.v * x.g[2]) * inv,
-            ],
-        }
+        self.atan2_with(x, self.v.atan2(x.v))
     }
     #[inline]
     fn atan2_slope(self, x: Self) -> Self {

@@ -1166,6 +1166,28 @@ impl<T: Real> Closed<T> {
         Some((energy, terms))
     }
 
+    /// Case I: (y, x) whose atan2 is θ/(2ε) at Γ from sn Γ, dn Γ: atan2(√m sn, dn) at Γ minus
+    /// that at the base, as one rotated pair (x0, x1 = dn > 0, so both angles lie in (−π/2,
+    /// π/2) and one atan2 gives the difference exactly).
+    #[inline(always)]
+    fn turn_from_base_i(&self, sn: T, dn: T) -> (T, T) {
+        let (y1, x1) = (self.sqm * sn, dn);
+        let (y0, x0) = (self.y0, self.j0.dn);
+        (y1 * x0 - x1 * y0, x1 * x0 + y1 * y0)
+    }
+
+    /// Case II: ∫β2 = −(dn − dn0)/(m r) (FINDINGS §3) from sn Γ, dn Γ, in the form that does
+    /// not cancel: through sn² − sn0² = (dn0² − dn²)/m for small m, directly for m ≥ ½ (dn,
+    /// computed with relative accuracy, is tiny near the separatrix while sn ≈ 1).
+    #[inline(always)]
+    fn dn_integral_ii(&self, sn: T, dn: T) -> T {
+        if self.m.re() >= 0.5 {
+            (self.j0.dn - dn) * self.b2coef
+        } else {
+            (sn * sn - self.j0.sn * self.j0.sn) * self.inv_r / (dn + self.j0.dn)
+        }
+    }
+
     /// (∫β1, ∫β2, θ/(2ε)) at t of a form built without its phase (cases I and II,
     /// [`Self::new_phase_free`]): with u = r t and v = φ, the Jacobi functions at Γ = u + v by
     /// the addition theorems (A&S 16.17.1–3), with the cancellation-free denominator
@@ -1185,17 +1207,10 @@ impl<T: Real> Closed<T> {
         let ib1 = self.lin * t + (ju.zm - su * sv * sg) * self.zcoef;
         if !ii {
             let ib2 = (cg - cv) * self.b2coef;
-            // As in `pose`: one atan2 of the rotated pair (both angles in (−π/2, π/2)).
-            let (y1, x1) = (self.sqm * sg, dg);
-            let (y0, x0) = (self.y0, dv);
-            return (ib1, ib2, (y1 * x0 - x1 * y0).atan2_fast(x1 * x0 + y1 * y0));
+            let (y, x) = self.turn_from_base_i(sg, dg);
+            return (ib1, ib2, y.atan2_fast(x));
         }
-        // As in `pose`, −(dn − dn0)/(m r) in the form that does not cancel.
-        let ib2 = if self.m.re() >= 0.5 {
-            (dv - dg) * self.b2coef
-        } else {
-            (sg * sg - sv * sv) * self.inv_r / (dg + dv)
-        };
+        let ib2 = self.dn_integral_ii(sg, dg);
         // e^{i am Γ}·conj(e^{i am u})·conj(e^{i am v}), with e^{i am x} = cn x + i sn x.
         let (re1, im1) = (cg * cu + sg * su, sg * cu - cg * su);
         let (re2, im2) = (re1 * cv + im1 * sv, im1 * cv - re1 * sv);
@@ -1265,11 +1280,7 @@ impl<T: Real> Closed<T> {
                 let j = self.landen.eval(self.r * t + self.phi, false);
                 let ib1 = self.lin * t + (j.zm - self.j0.zm) * self.zcoef;
                 let ib2 = (j.cn - self.j0.cn) * self.b2coef;
-                // atan2(y1, x1) − atan2(y0, x0) with x0, x1 = dn > 0: both angles lie in
-                // (−π/2, π/2), so one atan2 of the rotated pair gives the difference exactly.
-                let (y1, x1) = (self.sqm * j.sn, j.dn);
-                let (y0, x0) = (self.y0, self.j0.dn);
-                let (y, x) = (y1 * x0 - x1 * y0, x1 * x0 + y1 * y0);
+                let (y, x) = self.turn_from_base_i(j.sn, j.dn);
                 let ht = if THETA_VALUE {
                     y.atan2_fast(x)
                 } else {
@@ -1285,14 +1296,7 @@ impl<T: Real> Closed<T> {
                 };
                 let j = self.landen.eval_amplitude(self.r * t + self.phi, amp);
                 let ib1 = self.lin * t + (j.zm - self.j0.zm) * self.zcoef;
-                // −(dn − dn0)/(m r) (FINDINGS §3), in the form that does not cancel: through
-                // sn² − sn0² = (dn0² − dn²)/m for small m, directly for m ≥ ½ (dn, computed
-                // with relative accuracy, is tiny near the separatrix while sn ≈ 1).
-                let ib2 = if self.m.re() >= 0.5 {
-                    (self.j0.dn - j.dn) * self.b2coef
-                } else {
-                    (j.sn * j.sn - self.j0.sn * self.j0.sn) * self.inv_r / (j.dn + self.j0.dn)
-                };
+                let ib2 = self.dn_integral_ii(j.sn, j.dn);
                 (ib1, ib2, j.am - self.th0)
             }
             Case::III => {

@@ -810,7 +810,8 @@ fn closed_scan(
     if !report.uncertain {
         return Ok(report);
     }
-    Ok(certify_margin(a, s, &g).unwrap_or(report))
+    // It compares against g at t_margin, which the scan has already evaluated.
+    Ok(certify_margin(a, s, &|t| recorded.at(t)).unwrap_or(report))
 }
 
 /// g with the evaluations it has made kept, so that the margin's error bound, read at
