@@ -1223,27 +1223,37 @@ impl<T: Real> Closed<T> {
     /// A form built without its phase ([`Self::new_phase_free`]) places Γ by the addition
     /// theorems instead ([`Self::integrals_additive`]).
     pub fn pose(&self, t: f64) -> [T; 3] {
-        self.pose_with::<true>(t)
+        self.pose_with::<true, false>(t).0
     }
 
     /// [`Self::pose`] for its derivatives alone (J(t)): θ's value is left out in cases I and
     /// II (an arctangent per call, ~5 % of a stability scan's sample), every derivative the
     /// same bit for bit. x and y keep their values.
     pub fn pose_for_jacobian(&self, t: f64) -> [T; 3] {
-        self.pose_with::<false>(t)
+        self.pose_with::<false, false>(t).0
     }
 
-    /// [`Self::pose`] with θ's value (`THETA_VALUE`) or its derivatives alone; a constant so
-    /// that each build folds the choice away.
+    /// [`Self::pose_for_jacobian`] and the curvature κ(t) from the same Jacobi values (cases
+    /// I, II and III; NaN in the others and on a form built without its phase): with dual
+    /// numbers ∂κ/∂a, which gives d det J/dt = det[J_x; J_y; ∂κ/∂a] (the rows x', y' of J' =
+    /// ∂(cos θ, sin θ, κ)/∂a are multiples of the θ row, so they add nothing).
+    pub fn pose_and_curvature_for_jacobian(&self, t: f64) -> ([T; 3], T) {
+        self.pose_with::<false, true>(t)
+    }
+
+    /// [`Self::pose`] with θ's value (`THETA_VALUE`) or its derivatives alone, and the
+    /// curvature if `CURVATURE` (else NaN); constants so that each build folds the choices
+    /// away.
     #[inline(always)]
-    fn pose_with<const THETA_VALUE: bool>(&self, t: f64) -> [T; 3] {
+    fn pose_with<const THETA_VALUE: bool, const CURVATURE: bool>(&self, t: f64) -> ([T; 3], T) {
+        let unknown = T::from_f64(f64::NAN);
         if t == 0.0 {
             // the base is clamped at the identity: q(0) = 0 and J(0) = 0 exactly
             let zero = T::from_f64(0.0);
-            return [zero, zero, zero];
+            return ([zero, zero, zero], unknown);
         }
         let eps = self.eps;
-        let (ib1, ib2, half_theta) = match self.case {
+        let (ib1, ib2, half_theta, kappa) = match self.case {
             Case::Straight => {
                 let (s1, s2, s3) = straight_integrals(self.a4, t);
                 let zero = self.a3 * 0.0;
@@ -1251,11 +1261,11 @@ impl<T: Real> Closed<T> {
                     // Values are exact (θ = y = 0, x = t); only derivatives overflow.
                     let big = T::from_f64(f64::INFINITY);
                     let th = if T::HAS_DERIVATIVES { zero + big } else { zero };
-                    return [zero + t, th, th];
+                    return ([zero + t, th, th], unknown);
                 }
                 let th = self.a3 * s1 - self.a5 * s2;
                 let y = self.a3 * s2 - self.a5 * s3;
-                return [zero + t, y, th];
+                return ([zero + t, y, th], unknown);
             }
             Case::Circle | Case::SmallForce => {
                 let c = self.a3;
@@ -1267,15 +1277,21 @@ impl<T: Real> Closed<T> {
                 let th = tau;
                 if T::HAS_DERIVATIVES || self.case == Case::SmallForce {
                     let d = circle_force_terms(c, t);
-                    return [
-                        x + self.a4 * d[2] + self.a5 * d[3],
-                        y + self.a4 * d[4] + self.a5 * d[5],
-                        th + self.a4 * d[0] + self.a5 * d[1],
-                    ];
+                    return (
+                        [
+                            x + self.a4 * d[2] + self.a5 * d[3],
+                            y + self.a4 * d[4] + self.a5 * d[5],
+                            th + self.a4 * d[0] + self.a5 * d[1],
+                        ],
+                        unknown,
+                    );
                 }
-                return [x, y, th];
+                return ([x, y, th], unknown);
             }
-            Case::I | Case::II if self.phase_unknown => self.integrals_additive(t),
+            Case::I | Case::II if self.phase_unknown => {
+                let (ib1, ib2, ht) = self.integrals_additive(t);
+                (ib1, ib2, ht, unknown)
+            }
             Case::I => {
                 let j = self.landen.eval(self.r * t + self.phi, false);
                 let ib1 = self.lin * t + (j.zm - self.j0.zm) * self.zcoef;
@@ -1286,7 +1302,12 @@ impl<T: Real> Closed<T> {
                 } else {
                     y.atan2_slope(x)
                 };
-                (ib1, ib2, ht)
+                let kappa = if CURVATURE {
+                    self.sqa3 * j.cn * self.eps
+                } else {
+                    unknown
+                };
+                (ib1, ib2, ht, kappa)
             }
             Case::II => {
                 let amp = if THETA_VALUE {
@@ -1297,7 +1318,12 @@ impl<T: Real> Closed<T> {
                 let j = self.landen.eval_amplitude(self.r * t + self.phi, amp);
                 let ib1 = self.lin * t + (j.zm - self.j0.zm) * self.zcoef;
                 let ib2 = self.dn_integral_ii(j.sn, j.dn);
-                (ib1, ib2, j.am - self.th0)
+                let kappa = if CURVATURE {
+                    self.sqa3 * j.dn * self.eps
+                } else {
+                    unknown
+                };
+                (ib1, ib2, j.am - self.th0, kappa)
             }
             Case::III => {
                 let u = self.r * t + self.phi;
@@ -1305,11 +1331,16 @@ impl<T: Real> Closed<T> {
                 let ib1 = (e - self.e0) * 2.0 / self.r - t;
                 let ib2 = -self.sqm * (cn - self.j0.cn) / self.r;
                 let ht = (self.sqm * sn).atan2(dn) - self.th0;
-                (ib1, ib2, ht)
+                let kappa = if CURVATURE {
+                    self.sqa3 * cn * self.eps
+                } else {
+                    unknown
+                };
+                (ib1, ib2, ht, kappa)
             }
         };
         let x = -self.chat * ib1 + self.shat * ib2 * (2.0 * eps);
         let y = -self.shat * ib1 - self.chat * ib2 * (2.0 * eps);
-        [x, y, half_theta * (2.0 * eps)]
+        ([x, y, half_theta * (2.0 * eps)], kappa)
     }
 }

@@ -771,8 +771,9 @@ pub fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian)
 /// Stability of the equilibrium a (Bretl & McCarthy; FINDINGS §5): stable iff det J(t, a) > 0
 /// on (0, 1]. g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) is scanned on a grid whose spacing
 /// follows the rod's wavelength (from t = 0.02 on the closed form, 0.01 on the series; below,
-/// det J > 0 by its leading term), sign changes are located by regula falsi and local minima
-/// refined. The margin is FINDINGS §5 `det_min`, min over t ∈ [0.05, 1] of g; the report is
+/// det J > 0 by its leading term), sign changes are located to 1e-7 and local minima refined;
+/// on the closed form every sample also gives g′(t) (d det J/dt = det[J_x; J_y; ∂κ/∂a]), which
+/// finds minima between samples and steers those refinements (half-wavelength grid). The margin is FINDINGS §5 `det_min`, min over t ∈ [0.05, 1] of g; the report is
 /// `uncertain` when it lies within its error bound (the closed form first hands such rods to
 /// the series). The straight rod (a3 = a5 = 0) has det J ≡ 0: uncertain, margin 0.
 ///
