@@ -765,6 +765,59 @@ fn signs_where_possible(
     }
 }
 
+/// Where the closed-form scan takes g(t) from: the closed form where its bound is within
+/// [`CLOSED_G_ERROR`], else (double-double pass) the small-angle prefix or the double-double
+/// closed form, else the small-angle prefix or the short series from the base.
+struct ClosedSamples<'a> {
+    c: &'a Closed<Dual3>,
+    a: &'a PlanarParams,
+    norm_wise: bool,
+    dd: Option<&'a Closed<DualDd>>,
+    start: ShortSeries,
+    root_f: f64,
+}
+
+impl ClosedSamples<'_> {
+    /// g(t), its bound and its slope (NaN where the value does not come from the f64 closed
+    /// form within its acceptance).
+    fn eval(&self, t: f64) -> (f64, f64, f64) {
+        let (a, a3, a5, root_f) = (self.a, self.a[0], self.a[2], self.root_f);
+        let (v, e, slope) = normalised_det_sloped(self.c, a3, a5, t, self.norm_wise);
+        // Relative to |g| where g is large: under a strong tension g reaches 1e4 between the
+        // base and the margin, its bound 1e-3 of that, and the short series would otherwise be
+        // extended there (~100 µs) for samples far above the margin that cannot change it.
+        let accepted = CLOSED_G_ERROR * v.abs().max(1.0);
+        if e <= accepted {
+            return (v, e, slope);
+        }
+        if let Some(dd) = self.dd {
+            // The double-double pass: the small-angle prefix where its bound holds, else the
+            // double-double closed form (its value, with its own norm-wise bound).
+            if let Some((v0, e0)) = small_angle_prefix(a, t) {
+                if e0 <= CLOSED_G_ERROR * v0.abs().max(1.0) {
+                    return (v0, e0, f64::NAN);
+                }
+            }
+            if root_f * t > SHORT_SERIES_REACH {
+                let (v, e) = normalised_det_extended(dd, a3, a5, t);
+                return (v, e, f64::NAN);
+            }
+        }
+        // Past here g is off by more than its acceptance; its slope is not used.
+        if self.norm_wise && root_f * t > SHORT_SERIES_REACH {
+            return (v, e, f64::NAN);
+        }
+        if let Some((v0, e0)) = small_angle_prefix(a, t) {
+            if e0 <= CLOSED_G_ERROR * v0.abs().max(1.0) {
+                return (v0, e0, f64::NAN);
+            }
+        }
+        self.start
+            .normalised_det(t)
+            .map_or((v, e, f64::NAN), |(v0, e0)| (v0, e0, f64::NAN))
+    }
+}
+
 /// The scan of g on the closed form (a short series near the base); the report, uncertain
 /// where the error bound covers the margin (`norm_wise`: see [`normalised_det`]).
 fn closed_scan(
@@ -779,44 +832,15 @@ fn closed_scan(
     // which is accurate relative to itself (one low-order step for t ≲ 0.2). Norm-wise
     // (near the separatrix under a force) g grows like e^{2√‖F‖ t}, and the closed form's
     // value is taken where it is accurate relative to itself.
-    let root_f = a[1].hypot(a[2]).sqrt();
-    let start = ShortSeries::for_scan(a, norm_wise);
-    let g = |t: f64| {
-        let (v, e, slope) = normalised_det_sloped(c, a3, a5, t, norm_wise);
-        // Relative to |g| where g is large: under a strong tension g reaches 1e4 between the
-        // base and the margin, its bound 1e-3 of that, and the short series would otherwise be
-        // extended there (~100 µs) for samples far above the margin that cannot change it.
-        let accepted = CLOSED_G_ERROR * v.abs().max(1.0);
-        if e <= accepted {
-            return (v, e, slope);
-        }
-        if let Some(dd) = dd {
-            // The double-double pass: the small-angle prefix where its bound holds, else the
-            // double-double closed form (its value, with its own norm-wise bound).
-            if let Some((v0, e0)) = small_angle_prefix(a, t) {
-                if e0 <= CLOSED_G_ERROR * v0.abs().max(1.0) {
-                    return (v0, e0, f64::NAN);
-                }
-            }
-            if root_f * t > SHORT_SERIES_REACH {
-                let (v, e) = normalised_det_extended(dd, a3, a5, t);
-                return (v, e, f64::NAN);
-            }
-        }
-        // Past here g is off by more than its acceptance; its slope is not used.
-        if norm_wise && root_f * t > SHORT_SERIES_REACH {
-            return (v, e, f64::NAN);
-        }
-        if let Some((v0, e0)) = small_angle_prefix(a, t) {
-            if e0 <= CLOSED_G_ERROR * v0.abs().max(1.0) {
-                return (v0, e0, f64::NAN);
-            }
-        }
-        start
-            .normalised_det(t)
-            .map_or((v, e, f64::NAN), |(v0, e0)| (v0, e0, f64::NAN))
+    let samples = ClosedSamples {
+        c,
+        a,
+        norm_wise,
+        dd,
+        start: ShortSeries::for_scan(a, norm_wise),
+        root_f: a[1].hypot(a[2]).sqrt(),
     };
-    let recorded = Recorded::new(g);
+    let recorded = Recorded::new(|t| samples.eval(t));
     let sloped = |t: f64| recorded.eval(t);
     let g = |t: f64| {
         let (v, e, _) = recorded.eval(t);
