@@ -40,6 +40,20 @@ const THEOREM_PHASE_MARGIN: f64 = 1e-9;
 /// Smallest size of λ4's terms for which [`Closed::conjugate_free`] trusts its sign: below,
 /// the squares lose digits to underflow.
 const THEOREM_MIN_TERMS: f64 = 1e-280;
+/// The sample times of [`Closed::dip_times`] (a fixed array: a scan would otherwise allocate).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct DipTimes {
+    times: [f64; MAX_DIP_TIMES],
+    len: usize,
+}
+
+impl DipTimes {
+    /// The times, from the base.
+    pub(crate) fn as_slice(&self) -> &[f64] {
+        &self.times[..self.len]
+    }
+}
+
 /// Most sample times [`Closed::dip_times`] gives, from the base (a share of the scan's sample
 /// budget; a rod with more periods has the grid alone beyond the eighth).
 pub(crate) const MAX_DIP_TIMES: usize = 8;
@@ -1063,20 +1077,21 @@ impl<T: Real> Closed<T> {
     /// Near the separatrix g has narrow dips there (width ~1 in Γ, the loops' scale, where the
     /// grid's quarter period is K/2): on 5 reference rods whose scanned margin was 12–74 %
     /// above the reference's, the dense minimum sat within 0.03 K of such a point.
-    pub(crate) fn dip_times(&self, spacing: f64) -> Vec<f64> {
+    pub(crate) fn dip_times(&self, spacing: f64) -> DipTimes {
+        let mut out = DipTimes::default();
         let (k, phi, r) = (self.landen.k().re(), self.phi.re(), self.r.re());
         if !matches!(self.case, Case::I | Case::II) || r * spacing <= 1.0 {
-            return Vec::new();
+            return out;
         }
         let (_, mut gamma) = self.inflections_around_base();
-        let mut out = Vec::new();
-        while out.len() < MAX_DIP_TIMES {
+        while out.len < MAX_DIP_TIMES {
             let t = (gamma - phi) / r;
             // NaN ends the loop too.
             if t.partial_cmp(&1.0) != Some(std::cmp::Ordering::Less) {
                 break;
             }
-            out.push(t);
+            out.times[out.len] = t;
+            out.len += 1;
             gamma += 2.0 * k;
         }
         out

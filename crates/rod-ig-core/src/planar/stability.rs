@@ -860,7 +860,7 @@ fn closed_scan(
         t0,
         spacing,
         (a3, a5),
-        &c.dip_times(spacing),
+        c.dip_times(spacing).as_slice(),
     )?;
     if !norm_wise {
         return Ok(verdict(s, recorded.at(s.t_margin).1));
