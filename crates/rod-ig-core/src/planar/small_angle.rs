@@ -335,10 +335,20 @@ const ENTRY_ULPS: f64 = 64.0;
 /// entries grow like e^{√a4 t} (the x row like e^{2√a4 t}) while det J grows slower: the
 /// bound shows that cancellation.
 pub(crate) fn normalised_det(a3: f64, a4: f64, a5: f64, t: f64) -> (f64, f64) {
+    let (g, rounding, _) = normalised_det_sloped(a3, a4, a5, t);
+    (g, rounding)
+}
+
+/// [`normalised_det`] and the slope g₀′(t): d det J/dt = det[J_x; J_y; ∂κ/∂a], since the
+/// linearised rod's rows x′ = −θ·J_θ and y′ = J_θ are multiples of the θ row; κ = θ′ =
+/// a3 S1′ − a5 S1 with S1′ = 1 + a4 S2 (θ'' = a4 θ − a5 and S2 = ∫S1, module docs). The slope
+/// only steers the scan's samples and carries no bound.
+pub(crate) fn normalised_det_sloped(a3: f64, a4: f64, a5: f64, t: f64) -> (f64, f64, f64) {
     let sigma = a3.abs().max(a5.abs());
     let (u3, u5) = (a3 / sigma, a5 / sigma);
     // The x row and the a4 column divided by σ.
-    let (j, size) = jacobian_and_sizes(u3, u5, &straight_jets(a4, t));
+    let jets = straight_jets(a4, t);
+    let (j, size) = jacobian_and_sizes(u3, u5, &jets);
     let mut det = 0.0;
     let mut err = 0.0;
     for c in 0..3 {
@@ -354,8 +364,29 @@ pub(crate) fn normalised_det(a3: f64, a4: f64, a5: f64, t: f64) -> (f64, f64) {
                     + size[1][c2] * j[2][c1].abs()
                     + j[1][c2].abs() * size[2][c1]);
     }
+    let [s1, s2, ..] = jets;
+    // ∂κ/∂(a3, a4/σ, a5/σ·σ): the θ row's t-derivative (S1′ = 1 + a4 S2, S2′ = S1).
+    let s1_slope = Jet {
+        v: 1.0 + a4 * s2.v,
+        d: s2.v + a4 * s2.d,
+    };
+    let kappa_row = [s1_slope.v, u3 * s1_slope.d - u5 * s1.d, -s1.v];
+    let det_slope = det3_rows(&j[0], &j[1], &kappa_row);
     let n = crate::planar_det_leading_term(u3, u5, t);
-    (det / n, ENTRY_ULPS * f64::EPSILON * err / n)
+    let (b3, b5) = (u3 * u3, u5 * u5);
+    let log_slope = 9.0 / t + (b5 * t / 16800.0) / (b3 / 8640.0 + b5 * t * t / 33600.0);
+    let g = det / n;
+    (
+        g,
+        ENTRY_ULPS * f64::EPSILON * err / n,
+        det_slope / n - g * log_slope,
+    )
+}
+
+/// The determinant of the matrix with rows r0, r1, r2.
+fn det3_rows(r0: &[f64; 3], r1: &[f64; 3], r2: &[f64; 3]) -> f64 {
+    r0[0] * (r1[1] * r2[2] - r1[2] * r2[1]) - r0[1] * (r1[0] * r2[2] - r1[2] * r2[0])
+        + r0[2] * (r1[0] * r2[1] - r1[1] * r2[0])
 }
 
 /// The linearised rod at some t: pose, J and first-order bounds on their rounding.
