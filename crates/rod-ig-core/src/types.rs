@@ -84,6 +84,13 @@ pub fn planar_det_leading_term(a3: f64, a5: f64, t: f64) -> f64 {
     t9 * (a3 * a3 / 8640.0 + a5 * a5 * t2 / 33600.0)
 }
 
+/// N′/N of that leading term N ([`planar_det_leading_term`]): 9/t + (a5²t/16800)/(a3²/8640 +
+/// a5²t²/33600), for the slope of g = det J/N, g′ = det′/N − g·N′/N.
+pub(crate) fn planar_det_leading_term_log_slope(a3: f64, a5: f64, t: f64) -> f64 {
+    let (b3, b5) = (a3 * a3, a5 * a5);
+    9.0 / t + (b5 * t / 16800.0) / (b3 / 8640.0 + b5 * t * t / 33600.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -365,7 +365,8 @@ pub(crate) fn normalised_det_sloped(a3: f64, a4: f64, a5: f64, t: f64) -> (f64, 
                     + j[1][c2].abs() * size[2][c1]);
     }
     let [s1, s2, ..] = jets;
-    // ∂κ/∂(a3, a4/σ, a5/σ·σ): the θ row's t-derivative (S1′ = 1 + a4 S2, S2′ = S1).
+    // ∂κ/∂a, scaled as the θ row (a4 column over σ): the θ row's t-derivative, with
+    // S1′ = 1 + a4 S2 and S2′ = S1.
     let s1_slope = Jet {
         v: 1.0 + a4 * s2.v,
         d: s2.v + a4 * s2.d,
@@ -373,9 +374,8 @@ pub(crate) fn normalised_det_sloped(a3: f64, a4: f64, a5: f64, t: f64) -> (f64, 
     let kappa_row = [s1_slope.v, u3 * s1_slope.d - u5 * s1.d, -s1.v];
     let det_slope = det3_rows(&j[0], &j[1], &kappa_row);
     let n = crate::planar_det_leading_term(u3, u5, t);
-    let (b3, b5) = (u3 * u3, u5 * u5);
-    let log_slope = 9.0 / t + (b5 * t / 16800.0) / (b3 / 8640.0 + b5 * t * t / 33600.0);
     let g = det / n;
+    let log_slope = crate::types::planar_det_leading_term_log_slope(u3, u5, t);
     (
         g,
         ENTRY_ULPS * f64::EPSILON * err / n,

@@ -103,7 +103,7 @@ fn normalised_det(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64, norm_wise: bool) 
 
 /// [`normalised_det`] and the slope g′(t), from the same Jacobi values: d det J/dt =
 /// det[J_x; J_y; ∂κ/∂a] ([`Closed::pose_and_curvature_for_jacobian`]) and
-/// g′ = det′/N − g·N′/N with N′/N = 9/t + (a5²t/16800)/(a3²/8640 + a5²t²/33600). The slope
+/// g′ = det′/N − g·N′/N (`planar_det_leading_term_log_slope`). The slope
 /// only guides where the scan samples next (it is never a verdict), so it carries no bound.
 fn normalised_det_sloped(
     c: &Closed<Dual3>,
@@ -116,8 +116,7 @@ fn normalised_det_sloped(
     let j = rows(&pose);
     let (g, e, n) = normalised_det_from(c, &j, (a3, a5, t), norm_wise);
     let det_slope = det3(&[j[0], j[1], kappa.g]);
-    let (a3s, a5s) = (a3 * a3, a5 * a5);
-    let log_slope = 9.0 / t + (a5s * t / 16800.0) / (a3s / 8640.0 + a5s * t * t / 33600.0);
+    let log_slope = crate::types::planar_det_leading_term_log_slope(a3, a5, t);
     (g, e, det_slope / n - g * log_slope)
 }
 
@@ -216,11 +215,9 @@ fn series_probe<T: Gradient>(rod: &TaylorRod<T>, a3: f64, a5: f64, t: f64) -> Pr
     let sigma = a3.abs().max(a5.abs());
     let mut k = kappa.gradient();
     k[1] /= sigma;
-    let (u3, u5) = (a3 / sigma, a5 / sigma);
     let n = normalisation_scaled(a3, a5, t);
     let v = det3(&j) / n;
-    let (b3, b5) = (u3 * u3, u5 * u5);
-    let log_slope = 9.0 / t + (b5 * t / 16800.0) / (b3 / 8640.0 + b5 * t * t / 33600.0);
+    let log_slope = crate::types::planar_det_leading_term_log_slope(a3 / sigma, a5 / sigma, t);
     Probe {
         v,
         d: det3(&[j[0], j[1], k]) / n - v * log_slope,
