@@ -1387,13 +1387,41 @@ fn refine_margin(
 /// (g′(l) ≤ 0 ≤ g′(r)): its minimiser by Nocedal & Wright's eq. 3.59.
 fn cubic_low((l, pl): (f64, Probe), (r, pr): (f64, Probe)) -> f64 {
     let t = cubic_minimiser((l, pl), (r, pr));
-    let h = r - l;
-    let s = (t - l) / h;
-    let (m0, m1) = (pl.d * h, pr.d * h);
-    let c2 = 3.0 * (pr.v - pl.v) - 2.0 * m0 - m1;
-    let c3 = 2.0 * (pl.v - pr.v) + m0 + m1;
-    let v = pl.v + s * (m0 + s * (c2 + s * c3));
+    let cubic = HermiteCubic::new((l, pl), (r, pr));
+    let v = cubic.at((t - l) / (r - l));
     v.min(pl.v).min(pr.v)
+}
+
+/// The cubic Hermite interpolant through (t0, g0, g0′), (t1, g1, g1′) in s = (t − t0)/h:
+/// g0 + m0 s + c2 s² + c3 s³ with m = g′h.
+struct HermiteCubic {
+    g0: f64,
+    m0: f64,
+    c2: f64,
+    c3: f64,
+}
+
+impl HermiteCubic {
+    fn new((t0, p0): (f64, Probe), (t1, p1): (f64, Probe)) -> Self {
+        let h = t1 - t0;
+        let (m0, m1) = (p0.d * h, p1.d * h);
+        Self {
+            g0: p0.v,
+            m0,
+            c2: 3.0 * (p1.v - p0.v) - 2.0 * m0 - m1,
+            c3: 2.0 * (p0.v - p1.v) + m0 + m1,
+        }
+    }
+
+    /// Its value at s.
+    fn at(&self, s: f64) -> f64 {
+        self.g0 + s * (self.m0 + s * (self.c2 + s * self.c3))
+    }
+
+    /// Its derivative in s at s.
+    fn slope(&self, s: f64) -> f64 {
+        self.m0 + s * (2.0 * self.c2 + s * 3.0 * self.c3)
+    }
 }
 
 /// The minimiser in (l, r) of the cubic Hermite interpolant through g and g′ at both ends
@@ -1576,20 +1604,17 @@ fn find_root(g: &impl Fn(f64) -> Probe, (t0, p0): (f64, Probe), (t1, p1): (f64, 
 /// falsi point, bisection where a step leaves the bracket, to 1e-3 of [`ROOT_TOL`].
 fn hermite_root((t0, p0): (f64, Probe), (t1, p1): (f64, Probe)) -> f64 {
     let h = t1 - t0;
-    let (m0, m1) = (p0.d * h, p1.d * h);
-    let c2 = 3.0 * (p1.v - p0.v) - 2.0 * m0 - m1;
-    let c3 = 2.0 * (p0.v - p1.v) + m0 + m1;
+    let cubic = HermiteCubic::new((t0, p0), (t1, p1));
     let (mut lo, mut hi) = (0.0f64, 1.0f64);
     let mut s = p0.v / (p0.v - p1.v);
     for _ in 0..12 {
-        let v = p0.v + s * (m0 + s * (c2 + s * c3));
+        let v = cubic.at(s);
         if v > 0.0 {
             lo = s;
         } else {
             hi = s;
         }
-        let dv = m0 + s * (2.0 * c2 + s * 3.0 * c3);
-        let next = s - v / dv;
+        let next = s - v / cubic.slope(s);
         let next = if next > lo && next < hi {
             next
         } else {
