@@ -729,6 +729,21 @@ impl<T: Real> Duplication<T> {
         T::from_f64(1.0) - self.m * (self.q + 1.0) * 0.5
     }
 
+    /// (sn, cn, dn, D) at any real u, f64 values, with D(u) = ∫₀ᵘ sn² unreduced: u = v + 2jK,
+    /// |v| ≤ K, D(u) = D(v) + 2j D(m) (sn² has period 2K), sn and cn change sign with j.
+    #[inline]
+    pub(crate) fn values_with_integral(&self, u: f64) -> (f64, f64, f64, f64) {
+        let j = fast_round(u / (2.0 * self.kr));
+        let v = if j != 0.0 { u - self.kr * (2.0 * j) } else { u };
+        let (s, c, d, dv) = self.core(v);
+        let dd = dv + 2.0 * j * self.dcompr;
+        if (j as i64) & 1 != 0 {
+            (-s, -c, d, dd)
+        } else {
+            (s, c, d, dd)
+        }
+    }
+
     /// (sn, cn, dn, D) at v ∈ [−K, K] (f64 values).
     #[inline]
     fn core(&self, v: f64) -> (f64, f64, f64, f64) {

@@ -84,6 +84,15 @@ pub fn planar_det_leading_term(a3: f64, a5: f64, t: f64) -> f64 {
     t9 * (a3 * a3 / 8640.0 + a5 * a5 * t2 / 33600.0)
 }
 
+/// det of a 3×3 matrix by expansion along its first row (J, or J with a row replaced).
+#[inline]
+pub(crate) fn det3(j: &[[f64; 3]; 3]) -> f64 {
+    let m0 = j[1][1] * j[2][2] - j[1][2] * j[2][1];
+    let m1 = j[1][0] * j[2][2] - j[1][2] * j[2][0];
+    let m2 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
+    j[0][0] * m0 - j[0][1] * m1 + j[0][2] * m2
+}
+
 /// N′/N of that leading term N ([`planar_det_leading_term`]): 9/t + (a5²t/16800)/(a3²/8640 +
 /// a5²t²/33600), for the slope of g = det J/N, g′ = det′/N − g·N′/N.
 pub(crate) fn planar_det_leading_term_log_slope(a3: f64, a5: f64, t: f64) -> f64 {

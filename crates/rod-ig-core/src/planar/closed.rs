@@ -7,6 +7,9 @@
 use crate::elliptic::{inverse_phase_zeta, Amplitude, Duplication, JacobiValues};
 use crate::scalar::Real;
 
+mod det_fields;
+pub(crate) use det_fields::DetFrame;
+
 /// Which closed form applies (decided on f64 values).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Case {

@@ -372,7 +372,7 @@ pub(crate) fn normalised_det_sloped(a3: f64, a4: f64, a5: f64, t: f64) -> (f64, 
         d: s2.v + a4 * s2.d,
     };
     let kappa_row = [s1_slope.v, u3 * s1_slope.d - u5 * s1.d, -s1.v];
-    let det_slope = det3_rows(&j[0], &j[1], &kappa_row);
+    let det_slope = crate::types::det3(&[j[0], j[1], kappa_row]);
     let n = crate::planar_det_leading_term(u3, u5, t);
     let g = det / n;
     let log_slope = crate::types::planar_det_leading_term_log_slope(u3, u5, t);
@@ -381,12 +381,6 @@ pub(crate) fn normalised_det_sloped(a3: f64, a4: f64, a5: f64, t: f64) -> (f64, 
         ENTRY_ULPS * f64::EPSILON * err / n,
         det_slope / n - g * log_slope,
     )
-}
-
-/// The determinant of the matrix with rows r0, r1, r2.
-fn det3_rows(r0: &[f64; 3], r1: &[f64; 3], r2: &[f64; 3]) -> f64 {
-    r0[0] * (r1[1] * r2[2] - r1[2] * r2[1]) - r0[1] * (r1[0] * r2[2] - r1[2] * r2[0])
-        + r0[2] * (r1[0] * r2[1] - r1[1] * r2[0])
 }
 
 /// The linearised rod at some t: pose, J and first-order bounds on their rounding.

@@ -1,11 +1,12 @@
 //! Fast stability test on the closed form (FINDINGS §5).
 
-use super::closed::{Case, Closed, SeriesNeed};
+use super::closed::{Case, Closed, DetFrame, SeriesNeed};
 use super::small_angle;
 use super::taylor::{CoarseDual3, Gradient, TaylorRod};
 use crate::dd::DualDd;
 use crate::planar_det_leading_term as normalisation;
 use crate::scalar::Dual3;
+use crate::types::det3;
 use crate::{PlanarParams, RodError, StabilityReport};
 
 /// Below this t the closed-form det J is dominated by rounding; it is positive there by its
@@ -70,15 +71,6 @@ fn det_and_error(j: &[[f64; 3]; 3], rel: f64, abs: f64) -> (f64, f64) {
         }
     }
     (det, err + 8.0 * f64::EPSILON * size)
-}
-
-/// det J by expansion along the x row.
-#[inline]
-fn det3(j: &[[f64; 3]; 3]) -> f64 {
-    let m0 = j[1][1] * j[2][2] - j[1][2] * j[2][1];
-    let m1 = j[1][0] * j[2][2] - j[1][2] * j[2][0];
-    let m2 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
-    j[0][0] * m0 - j[0][1] * m1 + j[0][2] * m2
 }
 
 fn rows(p: &[Dual3; 3]) -> [[f64; 3]; 3] {
@@ -820,6 +812,8 @@ struct ClosedSamples<'a> {
     dd: Option<&'a Closed<DualDd>>,
     start: ShortSeries,
     root_f: f64,
+    /// The Jacobi fields' det J ([`Closed::det_frame`]): off the separatrix (not norm-wise).
+    frame: Option<DetFrame>,
 }
 
 impl ClosedSamples<'_> {
@@ -827,12 +821,21 @@ impl ClosedSamples<'_> {
     /// form within its acceptance).
     fn eval(&self, t: f64) -> (f64, f64, f64) {
         let (a, a3, a5, root_f) = (self.a, self.a[0], self.a[2], self.root_f);
-        let (v, e, slope) = normalised_det_sloped(self.c, a3, a5, t, self.norm_wise);
         // Relative to |g| where g is large: under a strong tension g reaches 1e4 between the
         // base and the margin, its bound 1e-3 of that, and the short series would otherwise be
         // extended there (~100 µs) for samples far above the margin that cannot change it.
-        let accepted = CLOSED_G_ERROR * v.abs().max(1.0);
-        if e <= accepted {
+        let accepted = |v: f64, e: f64| e <= CLOSED_G_ERROR * v.abs().max(1.0);
+        if let Some(frame) = self.frame.as_ref().filter(|f| f.covers(t)) {
+            let s = self.c.det_sample(frame, t);
+            let n = normalisation(a3, a5, t);
+            let (v, e) = (s.det / n, s.error / n);
+            if accepted(v, e) {
+                let log_slope = crate::types::planar_det_leading_term_log_slope(a3, a5, t);
+                return (v, e, s.slope / n - v * log_slope);
+            }
+        }
+        let (v, e, slope) = normalised_det_sloped(self.c, a3, a5, t, self.norm_wise);
+        if accepted(v, e) {
             return (v, e, slope);
         }
         if let Some(dd) = self.dd {
@@ -884,6 +887,7 @@ fn closed_scan(
         dd,
         start: ShortSeries::for_scan(a, norm_wise),
         root_f: a[1].hypot(a[2]).sqrt(),
+        frame: if norm_wise { None } else { c.det_frame() },
     };
     let recorded = Recorded::new(|t| samples.eval(t));
     let sloped = |t: f64| recorded.eval(t);
