@@ -86,7 +86,9 @@ pub(crate) struct DetFrame {
     r: f64,
     phi: f64,
     m: f64,
-    m1: f64,
+    /// 1/(2 m1), 1/m.
+    inv_2m1: f64,
+    inv_m: f64,
     k: f64,
     base: Canonical,
     /// det ∂(φ, r, p)/∂a / r³.
@@ -116,10 +118,12 @@ impl DetFrame {
 
     /// The canonical elastica at s from its Jacobi values (sn, cn, dn, D = ∫₀ˢ sn²).
     fn canonical(&self, s: f64, (sn, cn, dn, d): (f64, f64, f64, f64)) -> Canonical {
-        let (m, m1, k) = (self.m, self.m1, self.k);
+        let (m, k) = (self.m, self.k);
+        // One division per sample (1/dn); 1/(2 m1) and 1/m are the frame's.
+        let inv_dn = dn.recip();
         let s_minus_d = s - d;
-        let a = (sn * cn - dn * s_minus_d) / (2.0 * m1);
-        let a_size = ((sn * cn).abs() + dn * s_minus_d.abs()) / (2.0 * m1);
+        let a = (sn * cn - dn * s_minus_d) * self.inv_2m1;
+        let a_size = ((sn * cn).abs() + dn * s_minus_d.abs()) * self.inv_2m1;
         let sized = |v: f64, size: f64| Sized { v, size };
         if !self.case_ii {
             let sin = 2.0 * k * sn * dn;
@@ -133,8 +137,8 @@ impl DetFrame {
                 x: sized(s - 2.0 * m * d, s.abs() + 2.0 * m * d.abs()),
                 y: sized(-2.0 * k * cn, 2.0 * k * cn.abs()),
                 theta_p: sized(
-                    2.0 * (sn + 2.0 * m * cn * a) / dn,
-                    2.0 * (sn.abs() + 2.0 * m * cn.abs() * a_size) / dn,
+                    2.0 * (sn + 2.0 * m * cn * a) * inv_dn,
+                    2.0 * (sn.abs() + 2.0 * m * cn.abs() * a_size) * inv_dn,
                 ),
                 x_p: sized(
                     2.0 * k * (2.0 * dn * a - d),
@@ -144,9 +148,10 @@ impl DetFrame {
                 kappa_p: 2.0 * cn - 4.0 * m * sn * a,
             }
         } else {
-            let h = (sn * sn + 2.0 * m * sn * cn * a) / dn;
-            let h_size = (sn * sn + 2.0 * m * (sn * cn).abs() * a_size) / dn;
-            let y = -2.0 * dn / m;
+            let inv_m = self.inv_m;
+            let h = (sn * sn + 2.0 * m * sn * cn * a) * inv_dn;
+            let h_size = (sn * sn + 2.0 * m * (sn * cn).abs() * a_size) * inv_dn;
+            let y = -2.0 * dn * inv_m;
             Canonical {
                 cos: 1.0 - 2.0 * sn * sn,
                 sin: 2.0 * sn * cn,
@@ -155,8 +160,11 @@ impl DetFrame {
                 x: sized(s - 2.0 * d, s.abs() + 2.0 * d.abs()),
                 y: sized(y, y.abs()),
                 theta_p: sized(2.0 * a, 2.0 * a_size),
-                x_p: sized((2.0 * dn * a + d) / m, (2.0 * dn * a_size + d.abs()) / m),
-                y_p: sized((h - y) / m, (h_size + y.abs()) / m),
+                x_p: sized(
+                    (2.0 * dn * a + d) * inv_m,
+                    (2.0 * dn * a_size + d.abs()) * inv_m,
+                ),
+                y_p: sized((h - y) * inv_m, (h_size + y.abs()) * inv_m),
                 kappa_p: -h,
             }
         }
@@ -187,7 +195,8 @@ impl Closed<Dual3> {
             r,
             phi,
             m,
-            m1: self.m1,
+            inv_2m1: 0.5 / self.m1,
+            inv_m: m.recip(),
             k: self.sqm.v,
             base: Canonical {
                 cos: 0.0,
