@@ -812,7 +812,7 @@ struct ClosedSamples<'a> {
     dd: Option<&'a Closed<DualDd>>,
     start: ShortSeries,
     root_f: f64,
-    /// The Jacobi fields' det J ([`Closed::det_frame`]): off the separatrix (not norm-wise).
+    /// The Jacobi fields' det J ([`Closed::det_frame`]), tried first at every sample it covers.
     frame: Option<DetFrame>,
 }
 
@@ -887,7 +887,7 @@ fn closed_scan(
         dd,
         start: ShortSeries::for_scan(a, norm_wise),
         root_f: a[1].hypot(a[2]).sqrt(),
-        frame: if norm_wise { None } else { c.det_frame() },
+        frame: c.det_frame(),
     };
     let recorded = Recorded::new(|t| samples.eval(t));
     let sloped = |t: f64| recorded.eval(t);
