@@ -6,7 +6,7 @@ use super::taylor::{CoarseDual3, Gradient, TaylorRod};
 use crate::dd::DualDd;
 use crate::planar_det_leading_term as normalisation;
 use crate::scalar::Dual3;
-use crate::types::det3;
+use crate::types::{det3, det_and_error};
 use crate::{PlanarParams, RodError, StabilityReport};
 
 /// Below this t the closed-form det J is dominated by rounding; it is positive there by its
@@ -52,26 +52,6 @@ const SIGMA_RAY: f64 = 1e-60;
 /// carries an absolute error of a few ulps of 1 (observed 2.3e-16 at t = 0.05 on a rod with
 /// a = (1.4e-5, 10.4, −8.2e-3); ×64 allowance).
 const CLOSED_J_ABS: f64 = 64.0 * f64::EPSILON;
-
-/// det J and a first-order bound on its error: Σ e_ij |C_ij| over the entries' errors
-/// e_ij = rel·|J_ij| + abs and the cofactors C_ij, plus the rounding of the expansion.
-fn det_and_error(j: &[[f64; 3]; 3], rel: f64, abs: f64) -> (f64, f64) {
-    let det = det3(j);
-    let mut err = 0.0;
-    let mut size = 0.0;
-    for r in 0..3 {
-        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
-        for c in 0..3 {
-            let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
-            let cof = (j[r1][c1] * j[r2][c2]).abs() + (j[r1][c2] * j[r2][c1]).abs();
-            err += (rel * j[r][c].abs() + abs) * cof;
-            if r == 0 {
-                size += j[r][c].abs() * cof;
-            }
-        }
-    }
-    (det, err + 8.0 * f64::EPSILON * size)
-}
 
 fn rows(p: &[Dual3; 3]) -> [[f64; 3]; 3] {
     [p[0].g, p[1].g, p[2].g]

@@ -35,7 +35,7 @@
 
 use super::{Case, Closed};
 use crate::scalar::Dual3;
-use crate::types::det3;
+use crate::types::det_and_error;
 
 /// Safety factor of [`Closed::det_sample`]'s error model: against the double-double closed
 /// form, the largest error measured was 0.24 of the model without it (160,000 samples of box,
@@ -283,7 +283,9 @@ impl Closed<Dual3> {
         let rounding = (m[0][0] * cofs[0][0]).abs()
             + (m[0][1] * cofs[0][1]).abs()
             + (m[0][2] * cofs[0][2]).abs();
-        // (1 + 1e-3): the second-order terms of δM, rel ≤ 1e-6 wherever a sample is accepted.
+        // (1 + 1e-3): the second-order terms of δM, rel times the first-order ones for entries
+        // of comparable size (rel ≲ 1e-9 for m1 ≥ 1e-6 and moderate |Γ|; `fields_bound_holds`
+        // measures the whole model).
         let error = rel * spread * (1.0 + 1e-3) + 8.0 * f64::EPSILON * rounding;
         let slope = f.r
             * (g.kappa_slope * cofs[2][0]
@@ -298,20 +300,11 @@ impl Closed<Dual3> {
     }
 }
 
-/// det of a 3×3 matrix and Σ|a_ij||cofactor_ij| / |det| (its sensitivity to relative errors
-/// of the entries).
+/// det of a 3×3 matrix and (Σ|a_ij||C_ij| + its rounding) / |det| ([`det_and_error`] with
+/// relative errors of 1): its sensitivity to relative errors of the entries.
 fn det_and_condition(a: &[[f64; 3]; 3]) -> (f64, f64) {
-    let det = det3(a);
-    let mut sum = 0.0;
-    for r in 0..3 {
-        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
-        for c in 0..3 {
-            let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
-            let cof = (a[r1][c1] * a[r2][c2]).abs() + (a[r1][c2] * a[r2][c1]).abs();
-            sum += a[r][c].abs() * cof;
-        }
-    }
-    (det, sum / det.abs())
+    let (det, spread) = det_and_error(a, 1.0, 0.0);
+    (det, spread / det.abs())
 }
 
 #[cfg(test)]
@@ -319,6 +312,7 @@ mod tests {
     use super::*;
     use crate::dd::{Dd, DualDd};
     use crate::rng::SplitMix64;
+    use crate::types::det3;
 
     fn seeded(a: [f64; 3]) -> Option<Closed<Dual3>> {
         Closed::new(
