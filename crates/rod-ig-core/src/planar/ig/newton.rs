@@ -51,6 +51,17 @@ pub(crate) fn verify_with_stability(
     (e.pos_err <= tolerance && e.ang_err <= tolerance).then_some((e, ev.stability))
 }
 
+/// The iterate `a` evaluated by its tip alone (`planar::tip_by_closed_form`), with `jac` the J
+/// of an earlier iterate: a chord step's trial (`solver::globalised`). None where the closed
+/// form needs a series.
+pub(crate) fn eval_residual(
+    a: &PlanarParams,
+    jac: &PlanarJacobian,
+    target: &PlanarPose,
+) -> Option<Eval> {
+    eval_from((crate::planar::tip_by_closed_form(a)?, *jac), target)
+}
+
 fn eval_from((tip, jac): (PlanarPose, PlanarJacobian), target: &PlanarPose) -> Option<Eval> {
     let f = model::residual(&tip, target);
     if !(f.iter().all(|v| v.is_finite()) && jac.iter().all(|v| v.is_finite())) {
