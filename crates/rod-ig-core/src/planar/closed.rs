@@ -841,7 +841,9 @@ impl<T: Real> Closed<T> {
         self.case = Case::I;
         let m1 = lambda4 / (f * alpha3);
         let m = complement_near_one(alpha3 / (f * 4.0), m1);
-        let landen = Duplication::new(m, m1);
+        // Built in place: a local moved into the field was a ~200-byte memcpy.
+        self.landen = Duplication::new(m, m1);
+        let landen = &self.landen;
         if !landen.converged() {
             return None;
         }
@@ -871,7 +873,6 @@ impl<T: Real> Closed<T> {
         self.zcoef = m * self.inv_r * 2.0;
         self.b2coef = -self.sqm * self.inv_r;
         self.y0 = self.sqm * sn;
-        self.landen = landen;
         Some(())
     }
 
@@ -899,7 +900,8 @@ impl<T: Real> Closed<T> {
         }
         let m1 = -lambda4 * 4.0 / (alpha3 * alpha3);
         let m = complement_near_one(m, m1);
-        let landen = Duplication::new(m, m1);
+        self.landen = Duplication::new(m, m1);
+        let landen = &self.landen;
         if !landen.converged() {
             return None;
         }
@@ -935,7 +937,6 @@ impl<T: Real> Closed<T> {
         self.inv_r = self.r.recip();
         self.zcoef = self.inv_r * 2.0;
         self.b2coef = (m * self.r).recip();
-        self.landen = landen;
         Some(())
     }
 
