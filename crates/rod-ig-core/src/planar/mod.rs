@@ -729,7 +729,7 @@ const ITERATION_F64_MAX_ERROR: f64 = 1e-6;
 /// while an iterate that wanders there from an ordinary start keeps the cheap f64 evaluation
 /// and fails fast instead of spending the deadline.
 pub(crate) fn needs_precise_iterations(a: &PlanarParams) -> bool {
-    a[1].hypot(a[2]).sqrt().exp() * f64::EPSILON > ITERATION_F64_MAX_ERROR
+    crate::scalar::fast_hypot(a[1], a[2]).sqrt().exp() * f64::EPSILON > ITERATION_F64_MAX_ERROR
 }
 
 /// q(1) and J(1, a) for the iterations of a solver: as [`tip_and_jacobian`] except on

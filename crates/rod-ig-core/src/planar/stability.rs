@@ -866,7 +866,7 @@ fn closed_scan(
         norm_wise,
         dd,
         start: ShortSeries::for_scan(a, norm_wise),
-        root_f: a[1].hypot(a[2]).sqrt(),
+        root_f: crate::scalar::fast_hypot(a[1], a[2]).sqrt(),
         frame: c.det_frame(),
     };
     let recorded = Recorded::new(|t| samples.eval(t));
@@ -1083,7 +1083,7 @@ impl ShortSeries {
     /// bent one (ρ = max(|a3|, √‖F‖) ≫ 1) the steps shrink like 1/ρ while the closed form is
     /// accurate from t ~ 1/ρ on: the first end is capped there (it still grows to 2t).
     fn for_scan(a: &PlanarParams, norm_wise: bool) -> Self {
-        let root_f = a[1].hypot(a[2]).sqrt();
+        let root_f = crate::scalar::fast_hypot(a[1], a[2]).sqrt();
         if norm_wise {
             Self::new(a, 0.0, (SHORT_SERIES_REACH / root_f).min(1.0))
         } else {
@@ -1138,7 +1138,7 @@ impl ShortSeries {
         if rod.t_end() < t {
             return None;
         }
-        let root_f = self.a[1].hypot(self.a[2]).sqrt();
+        let root_f = crate::scalar::fast_hypot(self.a[1], self.a[2]).sqrt();
         let amplified = (f64::EPSILON + COARSE_AMPLIFIED) * (root_f * t).exp();
         let j = scaled_series_jacobian(rod, a3, a5, t)?;
         let (v, e) = normalised_det_of(

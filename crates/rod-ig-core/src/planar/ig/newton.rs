@@ -67,7 +67,7 @@ fn eval_from((tip, jac): (PlanarPose, PlanarJacobian), target: &PlanarPose) -> O
     if !(f.iter().all(|v| v.is_finite()) && jac.iter().all(|v| v.is_finite())) {
         return None;
     }
-    let pos_err = f[0].hypot(f[1]);
+    let pos_err = crate::scalar::fast_hypot(f[0], f[1]);
     let ang_err = f[2].abs();
     Some(Eval {
         tip,
