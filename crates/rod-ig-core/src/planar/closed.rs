@@ -61,11 +61,11 @@ impl DipTimes {
 /// budget; a rod with more periods has the grid alone beyond the eighth).
 pub(crate) const MAX_DIP_TIMES: usize = 8;
 
-/// Smallest m for which [`Closed::new_phase_free`] leaves out the phase: the small-m regimes
+/// Smallest m for which a form built without its phase ([`Closed::complete`]) leaves it out: the small-m regimes
 /// (nearly straight rods under compression, near-circles) keep the form their error estimates
 /// were measured on.
 const PHASE_FREE_MIN_M: f64 = 0.01;
-/// Smallest m1 = 1 − m for which [`Closed::new_phase_free`] leaves out the phase: the
+/// Smallest m1 = 1 − m for which a form built without its phase leaves it out: the
 /// addition theorems' numerators cancel as m → 1, and case II's amplitude is unwrapped by its
 /// mean slope π/(2K), which is unambiguous while 3·max|am(x) − πx/(2K)| < π (0.63π at
 /// m = 0.999, by quadrature).
@@ -127,7 +127,7 @@ pub(crate) struct Closed<T: Real> {
     th0: T,
     /// Case III: E(am φ) and cn φ (first order in δ).
     e0: T,
-    /// φ and Z(φ) were left out ([`Closed::new_phase_free`]; then both 0): `pose` places
+    /// φ and Z(φ) were left out ([`Closed::complete`] without the phase; then both 0): `pose` places
     /// Γ = r t + φ by the addition theorems ([`Closed::integrals_additive`]), and nothing that
     /// needs φ itself (stability, energy, curvature, the theorem) may be asked.
     phase_unknown: bool,
@@ -678,8 +678,8 @@ impl<T: Real> Closed<T> {
     }
 
     /// The exactly straight rod's form (case [`Case::Straight`]), every field set: the start
-    /// of [`Self::new`], which fills in the others' constants.
-    fn straight(a3: T, a4: T, a5: T) -> Self {
+    /// of [`Self::new`] and [`Self::complete`], which fill in the others' constants.
+    pub(crate) fn straight(a3: T, a4: T, a5: T) -> Self {
         let zero = T::from_f64(0.0);
         let one = T::from_f64(1.0);
         let eps = if a3.re() < 0.0 { -1.0 } else { 1.0 };
@@ -733,11 +733,9 @@ impl<T: Real> Closed<T> {
         Self::build(a3, a4, a5, true)
     }
 
-    /// As [`Self::new`], for the pose alone (no stability scan, energy, curvature or theorem,
-    /// which need φ): in f64, where m ∈ [[`PHASE_FREE_MIN_M`], 1 − [`PHASE_FREE_MIN_M1`]]
-    /// (cases I and II), the phase φ = F(am φ | m) is not computed (Carlson's R_F and R_D,
-    /// ~20 % of q(1)) and `pose` places Γ = r t + φ by the addition theorems from the base's
-    /// sn, cn, dn, which are algebraic in a. Elsewhere the same as [`Self::new`].
+    /// As [`Self::new`], for the pose alone ([`Self::complete`] without the phase; the hot
+    /// paths call that directly).
+    #[cfg(test)]
     pub fn new_phase_free(a3: T, a4: T, a5: T) -> Option<Self> {
         Self::build(a3, a4, a5, false)
     }
@@ -749,14 +747,34 @@ impl<T: Real> Closed<T> {
     }
 
     fn build(a3: T, a4: T, a5: T, with_phase: bool) -> Option<Self> {
-        let (a3r, a4r, a5r) = (a3.re(), a4.re(), a5.re());
         let mut s = Self::straight(a3, a4, a5);
+        s.complete(a3, a4, a5, with_phase).then_some(s)
+    }
+
+    /// Completes the straight rod's form from [`Self::straight`] into the form for a, in
+    /// place: false when an intermediate quantity is not finite (the form is then not to be
+    /// used). Without the phase (`with_phase` false: for the pose alone, no stability scan,
+    /// energy, curvature or theorem, which need φ), in f64 where m ∈ [[`PHASE_FREE_MIN_M`],
+    /// 1 − [`PHASE_FREE_MIN_M1`]] (cases I and II), the phase φ = F(am φ | m) is not computed
+    /// (Carlson's R_F and R_D, ~20 % of q(1)) and `pose` places Γ = r t + φ by the addition
+    /// theorems from the base's sn, cn, dn, which are algebraic in a; elsewhere it is.
+    /// The hot paths build the form in their own variable this way,
+    /// `let mut c = Closed::straight(a3, a4, a5); if c.complete(a3, a4, a5, true) { .. }`:
+    /// [`Self::new`]'s `Option` costs a copy of the whole form out of the builder (~450 bytes
+    /// in f64, 5 % of q(1); ~1 KB in dual numbers).
+    pub(crate) fn complete(&mut self, a3: T, a4: T, a5: T, with_phase: bool) -> bool {
+        self.complete_or_none(a3, a4, a5, with_phase).is_some()
+    }
+
+    fn complete_or_none(&mut self, a3: T, a4: T, a5: T, with_phase: bool) -> Option<()> {
+        let s = self;
+        let (a3r, a4r, a5r) = (a3.re(), a4.re(), a5.re());
         if a3r == 0.0 && a5r == 0.0 {
-            return Some(s);
+            return Some(());
         }
         if a4r == 0.0 && a5r == 0.0 {
             s.case = Case::Circle;
-            return Some(s);
+            return Some(());
         }
         // F without overflow of the squares.
         let scale = a4r.abs().max(a5r.abs());
@@ -800,7 +818,7 @@ impl<T: Real> Closed<T> {
         } else if l4 < 0.0 {
             s.init_case_ii(&invariants, with_phase)?;
             if s.case == Case::SmallForce {
-                return Some(s);
+                return Some(());
             }
         } else {
             s.init_case_iii(&invariants);
@@ -811,7 +829,7 @@ impl<T: Real> Closed<T> {
             s.inv_m = m.recip();
             s.inv_sqrt_m = m.sqrt().recip();
         }
-        s.is_valid().then_some(s)
+        s.is_valid().then_some(())
     }
 
     /// Phase pair (sn φ, cn φ) of cases I and III: cn φ = |a3|/√α3,
@@ -1208,7 +1226,7 @@ impl<T: Real> Closed<T> {
     }
 
     /// (∫β1, ∫β2, θ/(2ε)) at t of a form built without its phase (cases I and II,
-    /// [`Self::new_phase_free`]): with u = r t and v = φ, the Jacobi functions at Γ = u + v by
+    /// [`Self::complete`] without the phase): with u = r t and v = φ, the Jacobi functions at Γ = u + v by
     /// the addition theorems (A&S 16.17.1–3), with the cancellation-free denominator
     /// Δ = 1 − m sn²u sn²v = cn²u + sn²u dn²v, from those at u and the base's sn v, cn v,
     /// dn v (algebraic in a); Z(u + v) − Z(v) = Z(u) − m sn u sn v sn(u + v) (A&S 17.4.35).
@@ -1239,7 +1257,7 @@ impl<T: Real> Closed<T> {
     /// Pose (x, y, θ)(t) with θ unwrapped (FINDINGS §1 position formulas, §3 integrals):
     /// x = −(a4/F)∫β1 + 2ε(a5/F)∫β2, y = −(a5/F)∫β1 − 2ε(a4/F)∫β2.
     ///
-    /// A form built without its phase ([`Self::new_phase_free`]) places Γ by the addition
+    /// A form built without its phase ([`Self::complete`]) places Γ by the addition
     /// theorems instead ([`Self::integrals_additive`]).
     pub fn pose(&self, t: f64) -> [T; 3] {
         self.pose_with::<true, false>(t).0

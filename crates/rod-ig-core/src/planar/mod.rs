@@ -258,12 +258,19 @@ fn with_seeded<R>(
     series: impl FnOnce() -> Result<R, RodError>,
 ) -> Result<R, RodError> {
     check_params(a)?;
-    let closed = seeded_closed(a);
-    match &closed {
-        Some(c) => f(c),
+    let (a3, a4, a5) = (
+        Dual3::variable(a[0], 0),
+        Dual3::variable(a[1], 1),
+        Dual3::variable(a[2], 2),
+    );
+    // Built in place (`Closed::complete`): through `Closed::new`'s Option the form was copied.
+    let mut c = Closed::straight(a3, a4, a5);
+    if c.complete(a3, a4, a5, true) {
+        f(&c)
+    } else {
         // The closed form's intermediate ratios overflowed (e.g. a tiny moment against a
         // moderate force): the series has its own overflow detection.
-        None => series(),
+        series()
     }
 }
 
@@ -652,9 +659,8 @@ pub(crate) fn tip_by_closed_form(a: &PlanarParams) -> Option<PlanarPose> {
     if check_params(a).is_err() || series_first(a) {
         return None;
     }
-    let closed = Closed::<f64>::new_phase_free(a[0], a[1], a[2]);
-    let closed = closed.as_ref()?;
-    if closed.needs_series() != SeriesNeed::None {
+    let mut closed = Closed::<f64>::straight(a[0], a[1], a[2]);
+    if !closed.complete(a[0], a[1], a[2], false) || closed.needs_series() != SeriesNeed::None {
         return None;
     }
     let [x, y, theta] = closed.pose(1.0);
@@ -674,12 +680,12 @@ pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
     let [x, y, th] = if series_first(a) {
         series_f64(a, false)?.tip()
     } else {
-        // Matched by reference: binding the rod out of the Option copied its ~600 bytes.
-        // Without the phase where the addition theorems place the tip instead (~18 % of q(1)).
-        let closed = Closed::<f64>::new_phase_free(a[0], a[1], a[2]);
-        let Some(closed) = &closed else {
+        // Built in place (`Closed::complete`: through an Option the form was copied), without
+        // the phase where the addition theorems place the tip instead (~18 % of q(1)).
+        let mut closed = Closed::<f64>::straight(a[0], a[1], a[2]);
+        if !closed.complete(a[0], a[1], a[2], false) {
             return finite_tip(series_f64(a, false)?.tip());
-        };
+        }
         match closed.needs_series() {
             SeriesNeed::None => closed.pose(1.0),
             _ if let Some(tip) = small_angle_tip(a) => tip,
