@@ -2,6 +2,7 @@
 //! `cargo run --release -p rod-ig-bench --example profile -- MODE SAMPLE_INDEX ROUNDS` with MODE
 //! forward, tip, tipj, stability, solve, buckets, slowest-forward or slowest (sample 0 is the
 //! uniform box, 1 the log-scale sample, 3 strong force); `one a3 a4 a5` times one rod,
+//! `track ROUNDS` follows the benchmark's ellipse of targets with the planar tracker,
 //! `calls SAMPLE_INDEX` splits a sample's per-rod times by the sign of a4, `file PATH` lists
 //! the refusals and uncertain verdicts of the rods in a file of "a3 a4 a5" lines.
 
@@ -17,6 +18,7 @@ fn main() {
         Some("calls") => calls(&args),
         Some("file") => file(&args),
         Some("tipj3d" | "evaluate3d" | "solve3d") => spatial_rounds(&args),
+        Some("track") => track(&args),
         _ => rounds(&args),
     }
 }
@@ -45,6 +47,27 @@ fn one(args: &[String]) {
         per_call(|| planar::energy(black_box(&a))),
     );
     println!("{:?}", planar::evaluate(&a));
+}
+
+/// `track ROUNDS`: the planar `Tracker` along the benchmark's ellipse of 1,000 targets, a
+/// fresh tracker each round (the first, cold solve of each round included).
+fn track(args: &[String]) {
+    let rounds: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(20);
+    let path = rod_ig_bench::planar::ellipse_path(0.5, 0.2, 0.3, 0.0, 0.5, 1000);
+    let options = SolveOptions::default();
+    ig::warm_up();
+    let t0 = Instant::now();
+    for _ in 0..rounds {
+        let mut tracker = ig::Tracker::new(options);
+        for b in &path {
+            let _ = black_box(tracker.solve(black_box(b)));
+        }
+    }
+    let us = t0.elapsed().as_secs_f64() * 1e6 / (rounds * path.len()).max(1) as f64;
+    println!(
+        "track on the ellipse: {} steps per round, {us:.2} µs per step",
+        path.len()
+    );
 }
 
 /// `tipj3d|evaluate3d|solve3d N ROUNDS`: the 3-D forward map with J, the evaluation with the

@@ -77,24 +77,10 @@ pub(crate) fn tip_and_jacobian_for_iteration(
     crate::planar::tip_and_jacobian_for_iteration(a, precision == Precision::Precise)
 }
 
-/// Υ(a) and J(1, a) at full accuracy: for the verification of an answer.
-#[inline]
-pub(crate) fn tip_and_jacobian_precise(
-    a: &PlanarParams,
-) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-    super::tip_and_jacobian(a)
-}
-
 /// Υ(a), J(1, a), energy and the stability test at full accuracy from one precomputation.
 #[inline]
 pub(crate) fn evaluate_precise(a: &PlanarParams) -> Result<crate::planar::Evaluation, RodError> {
     super::evaluate(a)
-}
-
-/// The stability verdict of FINDINGS §5 (det J(t, a) > 0 on (0, 1]).
-#[inline]
-pub(crate) fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
-    super::stability(a)
 }
 
 /// Elastic energy ½∫κ² from the tip, by the identity of FINDINGS §1:

@@ -288,7 +288,8 @@ mod tests {
     /// Newton from a start near a stable rod of the paper's box (its tip the target, the
     /// start 1e-3 away in each parameter: ‖f‖ ~ 1e-3, inside the chord steps' range) ends
     /// on chord steps, and every point reached that way passes the full verification at the
-    /// 1e-10 tolerance: the residual-only evaluations judge convergence as full ones do.
+    /// 1e-10 tolerance and the stability test: the residual-only evaluations judge convergence
+    /// as full ones do.
     #[test]
     fn chord_steps_end_near_converged_solves_and_pass_verification() {
         let mut rng = SplitMix64::new(23);
@@ -311,7 +312,8 @@ mod tests {
             solved += 1;
             by_chord += usize::from(r.chord_steps > 0);
             assert!(
-                super::super::newton::verify(&found, &tip, 1e-10).is_some(),
+                super::super::newton::verify_with_stability(&found, &tip, 1e-10)
+                    .is_some_and(|(_, st)| st.stable),
                 "{found:?} for the rod {a:?}: chord steps {}",
                 r.chord_steps
             );

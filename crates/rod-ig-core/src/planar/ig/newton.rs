@@ -29,17 +29,11 @@ pub(crate) fn eval(a: &PlanarParams, target: &PlanarPose, precision: Precision) 
     )
 }
 
-/// The converged iterate `a` re-evaluated at full accuracy: Some when it still meets the
-/// tolerance (iterations may use a cheaper evaluation on ill-conditioned rods).
-pub(crate) fn verify(a: &PlanarParams, target: &PlanarPose, tolerance: f64) -> Option<Eval> {
-    let e = eval_from(model::tip_and_jacobian_precise(a).ok()?, target)?;
-    (e.pos_err <= tolerance && e.ang_err <= tolerance).then_some(e)
-}
-
-/// [`verify`] and the stability test of the verified point from one evaluation
-/// (`planar::evaluate`: one closed form or one dense series serves the tip, J and the scan of
-/// det J(t), where separate calls built it twice). None when the re-evaluated point misses the
-/// tolerance or cannot be evaluated.
+/// The converged iterate `a` re-evaluated at full accuracy (iterations may use a cheaper
+/// evaluation on ill-conditioned rods, or the tip alone), and its stability test, from one
+/// evaluation (`planar::evaluate`: one closed form or one dense series serves the tip, J, the
+/// energy and the scan of det J(t), where separate calls built it three times). None when the
+/// re-evaluated point misses the tolerance or cannot be evaluated.
 pub(crate) fn verify_with_stability(
     a: &PlanarParams,
     target: &PlanarPose,

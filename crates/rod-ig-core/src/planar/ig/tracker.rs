@@ -148,10 +148,10 @@ impl Tracker {
         let r = local::solve_predicted(target, a0, predicted, 1.0, budget, tolerance);
         let work = (r.iterations, r.evaluations);
         let (a, _) = r.found.ok_or(work)?;
-        let e = super::newton::verify(&a, target, tolerance).ok_or(work)?;
-        let st = model::stability(&a)
-            .ok()
-            .filter(|st| st.stable)
+        // One evaluation (one closed form) gives the tip, J, the energy and the stability
+        // test; separate calls built the form three times.
+        let (e, st) = super::newton::verify_with_stability(&a, target, tolerance)
+            .filter(|(_, st)| st.stable)
             .ok_or(work)?;
         let mut s = make_solution(&a, &e, true, st.margin, r.iterations);
         s.evaluations = r.evaluations;
