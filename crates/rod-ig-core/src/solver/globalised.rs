@@ -64,11 +64,14 @@ pub(crate) trait Problem<const N: usize> {
     /// Solves m x = r; `None` when m is numerically singular or x is not finite.
     fn solve(&self, m: &SMatrix<f64, N, N>, r: &SVector<f64, N>) -> Option<SVector<f64, N>>;
 
+    /// Whether [`Problem::evaluate_residual`] is offered (chord steps, module docs): where the
+    /// residual alone is not much cheaper than [`Problem::evaluate`], not (the default).
+    const OFFERS_RESIDUAL: bool = false;
+
     /// The trial point `a` (reached from an iterate of merit `from`) evaluated without its
     /// Jacobian, for chord steps (module docs): `jacobian` is the J the run keeps, to be stored
-    /// in the iterate. `None` where the residual alone is not much cheaper than
-    /// [`Problem::evaluate`] (the default), or `a` cannot be evaluated that way: the run then
-    /// stops taking chord steps.
+    /// in the iterate. `None` where `a` cannot be evaluated that way (or nothing is offered,
+    /// the default): the run then stops taking chord steps.
     fn evaluate_residual(
         &mut self,
         _a: &SVector<f64, N>,
@@ -242,7 +245,8 @@ fn chord_step<const N: usize, P: Problem<N>>(
     chord: &mut Chord<N, P::Data>,
     settings: &Settings,
 ) -> Result<bool, IgError> {
-    if !chord.open
+    if !P::OFFERS_RESIDUAL
+        || !chord.open
         || state.chord_steps >= CHORD_MAX_STEPS
         || state.last.norm.is_nan()
         || state.last.norm > CHORD_MAX_NORM
@@ -420,6 +424,7 @@ mod tests {
 
     impl Problem<2> for Toy {
         type Data = ();
+        const OFFERS_RESIDUAL: bool = true;
 
         fn evaluate(
             &mut self,
@@ -546,6 +551,7 @@ mod tests {
         struct Spoiled(Toy);
         impl Problem<2> for Spoiled {
             type Data = ();
+            const OFFERS_RESIDUAL: bool = true;
             fn evaluate(
                 &mut self,
                 a: &Vector2<f64>,

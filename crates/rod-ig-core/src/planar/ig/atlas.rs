@@ -157,14 +157,15 @@ const CELLS_PER_GATHER: usize = NXY * NT;
 
 /// The atlas under construction, in three phases of small pieces: chunks of rays integrated
 /// into seeds, the seeds gathered in cell order by x slab, then the cells' short lists by x
-/// slab. The request that triggers the build is
-/// charged only the pieces its deadline allows (issue 24: no request answers later than its
-/// deadline) and the next request resumes; threads that need the atlas build it together,
-/// each computing the pieces it claims outside the lock. Seeds are filed in ray order whatever
-/// thread computed them, so the atlas is the same on every run.
+/// slab. The request that triggers the build is charged only the pieces its deadline allows
+/// (issue 24: no request answers later than its deadline) and the next request resumes;
+/// threads that need the atlas build it together, each computing the pieces it claims outside
+/// the lock (the gathering's pieces under it). Seeds are filed in ray order whatever thread
+/// computed them, so the atlas is the same on every run.
 struct Builder {
     cells: Vec<Vec<(Seed, f64)>>,
-    /// Pieces handed out so far: chunks 0..CHUNKS, then slabs.
+    /// Pieces handed out so far: chunks 0..CHUNKS, then slabs (the gathering between them is
+    /// done by whichever thread asks next, under the lock).
     handed_out: usize,
     /// When each piece was (last) handed out.
     handed_at: Vec<Instant>,

@@ -180,6 +180,7 @@ fn iterate(e: Eval) -> Iterate<3, Eval> {
 
 impl Problem<3> for PlanarSteps<'_> {
     type Data = Eval;
+    const OFFERS_RESIDUAL: bool = true;
 
     fn evaluate(
         &mut self,
