@@ -594,7 +594,10 @@ impl Atlas {
         };
         let c = index(ix, iy, it);
         let start = out.len();
-        for &k in &self.near[self.near_offsets[c] as usize..self.near_offsets[c + 1] as usize] {
+        let near = &self.near[self.near_offsets[c] as usize..self.near_offsets[c + 1] as usize];
+        // One allocation of the right size (growing by pushes reallocated twice per solve).
+        out.reserve(near.len());
+        for &k in near {
             out.push((tip_distance2(&self.seeds[k as usize].tip, &tgt), k));
         }
         out[start..].sort_by(|p, q| p.0.total_cmp(&q.0));

@@ -239,7 +239,8 @@ impl<'t> Starts<'t> {
             buf: Vec::new(),
             pos: 0,
             stage: 0,
-            served: Vec::new(),
+            // Most solves serve a few starts: one allocation for them.
+            served: Vec::with_capacity(8),
             model: ModelStarts::new(target),
         };
         if guess.is_some() {
