@@ -25,8 +25,8 @@ use nalgebra::{Matrix3, Vector3};
 
 /// Outcome of one local solve.
 pub(crate) struct Local {
-    /// Converged point and its evaluation (not yet checked by the full stability test).
-    pub found: Option<(PlanarParams, Eval)>,
+    /// Converged point and its errors (not yet checked by the full stability test).
+    pub found: Option<(PlanarParams, TipErrors)>,
     /// Accepted Newton steps.
     pub iterations: u32,
     /// Evaluations of Υ and J.
@@ -169,31 +169,45 @@ struct PlanarSteps<'t> {
     tolerance: f64,
 }
 
-fn iterate(e: Eval) -> Iterate<3, Eval> {
+/// What an iterate keeps of its evaluation besides f, ‖f‖ and J: the tip errors the
+/// convergence test reads (the whole evaluation, ~160 bytes, was copied with every move of an
+/// iterate).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TipErrors {
+    /// Position error (rod lengths).
+    pub position: f64,
+    /// Wrapped angle error (rad).
+    pub angle: f64,
+}
+
+fn iterate(e: Eval) -> Iterate<3, TipErrors> {
     Iterate {
         f: e.f,
         norm: e.norm,
         jacobian: e.jac,
-        data: e,
+        data: TipErrors {
+            position: e.pos_err,
+            angle: e.ang_err,
+        },
     }
 }
 
 impl Problem<3> for PlanarSteps<'_> {
-    type Data = Eval;
+    type Data = TipErrors;
     const OFFERS_RESIDUAL: bool = true;
 
     fn evaluate(
         &mut self,
         a: &PlanarParams,
         _from: f64,
-    ) -> Result<Option<Iterate<3, Eval>>, IgError> {
+    ) -> Result<Option<Iterate<3, TipErrors>>, IgError> {
         Ok(eval(a, self.target, self.precision)
             .filter(|e| e.jac.determinant() > 0.0)
             .map(iterate))
     }
 
-    fn converged(&self, x: &Iterate<3, Eval>) -> bool {
-        x.data.pos_err <= self.tolerance && x.data.ang_err <= self.tolerance
+    fn converged(&self, x: &Iterate<3, TipErrors>) -> bool {
+        x.data.position <= self.tolerance && x.data.angle <= self.tolerance
     }
 
     fn step_scale(&self, _a: &PlanarParams, p: &Vector3<f64>) -> f64 {
@@ -211,7 +225,7 @@ impl Problem<3> for PlanarSteps<'_> {
         a: &PlanarParams,
         _from: f64,
         jacobian: &Matrix3<f64>,
-    ) -> Result<Option<Iterate<3, Eval>>, IgError> {
+    ) -> Result<Option<Iterate<3, TipErrors>>, IgError> {
         Ok(eval_residual(a, jacobian, self.target).map(iterate))
     }
 }
