@@ -1190,7 +1190,8 @@ fn scan(
     (a3, a5): (f64, f64),
     extra: &[f64],
 ) -> Result<Scan, RodError> {
-    let (mut ts, np) = sample_times(t0, h_target, (a3, a5), extra);
+    let mut ts = [0.0f64; MAX_SAMPLES];
+    let np = sample_times_into(&mut ts, t0, h_target, (a3, a5), extra);
     let mut ps = [Probe { v: 0.0, d: 0.0 }; MAX_SAMPLES];
     // NaN: g's sign there is rounding where det J > 0 is known ([`closed_scan`]); dropped.
     let mut kept = 0;
@@ -1236,10 +1237,23 @@ fn sample_times(
     (a3, a5): (f64, f64),
     extra: &[f64],
 ) -> ([f64; MAX_SAMPLES], usize) {
+    let mut ts = [0.0f64; MAX_SAMPLES];
+    let np = sample_times_into(&mut ts, t0, h_target, (a3, a5), extra);
+    (ts, np)
+}
+
+/// [`sample_times`] written into `ts` (the scan's own array: returned by value, the 112 times
+/// were copied); returns their number.
+fn sample_times_into(
+    ts: &mut [f64; MAX_SAMPLES],
+    t0: f64,
+    h_target: f64,
+    (a3, a5): (f64, f64),
+    extra: &[f64],
+) -> usize {
     let n = ((1.0 - t0) / h_target).ceil().max(1.0) as usize;
     let n = n.min(MAX_SAMPLES - 4 - MAX_EXTRA_SAMPLES);
     let h = (1.0 - t0) / n as f64;
-    let mut ts = [0.0f64; MAX_SAMPLES];
     let mut np = n + 1;
     for (i, t) in ts.iter_mut().enumerate().take(np) {
         *t = if i == n { 1.0 } else { t0 + i as f64 * h };
@@ -1265,7 +1279,7 @@ fn sample_times(
             np += 1;
         }
     }
-    (ts, np)
+    np
 }
 
 /// The first sign change of g over the samples (det ≤ 0): (where, located by [`find_root`],
