@@ -399,15 +399,13 @@ mod tests {
     use super::*;
     use nalgebra::{Matrix2, Vector2};
 
-    /// f(a) = (a0² + a1 − 3, a0 + a1³ − 9) − b-shift: root a* = (1, 2) for `shift` = 0. A toy
-    /// with the chord steps' two evaluations counted apart; `offer` says whether it offers
-    /// residual evaluations, `reject` makes `evaluate` refuse points with a0 > that bound
-    /// (a stable set's boundary), `residual_scale` spoils the residual-only evaluations
+    /// f(a) = (a0² + a1 − 3, a0 + a1³ − 9), root a* = (1, 2): a toy with the chord steps' two
+    /// evaluations counted apart. `evaluate` refuses points with a0 > `reject` (a stable
+    /// set's boundary); residual-only evaluations fail (not finite) from the `fail_from`-th on
     /// (a chord trial that falls short).
     struct Toy {
-        offer: bool,
         reject: f64,
-        residual_scale: f64,
+        fail_from: u32,
         full: u32,
         residual_only: u32,
     }
@@ -462,11 +460,13 @@ mod tests {
             _from: f64,
             jacobian: &Matrix2<f64>,
         ) -> Result<Option<Iterate<2, ()>>, IgError> {
-            if !self.offer {
-                return Ok(None);
-            }
+            let scale = if self.residual_only >= self.fail_from {
+                f64::INFINITY
+            } else {
+                1.0
+            };
             self.residual_only += 1;
-            let f = toy_f(a) * self.residual_scale;
+            let f = toy_f(a) * scale;
             Ok(Some(Iterate {
                 f,
                 norm: f.norm(),
@@ -476,11 +476,11 @@ mod tests {
         }
     }
 
-    fn toy(offer: bool) -> Toy {
+    /// Residual-only evaluations offered (and sound) from the `fail_from`-th on.
+    fn toy(fail_from: u32) -> Toy {
         Toy {
-            offer,
             reject: f64::INFINITY,
-            residual_scale: 1.0,
+            fail_from,
             full: 0,
             residual_only: 0,
         }
@@ -499,7 +499,9 @@ mod tests {
     #[test]
     fn chord_steps_reach_the_same_root_with_fewer_full_evaluations() {
         let a0 = Vector2::new(1.3, 1.7);
-        let (mut newton, mut chord) = (toy(false), toy(true));
+        // Failing from the first on, residual-only evaluations end the chord steps at once: the
+        // run is Newton's, one residual-only evaluation aside.
+        let (mut newton, mut chord) = (toy(0), toy(u32::MAX));
         let (rn, rc) = (run_toy(&mut newton, a0), run_toy(&mut chord, a0));
         assert_eq!(rn.stop, Stop::Converged);
         assert_eq!(rc.stop, Stop::Converged);
@@ -525,12 +527,9 @@ mod tests {
 
     #[test]
     fn a_chord_trial_that_falls_short_hands_back_to_newton() {
-        // Residual-only evaluations that fail (not finite) never show the contraction: the
-        // first chord trial ends them, and Newton converges on full evaluations.
-        let mut p = Toy {
-            residual_scale: f64::INFINITY,
-            ..toy(true)
-        };
+        // Residual-only evaluations that fail never show the contraction: the first chord
+        // trial ends them, and Newton converges on full evaluations.
+        let mut p = toy(0);
         let r = run_toy(&mut p, Vector2::new(1.3, 1.7));
         assert_eq!(r.stop, Stop::Converged);
         assert_eq!(r.chord_steps, 0);
@@ -548,52 +547,10 @@ mod tests {
         // not check it) and is taken; the second falls short (its evaluation fails). The
         // refresh of the chord point is refused: the run goes back to the last full iterate
         // and ends on the stable side, its last iterate a full one.
-        struct Spoiled(Toy);
-        impl Problem<2> for Spoiled {
-            type Data = ();
-            const OFFERS_RESIDUAL: bool = true;
-            fn evaluate(
-                &mut self,
-                a: &Vector2<f64>,
-                from: f64,
-            ) -> Result<Option<Iterate<2, ()>>, IgError> {
-                self.0.evaluate(a, from)
-            }
-            fn converged(&self, x: &Iterate<2, ()>) -> bool {
-                self.0.converged(x)
-            }
-            fn step_scale(&self, a: &Vector2<f64>, p: &Vector2<f64>) -> f64 {
-                self.0.step_scale(a, p)
-            }
-            fn solve(&self, m: &Matrix2<f64>, r: &Vector2<f64>) -> Option<Vector2<f64>> {
-                self.0.solve(m, r)
-            }
-            fn evaluate_residual(
-                &mut self,
-                a: &Vector2<f64>,
-                from: f64,
-                j: &Matrix2<f64>,
-            ) -> Result<Option<Iterate<2, ()>>, IgError> {
-                if self.0.residual_only >= 1 {
-                    self.0.residual_scale = f64::INFINITY;
-                }
-                self.0.evaluate_residual(a, from, j)
-            }
-        }
         let reject = 1.0 - 1e-3;
-        let mut p = Spoiled(Toy {
-            reject,
-            ..toy(true)
-        });
-        let a0 = Vector2::new(0.99, 2.01);
-        let x0 = p.0.evaluate(&a0, f64::INFINITY).unwrap().unwrap();
-        let settings = Settings {
-            alpha: 1.0,
-            max_iterations: 50,
-            max_evaluations: 200,
-        };
-        let r = run(&mut p, a0, x0, &settings).unwrap();
-        assert_eq!(p.0.residual_only, 2);
+        let mut p = Toy { reject, ..toy(1) };
+        let r = run_toy(&mut p, Vector2::new(0.99, 2.01));
+        assert_eq!(p.residual_only, 2);
         assert_eq!(r.chord_steps, 0);
         assert!(r.a[0] <= reject, "{:?}", r.a);
         assert_ne!(r.stop, Stop::Converged);
