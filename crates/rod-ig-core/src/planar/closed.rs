@@ -61,9 +61,9 @@ impl DipTimes {
 /// budget; a rod with more periods has the grid alone beyond the eighth).
 pub(crate) const MAX_DIP_TIMES: usize = 8;
 
-/// Smallest m for which a form built without its phase ([`Closed::complete`]) leaves it out: the small-m regimes
-/// (nearly straight rods under compression, near-circles) keep the form their error estimates
-/// were measured on.
+/// Smallest m for which a form built without its phase ([`Closed::complete`]) leaves it out:
+/// the small-m regimes (nearly straight rods under compression, near-circles) keep the form
+/// their error estimates were measured on.
 const PHASE_FREE_MIN_M: f64 = 0.01;
 /// Smallest m1 = 1 − m for which a form built without its phase leaves it out: the
 /// addition theorems' numerators cancel as m → 1, and case II's amplitude is unwrapped by its
@@ -127,9 +127,9 @@ pub(crate) struct Closed<T: Real> {
     th0: T,
     /// Case III: E(am φ) and cn φ (first order in δ).
     e0: T,
-    /// φ and Z(φ) were left out ([`Closed::complete`] without the phase; then both 0): `pose` places
-    /// Γ = r t + φ by the addition theorems ([`Closed::integrals_additive`]), and nothing that
-    /// needs φ itself (stability, energy, curvature, the theorem) may be asked.
+    /// φ and Z(φ) were left out ([`Closed::complete`] without the phase; then both 0): `pose`
+    /// places Γ = r t + φ by the addition theorems ([`Closed::integrals_additive`]), and
+    /// nothing that needs φ itself (stability, energy, curvature, the theorem) may be asked.
     phase_unknown: bool,
     /// Straight rod / circle: nothing else needed.
     _p: (),
@@ -1226,7 +1226,7 @@ impl<T: Real> Closed<T> {
     }
 
     /// (∫β1, ∫β2, θ/(2ε)) at t of a form built without its phase (cases I and II,
-    /// [`Self::complete`] without the phase): with u = r t and v = φ, the Jacobi functions at Γ = u + v by
+    /// [`Self::complete`]): with u = r t and v = φ, the Jacobi functions at Γ = u + v by
     /// the addition theorems (A&S 16.17.1–3), with the cancellation-free denominator
     /// Δ = 1 − m sn²u sn²v = cn²u + sn²u dn²v, from those at u and the base's sn v, cn v,
     /// dn v (algebraic in a); Z(u + v) − Z(v) = Z(u) − m sn u sn v sn(u + v) (A&S 17.4.35).
