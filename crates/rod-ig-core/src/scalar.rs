@@ -256,12 +256,20 @@ pub fn fast_atan2(y: f64, x: f64) -> f64 {
     } else {
         (t, 0.0)
     };
+    // atan z = z + z³ Q(z²): Q (13th degree) by Estrin's scheme, four levels of independent
+    // products where Horner chains fourteen (~15 % of q(1) in time); z is added last, as in
+    // Horner, so that the leading term is not rounded into the others.
+    let c = &ATAN_COEFFS;
     let z2 = z * z;
-    let mut p = ATAN_COEFFS[14];
-    for k in (0..14).rev() {
-        p = p * z2 + ATAN_COEFFS[k];
-    }
-    let mut r = off + z * p;
+    let (z4, z3) = (z2 * z2, z2 * z);
+    let z8 = z4 * z4;
+    let pair = |i: usize| c[i] + c[i + 1] * z2;
+    let b0 = pair(1) + pair(3) * z4;
+    let b1 = pair(5) + pair(7) * z4;
+    let b2 = pair(9) + pair(11) * z4;
+    let b3 = pair(13);
+    let q = (b0 + b1 * z8) + (b2 + b3 * z8) * (z8 * z8);
+    let mut r = off + (z + z3 * q);
     if swap {
         r = FRAC_PI_2 - r;
     }
