@@ -569,7 +569,8 @@ pub enum Amplitude {
 /// * z = w/2ⁿ ≤ 1/32: Maclaurin series of sn, cn, dn (A&S 16.22) and D = ∫sn²;
 /// * n duplications (A&S 16.18) with the cancellation-free forms Δ = 1 − m sn⁴ = cn² + sn²dn²,
 ///   cn² − sn²dn² = cn²dn² − m1 sn², dn² − m sn²cn² = m1 + m cn⁴, and
-///   D(2z) = 2D(z) + sn²(z) sn(2z) (from the addition theorem of E(am u), A&S 17.4.14).
+///   D(2z) = 2D(z) + sn²(z) sn(2z) (from the addition theorem of E(am u), A&S 17.4.14); in
+///   f64 in homogeneous coordinates, without a division per step ([`Self::core`]).
 ///
 /// Z(u)/m = v D(m)/K − D(v) is periodic in u, so it never forms u − E(am u) at large u.
 ///
@@ -745,6 +746,13 @@ impl<T: Real> Duplication<T> {
     }
 
     /// (sn, cn, dn, D) at v ∈ [−K, K] (f64 values).
+    ///
+    /// The duplications run in homogeneous coordinates, (sn, cn, dn) = (s, c, d)/q: the
+    /// formulas of [`Duplication`] share the denominator Δ = cn² + sn²dn², so one step is
+    /// s ← 2 s c d q, c ← c²d² − m1 s²q², d ← m c⁴ + m1 q⁴, q ← c²q² + s²d², without a
+    /// division on the chain from one step to the next (~10 cycles a step where the division
+    /// made it ~25; the reciprocal of q, which D's sum needs, is computed beside the chain).
+    /// q is brought back to 1 if it leaves [1e-150, 1e150] (q shrinks like Δ^(4ⁿ) near m = 1).
     #[inline]
     fn core(&self, v: f64) -> (f64, f64, f64, f64) {
         let kr = self.kr;
@@ -768,25 +776,39 @@ impl<T: Real> Duplication<T> {
         let mut d = z2 * (dc[0] + z2 * (dc[1] + z2 * (dc[2] + z2 * dc[3]))) + 1.0;
         let mut dd = z * z2 * (z2 * (pc[0] + z2 * (pc[1] + z2 * (pc[2] + z2 * pc[3]))) + 1.0 / 3.0);
         let (m, m1) = (self.mr, self.m1r);
+        let mut q = 1.0;
+        // sn before the step (s/q), for D(2z) = 2D(z) + sn²(z) sn(2z).
+        let mut sn_before = s;
         for _ in 0..n {
-            let s2 = s * s;
-            let c2 = c * c;
-            let d2 = d * d;
-            let inv = 1.0 / (c2 + s2 * d2);
-            let sn = s * c * d * inv * 2.0;
-            // cn² − sn²dn² = cn²dn² − m1 sn²: no cancellation as m → 1 (dn → cn)
-            c = (c2 * d2 - m1 * s2) * inv;
-            d = (m * c2 * c2 + m1) * inv;
-            dd = dd * 2.0 + s2 * sn;
-            s = sn;
+            let (s2, c2, d2, q2) = (s * s, c * c, d * d, q * q);
+            let q_next = c2 * q2 + s2 * d2;
+            // c²d² − m1 s²q² and m c⁴ + m1 q⁴: the cancellation-free forms of cn² − sn²dn²
+            // and dn² − m sn²cn² (see [`Duplication`]).
+            let c_next = c2 * d2 - m1 * (s2 * q2);
+            let d_next = m * (c2 * c2) + m1 * (q2 * q2);
+            let s_next = (s * c) * (d * q) * 2.0;
+            let inv = 1.0 / q_next;
+            let sn_after = s_next * inv;
+            dd = dd * 2.0 + sn_before * sn_before * sn_after;
+            sn_before = sn_after;
+            (s, c, d, q) = (s_next, c_next, d_next, q_next);
+            if !(q > 1e-150 && q < 1e150) {
+                (s, c, d, q) = (s * inv, c * inv, d * inv, 1.0);
+            }
         }
         if refl {
-            let inv = 1.0 / d;
-            let (s0, c0) = (s, c);
-            s = c0 * inv;
-            c = self.sqm1r * s0 * inv;
-            d = self.sqm1r * inv;
-            dd = self.dcompr - dd - s0 * s;
+            // sn(K − w) = cn/dn, cn(K − w) = √m1 sn/dn, dn(K − w) = √m1/dn: 1/q and 1/d from
+            // one division.
+            let inv = 1.0 / (q * d);
+            let (inv_q, inv_d) = (d * inv, q * inv);
+            let s_w = s * inv_q;
+            (s, c, d) = (c * inv_d, self.sqm1r * s * inv_d, self.sqm1r * q * inv_d);
+            dd = self.dcompr - dd - s_w * s;
+        } else if n > 0 {
+            let inv = 1.0 / q;
+            s *= inv;
+            c *= inv;
+            d *= inv;
         }
         if neg {
             s = -s;
@@ -976,7 +998,7 @@ mod tests {
     fn duplication_matches_landen() {
         let mut worst = [0.0f64; 5];
         for &m1 in &[
-            1.0, 0.999, 0.7, 0.5, 0.2, 0.01, 1e-4, 1e-8, 1e-12, 1e-16, 1e-25,
+            1.0, 0.999, 0.7, 0.5, 0.2, 0.01, 1e-4, 1e-8, 1e-12, 1e-16, 1e-25, 1e-100, 1e-300,
         ] {
             let m = 1.0 - m1;
             let l = Landen::new(m, m1);
