@@ -71,12 +71,14 @@ const PHASE_FREE_MIN_M: f64 = 0.01;
 /// m = 0.999, by quadrature).
 const PHASE_FREE_MIN_M1: f64 = 1e-3;
 
-/// Whether a case I or II rod of parameter m (m1 = 1 − m) may leave out its phase: in f64
-/// only. In dual numbers the addition theorems cost about as much as the phase they save
-/// (q + J: −3 % instructions on the box), and the forms that carry J must answer bit for bit
-/// alike (`evaluate` needs φ for its stability scan and energy).
+/// Whether a case I or II rod of parameter m (m1 = 1 − m) may leave out its phase and place
+/// its poses by the addition theorems (f64 and dual numbers, not double-double). In dual
+/// numbers the phase-free form costs about as many instructions as the phase it saves (q + J:
+/// −3 % on the box), but Carlson's R_F and R_D are a chain of dependent square roots: q + J
+/// takes 12 % less time without them. A form that keeps its phase (`evaluate`, for its scan
+/// and energy) still places the tip by the addition theorems, so that both give the same bits.
 fn phase_free_allowed<T: Real>(m: f64, m1: f64) -> bool {
-    !T::HAS_DERIVATIVES && !T::EXTENDED && m >= PHASE_FREE_MIN_M && m1 >= PHASE_FREE_MIN_M1
+    !T::EXTENDED && m >= PHASE_FREE_MIN_M && m1 >= PHASE_FREE_MIN_M1
 }
 
 /// Everything that depends on a only.
@@ -131,6 +133,11 @@ pub(crate) struct Closed<T: Real> {
     /// places Γ = r t + φ by the addition theorems ([`Closed::integrals_additive`]), and
     /// nothing that needs φ itself (stability, energy, curvature, the theorem) may be asked.
     phase_unknown: bool,
+    /// Cases I and II where the addition theorems hold ([`phase_free_allowed`]): `pose`, and
+    /// J(t) without the curvature, place Γ by them whether φ is known or not, so that a form
+    /// built with its phase (`evaluate`) and one without (`tip_and_jacobian`) give the same
+    /// tip and J bit for bit.
+    additive: bool,
     /// Straight rod / circle: nothing else needed.
     _p: (),
 }
@@ -723,6 +730,7 @@ impl<T: Real> Closed<T> {
             th0: zero,
             e0: zero,
             phase_unknown: false,
+            additive: false,
             _p: (),
         }
     }
@@ -744,6 +752,18 @@ impl<T: Real> Closed<T> {
     #[cfg(test)]
     pub(crate) fn phase_unknown(&self) -> bool {
         self.phase_unknown
+    }
+
+    /// This form with Γ placed directly at r t + φ, not by the addition theorems (the
+    /// reference the addition theorems are tested against).
+    #[cfg(test)]
+    pub(crate) fn with_direct_poses(mut self) -> Self {
+        assert!(
+            !self.phase_unknown,
+            "a form without its phase has no direct poses"
+        );
+        self.additive = false;
+        self
     }
 
     fn build(a3: T, a4: T, a5: T, with_phase: bool) -> Option<Self> {
@@ -866,7 +886,8 @@ impl<T: Real> Closed<T> {
             return None;
         }
         let (sn, cn) = self.phase_i(fp, fm, alpha3);
-        self.phase_unknown = !with_phase && phase_free_allowed::<T>(m.re(), m1.re());
+        self.additive = phase_free_allowed::<T>(m.re(), m1.re());
+        self.phase_unknown = !with_phase && self.additive;
         let (phi, zm0) = if self.phase_unknown {
             (zero, zero)
         } else {
@@ -929,7 +950,8 @@ impl<T: Real> Closed<T> {
         } else {
             ((fp / two_f).sqrt(), a5 * eps / (two_f * fp).sqrt())
         };
-        self.phase_unknown = !with_phase && phase_free_allowed::<T>(m.re(), m1.re());
+        self.additive = phase_free_allowed::<T>(m.re(), m1.re());
+        self.phase_unknown = !with_phase && self.additive;
         let (phi, zm0) = if self.phase_unknown {
             let zero = T::from_f64(0.0);
             (zero, zero)
@@ -1232,9 +1254,15 @@ impl<T: Real> Closed<T> {
     /// dn v (algebraic in a); Z(u + v) − Z(v) = Z(u) − m sn u sn v sn(u + v) (A&S 17.4.35).
     /// Case II's am(Γ) − am(v) is am(u) plus the principal angle of
     /// e^{i am Γ} e^{−i am u} e^{−i am v} (that sum lies in (−π, π), see [`PHASE_FREE_MIN_M1`]).
-    fn integrals_additive(&self, t: f64) -> (T, T, T) {
+    /// Without `THETA_VALUE`, θ's derivatives alone (the same bits, as in `pose_with`).
+    fn integrals_additive<const THETA_VALUE: bool>(&self, t: f64) -> (T, T, T) {
         let ii = self.case == Case::II;
-        let ju = self.landen.eval(self.r * t, ii);
+        let amp = match (ii, THETA_VALUE) {
+            (false, _) => Amplitude::None,
+            (true, true) => Amplitude::Value,
+            (true, false) => Amplitude::SlopeOnly,
+        };
+        let ju = self.landen.eval_amplitude(self.r * t, amp);
         let (su, cu, du) = (ju.sn, ju.cn, ju.dn);
         let (sv, cv, dv) = (self.j0.sn, self.j0.cn, self.j0.dn);
         let inv = (cu * cu + su * su * dv * dv).recip();
@@ -1245,13 +1273,23 @@ impl<T: Real> Closed<T> {
         if !ii {
             let ib2 = (cg - cv) * self.b2coef;
             let (y, x) = self.turn_from_base_i(sg, dg);
-            return (ib1, ib2, y.atan2_fast(x));
+            let ht = if THETA_VALUE {
+                y.atan2_fast(x)
+            } else {
+                y.atan2_slope(x)
+            };
+            return (ib1, ib2, ht);
         }
         let ib2 = self.dn_integral_ii(sg, dg);
         // e^{i am Γ}·conj(e^{i am u})·conj(e^{i am v}), with e^{i am x} = cn x + i sn x.
         let (re1, im1) = (cg * cu + sg * su, sg * cu - cg * su);
         let (re2, im2) = (re1 * cv + im1 * sv, im1 * cv - re1 * sv);
-        (ib1, ib2, ju.am + im2.atan2_fast(re2))
+        let turn = if THETA_VALUE {
+            im2.atan2_fast(re2)
+        } else {
+            im2.atan2_slope(re2)
+        };
+        (ib1, ib2, ju.am + turn)
     }
 
     /// Pose (x, y, θ)(t) with θ unwrapped (FINDINGS §1 position formulas, §3 integrals):
@@ -1325,8 +1363,9 @@ impl<T: Real> Closed<T> {
                 }
                 return ([x, y, th], unknown);
             }
-            Case::I | Case::II if self.phase_unknown => {
-                let (ib1, ib2, ht) = self.integrals_additive(t);
+            // The curvature needs Γ itself: the phase's form answers it directly.
+            Case::I | Case::II if self.phase_unknown || (self.additive && !CURVATURE) => {
+                let (ib1, ib2, ht) = self.integrals_additive::<THETA_VALUE>(t);
                 (ib1, ib2, ht, unknown)
             }
             Case::I => {
