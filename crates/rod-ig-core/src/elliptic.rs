@@ -611,7 +611,7 @@ pub enum Amplitude {
 }
 
 /// Jacobi functions by argument reduction, Maclaurin series and duplication (no sines, no
-/// arcsines). Per m: K(m) and D(m)/K(m) (polynomial pieces in f64, [`complete_kq`]; the AGM,
+/// arcsines). Per m: K(m) and D(m)/K(m) (polynomial pieces in f64, `complete_kq`; the AGM,
 /// the recurrences of [`Landen`] with nothing stored per level, for dual numbers below
 /// m = 0.01 and in double-double) and the series coefficients. Per u:
 /// * u = v + 2jK with |v| ≤ K (sn, cn change sign with j, dn does not, D(u) = D(v) + 2jD(m));
@@ -621,7 +621,7 @@ pub enum Amplitude {
 /// * n duplications (A&S 16.18) with the cancellation-free forms Δ = 1 − m sn⁴ = cn² + sn²dn²,
 ///   cn² − sn²dn² = cn²dn² − m1 sn², dn² − m sn²cn² = m1 + m cn⁴, and
 ///   D(2z) = 2D(z) + sn²(z) sn(2z) (from the addition theorem of E(am u), A&S 17.4.14); in
-///   f64 in homogeneous coordinates, without a division per step ([`Self::core`]).
+///   f64 in homogeneous coordinates, without a division per step (`Duplication::core`).
 ///
 /// Z(u)/m = v D(m)/K − D(v) is periodic in u, so it never forms u − E(am u) at large u.
 ///
