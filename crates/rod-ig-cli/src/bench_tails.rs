@@ -1,6 +1,7 @@
 //! `rod-ig bench --only tails`: per-call latency distributions (p50, p99, p99.9, max) of the
 //! forward map and of the robust solve on the uniform box next to log-scale samples of the
-//! regime a cable lives in (issue 9), with the ratio log-scale / box.
+//! regime a cable lives in (issue 9), with the ratio log-scale / box; the samples are timed
+//! interleaved, so that the ratios are not the machine's phases.
 
 use crate::planar_cmds::forward_line;
 use rod_ig_bench::families::samples;
@@ -35,29 +36,57 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
     sorted[i.min(sorted.len() - 1)]
 }
 
-/// Times every call of `f` individually (after one untimed warm-up pass).
-pub fn tails<T, R, E>(inputs: &[T], mut f: impl FnMut(&T) -> Result<R, E>) -> Tails {
-    for x in inputs {
+/// Slices each sample is cut into, timed in turn (slice j of every sample, then slice j + 1):
+/// the machine's phases (its speed varies ~1.5× within a minute) fall on every sample alike,
+/// so the ratios to the box compare like with like. Timed one sample after the other, the
+/// nearly straight rods' ratio ranged over 0.98–2.34× in eight runs of one build.
+const SLICES: usize = 20;
+
+/// Times every call of `f` on every sample individually, the samples interleaved slice by
+/// slice ([`SLICES`]), after one untimed warm-up pass: one [`Tails`] per sample.
+pub fn tails_interleaved<T, R, E>(
+    samples: &[&[T]],
+    mut f: impl FnMut(&T) -> Result<R, E>,
+) -> Vec<Tails> {
+    for x in samples.iter().flat_map(|s| s.iter()) {
         let _ = black_box(f(black_box(x)));
     }
-    let mut us = Vec::with_capacity(inputs.len());
-    let mut errors = 0;
-    for x in inputs {
-        let t0 = Instant::now();
-        let r = black_box(f(black_box(x)));
-        us.push(t0.elapsed().as_secs_f64() * 1e6);
-        errors += usize::from(r.is_err());
+    let mut us: Vec<Vec<f64>> = samples
+        .iter()
+        .map(|s| Vec::with_capacity(s.len()))
+        .collect();
+    let mut errors = vec![0usize; samples.len()];
+    for j in 0..SLICES {
+        for (k, sample) in samples.iter().enumerate() {
+            let slice = &sample[j * sample.len() / SLICES..(j + 1) * sample.len() / SLICES];
+            for x in slice {
+                let t0 = Instant::now();
+                let r = black_box(f(black_box(x)));
+                us[k].push(t0.elapsed().as_secs_f64() * 1e6);
+                errors[k] += usize::from(r.is_err());
+            }
+        }
     }
-    let mean = us.iter().sum::<f64>() / us.len().max(1) as f64;
-    us.sort_by(f64::total_cmp);
-    Tails {
-        mean,
-        p50: percentile(&us, 0.5),
-        p99: percentile(&us, 0.99),
-        p999: percentile(&us, 0.999),
-        max: us.last().copied().unwrap_or(0.0),
-        errors,
-    }
+    us.into_iter()
+        .zip(errors)
+        .map(|(mut us, errors)| {
+            let mean = us.iter().sum::<f64>() / us.len().max(1) as f64;
+            us.sort_by(f64::total_cmp);
+            Tails {
+                mean,
+                p50: percentile(&us, 0.5),
+                p99: percentile(&us, 0.99),
+                p999: percentile(&us, 0.999),
+                max: us.last().copied().unwrap_or(0.0),
+                errors,
+            }
+        })
+        .collect()
+}
+
+/// Times every call of `f` individually (after one untimed warm-up pass).
+pub fn tails<T, R, E>(inputs: &[T], f: impl FnMut(&T) -> Result<R, E>) -> Tails {
+    tails_interleaved(&[inputs], f)[0]
 }
 
 fn print_row(what: &str, sample: &str, t: &Tails, box_mean: f64) {
@@ -90,39 +119,39 @@ pub fn run(quick: bool) {
         "vs box",
         "errors"
     );
-    let mut box_mean = f64::NAN;
+    let inputs: Vec<&[PlanarParams]> = sets.iter().map(|(_, v)| v.as_slice()).collect();
+    let forward = tails_interleaved(&inputs, planar::evaluate);
+    let box_mean = forward[0].mean;
     let mut strong_forward = None;
     let mut within_twice = Vec::new();
-    for (name, inputs) in &sets {
-        let t = tails(inputs, planar::evaluate);
-        if box_mean.is_nan() {
-            box_mean = t.mean;
-        }
+    for ((name, _), t) in sets.iter().zip(&forward) {
         if name.starts_with("strong force") {
-            strong_forward = Some(t);
+            strong_forward = Some(*t);
         }
         if name.starts_with("near-circles") || name.starts_with("nearly straight") {
             within_twice.push((*name, t.mean / box_mean));
         }
-        print_row("forward", name, &t, box_mean);
+        print_row("forward", name, t, box_mean);
     }
     // Solve: targets that stable rods of each sample reach.
     let opts = SolveOptions::default();
-    let mut box_mean = f64::NAN;
-    for (name, inputs) in &sets {
-        let targets: Vec<PlanarPose> = inputs
-            .iter()
-            .filter_map(|a| planar::evaluate(a).ok())
-            .filter(|e| e.stability.stable)
-            .map(|e| e.tip)
-            .filter(|p| p.x.hypot(p.y) < 1.0)
-            .take(if quick { 100 } else { 1000 })
-            .collect();
-        let t = tails(&targets, |b| ig::solve(b, &opts));
-        if box_mean.is_nan() {
-            box_mean = t.mean;
-        }
-        print_row("solve", name, &t, box_mean);
+    let targets: Vec<Vec<PlanarPose>> = sets
+        .iter()
+        .map(|(_, inputs)| {
+            inputs
+                .iter()
+                .filter_map(|a| planar::evaluate(a).ok())
+                .filter(|e| e.stability.stable)
+                .map(|e| e.tip)
+                .filter(|p| p.x.hypot(p.y) < 1.0)
+                .take(if quick { 100 } else { 1000 })
+                .collect()
+        })
+        .collect();
+    let target_sets: Vec<&[PlanarPose]> = targets.iter().map(Vec::as_slice).collect();
+    let solve = tails_interleaved(&target_sets, |b| ig::solve(b, &opts));
+    for ((name, _), t) in sets.iter().zip(&solve) {
+        print_row("solve", name, t, solve[0].mean);
     }
     outln!("goal (issue 9): the log-scale sample within 1.5× the box per call");
     for (name, ratio) in within_twice {
@@ -142,17 +171,28 @@ pub fn run(quick: bool) {
     through_the_cli(&sets[0].1, n);
 }
 
-/// Mean µs per line of `rod-ig forward`'s work (parse, evaluate, JSON answer), after one
-/// untimed pass.
-fn per_line(lines: &[String]) -> f64 {
-    for l in lines {
+/// Mean µs per line of `rod-ig forward`'s work (parse, evaluate, JSON answer) for each group
+/// of lines, after one untimed pass, the groups interleaved slice by slice ([`SLICES`]).
+fn per_line(groups: &[&[String]]) -> Vec<f64> {
+    for l in groups.iter().flat_map(|g| g.iter()) {
         let _ = black_box(forward_line(black_box(l)));
     }
-    let t0 = Instant::now();
-    for l in lines {
-        let _ = black_box(forward_line(black_box(l)));
+    let mut seconds = vec![0.0; groups.len()];
+    for j in 0..SLICES {
+        for (k, lines) in groups.iter().enumerate() {
+            let slice = &lines[j * lines.len() / SLICES..(j + 1) * lines.len() / SLICES];
+            let t0 = Instant::now();
+            for l in slice {
+                let _ = black_box(forward_line(black_box(l)));
+            }
+            seconds[k] += t0.elapsed().as_secs_f64();
+        }
     }
-    t0.elapsed().as_secs_f64() * 1e6 / lines.len().max(1) as f64
+    seconds
+        .iter()
+        .zip(groups)
+        .map(|(s, g)| s * 1e6 / g.len().max(1) as f64)
+        .collect()
 }
 
 /// Issue 23's measure through the CLI: on a log-scale sample (|a3| 1e-8..5, |a4|, |a5|
@@ -177,7 +217,8 @@ fn through_the_cli(box_rods: &[PlanarParams], n: usize) {
         }
     }
     let box_lines: Vec<String> = box_rods.iter().map(line).collect();
-    let (b, i, s) = (per_line(&box_lines), per_line(&in_box), per_line(&strong));
+    let times = per_line(&[&box_lines, &in_box, &strong]);
+    let (b, i, s) = (times[0], times[1], times[2]);
     outln!(
         "through the CLI (rod-ig forward, per line: parse, evaluate, JSON; {n} lines each): box {b:.2} µs, \
          log-scale within the box's magnitudes {i:.2} µs ({:.2}×), log-scale with |a4| or |a5| 1e2..3e3 {s:.2} µs ({:.2}×)",
