@@ -1056,6 +1056,25 @@ mod tests {
         assert!(compared[0] > 500 && compared[1] > 500, "{compared:?}");
     }
 
+    /// Asserts that both errors (the form by the addition theorems, then with Γ placed
+    /// directly) are within `bound`, and keeps the worst error/bound of each.
+    fn within_bound(
+        a: &PlanarParams,
+        what: &str,
+        errors: [f64; 2],
+        bound: f64,
+        worst: &mut [f64; 2],
+    ) {
+        for ((form, e), w) in ["addition theorems", "direct"]
+            .iter()
+            .zip(errors)
+            .zip(worst)
+        {
+            assert!(e <= bound, "{a:?}: {what} by the {form}: {e:e} > {bound:e}");
+            *w = w.max(e / bound);
+        }
+    }
+
     /// Rod i of the samples for the addition theorems' range: the box, log-scale magnitudes
     /// with exact zeros, looped rods (|a3| ≤ 30), tensioned rods (|a4| to 1e3), and m1 from
     /// 1e-3 to 1e-1 in cases I and II (None where that case has no real a3).
@@ -1109,7 +1128,7 @@ mod tests {
     #[test]
     fn jacobian_without_the_phase_within_its_bound() {
         let mut r = SplitMix64::new(37);
-        let (mut taken, mut worst_free, mut worst_direct) = (0, 0.0f64, 0.0f64);
+        let (mut taken, mut worst) = (0, [0.0f64; 2]);
         // Rods that `tip_and_jacobian` answers from this form (not from the small-angle
         // expansion or the series, which the rest go to first).
         let mut same_as_form = 0;
@@ -1142,14 +1161,7 @@ mod tests {
                 pose_jac_from(free.pose(1.0)).expect("finite").1,
                 pose_jac_from(direct.pose(1.0)).expect("finite").1,
             );
-            let (e_free, e_direct) = (rel(j_free), rel(j_direct));
-            assert!(
-                e_free <= bound,
-                "{a:?}: addition theorems {e_free:e} > {bound:e}"
-            );
-            assert!(e_direct <= bound, "{a:?}: direct {e_direct:e} > {bound:e}");
-            worst_free = worst_free.max(e_free / bound);
-            worst_direct = worst_direct.max(e_direct / bound);
+            within_bound(&a, "J", [rel(j_free), rel(j_direct)], bound, &mut worst);
             let (tip, j) = tip_and_jacobian(&a).expect("answered");
             let e = evaluate(&a).expect("answered");
             assert!(
@@ -1166,7 +1178,8 @@ mod tests {
         assert!(same_as_form >= taken * 9 / 10, "{same_as_form} of {taken}");
         eprintln!(
             "{taken} rods ({same_as_form} answered by it): worst J error / estimate \
-             {worst_free:.4} (addition) {worst_direct:.4} (direct)"
+             {:.4} (addition) {:.4} (direct)",
+            worst[0], worst[1]
         );
     }
 
@@ -1184,7 +1197,7 @@ mod tests {
     #[test]
     fn tip_without_the_phase_within_the_pose_bound() {
         let mut r = SplitMix64::new(29);
-        let (mut taken, mut worst_free, mut worst_phase) = (0, 0.0f64, 0.0f64);
+        let (mut taken, mut worst) = (0, [0.0f64; 2]);
         for i in 0..5000usize {
             let Some(a) = addition_range_rod(&mut r, i) else {
                 continue;
@@ -1206,21 +1219,16 @@ mod tests {
             let dist =
                 |[x, y, th]: [f64; 3]| (x - xr).abs().max((y - yr).abs()).max((th - thr).abs());
             let bound = free.pose_abs_error();
-            let (d_free, d_phase) = (dist(free.pose(1.0)), dist(phase.pose(1.0)));
-            assert!(
-                d_free <= bound,
-                "{a:?}: addition theorems {d_free:e} > {bound:e}"
-            );
-            assert!(d_phase <= bound, "{a:?}: phase {d_phase:e} > {bound:e}");
-            worst_free = worst_free.max(d_free / bound);
-            worst_phase = worst_phase.max(d_phase / bound);
+            let errors = [dist(free.pose(1.0)), dist(phase.pose(1.0))];
+            within_bound(&a, "tip", errors, bound, &mut worst);
         }
         assert!(
             taken >= 3000,
             "{taken} rods in the addition theorems' range"
         );
         eprintln!(
-            "{taken} rods: worst error / bound {worst_free:.3} (addition) {worst_phase:.3} (phase)"
+            "{taken} rods: worst error / bound {:.3} (addition) {:.3} (phase)",
+            worst[0], worst[1]
         );
     }
 
