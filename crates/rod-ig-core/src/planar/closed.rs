@@ -774,10 +774,13 @@ impl<T: Real> Closed<T> {
     /// Completes the straight rod's form from [`Self::straight`] into the form for a, in
     /// place: false when an intermediate quantity is not finite (the form is then not to be
     /// used). Without the phase (`with_phase` false: for the pose alone, no stability scan,
-    /// energy, curvature or theorem, which need φ), in f64 where m ∈ [[`PHASE_FREE_MIN_M`],
-    /// 1 − [`PHASE_FREE_MIN_M1`]] (cases I and II), the phase φ = F(am φ | m) is not computed
-    /// (Carlson's R_F and R_D, ~20 % of q(1)) and `pose` places Γ = r t + φ by the addition
-    /// theorems from the base's sn, cn, dn, which are algebraic in a; elsewhere it is.
+    /// energy, curvature or theorem, which need φ), in f64 and dual numbers where
+    /// m ∈ [[`PHASE_FREE_MIN_M`], 1 − [`PHASE_FREE_MIN_M1`]] (cases I and II), the phase
+    /// φ = F(am φ | m) is not computed (Carlson's R_F and R_D, ~20 % of q(1) and of q + J in
+    /// time) and `pose` places Γ = r t + φ by the addition theorems from the base's sn, cn, dn,
+    /// which are algebraic in a; elsewhere it is. A form built with its phase places its
+    /// poses by the addition theorems there too (not the curvature's), so both give the same
+    /// bits.
     /// The hot paths build the form in their own variable this way,
     /// `let mut c = Closed::straight(a3, a4, a5); if c.complete(a3, a4, a5, true) { .. }`:
     /// [`Self::new`]'s `Option` costs a copy of the whole form out of the builder (~450 bytes
@@ -796,10 +799,15 @@ impl<T: Real> Closed<T> {
             s.case = Case::Circle;
             return Some(());
         }
-        // F without overflow of the squares.
+        // F without overflow or underflow of the squares: scaled by max(|a4|, |a5|) outside
+        // [1e-150, 1e150] only (the divisions sat on q(1)'s chain of dependent operations).
         let scale = a4r.abs().max(a5r.abs());
-        let (u4, u5) = (a4 / scale, a5 / scale);
-        let f = (u4 * u4 + u5 * u5).sqrt() * scale;
+        let f = if (1e-150..1e150).contains(&scale) {
+            (a4 * a4 + a5 * a5).sqrt()
+        } else {
+            let (u4, u5) = (a4 / scale, a5 / scale);
+            (u4 * u4 + u5 * u5).sqrt() * scale
+        };
         // F ± a4 without cancellation (FINDINGS §2).
         let (fp, fm) = if a4r >= 0.0 {
             let fp = f + a4;
