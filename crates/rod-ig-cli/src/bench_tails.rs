@@ -39,7 +39,7 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 /// Slices each sample is cut into, timed in turn (slice j of every sample, then slice j + 1):
 /// the machine's phases (its speed varies ~1.5× within a minute) fall on every sample alike,
 /// so the ratios to the box compare like with like. Timed one sample after the other, the
-/// nearly straight rods' ratio ranged over 0.98–2.34× in eight runs of one build.
+/// nearly straight rods' ratio ranged over 0.98–2.34× in thirteen runs of one build.
 const SLICES: usize = 20;
 
 /// Times every call of `f` on every sample individually, the samples interleaved slice by
