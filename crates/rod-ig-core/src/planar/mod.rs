@@ -251,7 +251,9 @@ fn seeded_closed(a: &PlanarParams) -> Option<Closed<Dual3>> {
 
 /// Runs `f` on the dual-number closed form seeded with the identity on a. The closed form
 /// (≈ 1 KB of dual numbers) is borrowed where it was built, never moved through an
-/// `Option`/`Result` (each move was a memcpy).
+/// `Option`/`Result` (each move was a memcpy). Without `with_phase` it leaves φ out where the
+/// addition theorems place its poses (`Closed::complete`): for callers that ask poses and J
+/// alone, which come out the same bits either way.
 fn with_seeded<R>(
     a: &PlanarParams,
     with_phase: bool,
@@ -779,7 +781,7 @@ pub(crate) fn tip_and_jacobian_for_substep(
     }
     with_seeded(
         a,
-        true,
+        false,
         |c| {
             if c.needs_series() != SeriesNeed::None && c.accurate_within(SUBSTEP_J_TOLERANCE) {
                 pose_jac_from(c.pose(1.0))
