@@ -13,8 +13,8 @@ dependent square roots and divisions; these pieces get them by two polynomials o
   the nome of m1): K = A(m1) ℓ + B(m1), A = K(m1)/π, and D = P(m1) ℓ + R(m1).
 
 Each piece is the Chebyshev interpolant at 13 nodes in mpmath (60 digits), converted to powers
-of t ∈ [−1, 1] and rounded to f64; its truncation error (printed) is below 1e-17 of the piece's
-values. c is the f64 piece centre that the Rust code subtracts. Run:
+of t ∈ [−1, 1] and rounded to f64; its truncation error (printed) is below 8e-17 of the piece's
+values in m (the piece [0.6, 0.7), nearest the singularity at m = 1) and 1.1e-19 in m1. c is the f64 piece centre that the Rust code subtracts. Run:
 python3 scripts/gen_elliptic_complete.py  (from the repository root; needs mpmath)
 
 Also writes crates/rod-ig-core/tests/data/elliptic_complete.jsonl: K and q at 80 digits for m
