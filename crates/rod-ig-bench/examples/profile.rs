@@ -1,6 +1,6 @@
 //! A loop to profile (perf, callgrind) one call on one sample of [`rod_ig_bench::families`]:
 //! `cargo run --release -p rod-ig-bench --example profile -- MODE SAMPLE_INDEX ROUNDS` with MODE
-//! forward, tip, tipj, stability, solve, buckets, slowest-forward or slowest (sample 0 is the
+//! forward, tip, tipj, stability, verdict, solve, buckets, slowest-forward or slowest (sample 0 is the
 //! uniform box, 1 the log-scale sample, 3 strong force); `one a3 a4 a5` times one rod,
 //! `track ROUNDS` follows the benchmark's ellipse of targets with the planar tracker,
 //! `calls SAMPLE_INDEX` splits a sample's per-rod times by the sign of a4, `file PATH` lists
@@ -250,6 +250,7 @@ fn rounds(args: &[String]) {
                     "tip" => drop(black_box(planar::tip(black_box(a)))),
                     "tipj" => drop(black_box(planar::tip_and_jacobian(black_box(a)))),
                     "stability" => drop(black_box(planar::stability(black_box(a)))),
+                    "verdict" => drop(black_box(planar::stability_verdict(black_box(a)))),
                     _ => drop(black_box(planar::evaluate(black_box(a)))),
                 }
             }

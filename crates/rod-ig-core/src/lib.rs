@@ -47,7 +47,7 @@ mod types;
 pub use error::RodError;
 pub use types::{
     planar_det_leading_term, wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, StabilityReport,
-    STABILITY_T_MIN,
+    StabilityVerdict, STABILITY_T_MIN,
 };
 
 // The README's Rust example is compiled and run as a doc-test.

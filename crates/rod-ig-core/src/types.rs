@@ -68,6 +68,40 @@ pub struct StabilityReport {
     pub uncertain: bool,
 }
 
+impl StabilityReport {
+    /// The verdict without the margin: what [`crate::planar::stability_verdict`] answers.
+    pub fn verdict(&self) -> StabilityVerdict {
+        if self.stable {
+            StabilityVerdict::Stable
+        } else if self.uncertain {
+            StabilityVerdict::Uncertain
+        } else {
+            StabilityVerdict::Unstable
+        }
+    }
+}
+
+/// The outcome of the stability test alone, without its margin
+/// ([`crate::planar::stability_verdict`]; [`StabilityReport::verdict`] of a full report).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StabilityVerdict {
+    /// det J(t, a) > 0 on (0, 1] was established (a scan beyond its error bound, or a theorem).
+    Stable,
+    /// det J(t, a) changes sign on (0, 1]: the rod has a conjugate point.
+    Unstable,
+    /// The sign of det J could not be decided in floating point ([`StabilityReport::uncertain`]).
+    Uncertain,
+}
+
+impl StabilityVerdict {
+    /// True only for [`StabilityVerdict::Stable`]: callers that need a stable rod reject the
+    /// other two, as they do a report whose `stable` is false.
+    pub fn is_stable(self) -> bool {
+        self == Self::Stable
+    }
+}
+
 pub use crate::angle::wrap_angle;
 
 /// Smallest t at which the sign of det J(t, a) is trusted by the stability tests (FINDINGS §5):

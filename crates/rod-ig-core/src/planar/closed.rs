@@ -1082,6 +1082,25 @@ impl<T: Real> Closed<T> {
         }
     }
 
+    /// True when a theorem places a conjugate point on (0, 1]: on an inflectional rod (case I)
+    /// the first conjugate point lies between its first and third inflection points (Sachkov
+    /// 2008, as [`Self::conjugate_free_until`]), so a third inflection at t ≤ 1 makes the rod
+    /// unstable. The third inflection after the base is taken [`THEOREM_PHASE_MARGIN`] late
+    /// for the rounding of φ and K, and one inflection later where the base lies within that
+    /// margin before an inflection (φ rounded to the wrong side of it would miscount by one;
+    /// a base exactly at an inflection, a3 = 0, counts the next one as first, the later of
+    /// the two counts).
+    pub(crate) fn conjugate_certain(&self) -> bool {
+        if self.case != Case::I || !self.case_is_sure() {
+            return false;
+        }
+        let (k, phi, r, margin) = self.phase_and_margin();
+        let (_, above) = self.inflections_around_base();
+        let later = if above - phi <= margin { 6.0 } else { 4.0 };
+        let t = (above + later * k + margin - phi) / r;
+        t.is_finite() && t <= 1.0
+    }
+
     /// K, φ, r (f64 values) and the margin [`THEOREM_PHASE_MARGIN`]·(|φ| + r + K) by which a
     /// bound on Γ is taken early for their rounding.
     fn phase_and_margin(&self) -> (f64, f64, f64, f64) {
