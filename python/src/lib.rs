@@ -124,6 +124,34 @@ fn forward<'py>(
     Ok(d)
 }
 
+/// Stability verdicts of n rods `a` (flattened (n, 3)) by `planar::stability_verdict`: true
+/// iff the rod is established stable (what `forward` gives as `stable`), without the margin
+/// it refines. A rod that cannot be evaluated gets false.
+#[pyfunction]
+#[pyo3(signature = (a, threads=None))]
+fn is_stable<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    let a = a.as_slice()?;
+    let n = a.len() / 3;
+    let threads = thread_count(threads)?;
+    let mut stable = vec![false; n];
+    batch(
+        py,
+        n,
+        threads,
+        FORWARD_BLOCK,
+        |i| {
+            let rod = PlanarParams::new(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+            planar::stability_verdict(&rod).is_ok_and(|v| v.is_stable())
+        },
+        |i, s| stable[i] = s,
+    )?;
+    Ok(stable.into_pyarray(py))
+}
+
 /// Shapes of n rods: `samples` poses (x, y, θ) each from the base to the tip (NaN for a rod
 /// that cannot be evaluated).
 #[pyfunction]
@@ -708,6 +736,7 @@ fn warm_up(py: Python<'_>) -> usize {
 #[pymodule]
 fn _rod_ig(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(forward, m)?)?;
+    m.add_function(wrap_pyfunction!(is_stable, m)?)?;
     m.add_function(wrap_pyfunction!(shape, m)?)?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(forward3d, m)?)?;

@@ -134,6 +134,24 @@ def test_3d_forward_and_solve_roundtrip() -> None:
 # --- shapes, broadcasting, errors --------------------------------------------------------------
 
 
+def test_is_stable_gives_the_forward_maps_verdicts() -> None:
+    """The verdict alone agrees with ``forward``'s on the box and on log-scale magnitudes with
+    exact zeros (both signs), keeps the batch shape, and rejects what ``forward`` rejects."""
+    rng = np.random.default_rng(31)
+    box = rng.uniform([-10, -100, -100], [10, 100, 100], size=(3000, 3))
+    logs = np.sign(rng.uniform(-1, 1, size=(3000, 3))) * 10 ** rng.uniform(-6, 3, size=(3000, 3))
+    logs[rng.uniform(size=logs.shape) < 0.1] = 0.0
+    a = np.concatenate([box, logs])
+    verdicts = rod_ig.is_stable(a)
+    assert verdicts.dtype == np.bool_ and verdicts.shape == (6000,)
+    assert np.array_equal(verdicts, rod_ig.forward(a).stable)
+    assert 0.2 < verdicts[:3000].mean() < 0.8
+    assert rod_ig.is_stable(a.reshape(2, 3000, 3)).shape == (2, 3000)
+    assert not rod_ig.is_stable([0.0, 0.0, 0.0])[()]
+    with pytest.raises(ValueError, match=r"a must have shape \(\.\.\., 3\)"):
+        rod_ig.is_stable(np.zeros((4, 2)))
+
+
 def test_batch_shapes_and_broadcasting() -> None:
     a = np.zeros((2, 3, 3))
     a[..., 0] = 1.0

@@ -147,7 +147,7 @@ pub fn verify(target: &PlanarPose, a: &PlanarParams, tolerance: f64) -> bool {
         wrap_angle(tip.theta - target.theta),
     ];
     let ok_pose = f[0].hypot(f[1]) <= tolerance && f[2].abs() <= tolerance;
-    let ok_stable = planar::stability(a).map(|s| s.stable).unwrap_or(false);
+    let ok_stable = planar::stability_verdict(a).is_ok_and(|v| v.is_stable());
     ok_pose && ok_stable
 }
 
@@ -301,10 +301,7 @@ pub fn random_stable_targets(n: usize, seed: u64, bx: ParamBox) -> Vec<(PlanarPa
             rng.range(-bx.a45_max, bx.a45_max),
             rng.range(-bx.a45_max, bx.a45_max),
         );
-        let Ok(st) = planar::stability(&a) else {
-            continue;
-        };
-        if !st.stable {
+        if !planar::stability_verdict(&a).is_ok_and(|v| v.is_stable()) {
             continue;
         }
         let Ok((tip, _)) = planar::tip_and_jacobian(&a) else {
