@@ -53,7 +53,8 @@ pub struct StabilityReport {
     /// True iff det J(t, a) > 0 on (0, 1] was established: the margin exceeds its error
     /// bound, or a theorem rules out any conjugate point on the rod (planar: non-inflectional
     /// rods and circles have none, and an inflectional rod none before its first inflection
-    /// point; Sachkov 2008), whatever a scan could decide.
+    /// point; Sachkov 2008), whatever a scan could decide. Where the same theorem places one
+    /// on (0, 1] (by an inflectional rod's third inflection point), false and certain.
     pub stable: bool,
     /// Normalised margin g_min = min over t ∈ [0.05, 1] of
     /// g(t) = det J(t) / (t⁹ (a3²/8640 + a5² t²/33600)) (FINDINGS §5 `det_min`): scale-free,

@@ -1082,23 +1082,46 @@ impl<T: Real> Closed<T> {
         }
     }
 
-    /// True when a theorem places a conjugate point on (0, 1]: on an inflectional rod (case I)
-    /// the first conjugate point lies between its first and third inflection points (Sachkov
-    /// 2008, as [`Self::conjugate_free_until`]), so a third inflection at t ≤ 1 makes the rod
-    /// unstable. The third inflection after the base is taken [`THEOREM_PHASE_MARGIN`] late
-    /// for the rounding of φ and K, and one inflection later where the base lies within that
-    /// margin before an inflection (φ rounded to the wrong side of it would miscount by one;
-    /// a base exactly at an inflection, a3 = 0, counts the next one as first, the later of
-    /// the two counts).
-    pub(crate) fn conjugate_certain(&self) -> bool {
+    /// A t_conj such that a theorem places a conjugate point on (0, t_conj]: on an
+    /// inflectional rod (case I) the first conjugate point lies between its first and third
+    /// inflection points (Sachkov 2008, as [`Self::conjugate_free_until`]). Infinite where
+    /// nothing is known. The third inflection after the base is taken [`THEOREM_PHASE_MARGIN`]
+    /// late for the rounding of φ and K, and one inflection later where the base lies within
+    /// that margin before an inflection (φ rounded to the wrong side of it would miscount by
+    /// one; a base exactly at an inflection, a3 = 0, counts the next one as first, the later
+    /// of the two counts).
+    pub(crate) fn conjugate_by(&self) -> f64 {
         if self.case != Case::I || !self.case_is_sure() {
-            return false;
+            return f64::INFINITY;
         }
         let (k, phi, r, margin) = self.phase_and_margin();
         let (_, above) = self.inflections_around_base();
         let later = if above - phi <= margin { 6.0 } else { 4.0 };
         let t = (above + later * k + margin - phi) / r;
-        t.is_finite() && t <= 1.0
+        if t.is_finite() {
+            t
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// True when a theorem places a conjugate point on (0, 1] ([`Self::conjugate_by`]): the
+    /// rod is unstable.
+    pub(crate) fn conjugate_certain(&self) -> bool {
+        self.conjugate_by() <= 1.0
+    }
+
+    /// The verdict a theorem gives, where one does: stable where no conjugate point can lie
+    /// on (0, 1] ([`Self::conjugate_free`]), unstable where one must
+    /// ([`Self::conjugate_certain`]).
+    pub(crate) fn theorem_verdict(&self) -> Option<crate::StabilityVerdict> {
+        if self.conjugate_free() {
+            Some(crate::StabilityVerdict::Stable)
+        } else if self.conjugate_certain() {
+            Some(crate::StabilityVerdict::Unstable)
+        } else {
+            None
+        }
     }
 
     /// K, φ, r (f64 values) and the margin [`THEOREM_PHASE_MARGIN`]·(|φ| + r + K) by which a

@@ -824,7 +824,7 @@ pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
         true,
         |c| {
             let report = stability::stability_of(c, a)?;
-            Ok(stability::with_theorem(report, || c.conjugate_free()))
+            Ok(stability::with_theorem(report, || c.theorem_verdict()))
         },
         || stability_by_series(a),
     )
@@ -855,7 +855,7 @@ pub fn stability_verdict(a: &PlanarParams) -> Result<StabilityVerdict, RodError>
             Some(verdict) => Ok(verdict),
             None => {
                 let report = stability::stability_of(c, a)?;
-                Ok(stability::with_theorem(report, || c.conjugate_free()).verdict())
+                Ok(stability::with_theorem(report, || c.theorem_verdict()).verdict())
             }
         },
         || stability_by_series(a).map(|r| r.verdict()),
@@ -865,13 +865,13 @@ pub fn stability_verdict(a: &PlanarParams) -> Result<StabilityVerdict, RodError>
 /// [`stability`] on the Taylor series (near-relaxed rods, or where the closed form overflows).
 fn stability_by_series(a: &PlanarParams) -> Result<StabilityReport, RodError> {
     let report = stability::stability_of_series(a, None, None, None)?;
-    Ok(stability::with_theorem(report, || conjugate_free(a)))
+    Ok(stability::with_theorem(report, || theorem_verdict(a)))
 }
 
-/// [`Closed::conjugate_free`] of a rod whose closed form was not built (false where it
+/// [`Closed::theorem_verdict`] of a rod whose closed form was not built (None where it
 /// cannot be).
-fn conjugate_free(a: &PlanarParams) -> bool {
-    Closed::<f64>::new(a[0], a[1], a[2]).is_some_and(|c| c.conjugate_free())
+fn theorem_verdict(a: &PlanarParams) -> Option<StabilityVerdict> {
+    Closed::<f64>::new(a[0], a[1], a[2]).and_then(|c| c.theorem_verdict())
 }
 
 /// Elastic energy ½∫₀¹κ² (FINDINGS §1 identity λ2/2 − a4 x(1) − a5 y(1)).
@@ -942,23 +942,23 @@ fn evaluate_small_angle(a: &PlanarParams) -> Result<Option<Evaluation>, RodError
 /// Tip, J(1, a), energy and stability in one call (one precomputation shared by all).
 pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
     check_params(a)?;
-    let series = || Ok(with_theorem(evaluate_series(a)?, || conjugate_free(a)));
+    let series = || Ok(with_theorem(evaluate_series(a)?, || theorem_verdict(a)));
     if series_first(a) {
         return series();
     }
     with_seeded(
         a,
         true,
-        |c| Ok(with_theorem(evaluate_closed(c, a)?, || c.conjugate_free())),
+        |c| Ok(with_theorem(evaluate_closed(c, a)?, || c.theorem_verdict())),
         series,
     )
 }
 
 /// The evaluation with the stability verdict a theorem gives where one applies
 /// ([`stability::with_theorem`]).
-fn with_theorem(e: Evaluation, conjugate_free: impl FnOnce() -> bool) -> Evaluation {
+fn with_theorem(e: Evaluation, theorem: impl FnOnce() -> Option<StabilityVerdict>) -> Evaluation {
     Evaluation {
-        stability: stability::with_theorem(e.stability, conjugate_free),
+        stability: stability::with_theorem(e.stability, theorem),
         ..e
     }
 }

@@ -239,22 +239,43 @@ fn straight_report() -> StabilityReport {
     }
 }
 
-/// The report with the verdict a theorem gives where one applies ([`Closed::conjugate_free`]:
+/// The report with the verdict a theorem gives where one applies ([`Closed::theorem_verdict`]:
 /// non-inflectional rods and circles have no conjugate point, nor an inflectional rod whose
-/// curvature keeps its sign): stable and certain there, whatever the scan could decide. The
-/// margin stays the scan's value (floored at 0: where the scan's bound covered zero, its sign
-/// was rounding). Elsewhere, or where the scan already established stability, unchanged.
+/// curvature keeps its sign, and an inflectional rod has one by its third inflection point):
+/// certain there, whatever the scan could decide. The margin stays the scan's value, floored
+/// at 0 for a stable verdict and capped at 0 for an unstable one (where the scan's bound
+/// covered zero, its sign was rounding); the conjugate point is the scan's where it found one.
+/// Elsewhere, or where the scan already agrees with certainty, unchanged.
 pub(crate) fn with_theorem(
     report: StabilityReport,
-    conjugate_free: impl FnOnce() -> bool,
+    theorem: impl FnOnce() -> Option<StabilityVerdict>,
 ) -> StabilityReport {
-    if report.stable && !report.uncertain || !conjugate_free() {
-        return report;
+    if report.stable && !report.uncertain {
+        // A certain scan that contradicts a theorem would be a bound that failed: the
+        // theorem is checked against the reference (`conjugate_points_respect_the_theorem`).
+        return match theorem() {
+            Some(StabilityVerdict::Unstable) => unstable_by_theorem(report),
+            _ => report,
+        };
     }
+    match theorem() {
+        Some(StabilityVerdict::Stable) => StabilityReport {
+            stable: true,
+            margin: report.margin.max(0.0),
+            first_conjugate_t: None,
+            uncertain: false,
+        },
+        Some(StabilityVerdict::Unstable) => unstable_by_theorem(report),
+        _ => report,
+    }
+}
+
+/// [`with_theorem`]'s unstable verdict.
+fn unstable_by_theorem(report: StabilityReport) -> StabilityReport {
     StabilityReport {
-        stable: true,
-        margin: report.margin.max(0.0),
-        first_conjugate_t: None,
+        stable: false,
+        margin: report.margin.min(0.0),
+        first_conjugate_t: report.first_conjugate_t,
         uncertain: false,
     }
 }
@@ -266,9 +287,9 @@ const QUICK_UNSTABLE_BOUNDS: f64 = 4.0;
 
 /// The verdict alone where one or no sample of g decides it ([`crate::planar::
 /// stability_verdict`]), None elsewhere (the caller runs the full test):
-/// - stable where a theorem rules out any conjugate point on (0, 1] ([`Closed::
-///   conjugate_free`]; [`with_theorem`] gives every report that verdict there), unstable
-///   where one places a conjugate point there ([`Closed::conjugate_certain`]);
+/// - stable where a theorem rules out any conjugate point on (0, 1], unstable where one
+///   places a conjugate point there ([`Closed::theorem_verdict`]; [`with_theorem`] gives
+///   every report that verdict);
 /// - unstable where g(1) < 0 beyond [`QUICK_UNSTABLE_BOUNDS`] times its error bound: g → 1 as
 ///   t → 0 (det J ~ t⁹(a3²/8640 + a5²t²/33600) > 0 off the straight rod, FINDINGS §5), so
 ///   det J vanishes somewhere on (0, 1), a conjugate point. Only on the rods whose scan is the
@@ -279,11 +300,8 @@ const QUICK_UNSTABLE_BOUNDS: f64 = 4.0;
 /// theorems, 13 % unstable by g(1); 20,000 rods), where the full test scans ~22 samples and
 /// refines the margin.
 pub(crate) fn quick_verdict(c: &Closed<Dual3>, a: &PlanarParams) -> Option<StabilityVerdict> {
-    if c.conjugate_free() {
-        return Some(StabilityVerdict::Stable);
-    }
-    if c.conjugate_certain() {
-        return Some(StabilityVerdict::Unstable);
+    if let Some(verdict) = c.theorem_verdict() {
+        return Some(verdict);
     }
     let (a3, a4, a5) = (a[0], a[1], a[2]);
     let theta = small_angle::max_angle(a3, a4, a5);
@@ -2324,16 +2342,18 @@ mod tests {
         PlanarParams::new(a[0], a[1], a[2])
     }
 
-    /// Sachkov's theorem ([`Closed::conjugate_free_until`]) against the reference integration
-    /// (DOP853 at rtol 1e-12 with its variational equations, det J on a grid of 2,000 points;
-    /// it knows nothing of elliptic functions or the theorem) on 4,000 rods of five families:
-    /// every first conjugate point the reference finds lies at or beyond t_free (within its
-    /// grid), no rod the theorem calls free of them is unstable there, and where the
-    /// reference's margin is clear `stability` gives its verdict.
+    /// Sachkov's theorem ([`Closed::conjugate_free_until`], [`Closed::conjugate_by`]) against
+    /// the reference integration (DOP853 at rtol 1e-12 with its variational equations, det J
+    /// on a grid of 2,000 points; it knows nothing of elliptic functions or the theorem) on
+    /// 4,000 rods of five families: every first conjugate point the reference finds lies
+    /// between t_free and t_conj (within its grid), no rod the theorem calls free of them is
+    /// unstable there, every rod with t_conj ≤ 1 is unstable where the reference decides, and
+    /// where the reference's margin is clear `stability` gives its verdict.
     #[test]
     fn conjugate_points_respect_the_theorem() {
         let mut r = SplitMix64::new(2011);
-        let (mut free, mut unstable_i, mut closest) = (0, 0, f64::INFINITY);
+        let (mut free, mut certain, mut unstable_i) = (0, 0, 0);
+        let (mut closest, mut farthest) = (f64::INFINITY, 0.0f64);
         for i in 0..4000 {
             let a = theorem_sample(&mut r, i);
             // Under a tension beyond ~150 the reference's rounding grows like e^{√a4} past its
@@ -2347,17 +2367,30 @@ mod tests {
             ) else {
                 continue;
             };
-            let t_free = c.conjugate_free_until();
+            let (t_free, t_conj) = (c.conjugate_free_until(), c.conjugate_by());
             free += usize::from(t_free > 1.0);
+            certain += usize::from(t_conj <= 1.0);
+            if t_conj <= 1.0 && !reference.uncertain {
+                assert!(
+                    !reference.stable,
+                    "{a:?}: conjugate point by {t_conj}, {reference:?}"
+                );
+            }
             if let (Some(tc), false) = (reference.first_conjugate_t, reference.stable) {
                 assert!(
                     tc >= t_free - 1.0 / 2000.0,
                     "{a:?} ({:?}): the reference's conjugate point {tc} < t_free {t_free}",
                     c.case
                 );
+                assert!(
+                    tc <= t_conj + 1.0 / 2000.0,
+                    "{a:?} ({:?}): the reference's conjugate point {tc} > t_conj {t_conj}",
+                    c.case
+                );
                 if c.case == Case::I {
                     unstable_i += 1;
                     closest = closest.min(tc / t_free);
+                    farthest = farthest.max(tc / t_conj);
                 }
             }
             if reference.margin.abs() > 1e-3 && !reference.uncertain {
@@ -2369,10 +2402,10 @@ mod tests {
             }
         }
         assert!(
-            free > 1000 && unstable_i > 300,
-            "{free} free, {unstable_i} unstable"
+            free > 1000 && certain > 300 && unstable_i > 300,
+            "{free} free, {certain} with one by t = 1, {unstable_i} unstable"
         );
-        eprintln!("{free} free of conjugate points, {unstable_i} unstable in case I, conjugate points ≥ {closest:.4}× t_free");
+        eprintln!("{free} free of conjugate points, {certain} with one by t = 1, {unstable_i} unstable in case I, conjugate points ≥ {closest:.4}× t_free and ≤ {farthest:.6}× t_conj");
     }
 
     /// `planar::stability_verdict` gives the full test's verdict on every rod of
