@@ -851,7 +851,7 @@ pub fn stability_verdict(a: &PlanarParams) -> Result<StabilityVerdict, RodError>
     with_seeded(
         a,
         true,
-        |c| match stability::quick_verdict(c, a) {
+        |c| match stability::verdict_of(c, a)? {
             Some(verdict) => Ok(verdict),
             None => {
                 let report = stability::stability_of(c, a)?;
