@@ -148,6 +148,27 @@ pub(crate) fn det_and_error(j: &[[f64; 3]; 3], rel: f64, abs: f64) -> (f64, f64)
     (det, err + 8.0 * f64::EPSILON * size)
 }
 
+/// det J and a bound on its error when every entry of column c of J is off by at most
+/// `column_error[c]` (first-order expansion over the cofactors, plus the rounding of the
+/// expansion itself, as [`det_and_error`]).
+pub(crate) fn det_and_error_by_column(j: &[[f64; 3]; 3], column_error: [f64; 3]) -> (f64, f64) {
+    let det = det3(j);
+    let mut err = 0.0;
+    let mut size = 0.0;
+    for r in 0..3 {
+        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+        for (c, e) in column_error.iter().enumerate() {
+            let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
+            let cof = (j[r1][c1] * j[r2][c2]).abs() + (j[r1][c2] * j[r2][c1]).abs();
+            err += e * cof;
+            if r == 0 {
+                size += j[r][c].abs() * cof;
+            }
+        }
+    }
+    (det, err + 8.0 * f64::EPSILON * size)
+}
+
 /// N′/N of that leading term N ([`planar_det_leading_term`]): 9/t + (a5²t/16800)/(a3²/8640 +
 /// a5²t²/33600), for the slope of g = det J/N, g′ = det′/N − g·N′/N.
 pub(crate) fn planar_det_leading_term_log_slope(a3: f64, a5: f64, t: f64) -> f64 {
