@@ -131,6 +131,17 @@ pub(crate) fn det3(j: &[[f64; 3]; 3]) -> f64 {
 /// det J and a first-order bound on its error: Σ e_ij |C_ij| over the entries' errors
 /// e_ij = rel·|J_ij| + abs and the cofactors C_ij, plus the rounding of the expansion.
 pub(crate) fn det_and_error(j: &[[f64; 3]; 3], rel: f64, abs: f64) -> (f64, f64) {
+    det_and_error_with(j, |r, c| rel * j[r][c].abs() + abs)
+}
+
+/// [`det_and_error`] when every entry of column c of J is off by at most `column_error[c]`.
+pub(crate) fn det_and_error_by_column(j: &[[f64; 3]; 3], column_error: [f64; 3]) -> (f64, f64) {
+    det_and_error_with(j, |_, c| column_error[c])
+}
+
+/// det J and Σ e_ij |C_ij| + 8ε Σ |J_0j C_0j| for the entries' errors e_ij = `entry_error(i, j)`.
+#[inline(always)]
+fn det_and_error_with(j: &[[f64; 3]; 3], entry_error: impl Fn(usize, usize) -> f64) -> (f64, f64) {
     let det = det3(j);
     let mut err = 0.0;
     let mut size = 0.0;
@@ -139,28 +150,7 @@ pub(crate) fn det_and_error(j: &[[f64; 3]; 3], rel: f64, abs: f64) -> (f64, f64)
         for c in 0..3 {
             let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
             let cof = (j[r1][c1] * j[r2][c2]).abs() + (j[r1][c2] * j[r2][c1]).abs();
-            err += (rel * j[r][c].abs() + abs) * cof;
-            if r == 0 {
-                size += j[r][c].abs() * cof;
-            }
-        }
-    }
-    (det, err + 8.0 * f64::EPSILON * size)
-}
-
-/// det J and a bound on its error when every entry of column c of J is off by at most
-/// `column_error[c]` (first-order expansion over the cofactors, plus the rounding of the
-/// expansion itself, as [`det_and_error`]).
-pub(crate) fn det_and_error_by_column(j: &[[f64; 3]; 3], column_error: [f64; 3]) -> (f64, f64) {
-    let det = det3(j);
-    let mut err = 0.0;
-    let mut size = 0.0;
-    for r in 0..3 {
-        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
-        for (c, e) in column_error.iter().enumerate() {
-            let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
-            let cof = (j[r1][c1] * j[r2][c2]).abs() + (j[r1][c2] * j[r2][c1]).abs();
-            err += e * cof;
+            err += entry_error(r, c) * cof;
             if r == 0 {
                 size += j[r][c].abs() * cof;
             }
