@@ -296,37 +296,12 @@ fn unstable_by_theorem(report: StabilityReport) -> StabilityReport {
     }
 }
 
-/// How many times its own error bound g(1) must lie below zero for [`quick_verdict`] to call
-/// a rod unstable from that one sample (the scans call a sign beyond one bound certain; the
-/// factor is a margin for the entry-wise bound's own approximations).
-const QUICK_UNSTABLE_BOUNDS: f64 = 4.0;
+/// How many times its own error bound g(1) must lie below zero for [`verdict_of`] to call a
+/// rod unstable from that one sample (the scans call a sign beyond one bound certain; the
+/// factor is a margin for the bound's own approximations).
+const END_UNSTABLE_BOUNDS: f64 = 4.0;
 
-/// The verdict alone where one or no sample of g decides it ([`crate::planar::
-/// stability_verdict`]), None elsewhere (the caller runs the full test):
-/// - stable where a theorem rules out any conjugate point on (0, 1], unstable where one
-///   places a conjugate point there ([`Closed::theorem_verdict`]; [`with_theorem`] gives
-///   every report that verdict);
-/// - unstable where g(1) < 0 beyond [`QUICK_UNSTABLE_BOUNDS`] times its error bound: g → 1 as
-///   t → 0 (det J ~ t⁹(a3²/8640 + a5²t²/33600) > 0 off the straight rod, FINDINGS §5), so
-///   det J vanishes somewhere on (0, 1), a conjugate point. Only on the rods whose scan is the
-///   plain closed-form one ([`stability_of_with`]'s last branch: no series, no double-double,
-///   no small-angle expansion), with the bound that scan uses.
-///
-/// On the paper's box this decides 64 % of rods (20 % stable and 31 % unstable by the
-/// theorems, 13 % unstable by g(1); 20,000 rods), where the full test scans ~22 samples and
-/// refines the margin.
-pub(crate) fn quick_verdict(c: &Closed<Dual3>, a: &PlanarParams) -> Option<StabilityVerdict> {
-    if let Some(verdict) = c.theorem_verdict() {
-        return Some(verdict);
-    }
-    if !plain_closed_scan(c, a) {
-        return None;
-    }
-    let (g, bound) = normalised_det(c, a[0], a[2], 1.0, false);
-    (g < -QUICK_UNSTABLE_BOUNDS * bound).then_some(StabilityVerdict::Unstable)
-}
-
-/// True where [`stability_of_with`] scans the f64 closed form with entry-wise bounds (its last
+/// True where [`stability_of_with`] scans the f64 closed form with its own bounds (its last
 /// branch): no series, no double-double, no small-angle expansion.
 fn plain_closed_scan(c: &Closed<Dual3>, a: &PlanarParams) -> bool {
     let theta = small_angle::max_angle(a[0], a[1], a[2]);
@@ -337,22 +312,40 @@ fn plain_closed_scan(c: &Closed<Dual3>, a: &PlanarParams) -> bool {
         && SMALL_ANGLE_TRUNCATION_C * theta * theta > SMALL_ANGLE_MAX_TRUNCATION
 }
 
-/// The verdict alone on the closed form ([`crate::planar::stability_verdict`]):
-/// [`quick_verdict`], else on the plain closed-form scan that scan from the theorem's t_free
-/// on ([`Closed::conjugate_free_until`]: no conjugate point before it, so det J > 0 on
-/// (0, t_free) and the rod is stable iff det J > 0 on [t_free, 1]), where the scan is
-/// certain. None elsewhere: the caller runs the full test. On the box the range skipped is
-/// the part of the rod before its first inflection: 7.1k instructions per call instead of
-/// 8.7k with the full test after [`quick_verdict`] (callgrind, 512 box rods).
+/// True where g(1) < 0 beyond [`END_UNSTABLE_BOUNDS`] times its error bound (on a rod of the
+/// plain scan, with the bound that scan uses): g → 1 as t → 0 (det J ~ t⁹(a3²/8640 +
+/// a5²t²/33600) > 0 off the straight rod, FINDINGS §5), so det J vanishes somewhere on
+/// (0, 1), a conjugate point.
+fn unstable_at_the_end(c: &Closed<Dual3>, a: &PlanarParams) -> bool {
+    let (g, bound) = normalised_det(c, a[0], a[2], 1.0, false);
+    g < -END_UNSTABLE_BOUNDS * bound
+}
+
+/// The verdict alone on the closed form ([`crate::planar::stability_verdict`]), None where the
+/// caller must run the full test. In order:
+/// 1. a theorem ([`Closed::theorem_verdict`]: no conjugate point before the first inflection,
+///    one by the third; [`with_theorem`] gives every report that verdict);
+/// 2. on the rods of the plain closed-form scan only, g(1) ([`unstable_at_the_end`]);
+/// 3. that scan from the theorem's t_free on ([`Closed::conjugate_free_until`]: no conjugate
+///    point before it, so det J > 0 on (0, t_free) and the rod is stable iff det J > 0 on
+///    [t_free, 1]), where the scan is certain.
+///
+/// On 20,000 rods of the paper's box the first two decide 64 % (20 % stable and 31 %
+/// unstable by the theorems, 13 % unstable by g(1)); with the third, 7.1k instructions per
+/// call, against 8.7k with the full test after the first two and 20.0k for the full test
+/// (callgrind, 512 box rods).
 pub(crate) fn verdict_of(
     c: &Closed<Dual3>,
     a: &PlanarParams,
 ) -> Result<Option<StabilityVerdict>, RodError> {
-    if let Some(verdict) = quick_verdict(c, a) {
+    if let Some(verdict) = c.theorem_verdict() {
         return Ok(Some(verdict));
     }
     if !plain_closed_scan(c, a) {
         return Ok(None);
+    }
+    if unstable_at_the_end(c, a) {
+        return Ok(Some(StabilityVerdict::Unstable));
     }
     let report = closed_scan_from(c, a, false, None, c.conjugate_free_until())?;
     Ok((!report.uncertain).then(|| report.verdict()))
@@ -2499,10 +2492,11 @@ mod tests {
             };
             let shortcut = verdict_of(&c, &a).expect("finite");
             let upper = c.conjugate_certain();
-            match (quick_verdict(&c, &a), shortcut) {
+            let by_the_end = || plain_closed_scan(&c, &a) && unstable_at_the_end(&c, &a);
+            match (c.theorem_verdict(), shortcut) {
                 (Some(StabilityVerdict::Stable), _) => by_theorem += 1,
-                (Some(_), _) if upper => by_upper += 1,
-                (Some(_), _) => by_end += 1,
+                (Some(_), _) => by_upper += 1,
+                (None, Some(_)) if by_the_end() => by_end += 1,
                 (None, Some(_)) => by_scan += 1,
                 (None, None) => continue,
             }
