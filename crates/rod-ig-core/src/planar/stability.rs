@@ -1253,13 +1253,16 @@ impl ShortSeries {
         );
         // g′ as [`normalised_det_sloped`] forms it, on the same scaled rows: the a4 entry of
         // ∂κ/∂a is scaled like J's a4 column (det′ and N then carry the same 1/σ²).
+        if !v.is_finite() {
+            return None;
+        }
         let slope = rod.curvature(t).map_or(f64::NAN, |kappa| {
             let mut k = kappa.gradient();
             k[1] /= a3.abs().max(a5.abs());
             let log_slope = crate::types::planar_det_leading_term_log_slope(a3, a5, t);
             det3(&[j[0], j[1], k]) / normalisation_scaled(a3, a5, t) - v * log_slope
         });
-        v.is_finite().then_some((v, e, slope))
+        Some((v, e, slope))
     }
 }
 
@@ -2361,7 +2364,7 @@ mod tests {
 
     /// A rod of the samples [`scans_never_contradict_the_theorem`] draws from: the box,
     /// log-scale magnitudes with exact zeros, strong force, near-circles and many-looped rods.
-    pub(super) fn theorem_sample(r: &mut SplitMix64, i: usize) -> PlanarParams {
+    fn theorem_sample(r: &mut SplitMix64, i: usize) -> PlanarParams {
         let zero_or = |r: &mut SplitMix64, v: f64| if r.uniform() < 0.1 { 0.0 } else { v };
         let a = match i % 5 {
             0 => [
