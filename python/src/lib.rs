@@ -70,6 +70,11 @@ fn thread_count(threads: Option<usize>) -> PyResult<usize> {
     }
 }
 
+/// Rod i of a flattened (n, 3) array of planar parameters (a3, a4, a5).
+fn planar_params(a: &[f64], i: usize) -> PlanarParams {
+    PlanarParams::new(a[3 * i], a[3 * i + 1], a[3 * i + 2])
+}
+
 fn f64_out<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
     v.into_pyarray(py)
 }
@@ -98,7 +103,7 @@ fn forward<'py>(
         n,
         threads,
         FORWARD_BLOCK,
-        |i| planar::evaluate(&PlanarParams::new(a[3 * i], a[3 * i + 1], a[3 * i + 2])).ok(),
+        |i| planar::evaluate(&planar_params(a, i)).ok(),
         |i, e| {
             if let Some(e) = e {
                 tip[3 * i..3 * i + 3].copy_from_slice(&[e.tip.x, e.tip.y, e.tip.theta]);
@@ -144,7 +149,7 @@ fn is_stable<'py>(
         threads,
         FORWARD_BLOCK,
         |i| {
-            let rod = PlanarParams::new(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+            let rod = planar_params(a, i);
             planar::stability_verdict(&rod).is_ok_and(|v| v.is_stable())
         },
         |i, s| stable[i] = s,
@@ -172,7 +177,7 @@ fn shape<'py>(
         threads,
         (FORWARD_BLOCK / samples.max(1)).max(1),
         |i| {
-            planar::PlanarRod::new(&PlanarParams::new(a[3 * i], a[3 * i + 1], a[3 * i + 2]))
+            planar::PlanarRod::new(&planar_params(a, i))
                 .ok()
                 .map(|rod| rod.shape(samples))
         },
