@@ -15,6 +15,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
 pub mod dop853;
+pub mod heavy_reference;
 pub mod planar_reference;
 pub mod rk4;
 

@@ -15,6 +15,7 @@
 
 mod closed;
 mod extended;
+pub mod heavy;
 pub mod ig;
 pub mod model;
 mod pendulum;

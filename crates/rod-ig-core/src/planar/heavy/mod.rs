@@ -1,0 +1,317 @@
+//! Planar rods with weight: a cable in a vertical plane, held by two grippers.
+//!
+//! Model (unit rod, unit bending stiffness, base at the identity): the dimensionless weight
+//! w = ρ g A L³ / EI ≥ 0 acts along the unit direction ĝ of gravity in the base frame. The
+//! parameters keep their meaning, a = (a3, a4, a5) = (moment, internal force) at the base; the
+//! internal force along the rod is n(t) = (a4, a5) − w t ĝ (force balance n' = −w ĝ), and the
+//! moment balance gives
+//!
+//! κ' = n_x(t) sin θ − n_y(t) cos θ, θ' = κ, x' = cos θ, y' = sin θ, κ(0) = a3,
+//!
+//! the weightless equation (FINDINGS §1) with (a4, a5) replaced by n(t). The tip gripper
+//! carries n(1) = n(0) − w ĝ. Energy: the elastic ½∫κ² plus the potential w ∫(−ĝ · r) dt
+//! (zero at the base); [`HeavyEvaluation::energy`] is their sum.
+//!
+//! Without weight (w = 0) every function here is the weightless closed form's
+//! ([`crate::planar`]), bit for bit. With weight the rod and its variational equations are
+//! integrated by Taylor series ([`series`]: polynomial recurrences, dense output), and the
+//! stability test scans det J(t) on the series' polynomials ([`scan`]).
+
+// `!(x > y)` comparisons deliberately reject NaN; index loops mirror the formulas.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+
+mod model;
+pub(crate) mod scan;
+pub(crate) mod series;
+
+pub use model::HeavyPlanar;
+
+use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
+use serde::{Deserialize, Serialize};
+use series::{Problem, Stop};
+
+/// Largest accepted dimensionless weight w (a 1 m USB cable is ~2,000).
+pub const MAX_WEIGHT: f64 = 1e4;
+/// Largest accepted |a_i|: beyond it the series would need more than its step budget.
+pub const MAX_PARAM: f64 = 1e5;
+
+/// Gravity acting on a planar rod: the dimensionless weight w = ρgAL³/EI and the direction of
+/// gravity in the base gripper's frame (unit, in the rod's plane).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Gravity {
+    weight: f64,
+    direction: [f64; 2],
+}
+
+impl Default for Gravity {
+    fn default() -> Self {
+        Self::NONE
+    }
+}
+
+impl Gravity {
+    /// No weight: the weightless rod (gravity pointing along −y, irrelevant).
+    pub const NONE: Gravity = Gravity {
+        weight: 0.0,
+        direction: [0.0, -1.0],
+    };
+
+    /// Weight `weight` ∈ [0, [`MAX_WEIGHT`]] along `direction` (any non-zero finite vector
+    /// of the base frame's plane; normalised here).
+    ///
+    /// ```
+    /// use rod_ig_core::planar::heavy::Gravity;
+    /// let g = Gravity::new(50.0, [0.0, -9.81]).unwrap();
+    /// assert_eq!(g.direction(), [0.0, -1.0]);
+    /// assert!(Gravity::new(-1.0, [0.0, -1.0]).is_err());
+    /// assert!(Gravity::new(1.0, [0.0, 0.0]).is_err());
+    /// ```
+    pub fn new(weight: f64, direction: [f64; 2]) -> Result<Self, RodError> {
+        RodError::check_finite("weight", &[weight])?;
+        RodError::check_finite("gravity", &direction)?;
+        if !(0.0..=MAX_WEIGHT).contains(&weight) {
+            return Err(RodError::OutOfDomain(format!(
+                "weight must be in [0, {MAX_WEIGHT:e}] (got {weight})"
+            )));
+        }
+        let norm = direction[0].hypot(direction[1]);
+        if !(norm > 1e-300) || !norm.is_finite() {
+            return Err(RodError::OutOfDomain(
+                "gravity must be a non-zero vector".into(),
+            ));
+        }
+        Ok(Self {
+            weight,
+            direction: [direction[0] / norm, direction[1] / norm],
+        })
+    }
+
+    /// The dimensionless weight w.
+    pub fn weight(&self) -> f64 {
+        self.weight
+    }
+
+    /// The unit direction ĝ of gravity in the base frame.
+    pub fn direction(&self) -> [f64; 2] {
+        self.direction
+    }
+
+    /// True when w = 0.
+    pub fn is_weightless(&self) -> bool {
+        self.weight == 0.0
+    }
+
+    /// The same direction with another weight (continuation in w).
+    pub fn with_weight(&self, weight: f64) -> Result<Self, RodError> {
+        Self::new(weight, self.direction)
+    }
+
+    /// The weight per unit length w ĝ.
+    pub fn load(&self) -> [f64; 2] {
+        [
+            self.weight * self.direction[0],
+            self.weight * self.direction[1],
+        ]
+    }
+
+    /// The internal force at the tip, n(1) = (a4, a5) − w ĝ: what the tip gripper holds.
+    pub fn tip_force(&self, a: &PlanarParams) -> [f64; 2] {
+        let l = self.load();
+        [a[1] - l[0], a[2] - l[1]]
+    }
+
+    fn problem(&self, a: &PlanarParams) -> Problem {
+        Problem {
+            a: [a[0], a[1], a[2]],
+            load: self.load(),
+            direction: self.direction,
+        }
+    }
+}
+
+/// Tip, J(1, a), energies and stability of a heavy rod.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeavyEvaluation {
+    /// q(1) = (x, y, θ), θ unwrapped.
+    pub tip: PlanarPose,
+    /// J(1, a) = ∂q(1)/∂a, rows (x, y, θ).
+    pub jacobian: PlanarJacobian,
+    /// Total energy: elastic + gravitational, w ∫(−ĝ · r) dt.
+    pub energy: f64,
+    /// Elastic energy ½∫κ².
+    pub elastic_energy: f64,
+    /// Stability verdict and margin ([`scan`]).
+    pub stability: StabilityReport,
+}
+
+fn check_params(a: &PlanarParams) -> Result<(), RodError> {
+    RodError::check_finite("a", a.as_slice())?;
+    if let Some(v) = a.iter().find(|v| v.abs() > MAX_PARAM) {
+        return Err(RodError::OutOfDomain(format!(
+            "|a_i| <= {MAX_PARAM:e} is required with weight (got {v})"
+        )));
+    }
+    Ok(())
+}
+
+fn stop_error(s: Stop) -> RodError {
+    match s {
+        Stop::NonFinite { t } => RodError::Overflow(format!("the heavy rod's state at t = {t}")),
+        Stop::Budget { t } => RodError::Integration(format!(
+            "the heavy rod needs more than {} series steps (stopped at t = {t})",
+            series::MAX_STEPS
+        )),
+        Stop::Deadline { t } => {
+            RodError::Integration(format!("deadline passed at t = {t} of the heavy rod"))
+        }
+    }
+}
+
+fn jacobian_of(s: &series::State) -> PlanarJacobian {
+    let mut j = PlanarJacobian::zeros();
+    for c in 0..3 {
+        j[(0, c)] = s.var[c][2];
+        j[(1, c)] = s.var[c][3];
+        j[(2, c)] = s.var[c][0];
+    }
+    j
+}
+
+/// Tip pose q(1) of the heavy rod (w = 0: [`crate::planar::tip`]).
+pub fn tip(a: &PlanarParams, g: &Gravity) -> Result<PlanarPose, RodError> {
+    if g.is_weightless() {
+        return crate::planar::tip(a);
+    }
+    check_params(a)?;
+    let end = series::integrate(&g.problem(a), false, |_| true).map_err(stop_error)?;
+    Ok(PlanarPose::new(end.x, end.y, end.theta))
+}
+
+/// Tip pose q(1) and J(1, a) (w = 0: [`crate::planar::tip_and_jacobian`]).
+pub fn tip_and_jacobian(
+    a: &PlanarParams,
+    g: &Gravity,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    if g.is_weightless() {
+        return crate::planar::tip_and_jacobian(a);
+    }
+    check_params(a)?;
+    let end = series::integrate(&g.problem(a), true, |_| true).map_err(stop_error)?;
+    Ok((PlanarPose::new(end.x, end.y, end.theta), jacobian_of(&end)))
+}
+
+/// Pose q(t) and J(t, a) for t ∈ [0, 1] (w = 0: [`crate::planar::pose_and_jacobian`]).
+pub fn pose_and_jacobian(
+    a: &PlanarParams,
+    g: &Gravity,
+    t: f64,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    if g.is_weightless() {
+        return crate::planar::pose_and_jacobian(a, t);
+    }
+    check_params(a)?;
+    RodError::check_finite("t", &[t])?;
+    if !(0.0..=1.0).contains(&t) {
+        return Err(RodError::OutOfDomain(format!("t = {t} is outside [0, 1]")));
+    }
+    let mut at = None;
+    let end = series::integrate(&g.problem(a), true, |s| {
+        if t <= s.t0 + s.h {
+            at = Some(s.state_at(t - s.t0));
+            return false;
+        }
+        true
+    })
+    .map_err(stop_error)?;
+    let s = at.unwrap_or(end);
+    Ok((PlanarPose::new(s.x, s.y, s.theta), jacobian_of(&s)))
+}
+
+/// `samples` poses at t_i = i/(samples − 1), base to tip (w = 0:
+/// [`crate::planar::PlanarRod::shape`]). One integration; each pose is a Horner evaluation of
+/// the step's polynomials.
+pub fn shape(a: &PlanarParams, g: &Gravity, samples: usize) -> Result<Vec<PlanarPose>, RodError> {
+    if g.is_weightless() {
+        return Ok(crate::planar::PlanarRod::new(a)?.shape(samples));
+    }
+    check_params(a)?;
+    let mut out = Vec::new();
+    out.try_reserve_exact(samples)
+        .map_err(|_| RodError::OutOfDomain(format!("{samples} samples do not fit in memory")))?;
+    if samples == 0 {
+        return Ok(out);
+    }
+    let t_of = |i: usize| {
+        if samples == 1 {
+            0.0
+        } else {
+            i as f64 / (samples - 1) as f64
+        }
+    };
+    series::integrate(&g.problem(a), false, |s| {
+        let end = s.t0 + s.h;
+        while out.len() < samples && (t_of(out.len()) <= end || end >= 1.0) {
+            let [x, y, th] = s.pose_at((t_of(out.len()) - s.t0).clamp(0.0, s.h));
+            out.push(PlanarPose::new(x, y, th));
+        }
+        out.len() < samples
+    })
+    .map_err(stop_error)?;
+    Ok(out)
+}
+
+/// Stability of the heavy rod ([`scan`]; w = 0: [`crate::planar::stability`]).
+pub fn stability(a: &PlanarParams, g: &Gravity) -> Result<StabilityReport, RodError> {
+    Ok(evaluate(a, g)?.stability)
+}
+
+/// (total, elastic) energy (w = 0: both [`crate::planar::energy`]).
+pub fn energy(a: &PlanarParams, g: &Gravity) -> Result<(f64, f64), RodError> {
+    if g.is_weightless() {
+        let e = crate::planar::energy(a)?;
+        return Ok((e, e));
+    }
+    check_params(a)?;
+    let end = series::integrate(&g.problem(a), false, |_| true).map_err(stop_error)?;
+    Ok((end.elastic + g.weight * end.potential, end.elastic))
+}
+
+/// Tip, J(1, a), energies and stability in one integration (w = 0: [`crate::planar::evaluate`]).
+///
+/// ```
+/// use rod_ig_core::planar::heavy::{self, Gravity};
+/// use rod_ig_core::PlanarParams;
+/// // A rod held level at both ends sags: a5 = −w/2 by symmetry.
+/// let g = Gravity::new(50.0, [0.0, -1.0]).unwrap();
+/// let e = heavy::evaluate(&PlanarParams::new(3.0, -2.0, -25.0), &g).unwrap();
+/// assert!(e.energy < e.elastic_energy); // the rod hangs below its base
+/// ```
+pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyEvaluation, RodError> {
+    if g.is_weightless() {
+        let e = crate::planar::evaluate(a)?;
+        return Ok(HeavyEvaluation {
+            tip: e.tip,
+            jacobian: e.jacobian,
+            energy: e.energy,
+            elastic_energy: e.energy,
+            stability: e.stability,
+        });
+    }
+    check_params(a)?;
+    let p = g.problem(a);
+    let mut scan = scan::Scan::new(a[0], a[2], p.load[1]);
+    let end = series::integrate(&p, true, |s| {
+        if !scan.degenerate() {
+            scan.push(s);
+        }
+        true
+    })
+    .map_err(stop_error)?;
+    Ok(HeavyEvaluation {
+        tip: PlanarPose::new(end.x, end.y, end.theta),
+        jacobian: jacobian_of(&end),
+        energy: end.elastic + g.weight * end.potential,
+        elastic_energy: end.elastic,
+        stability: scan.report(),
+    })
+}

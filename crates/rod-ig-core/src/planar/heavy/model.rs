@@ -1,0 +1,388 @@
+//! The heavy planar rod as a model of the solvers ([`RodModel`], [`InverseGeometry`]).
+//!
+//! Its robust search starts from the weightless rods that reach the target (the closed
+//! forms' atlas and search, exact at w = 0) and follows each to the rod's weight:
+//! first one damped Newton run from the weightless rod with the load shared between the two
+//! grippers (a + (0, w ĝ/2): the symmetric share, exact for a level rod), then, where that
+//! fails, a continuation in w (secant predictor, Newton corrector, det J(1) keeping its sign
+//! so the branch is not left). Every returned rod passed the heavy rod's stability test.
+
+use super::{Gravity, HeavyEvaluation};
+use crate::planar::ig::SolveOptions;
+use crate::planar::model::{residual, solve3};
+use crate::planar::PlanarClosedForm;
+use crate::solver::{
+    relative_distance, Failure, Found, IgError, InverseGeometry, ModelEvaluation, RodModel,
+    Solution, Verified, Work, DISTINCT,
+};
+use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError};
+use nalgebra::{SMatrix, Vector3};
+
+/// The planar rod under its own weight ([`super`]): with [`Gravity::NONE`] it is
+/// [`PlanarClosedForm`] exactly.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HeavyPlanar {
+    /// Weight and direction of gravity.
+    pub gravity: Gravity,
+}
+
+impl HeavyPlanar {
+    /// The model for `gravity`.
+    pub fn new(gravity: Gravity) -> Self {
+        Self { gravity }
+    }
+
+    /// Tip, J, energies and stability ([`super::evaluate`]).
+    pub fn evaluate_heavy(&self, a: &PlanarParams) -> Result<HeavyEvaluation, RodError> {
+        super::evaluate(a, &self.gravity)
+    }
+}
+
+impl RodModel<3> for HeavyPlanar {
+    type Pose = PlanarPose;
+
+    fn name(&self) -> &'static str {
+        "planar rod with weight"
+    }
+
+    fn tip(&self, a: &Vector3<f64>) -> Result<PlanarPose, RodError> {
+        super::tip(a, &self.gravity)
+    }
+
+    fn evaluate(&self, a: &Vector3<f64>) -> Result<ModelEvaluation<3, PlanarPose>, RodError> {
+        let e = super::evaluate(a, &self.gravity)?;
+        Ok(ModelEvaluation {
+            tip: e.tip,
+            jacobian: e.jacobian,
+            energy: e.energy,
+            stability: e.stability,
+            full_accuracy: true,
+        })
+    }
+
+    fn tip_and_jacobian(&self, a: &Vector3<f64>) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+        super::tip_and_jacobian(a, &self.gravity)
+    }
+
+    fn energy(&self, a: &Vector3<f64>) -> Result<f64, RodError> {
+        Ok(super::energy(a, &self.gravity)?.0)
+    }
+
+    fn param_scale(&self) -> Vector3<f64> {
+        PlanarClosedForm.param_scale()
+    }
+
+    fn pose_error(&self, tip: &PlanarPose, target: &PlanarPose) -> (f64, f64) {
+        PlanarClosedForm.pose_error(tip, target)
+    }
+
+    fn newton_increment(
+        &self,
+        tip: &PlanarPose,
+        jacobian: &SMatrix<f64, 3, 3>,
+        target: &PlanarPose,
+    ) -> Result<Vector3<f64>, f64> {
+        PlanarClosedForm.newton_increment(tip, jacobian, target)
+    }
+
+    fn check_target(&self, target: &PlanarPose) -> Result<(), IgError> {
+        PlanarClosedForm.check_target(target)
+    }
+
+    fn canonical_target(&self, target: &PlanarPose) -> PlanarPose {
+        PlanarClosedForm.canonical_target(target)
+    }
+
+    fn jacobian_det(&self, jacobian: &SMatrix<f64, 3, 3>) -> f64 {
+        jacobian.determinant()
+    }
+
+    fn interpolate(&self, from: &PlanarPose, to: &PlanarPose, s: f64) -> PlanarPose {
+        PlanarClosedForm.interpolate(from, to, s)
+    }
+}
+
+/// Newton iterations of one corrector run (a substep of the continuation).
+const CORRECTOR_ITERATIONS: u32 = 8;
+/// Tolerance of the continuation's intermediate rods.
+const SUBSTEP_TOLERANCE: f64 = 1e-6;
+/// Smallest continuation step in w, relative to the weight.
+const MIN_FRACTION: f64 = 1.0 / 4096.0;
+/// Halvings of a Newton step in the line search.
+const LINE_SEARCH: u32 = 10;
+
+/// The search's running state: the deadline, the budget and the work done.
+struct Search<'a> {
+    target: PlanarPose,
+    options: &'a SolveOptions,
+    work: Work,
+    last_error: Option<IgError>,
+}
+
+fn norm(r: &Vector3<f64>) -> f64 {
+    r.norm()
+}
+
+impl Search<'_> {
+    fn out_of_time(&self) -> bool {
+        crate::solver::deadline::expired()
+    }
+
+    /// Damped Newton on the rod of weight `g` from `a0` to `tol` (the residual may only
+    /// decrease; det J(1) keeps the sign it had at `a0` when `keep_sign`).
+    fn newton(
+        &mut self,
+        g: &Gravity,
+        a0: &PlanarParams,
+        tol: f64,
+        max: u32,
+    ) -> Option<PlanarParams> {
+        let mut a = *a0;
+        let (mut tip, mut jac) = self.eval(g, &a)?;
+        let sign = jac.determinant().signum();
+        for _ in 0..max {
+            let r = residual(&tip, &self.target);
+            if r[0].hypot(r[1]) <= tol && r[2].abs() <= tol {
+                return Some(a);
+            }
+            if self.out_of_time() {
+                self.last_error = Some(IgError::Deadline {
+                    iteration: self.work.iterations,
+                });
+                return None;
+            }
+            let step = solve3(&jac, &-r).ok()?;
+            let mut lambda = 1.0;
+            let mut accepted = None;
+            for _ in 0..LINE_SEARCH {
+                let trial = a + step * lambda;
+                if let Some((t, j)) = self.eval(g, &trial) {
+                    if norm(&residual(&t, &self.target)) < norm(&r)
+                        && j.determinant().signum() == sign
+                    {
+                        accepted = Some((trial, t, j));
+                        break;
+                    }
+                }
+                lambda *= 0.5;
+            }
+            let (na, nt, nj) = accepted?;
+            self.work.iterations += 1;
+            (a, tip, jac) = (na, nt, nj);
+        }
+        let r = residual(&tip, &self.target);
+        (r[0].hypot(r[1]) <= tol && r[2].abs() <= tol).then_some(a)
+    }
+
+    fn eval(&mut self, g: &Gravity, a: &PlanarParams) -> Option<(PlanarPose, PlanarJacobian)> {
+        self.work.evaluations += 1;
+        match super::tip_and_jacobian(a, g) {
+            Ok(v) => Some(v),
+            Err(e) => {
+                self.last_error = Some(IgError::Evaluation {
+                    iteration: self.work.iterations,
+                    detail: e.to_string(),
+                });
+                None
+            }
+        }
+    }
+
+    /// Follows the weightless rod `a0` (on target at w = 0) to the weight of `g`.
+    fn continuation(&mut self, g: &Gravity, a0: &PlanarParams) -> Option<PlanarParams> {
+        let w = g.weight();
+        let (mut s, mut a) = (0.0f64, *a0);
+        let mut prev: Option<(f64, PlanarParams)> = None;
+        let mut ds = 0.25f64;
+        while s < 1.0 {
+            if self.out_of_time() {
+                return None;
+            }
+            let s1 = (s + ds).min(1.0);
+            let guess = match prev {
+                Some((sp, ap)) if s > sp => a + (a - ap) * ((s1 - s) / (s - sp)),
+                _ => {
+                    let l = g.load();
+                    a + Vector3::new(0.0, 0.5 * l[0], 0.5 * l[1]) * (s1 - s)
+                }
+            };
+            let gs = g.with_weight(w * s1).ok()?;
+            match self.newton(&gs, &guess, SUBSTEP_TOLERANCE, CORRECTOR_ITERATIONS) {
+                Some(next) => {
+                    prev = Some((s, a));
+                    (s, a) = (s1, next);
+                    ds = (ds * 1.5).min(0.5);
+                }
+                None => {
+                    ds *= 0.5;
+                    if ds < MIN_FRACTION {
+                        return None;
+                    }
+                }
+            }
+        }
+        Some(a)
+    }
+
+    /// The rod `a` polished to the tolerance and verified stable, as a solution.
+    fn finish(
+        &mut self,
+        g: &Gravity,
+        a: &PlanarParams,
+    ) -> Option<Solution<PlanarParams, PlanarPose>> {
+        let tol = self.options.tolerance;
+        let a = self.newton(g, a, tol, self.options.max_iterations)?;
+        self.work.evaluations += 1;
+        let e = match super::evaluate(&a, g) {
+            Ok(e) => e,
+            Err(err) => {
+                self.last_error = Some(IgError::Evaluation {
+                    iteration: self.work.iterations,
+                    detail: err.to_string(),
+                });
+                return None;
+            }
+        };
+        if !e.stability.stable {
+            self.last_error = Some(IgError::LeftStableSet {
+                iteration: self.work.iterations,
+            });
+            return None;
+        }
+        let errors = PlanarClosedForm.pose_error(&e.tip, &self.target);
+        if errors.0 > tol || errors.1 > tol {
+            return None;
+        }
+        let v = Verified {
+            tip: e.tip,
+            errors,
+            energy: e.energy,
+            margin: e.stability.margin,
+        };
+        Some(Solution::new(a, v, self.work))
+    }
+
+    /// One weightless start followed to the weight: direct first, then by continuation.
+    fn follow(
+        &mut self,
+        g: &Gravity,
+        a0: &PlanarParams,
+    ) -> Option<Solution<PlanarParams, PlanarPose>> {
+        self.work.starts += 1;
+        let l = g.load();
+        let shared = a0 + Vector3::new(0.0, 0.5 * l[0], 0.5 * l[1]);
+        if let Some(a) = self.newton(g, &shared, SUBSTEP_TOLERANCE, 2 * CORRECTOR_ITERATIONS) {
+            if let Some(s) = self.finish(g, &a) {
+                return Some(s);
+            }
+        }
+        let a = self.continuation(g, a0)?;
+        self.finish(g, &a)
+    }
+
+    fn failure(self) -> Failure<PlanarParams> {
+        let reason = if self.out_of_time() {
+            IgError::Deadline {
+                iteration: self.work.iterations,
+            }
+        } else {
+            IgError::NoStableSolution {
+                starts: self.work.starts,
+                last: self.last_error.map(Box::new),
+            }
+        };
+        Failure {
+            reason,
+            iterations: self.work.iterations,
+            residual: f64::INFINITY,
+            last_a: None,
+            elapsed_us: 0.0,
+        }
+    }
+}
+
+/// The weightless rods the search starts from: the stable solutions of the weightless target
+/// (the closed forms' search, least energy first), the caller's guess first.
+fn weightless_starts(target: &PlanarPose, options: &SolveOptions) -> Vec<PlanarParams> {
+    let found = PlanarClosedForm.robust_all(target, options);
+    let mut sols = found.solutions;
+    if sols.is_empty() {
+        if let Ok(s) = PlanarClosedForm.robust(target, options) {
+            sols.push(s);
+        }
+    }
+    sols.sort_by(|a, b| a.energy.total_cmp(&b.energy));
+    let mut starts: Vec<PlanarParams> = options.initial_guess.into_iter().collect();
+    starts.extend(sols.into_iter().map(|s| s.a));
+    starts
+}
+
+impl InverseGeometry<3> for HeavyPlanar {
+    fn robust(
+        &self,
+        target: &PlanarPose,
+        options: &SolveOptions,
+    ) -> Result<Solution<PlanarParams, PlanarPose>, Failure<PlanarParams>> {
+        if self.gravity.is_weightless() {
+            return PlanarClosedForm.robust(target, options);
+        }
+        let mut search = Search {
+            target: *target,
+            options,
+            work: Work::default(),
+            last_error: None,
+        };
+        for a0 in weightless_starts(target, options) {
+            if let Some(s) = search.follow(&self.gravity, &a0) {
+                return Ok(s);
+            }
+            if search.out_of_time() {
+                break;
+            }
+        }
+        Err(search.failure())
+    }
+
+    fn robust_all(
+        &self,
+        target: &PlanarPose,
+        options: &SolveOptions,
+    ) -> Found<PlanarParams, PlanarPose> {
+        if self.gravity.is_weightless() {
+            return PlanarClosedForm.robust_all(target, options);
+        }
+        let mut search = Search {
+            target: *target,
+            options,
+            work: Work::default(),
+            last_error: None,
+        };
+        let scale = self.param_scale();
+        let mut solutions: Vec<Solution<PlanarParams, PlanarPose>> = Vec::new();
+        for a0 in weightless_starts(target, options) {
+            if search.out_of_time() {
+                break;
+            }
+            if let Some(s) = search.follow(&self.gravity, &a0) {
+                if solutions
+                    .iter()
+                    .all(|o| relative_distance(&o.a, &s.a, &scale) > DISTINCT)
+                {
+                    solutions.push(s);
+                }
+            }
+        }
+        Found {
+            solutions,
+            iterations: search.work.iterations,
+            evaluations: search.work.evaluations,
+            starts: search.work.starts,
+        }
+    }
+
+    fn default_start(&self, target: &PlanarPose) -> Option<PlanarParams> {
+        let a = PlanarClosedForm.default_start(target)?;
+        let l = self.gravity.load();
+        Some(a + Vector3::new(0.0, 0.5 * l[0], 0.5 * l[1]))
+    }
+}

@@ -1,0 +1,332 @@
+//! Taylor-series integration of the heavy planar rod and its variational equations.
+//!
+//! The right-hand side is polynomial in (cos θ, sin θ, κ, t) (module docs of [`super`]):
+//!
+//! * θ' = κ, κ' = n_x(t) s − n_y(t) c, c' = −s κ, s' = c κ, x' = c, y' = s,
+//! * n(t) = n(t₀) − w ĝ τ (τ = t − t₀), so each product with n is a two-term sum;
+//! * variations (one column per parameter a3, a4, a5): δθ' = δκ,
+//!   δκ' = P δθ + (0, s, −c)_j with P = n_x c + n_y s, δx' = −s δθ, δy' = c δθ;
+//! * quadratures: elastic energy e' = κ²/2, potential p' = −ĝ · r.
+//!
+//! Each step computes the Taylor coefficients of every quantity to [`ORDER`] by the usual
+//! recurrences (Cauchy products, no transcendental call but one `sin_cos` per step), so a
+//! step is exact polynomial arithmetic plus a truncation of order τ^(ORDER+1), and gives
+//! dense output for free (the shape and the stability scan evaluate the step's polynomials).
+//!
+//! Step size (Jorba & Zou 2005, "A software package for the numerical integration of ODEs
+//! by means of high-order Taylor methods"): h = ρ · TRUNCATION^(1/ORDER) with ρ the radius
+//! estimated from θ's last two coefficients, capped by [`OMEGA_STEP`] / ω where
+//! ω = |κ(t₀)| + √max‖n‖ bounds the growth rate of the linear parts (a straight rod under
+//! tension has an entire θ ≡ 0 but J growing like e^{√‖n‖ t}).
+
+/// Order of the Taylor polynomials (Jorba & Zou: −½ ln ε + 1 ≈ 19 for f64).
+pub(crate) const ORDER: usize = 20;
+const N: usize = ORDER + 1;
+/// Target truncation per step relative to the scale of θ (below f64 rounding of O(1) angles).
+const TRUNCATION: f64 = 1e-16;
+/// ω h ≤ this: the terms of the entire parts are then ≤ 1.5^20 / 20! ≈ 1.4e-15.
+const OMEGA_STEP: f64 = 1.5;
+/// Steps allowed for one integration of the unit rod: ω ≤ |a3| + √(‖(a4, a5)‖ + w) with the
+/// contract's bounds gives at most a few hundred; this is a safety net against a NaN loop.
+pub(crate) const MAX_STEPS: usize = 20_000;
+
+/// Evaluation of a polynomial with coefficients `c` at τ (Horner).
+#[inline(always)]
+pub(crate) fn horner(c: &[f64; N], tau: f64) -> f64 {
+    let mut v = c[ORDER];
+    for k in (0..ORDER).rev() {
+        v = v.mul_add(tau, c[k]);
+    }
+    v
+}
+
+/// (a · b)_k, the k-th coefficient of a Cauchy product.
+#[inline(always)]
+fn cauchy(a: &[f64; N], b: &[f64; N], k: usize) -> f64 {
+    let mut s = 0.0;
+    for i in 0..=k {
+        s = a[i].mul_add(b[k - i], s);
+    }
+    s
+}
+
+/// The data of the rod that the series needs: a and the load w ĝ.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Problem {
+    /// a = (a3, a4, a5).
+    pub a: [f64; 3],
+    /// w ĝ (the weight per unit length, in the base frame).
+    pub load: [f64; 2],
+    /// ĝ (unit), for the potential energy.
+    pub direction: [f64; 2],
+}
+
+impl Problem {
+    /// n(t) = (a4, a5) − t w ĝ.
+    #[inline(always)]
+    pub(crate) fn force(&self, t: f64) -> [f64; 2] {
+        [
+            (-t).mul_add(self.load[0], self.a[1]),
+            (-t).mul_add(self.load[1], self.a[2]),
+        ]
+    }
+}
+
+/// The state at the start of a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct State {
+    pub t: f64,
+    pub theta: f64,
+    pub kappa: f64,
+    pub x: f64,
+    pub y: f64,
+    pub elastic: f64,
+    pub potential: f64,
+    /// Columns (a3, a4, a5) of (δθ, δκ, δx, δy).
+    pub var: [[f64; 4]; 3],
+}
+
+impl State {
+    /// The base: identity pose, κ = a3, δκ/δa3 = 1.
+    pub(crate) fn base(a: &[f64; 3]) -> Self {
+        let mut var = [[0.0; 4]; 3];
+        var[0][1] = 1.0;
+        Self {
+            kappa: a[0],
+            var,
+            ..Self::default()
+        }
+    }
+}
+
+/// The Taylor polynomials of one step, valid for τ = t − t0 ∈ [0, h].
+#[derive(Clone, Debug)]
+pub(crate) struct Step {
+    pub t0: f64,
+    pub h: f64,
+    pub theta: [f64; N],
+    pub kappa: [f64; N],
+    pub cos: [f64; N],
+    pub sin: [f64; N],
+    pub x: [f64; N],
+    pub y: [f64; N],
+    pub elastic: [f64; N],
+    pub potential: [f64; N],
+    /// Per column j: δθ, δκ, δx, δy.
+    pub dtheta: [[f64; N]; 3],
+    pub dkappa: [[f64; N]; 3],
+    pub dx: [[f64; N]; 3],
+    pub dy: [[f64; N]; 3],
+    /// P = n_x c + n_y s, the coefficient of δθ in δκ'.
+    stiffness: [f64; N],
+    /// True when the variational polynomials were computed.
+    pub with_jacobian: bool,
+}
+
+impl Step {
+    fn zeroed() -> Self {
+        Self {
+            t0: 0.0,
+            h: 0.0,
+            theta: [0.0; N],
+            kappa: [0.0; N],
+            cos: [0.0; N],
+            sin: [0.0; N],
+            x: [0.0; N],
+            y: [0.0; N],
+            elastic: [0.0; N],
+            potential: [0.0; N],
+            dtheta: [[0.0; N]; 3],
+            dkappa: [[0.0; N]; 3],
+            dx: [[0.0; N]; 3],
+            dy: [[0.0; N]; 3],
+            stiffness: [0.0; N],
+            with_jacobian: false,
+        }
+    }
+
+    /// The state at τ ∈ [0, h] (the variations only when computed).
+    pub(crate) fn state_at(&self, tau: f64) -> State {
+        let mut var = [[0.0; 4]; 3];
+        if self.with_jacobian {
+            for (j, v) in var.iter_mut().enumerate() {
+                *v = [
+                    horner(&self.dtheta[j], tau),
+                    horner(&self.dkappa[j], tau),
+                    horner(&self.dx[j], tau),
+                    horner(&self.dy[j], tau),
+                ];
+            }
+        }
+        State {
+            t: self.t0 + tau,
+            theta: horner(&self.theta, tau),
+            kappa: horner(&self.kappa, tau),
+            x: horner(&self.x, tau),
+            y: horner(&self.y, tau),
+            elastic: horner(&self.elastic, tau),
+            potential: horner(&self.potential, tau),
+            var,
+        }
+    }
+
+    /// (x, y, θ) at τ.
+    pub(crate) fn pose_at(&self, tau: f64) -> [f64; 3] {
+        [
+            horner(&self.x, tau),
+            horner(&self.y, tau),
+            horner(&self.theta, tau),
+        ]
+    }
+
+    /// J(t0 + τ) as rows (x, y, θ) × columns (a3, a4, a5).
+    pub(crate) fn jacobian_at(&self, tau: f64) -> [[f64; 3]; 3] {
+        let mut j = [[0.0; 3]; 3];
+        for c in 0..3 {
+            j[0][c] = horner(&self.dx[c], tau);
+            j[1][c] = horner(&self.dy[c], tau);
+            j[2][c] = horner(&self.dtheta[c], tau);
+        }
+        j
+    }
+
+    /// Fills the coefficients from the state `s` (the recurrences of the module docs).
+    fn expand(&mut self, p: &Problem, s: &State, jacobian: bool) {
+        let (sn, cs) = s.theta.sin_cos();
+        let n0 = p.force(s.t);
+        let n1 = [-p.load[0], -p.load[1]];
+        self.t0 = s.t;
+        self.with_jacobian = jacobian;
+        self.theta[0] = s.theta;
+        self.kappa[0] = s.kappa;
+        self.cos[0] = cs;
+        self.sin[0] = sn;
+        self.x[0] = s.x;
+        self.y[0] = s.y;
+        self.elastic[0] = s.elastic;
+        self.potential[0] = s.potential;
+        for j in 0..3 {
+            self.dtheta[j][0] = s.var[j][0];
+            self.dkappa[j][0] = s.var[j][1];
+            self.dx[j][0] = s.var[j][2];
+            self.dy[j][0] = s.var[j][3];
+        }
+        let (gx, gy) = (p.direction[0], p.direction[1]);
+        for k in 0..ORDER {
+            let inv = 1.0 / (k + 1) as f64;
+            // Products with n(t) = n0 + n1 τ: two terms.
+            let (s_prev, c_prev) = if k > 0 {
+                (self.sin[k - 1], self.cos[k - 1])
+            } else {
+                (0.0, 0.0)
+            };
+            let torque =
+                n0[0] * self.sin[k] + n1[0] * s_prev - n0[1] * self.cos[k] - n1[1] * c_prev;
+            let sk = cauchy(&self.sin, &self.kappa, k);
+            let ck = cauchy(&self.cos, &self.kappa, k);
+            self.theta[k + 1] = self.kappa[k] * inv;
+            self.kappa[k + 1] = torque * inv;
+            self.cos[k + 1] = -sk * inv;
+            self.sin[k + 1] = ck * inv;
+            self.x[k + 1] = self.cos[k] * inv;
+            self.y[k + 1] = self.sin[k] * inv;
+            self.elastic[k + 1] = 0.5 * cauchy(&self.kappa, &self.kappa, k) * inv;
+            self.potential[k + 1] = -(gx * self.x[k] + gy * self.y[k]) * inv;
+            if jacobian {
+                // P = n_x c + n_y s as its own series, coefficient k.
+                let pk =
+                    n0[0] * self.cos[k] + n1[0] * c_prev + n0[1] * self.sin[k] + n1[1] * s_prev;
+                self.variation_coefficient(k, pk, inv);
+            }
+        }
+    }
+
+    /// Coefficient k + 1 of the variational columns, given P_k.
+    #[inline(always)]
+    fn variation_coefficient(&mut self, k: usize, pk: f64, inv: f64) {
+        self.stiffness[k] = pk;
+        for j in 0..3 {
+            let forcing = match j {
+                0 => 0.0,
+                1 => self.sin[k],
+                _ => -self.cos[k],
+            };
+            let pd = cauchy(&self.stiffness, &self.dtheta[j], k);
+            self.dtheta[j][k + 1] = self.dkappa[j][k] * inv;
+            self.dkappa[j][k + 1] = (pd + forcing) * inv;
+            self.dx[j][k + 1] = -cauchy(&self.sin, &self.dtheta[j], k) * inv;
+            self.dy[j][k + 1] = cauchy(&self.cos, &self.dtheta[j], k) * inv;
+        }
+    }
+
+    /// The step size from the coefficients just computed (module docs), at most `left`.
+    fn choose_h(&self, p: &Problem, left: f64) -> f64 {
+        let radius = |c: &[f64; N]| {
+            let r1 = (1.0 / c[ORDER - 1].abs()).powf(1.0 / (ORDER - 1) as f64);
+            let r2 = (1.0 / c[ORDER].abs()).powf(1.0 / ORDER as f64);
+            r1.min(r2)
+        };
+        let rho = radius(&self.theta);
+        let n0 = p.force(self.t0);
+        let n1 = p.force(self.t0 + left.min(1.0));
+        let nmax = n0[0].hypot(n0[1]).max(n1[0].hypot(n1[1]));
+        let omega = self.kappa[0].abs() + nmax.sqrt();
+        let h = (rho * TRUNCATION.powf(1.0 / ORDER as f64)).min(OMEGA_STEP / omega);
+        if h.is_nan() {
+            return left;
+        }
+        h.min(left)
+    }
+}
+
+/// Why an integration stopped early.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Stop {
+    /// A coefficient or the state overflowed.
+    NonFinite { t: f64 },
+    /// More than [`MAX_STEPS`] steps.
+    Budget { t: f64 },
+    /// The solver's deadline passed (checked once per step).
+    Deadline { t: f64 },
+}
+
+/// Integrates from t = 0 to t = 1, handing each step's polynomials to `visit` (which may stop
+/// the integration by returning `false`). Returns the state at the end of the last step.
+pub(crate) fn integrate(
+    p: &Problem,
+    jacobian: bool,
+    mut visit: impl FnMut(&Step) -> bool,
+) -> Result<State, Stop> {
+    let mut state = State::base(&p.a);
+    let mut step = Step::zeroed();
+    for n in 0..MAX_STEPS {
+        if n > 0 && crate::solver::deadline::expired() {
+            return Err(Stop::Deadline { t: state.t });
+        }
+        step.expand(p, &state, jacobian);
+        let left = 1.0 - state.t;
+        let mut h = step.choose_h(p, left);
+        // The step that ends the rod lands on t = 1 exactly (no sliver step after it).
+        let last = h >= left * (1.0 - 1e-12);
+        if last {
+            h = left;
+        }
+        step.h = h;
+        let mut next = step.state_at(h);
+        next.t = if last { 1.0 } else { state.t + h };
+        let finite = next.theta.is_finite()
+            && next.kappa.is_finite()
+            && next.x.is_finite()
+            && next.y.is_finite()
+            && next.var.iter().flatten().all(|v| v.is_finite());
+        if !finite || !(h > 0.0) {
+            return Err(Stop::NonFinite { t: state.t });
+        }
+        let go_on = visit(&step);
+        state = next;
+        if last || !go_on {
+            return Ok(state);
+        }
+    }
+    Err(Stop::Budget { t: state.t })
+}
