@@ -28,6 +28,7 @@ mod svg;
 mod timing;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use rod_ig_core::planar::heavy::Gravity;
 use std::io::{self, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -117,6 +118,13 @@ enum Command {
         /// Write to this file instead of stdout.
         #[arg(long, short)]
         output: Option<PathBuf>,
+        /// Dimensionless weight w = ρgAL³/EI of the rods (default 0). With --target, the
+        /// picture shows the heavy rods beside the weightless ones through the same grippers.
+        #[arg(long, default_value_t = 0.0)]
+        weight: f64,
+        /// Direction of gravity "gx,gy" in the base frame (default 0,-1).
+        #[arg(long, allow_hyphen_values = true, default_value = "0,-1")]
+        gravity: String,
     },
     /// Measures every speed figure in one run: forward map, J, stability, shape against the
     /// paper's RK4 baseline (dt = 1e-4); the paper's Table 1 protocol for Newton; the robust
@@ -174,23 +182,58 @@ fn parse_triple(text: &str, what: &str) -> Result<[f64; 3], String> {
 /// picture's size stays bounded whatever `--samples` asks.
 const SVG_POINTS: usize = 2000;
 
-fn shape_command(
-    params: &[String],
-    target: Option<&str>,
+fn parse_gravity(weight: f64, text: &str) -> Result<Gravity, String> {
+    let parts: Vec<f64> = text
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("--gravity needs two comma-separated numbers, got {text:?}"))?;
+    let [gx, gy] = parts[..] else {
+        return Err(format!(
+            "--gravity needs two comma-separated numbers, got {text:?}"
+        ));
+    };
+    planar_cmds::gravity_of(Some(weight), Some([gx, gy]))
+}
+
+/// What `rod-ig shape` draws: rods by parameters or by target, with or without weight.
+struct ShapeRequest<'a> {
+    params: &'a [String],
+    target: Option<&'a str>,
     samples: usize,
+    gravity: Gravity,
+}
+
+fn shape_command(
+    request: ShapeRequest,
     format: Option<Format>,
     output: Option<&PathBuf>,
 ) -> Result<(), String> {
+    let ShapeRequest {
+        params,
+        target,
+        samples,
+        gravity,
+    } = request;
     planar_cmds::check_samples(samples)?;
+    // (a, gravity) of every rod drawn.
     let mut rods = Vec::new();
     for text in params {
-        rods.push(parse_triple(text, "--a")?);
+        rods.push((parse_triple(text, "--a")?, gravity));
     }
     let mut title = String::from("rod-ig: planar Kirchhoff rods");
     if let Some(text) = target {
         let [x, y, theta] = parse_triple(text, "--target")?;
         title = format!("Stable rods reaching x = {x}, y = {y}, θ = {theta}");
-        rods.extend(planar_cmds::all_stable_solutions(x, y, theta)?);
+        if !gravity.is_weightless() {
+            title = format!("{title}, with weight {} and without", gravity.weight());
+            for a in planar_cmds::all_stable_solutions(x, y, theta, &gravity)? {
+                rods.push((a, gravity));
+            }
+        }
+        for a in planar_cmds::all_stable_solutions(x, y, theta, &Gravity::NONE)? {
+            rods.push((a, Gravity::NONE));
+        }
     }
     if rods.is_empty() {
         return Err("give --a a3,a4,a5 (repeatable) or --target x,y,theta".to_string());
@@ -209,15 +252,15 @@ fn shape_command(
     match format {
         // One line per rod, written pose by pose: memory does not grow with --samples.
         Format::Json => {
-            for a in rods {
-                planar_cmds::write_shape_line(&mut out, a, samples)?;
+            for (a, g) in rods {
+                planar_cmds::write_shape_line(&mut out, a, &g, samples)?;
             }
         }
         Format::Svg => {
             let mut drawn = Vec::with_capacity(rods.len());
-            for a in rods {
-                let poses = planar_cmds::sample_shape(a, samples.min(SVG_POINTS))?;
-                drawn.push(planar_cmds::drawn_rod(a, poses));
+            for (a, g) in rods {
+                let poses = planar_cmds::sample_shape(a, &g, samples.min(SVG_POINTS))?;
+                drawn.push(planar_cmds::drawn_rod(a, &g, poses));
             }
             out.write_all(svg::draw(&drawn, &title).as_bytes())
                 .map_err(|e| e.to_string())?;
@@ -325,7 +368,17 @@ fn main() -> ExitCode {
             samples,
             format,
             output,
-        } => shape_command(&params, target.as_deref(), samples, format, output.as_ref()),
+            weight,
+            gravity,
+        } => parse_gravity(weight, &gravity).and_then(|gravity| {
+            let request = ShapeRequest {
+                params: &params,
+                target: target.as_deref(),
+                samples,
+                gravity,
+            };
+            shape_command(request, format, output.as_ref())
+        }),
         Command::Bench {
             quick,
             ig_cases,

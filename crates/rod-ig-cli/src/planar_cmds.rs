@@ -2,6 +2,7 @@
 
 use crate::answer::answer;
 use crate::jsonl::{self, Knobs, MethodName, ObjectiveName};
+use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
 use rod_ig_core::planar::ig::{self, SolveOptions};
 use rod_ig_core::planar::PlanarClosedForm;
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
@@ -14,6 +15,15 @@ use std::io::Write;
 #[serde(deny_unknown_fields)]
 struct ForwardRequest {
     a: [f64; 3],
+    /// Dimensionless weight w = ρgAL³/EI (default 0: the weightless rod).
+    weight: Option<f64>,
+    /// Direction of gravity in the base frame (default [0, -1]).
+    gravity: Option<[f64; 2]>,
+}
+
+/// The gravity of a request: `weight` (default 0) along `gravity` (default −y, normalised).
+pub fn gravity_of(weight: Option<f64>, gravity: Option<[f64; 2]>) -> Result<Gravity, String> {
+    Gravity::new(weight.unwrap_or(0.0), gravity.unwrap_or([0.0, -1.0])).map_err(|e| e.to_string())
 }
 
 /// One `rod-ig forward` answer (the CLI contract of issue #2, plus the stability margin).
@@ -29,6 +39,12 @@ struct ForwardAnswer {
     /// The margin is within its rounding-error bound: the verdict is undecided (`stable` is
     /// false then). Always true for the exactly straight rod.
     stability_uncertain: bool,
+    /// With weight: the elastic part of `energy` (which is elastic + gravitational).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    elastic_energy: Option<f64>,
+    /// With weight: the internal force at the tip, n(1) = (a4, a5) − w ĝ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    tip_force: Option<[f64; 2]>,
 }
 
 fn rows(j: &rod_ig_core::PlanarJacobian) -> [[f64; 3]; 3] {
@@ -39,7 +55,10 @@ fn rows(j: &rod_ig_core::PlanarJacobian) -> [[f64; 3]; 3] {
 pub fn forward_line(line: &str) -> Result<Value, String> {
     let request: ForwardRequest = jsonl::parse(line)?;
     let a = PlanarParams::from(request.a);
-    let e = planar::evaluate(&a).map_err(|e| e.to_string())?;
+    let g = gravity_of(request.weight, request.gravity)?;
+    let e = heavy::evaluate(&a, &g).map_err(|e| e.to_string())?;
+    // Without a `weight` field the answer is the weightless contract's, byte for byte.
+    let heavy = request.weight.is_some();
     jsonl::to_value(&ForwardAnswer {
         tip: e.tip,
         jacobian: rows(&e.jacobian),
@@ -47,6 +66,8 @@ pub fn forward_line(line: &str) -> Result<Value, String> {
         energy: e.energy,
         stability_margin: e.stability.margin,
         stability_uncertain: e.stability.uncertain,
+        elastic_energy: heavy.then_some(e.elastic_energy),
+        tip_force: heavy.then(|| g.tip_force(&a)),
     })
 }
 
@@ -68,6 +89,10 @@ struct SolveRequest {
     all: bool,
     /// Wall-time budget of the request in ms (default 250, at most 10000).
     deadline_ms: Option<f64>,
+    /// Dimensionless weight w (default 0).
+    weight: Option<f64>,
+    /// Direction of gravity in the base frame (default [0, -1]).
+    gravity: Option<[f64; 2]>,
 }
 
 /// Answers one `solve` line (`verbose`: the solver's events on stderr).
@@ -83,6 +108,18 @@ pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
         a0: request.a0.map(PlanarParams::from),
     };
     let options = jsonl::solve_options(knobs, SolveOptions::default())?;
+    let g = gravity_of(request.weight, request.gravity)?;
+    if !g.is_weightless() {
+        return jsonl::to_value(&answer(
+            &HeavyPlanar::new(g),
+            &request.target,
+            &options,
+            request.all,
+            verbose,
+            |a| [a[0], a[1], a[2]],
+            |tip| *tip,
+        ));
+    }
     jsonl::to_value(&answer(
         &PlanarClosedForm,
         &request.target,
@@ -109,18 +146,29 @@ pub fn check_samples(samples: usize) -> Result<(), String> {
     }
 }
 
-/// Samples the rod `a` at `samples` points from the base to the tip.
-pub fn sample_shape(a: [f64; 3], samples: usize) -> Result<Vec<PlanarPose>, String> {
+/// Samples the rod `a` under `g` at `samples` points from the base to the tip.
+pub fn sample_shape(a: [f64; 3], g: &Gravity, samples: usize) -> Result<Vec<PlanarPose>, String> {
     check_samples(samples)?;
-    let rod = planar::PlanarRod::new(&PlanarParams::from(a)).map_err(|e| e.to_string())?;
-    Ok(rod.shape(samples))
+    heavy::shape(&PlanarParams::from(a), g, samples).map_err(|e| e.to_string())
 }
 
 /// Writes the rod `a` as one JSON line {"a": [..], "poses": [{"x", "y", "theta"}, ..]} with
 /// `samples` poses from the base to the tip, each written as it is computed (the same poses
 /// as [`planar::PlanarRod::shape`], in memory independent of `samples`).
-pub fn write_shape_line(out: &mut impl Write, a: [f64; 3], samples: usize) -> Result<(), String> {
+pub fn write_shape_line(
+    out: &mut impl Write,
+    a: [f64; 3],
+    g: &Gravity,
+    samples: usize,
+) -> Result<(), String> {
     check_samples(samples)?;
+    if !g.is_weightless() {
+        // The heavy rod's poses come from one integration (24 bytes each, ≤ 24 MB).
+        let poses = sample_shape(a, g, samples)?;
+        let line = serde_json::json!({ "a": a, "poses": poses });
+        serde_json::to_writer(&mut *out, &line).map_err(|e| e.to_string())?;
+        return out.write_all(b"\n").map_err(|e| e.to_string());
+    }
     let rod = planar::PlanarRod::new(&PlanarParams::from(a)).map_err(|e| e.to_string())?;
     let io = |e: std::io::Error| e.to_string();
     write!(out, "{{\"a\":").map_err(io)?;
@@ -141,11 +189,27 @@ pub fn write_shape_line(out: &mut impl Write, a: [f64; 3], samples: usize) -> Re
     out.write_all(b"]}\n").map_err(io)
 }
 
-/// Every distinct stable solution found for the target (x, y, θ), least energy first.
-pub fn all_stable_solutions(x: f64, y: f64, theta: f64) -> Result<Vec<[f64; 3]>, String> {
+/// Every distinct stable solution found for the target (x, y, θ) under `g`, least energy first.
+pub fn all_stable_solutions(
+    x: f64,
+    y: f64,
+    theta: f64,
+    g: &Gravity,
+) -> Result<Vec<[f64; 3]>, String> {
     let target = PlanarPose::new(x, y, theta);
     // A one-shot drawing: build the atlas first rather than charge it to the search's deadline.
     ig::warm_up();
+    if !g.is_weightless() {
+        let found = rod_ig_core::solver::solve_all(
+            &HeavyPlanar::new(*g),
+            &target,
+            &SolveOptions::default(),
+        );
+        if found.is_empty() {
+            return Err("no stable rod with this weight reaches the target".into());
+        }
+        return Ok(found.iter().map(|s| [s.a[0], s.a[1], s.a[2]]).collect());
+    }
     let found = ig::solve_all(&target, &SolveOptions::default());
     if found.is_empty() {
         // Say why: the first-found search's own reason.
@@ -158,16 +222,21 @@ pub fn all_stable_solutions(x: f64, y: f64, theta: f64) -> Result<Vec<[f64; 3]>,
 }
 
 /// A rod ready to draw, labelled with its parameters, energy and stability.
-pub fn drawn_rod(a: [f64; 3], poses: Vec<PlanarPose>) -> crate::svg::DrawnRod {
+pub fn drawn_rod(a: [f64; 3], g: &Gravity, poses: Vec<PlanarPose>) -> crate::svg::DrawnRod {
     let params = PlanarParams::from(a);
-    let (energy, stable) = match planar::evaluate(&params) {
+    let (energy, stable) = match heavy::evaluate(&params, g) {
         Ok(e) => (e.energy, e.stability.stable),
         Err(_) => (f64::NAN, false),
+    };
+    let weight = if g.is_weightless() {
+        String::new()
+    } else {
+        format!("   weight {}", g.weight())
     };
     crate::svg::DrawnRod {
         poses,
         label: format!(
-            "a = ({:.3}, {:.3}, {:.3})   energy {:.3}   {}",
+            "a = ({:.3}, {:.3}, {:.3}){weight}   energy {:.3}   {}",
             a[0],
             a[1],
             a[2],

@@ -349,3 +349,77 @@ fn plan_answers_with_stable_rods_or_a_reason() {
     assert!(out[1]["reason"].as_str().unwrap().contains("unreachable"));
     assert!(out[2]["error"].as_str().unwrap().contains("cloud"));
 }
+
+#[test]
+fn weight_and_gravity_fields() {
+    // A public gravity case (data/oracle/gravity_public.jsonl, line 1), then the same rod
+    // without weight (the weightless answer), then refusals that name the field.
+    let case = "\"a\": [-2.5899894578390388, -14.485326946763456, 28.871000799863218]";
+    let input = format!(
+        "{{{case}, \"weight\": 0.20137468828407715, \"gravity\": [0.12585306093929588, -0.9920488934786481]}}\n\
+         {{{case}}}\n\
+         {{{case}, \"weight\": -1}}\n\
+         {{{case}, \"weight\": 1, \"gravity\": [0, 0]}}\n\
+         {{{case}, \"weight\": 1, \"gravity\": [0, 0, -1]}}\n"
+    );
+    let out = run(&["forward"], &input);
+    assert_eq!(out.len(), 5);
+    let heavy = &out[0];
+    assert!((heavy["tip"]["x"].as_f64().unwrap() - 0.1422357048066626).abs() < 1e-9);
+    assert!((heavy["tip"]["y"].as_f64().unwrap() + 0.7237771386111447).abs() < 1e-9);
+    assert!((heavy["energy"].as_f64().unwrap() - 11.75830899936043).abs() < 1e-8);
+    assert!(heavy["elastic_energy"].is_f64() && heavy["tip_force"].is_array());
+    assert_eq!(heavy["stable"], true);
+    // Without `weight` the answer has exactly the weightless fields.
+    assert!(out[1].get("elastic_energy").is_none() && out[1].get("tip_force").is_none());
+    assert!(out[2]["error"].as_str().unwrap().contains("weight"));
+    assert!(out[3]["error"].as_str().unwrap().contains("gravity"));
+    assert!(out[4]["error"].is_string());
+
+    // Inverse geometry with weight: a rod held level sags with a5 = −w/2 (symmetry).
+    let out = run(
+        &["solve"],
+        "{\"target\": {\"x\": 0.6, \"y\": 0, \"theta\": 0}, \"weight\": 50, \"objective\": \"least_energy\"}\n",
+    );
+    assert_eq!(out[0]["success"], true, "{}", out[0]);
+    assert_eq!(out[0]["stable"], true);
+    assert!(
+        (out[0]["a"][2].as_f64().unwrap() + 25.0).abs() < 1e-4,
+        "{}",
+        out[0]
+    );
+}
+
+#[test]
+fn shape_draws_heavy_rods_beside_weightless_ones() {
+    let dir = std::env::temp_dir().join(format!("rod-ig-heavy-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("heavy.svg");
+    let status = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
+        .args(["shape", "--target", "0.6,0,0", "--weight", "50", "-o"])
+        .arg(&svg)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("weight 50") && text.contains("<svg"));
+    // JSON poses of a heavy rod: the base at the origin, one line per rod.
+    let out = run(
+        &[
+            "shape",
+            "--a",
+            "3,-2,-25",
+            "--weight",
+            "50",
+            "--gravity",
+            "0,-1",
+            "--samples",
+            "5",
+        ],
+        "",
+    );
+    assert_eq!(out.len(), 1);
+    assert_eq!(out[0]["poses"].as_array().unwrap().len(), 5);
+    assert_eq!(out[0]["poses"][0]["x"], 0.0);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -301,20 +301,48 @@ impl Search<'_> {
     }
 }
 
-/// The weightless rods the search starts from: the stable solutions of the weightless target
-/// (the closed forms' search, least energy first), the caller's guess first.
-fn weightless_starts(target: &PlanarPose, options: &SolveOptions) -> Vec<PlanarParams> {
-    let found = PlanarClosedForm.robust_all(target, options);
-    let mut sols = found.solutions;
-    if sols.is_empty() {
-        if let Ok(s) = PlanarClosedForm.robust(target, options) {
-            sols.push(s);
+/// The weightless rods the search starts from, in order: the caller's guess, the weightless
+/// robust search's first rod (one call of a few µs), then, only when `all` or when those fail,
+/// every stable weightless solution (least energy first).
+struct Starts<'a> {
+    target: &'a PlanarPose,
+    options: &'a SolveOptions,
+    queue: Vec<PlanarParams>,
+    stage: u8,
+}
+
+impl Iterator for Starts<'_> {
+    type Item = PlanarParams;
+    fn next(&mut self) -> Option<PlanarParams> {
+        while self.queue.is_empty() && self.stage < 3 {
+            self.stage += 1;
+            match self.stage {
+                1 => self.queue.extend(self.options.initial_guess),
+                2 => self.queue.extend(
+                    PlanarClosedForm
+                        .robust(self.target, self.options)
+                        .map(|s| s.a),
+                ),
+                _ => {
+                    let mut sols = PlanarClosedForm
+                        .robust_all(self.target, self.options)
+                        .solutions;
+                    sols.sort_by(|a, b| b.energy.total_cmp(&a.energy));
+                    self.queue.extend(sols.into_iter().map(|s| s.a));
+                }
+            }
         }
+        self.queue.pop()
     }
-    sols.sort_by(|a, b| a.energy.total_cmp(&b.energy));
-    let mut starts: Vec<PlanarParams> = options.initial_guess.into_iter().collect();
-    starts.extend(sols.into_iter().map(|s| s.a));
-    starts
+}
+
+fn weightless_starts<'a>(target: &'a PlanarPose, options: &'a SolveOptions) -> Starts<'a> {
+    Starts {
+        target,
+        options,
+        queue: Vec::new(),
+        stage: 0,
+    }
 }
 
 impl InverseGeometry<3> for HeavyPlanar {
@@ -359,10 +387,18 @@ impl InverseGeometry<3> for HeavyPlanar {
         };
         let scale = self.param_scale();
         let mut solutions: Vec<Solution<PlanarParams, PlanarPose>> = Vec::new();
+        let mut tried: Vec<PlanarParams> = Vec::new();
         for a0 in weightless_starts(target, options) {
             if search.out_of_time() {
                 break;
             }
+            if tried
+                .iter()
+                .any(|t| relative_distance(t, &a0, &scale) <= DISTINCT)
+            {
+                continue;
+            }
+            tried.push(a0);
             if let Some(s) = search.follow(&self.gravity, &a0) {
                 if solutions
                     .iter()
