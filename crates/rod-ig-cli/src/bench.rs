@@ -1,10 +1,12 @@
 //! `rod-ig bench`: every speed figure of the README, measured in one run on this machine.
 
-use crate::timing::{measure, Timing};
+use crate::timing::{measure, median, Timing};
 use rod_ig_bench::planar::{self as ig_bench, IgCase, ParamBox};
 use rod_ig_bench::SplitMix64;
 use rod_ig_core::ode::planar_reference as reference;
+use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
 use rod_ig_core::planar::ig::SolveOptions;
+use rod_ig_core::solver;
 use rod_ig_core::{planar, PlanarParams};
 use std::path::Path;
 
@@ -384,5 +386,106 @@ pub fn spatial(quick: bool) {
     for (why, count) in &r.failures {
         outln!("    failed ×{count}: {why}");
     }
+    outln!();
+}
+
+/// Box rods under log-scale weights w ∈ [0.1, 200] with gravity in every direction (seeded).
+fn heavy_inputs(n: usize, seed: u64) -> Vec<(PlanarParams, Gravity)> {
+    let mut rng = SplitMix64::new(seed);
+    sample_box(n, seed)
+        .into_iter()
+        .map(|a| {
+            let w = 10f64.powf(rng.range(-1.0, 2.3));
+            let angle = rng.range(0.0, std::f64::consts::TAU);
+            let g = Gravity::new(w, [angle.cos(), angle.sin()]).expect("a valid gravity");
+            (a, g)
+        })
+        .collect()
+}
+
+/// Heavy rods against the weightless closed forms, each pair measured in this run (issue 41's
+/// ratios: ≤ 10× for tip + J, for the forward map with its verdict and for the robust solve).
+pub fn weight(quick: bool) {
+    let (n, rounds, targets) = if quick { (64, 3, 20) } else { (512, 11, 200) };
+    let heavy_rods = heavy_inputs(n, 41);
+    let plain: Vec<PlanarParams> = heavy_rods.iter().map(|(a, _)| *a).collect();
+    outln!("## Planar rods with weight (box a, w = 10^U(−1, 2.3), gravity in every direction; {n} rods, {rounds} rounds; single thread)");
+    outln!(
+        "{:<36} {:>10} {:>10} {:>12} {:>8}   goal",
+        "µs per call",
+        "heavy",
+        "weightless",
+        "heavy mean",
+        "ratio"
+    );
+    let pair = |name: &str, heavy: Timing, weightless: Timing| {
+        let ratio = heavy.median_ns / weightless.median_ns;
+        outln!(
+            "{name:<36} {:>10.2} {:>10.2} {:>12.2} {:>7.1}×   ≤ 10×: {}",
+            heavy.median_ns / 1e3,
+            weightless.median_ns / 1e3,
+            heavy.mean_ns / 1e3,
+            ratio,
+            if ratio <= 10.0 { "met" } else { "NOT met" }
+        );
+    };
+    let tj = measure(&heavy_rods, rounds, |(a, g)| {
+        heavy::tip_and_jacobian(a, g).map(|(p, _)| p.x)
+    });
+    let tj0 = measure(&plain, rounds, |a| {
+        planar::tip_and_jacobian(a).map(|(p, _)| p.x)
+    });
+    pair("tip + J(1)", tj, tj0);
+    let ev = measure(&heavy_rods, rounds, |(a, g)| {
+        heavy::evaluate(a, g).map(|e| e.stability.stable)
+    });
+    let ev0 = measure(&plain, rounds, |a| {
+        planar::evaluate(a).map(|e| e.stability.stable)
+    });
+    pair("tip + J + energy + stability", ev, ev0);
+    // Robust solves of targets reached by stable heavy rods (|p| ≤ 0.98).
+    rod_ig_core::planar::ig::warm_up();
+    let mut cases = Vec::new();
+    for (a, g) in heavy_inputs(8 * targets, 42) {
+        if cases.len() == targets {
+            break;
+        }
+        let a = PlanarParams::new(a[0] * 0.6, a[1] * 0.3, a[2] * 0.3);
+        if let Ok(e) = heavy::evaluate(&a, &g) {
+            if e.stability.stable && e.tip.x.hypot(e.tip.y) <= 0.98 {
+                cases.push((e.tip, g));
+            }
+        }
+    }
+    let options = SolveOptions::default();
+    let mut solved = 0usize;
+    let mut times = Vec::new();
+    let mut times0 = Vec::new();
+    for (target, g) in &cases {
+        let t0 = std::time::Instant::now();
+        let ok = solver::solve(&HeavyPlanar::new(*g), target, &options).is_ok();
+        times.push(t0.elapsed().as_secs_f64() * 1e6);
+        solved += ok as usize;
+        let t0 = std::time::Instant::now();
+        let _ = rod_ig_core::planar::ig::solve(target, &options);
+        times0.push(t0.elapsed().as_secs_f64() * 1e6);
+    }
+    let (m, m0) = (median(&mut times.clone()), median(&mut times0));
+    times.sort_by(f64::total_cmp);
+    let p99 = times[(times.len() * 99 / 100).min(times.len() - 1)];
+    outln!(
+        "{:<36} {:>10.1} {:>10.1} {:>12.1} {:>7.1}×   ≤ 10×: {}",
+        "robust solve (µs, median)",
+        m,
+        m0,
+        p99,
+        m / m0,
+        if m / m0 <= 10.0 { "met" } else { "NOT met" }
+    );
+    outln!(
+        "    {solved} of {} targets of stable heavy rods solved ({:.1} %; goal ≥ 99.9 %)",
+        cases.len(),
+        100.0 * solved as f64 / cases.len().max(1) as f64
+    );
     outln!();
 }

@@ -151,6 +151,8 @@ enum BenchPart {
     Tails,
     Ig,
     Spatial,
+    /// Rods with weight against the weightless closed forms (issue 41's ratios).
+    Weight,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq)]
@@ -326,6 +328,9 @@ fn plan(
 
 /// `rod-ig bench`: the parts asked for, in order.
 fn bench(quick: bool, ig_cases: &std::path::Path, only: BenchPart) {
+    if matches!(only, BenchPart::All | BenchPart::Weight) {
+        bench::weight(quick);
+    }
     if matches!(only, BenchPart::All | BenchPart::Forward) {
         bench::planar_forward(quick);
     }

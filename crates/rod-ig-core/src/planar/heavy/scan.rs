@@ -30,7 +30,7 @@ fn product(a: &[f64; N], b: &[f64; N]) -> [f64; N] {
     for (k, o) in out.iter_mut().enumerate() {
         let mut s = 0.0;
         for i in 0..=k {
-            s = a[i].mul_add(b[k - i], s);
+            s += a[i] * b[k - i];
         }
         *o = s;
     }
