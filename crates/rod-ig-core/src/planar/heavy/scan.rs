@@ -45,9 +45,15 @@ fn difference(a: [f64; N], b: [f64; N]) -> [f64; N] {
     out
 }
 
+/// Column j of a coefficient-major variational series.
+fn column(v: &[[f64; 4]; N], j: usize) -> [f64; N] {
+    std::array::from_fn(|k| v[k][j])
+}
+
 /// det J(t0 + τ) as a polynomial in τ, truncated to the series' order (rows x, y, θ).
 fn det_polynomial(s: &Step) -> [f64; N] {
-    let (x, y, th) = (&s.dx, &s.dy, &s.dtheta);
+    let cols = |v: &[[f64; 4]; N]| [column(v, 0), column(v, 1), column(v, 2)];
+    let (x, y, th) = (cols(&s.dx), cols(&s.dy), cols(&s.dtheta));
     let m0 = difference(product(&y[1], &th[2]), product(&y[2], &th[1]));
     let m1 = difference(product(&y[0], &th[2]), product(&y[2], &th[0]));
     let m2 = difference(product(&y[0], &th[1]), product(&y[1], &th[0]));

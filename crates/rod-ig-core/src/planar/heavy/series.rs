@@ -42,13 +42,32 @@ pub(crate) fn horner(c: &[f64; N], tau: f64) -> f64 {
     v
 }
 
-/// (a · b)_k, the k-th coefficient of a Cauchy product.
+/// Four lanes: the three variational columns and a padding lane.
+pub(crate) type Lanes = [f64; 4];
+
+/// Horner on four lanes at once.
 #[inline(always)]
-fn cauchy(a: &[f64; N], b: &[f64; N], k: usize) -> f64 {
-    a[..=k]
-        .iter()
-        .zip(b[..=k].iter().rev())
-        .fold(0.0, |s, (x, y)| s + x * y)
+pub(crate) fn horner_lanes(c: &[Lanes; N], tau: f64) -> Lanes {
+    let mut v = c[ORDER];
+    for k in (0..ORDER).rev() {
+        for l in 0..4 {
+            v[l] = v[l] * tau + c[k][l];
+        }
+    }
+    v
+}
+
+/// The k-th coefficients of (s κ, c κ, κ κ), in one pass over κ.
+#[inline(always)]
+fn cauchy3(s: &[f64; N], c: &[f64; N], kappa: &[f64; N], k: usize) -> (f64, f64, f64) {
+    let (mut sk, mut ck, mut kk) = (0.0, 0.0, 0.0);
+    for i in 0..=k {
+        let q = kappa[k - i];
+        sk += s[i] * q;
+        ck += c[i] * q;
+        kk += kappa[i] * q;
+    }
+    (sk, ck, kk)
 }
 
 /// The data of the rod that the series needs: a and the load w ĝ.
@@ -110,11 +129,12 @@ pub(crate) struct Step {
     pub y: [f64; N],
     pub elastic: [f64; N],
     pub potential: [f64; N],
-    /// Per column j: δθ, δκ, δx, δy.
-    pub dtheta: [[f64; N]; 3],
-    pub dkappa: [[f64; N]; 3],
-    pub dx: [[f64; N]; 3],
-    pub dy: [[f64; N]; 3],
+    /// δθ, δκ, δx, δy, coefficient-major: `dx[k][j]` is coefficient k of column j (a3, a4,
+    /// a5; lane 3 is padding), so that the three columns' products run as one vector loop.
+    pub dtheta: [Lanes; N],
+    pub dkappa: [Lanes; N],
+    pub dx: [Lanes; N],
+    pub dy: [Lanes; N],
     /// P = n_x c + n_y s, the coefficient of δθ in δκ'.
     stiffness: [f64; N],
     /// True when the variational polynomials were computed.
@@ -134,10 +154,10 @@ impl Step {
             y: [0.0; N],
             elastic: [0.0; N],
             potential: [0.0; N],
-            dtheta: [[0.0; N]; 3],
-            dkappa: [[0.0; N]; 3],
-            dx: [[0.0; N]; 3],
-            dy: [[0.0; N]; 3],
+            dtheta: [[0.0; 4]; N],
+            dkappa: [[0.0; 4]; N],
+            dx: [[0.0; 4]; N],
+            dy: [[0.0; 4]; N],
             stiffness: [0.0; N],
             with_jacobian: false,
         }
@@ -147,13 +167,14 @@ impl Step {
     pub(crate) fn state_at(&self, tau: f64) -> State {
         let mut var = [[0.0; 4]; 3];
         if self.with_jacobian {
+            let (th, ka, x, y) = (
+                horner_lanes(&self.dtheta, tau),
+                horner_lanes(&self.dkappa, tau),
+                horner_lanes(&self.dx, tau),
+                horner_lanes(&self.dy, tau),
+            );
             for (j, v) in var.iter_mut().enumerate() {
-                *v = [
-                    horner(&self.dtheta[j], tau),
-                    horner(&self.dkappa[j], tau),
-                    horner(&self.dx[j], tau),
-                    horner(&self.dy[j], tau),
-                ];
+                *v = [th[j], ka[j], x[j], y[j]];
             }
         }
         State {
@@ -179,13 +200,16 @@ impl Step {
 
     /// J(t0 + τ) as rows (x, y, θ) × columns (a3, a4, a5).
     pub(crate) fn jacobian_at(&self, tau: f64) -> [[f64; 3]; 3] {
-        let mut j = [[0.0; 3]; 3];
-        for c in 0..3 {
-            j[0][c] = horner(&self.dx[c], tau);
-            j[1][c] = horner(&self.dy[c], tau);
-            j[2][c] = horner(&self.dtheta[c], tau);
-        }
-        j
+        let (x, y, th) = (
+            horner_lanes(&self.dx, tau),
+            horner_lanes(&self.dy, tau),
+            horner_lanes(&self.dtheta, tau),
+        );
+        [
+            [x[0], x[1], x[2]],
+            [y[0], y[1], y[2]],
+            [th[0], th[1], th[2]],
+        ]
     }
 
     /// Fills the coefficients from the state `s` (the recurrences of the module docs).
@@ -204,10 +228,10 @@ impl Step {
         self.elastic[0] = s.elastic;
         self.potential[0] = s.potential;
         for j in 0..3 {
-            self.dtheta[j][0] = s.var[j][0];
-            self.dkappa[j][0] = s.var[j][1];
-            self.dx[j][0] = s.var[j][2];
-            self.dy[j][0] = s.var[j][3];
+            self.dtheta[0][j] = s.var[j][0];
+            self.dkappa[0][j] = s.var[j][1];
+            self.dx[0][j] = s.var[j][2];
+            self.dy[0][j] = s.var[j][3];
         }
         let (gx, gy) = (p.direction[0], p.direction[1]);
         for k in 0..ORDER {
@@ -220,15 +244,14 @@ impl Step {
             };
             let torque =
                 n0[0] * self.sin[k] + n1[0] * s_prev - n0[1] * self.cos[k] - n1[1] * c_prev;
-            let sk = cauchy(&self.sin, &self.kappa, k);
-            let ck = cauchy(&self.cos, &self.kappa, k);
+            let (sk, ck, kk) = cauchy3(&self.sin, &self.cos, &self.kappa, k);
             self.theta[k + 1] = self.kappa[k] * inv;
             self.kappa[k + 1] = torque * inv;
             self.cos[k + 1] = -sk * inv;
             self.sin[k + 1] = ck * inv;
             self.x[k + 1] = self.cos[k] * inv;
             self.y[k + 1] = self.sin[k] * inv;
-            self.elastic[k + 1] = 0.5 * cauchy(&self.kappa, &self.kappa, k) * inv;
+            self.elastic[k + 1] = 0.5 * kk * inv;
             self.potential[k + 1] = -(gx * self.x[k] + gy * self.y[k]) * inv;
             if jacobian {
                 // P = n_x c + n_y s as its own series, coefficient k.
@@ -239,21 +262,31 @@ impl Step {
         }
     }
 
-    /// Coefficient k + 1 of the variational columns, given P_k.
+    /// Coefficient k + 1 of the three variational columns, given P_k: one loop over the
+    /// Cauchy products P·δθ, s·δθ and c·δθ, four lanes wide.
     #[inline(always)]
     fn variation_coefficient(&mut self, k: usize, pk: f64, inv: f64) {
         self.stiffness[k] = pk;
-        for j in 0..3 {
-            let forcing = match j {
-                0 => 0.0,
-                1 => self.sin[k],
-                _ => -self.cos[k],
-            };
-            let pd = cauchy(&self.stiffness, &self.dtheta[j], k);
-            self.dtheta[j][k + 1] = self.dkappa[j][k] * inv;
-            self.dkappa[j][k + 1] = (pd + forcing) * inv;
-            self.dx[j][k + 1] = -cauchy(&self.sin, &self.dtheta[j], k) * inv;
-            self.dy[j][k + 1] = cauchy(&self.cos, &self.dtheta[j], k) * inv;
+        let mut pd = [0.0; 4];
+        let mut sd = [0.0; 4];
+        let mut cd = [0.0; 4];
+        for i in 0..=k {
+            let d = self.dtheta[k - i];
+            let (p, sn, cs) = (self.stiffness[i], self.sin[i], self.cos[i]);
+            for l in 0..4 {
+                pd[l] += p * d[l];
+                sd[l] += sn * d[l];
+                cd[l] += cs * d[l];
+            }
+        }
+        // The forcing of δκ' by the parameters: 0 for a3, s for a4, −c for a5.
+        let forcing = [0.0, self.sin[k], -self.cos[k], 0.0];
+        let dkappa = self.dkappa[k];
+        for l in 0..4 {
+            self.dtheta[k + 1][l] = dkappa[l] * inv;
+            self.dkappa[k + 1][l] = (pd[l] + forcing[l]) * inv;
+            self.dx[k + 1][l] = -sd[l] * inv;
+            self.dy[k + 1][l] = cd[l] * inv;
         }
     }
 
