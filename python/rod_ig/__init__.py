@@ -79,6 +79,33 @@ def _broadcast(*arrays: FloatArray) -> tuple[list[FloatArray], tuple[int, ...]]:
     return out, shape
 
 
+def _weight_arrays(
+    weight: npt.ArrayLike | None, gravity: npt.ArrayLike | None
+) -> list[FloatArray]:
+    """``weight`` as (..., 1) and ``gravity`` as (..., 2) arrays to broadcast with the batch;
+    [] when neither is given (the weightless closed forms, bit for bit)."""
+    if weight is None and gravity is None:
+        return []
+    w = np.asarray(0.0 if weight is None else weight)
+    if w.dtype.kind not in "fiu":
+        raise TypeError(f"weight must hold real numbers, got dtype {w.dtype}")
+    # (ascontiguousarray would make a 0-d weight 1-d: a batch dimension of its own.)
+    w = np.asarray(w, dtype=np.float64)[..., None]
+    if not np.isfinite(w).all() or (w < 0).any() or (w > 1e4).any():
+        raise ValueError("weight must be finite and in [0, 1e4]")
+    g, _ = _batch("gravity", (0.0, -1.0) if gravity is None else gravity, 2)
+    if (np.hypot(g[..., 0], g[..., 1]) == 0).any():
+        raise ValueError("gravity must be a non-zero vector")
+    return [w, g]
+
+
+def _weight_kwargs(flat: list[FloatArray], start: int) -> dict[str, FloatArray]:
+    """The native keyword arguments from the broadcast arrays ``flat[start:]``."""
+    if len(flat) <= start:
+        return {}
+    return {"weight": flat[start], "gravity": flat[start + 1]}
+
+
 @dataclass(frozen=True)
 class ForwardResult:
     """Planar forward map of a batch of rods (shape ``(...)``)."""
@@ -95,7 +122,9 @@ class ForwardResult:
     uncertain: BoolArray
     """(...): the margin is within its rounding-error bound (``stable`` is then False)."""
     energy: FloatArray
-    """(...): elastic energy (unit stiffness)."""
+    """(...): energy (unit stiffness): elastic, plus gravitational with ``weight``."""
+    elastic_energy: FloatArray | None = None
+    """(...): the elastic part of ``energy`` (equal to it without weight)."""
 
 
 @dataclass(frozen=True)
@@ -154,12 +183,22 @@ def _solve_result(
     )
 
 
-def forward(a: npt.ArrayLike, threads: int | None = None) -> ForwardResult:
+def forward(
+    a: npt.ArrayLike,
+    threads: int | None = None,
+    weight: npt.ArrayLike | None = None,
+    gravity: npt.ArrayLike | None = None,
+) -> ForwardResult:
     """Planar forward map of rods ``a`` of shape (..., 3) = (a3, a4, a5): tip pose, J(1, a),
     stability verdict and margin, energy (closed forms, paper section 2). A rod that cannot be
-    evaluated (beyond the certified domain) gets NaN, ``stable`` False, ``uncertain`` True."""
-    arr, shape = _batch("a", a, 3)
-    d = _rod_ig.forward(arr.reshape(-1), threads=threads)
+    evaluated (beyond the certified domain) gets NaN, ``stable`` False, ``uncertain`` True.
+
+    ``weight`` (dimensionless w = rho g A L^3 / EI, in [0, 1e4]) and ``gravity`` (its direction in
+    the base frame, (..., 2), default (0, -1)) broadcast against the batch: the rod with weight
+    (docs/weight.md)."""
+    arr, _ = _batch("a", a, 3)
+    flat, shape = _broadcast(arr, *_weight_arrays(weight, gravity))
+    d = _rod_ig.forward(flat[0], threads=threads, **_weight_kwargs(flat, 1))
     return ForwardResult(
         tip=d["tip"].reshape(shape + (3,)),
         jacobian=d["jacobian"].reshape(shape + (3, 3)),
@@ -167,25 +206,40 @@ def forward(a: npt.ArrayLike, threads: int | None = None) -> ForwardResult:
         margin=d["margin"].reshape(shape),
         uncertain=d["uncertain"].reshape(shape),
         energy=d["energy"].reshape(shape),
+        elastic_energy=d["elastic_energy"].reshape(shape),
     )
 
 
-def is_stable(a: npt.ArrayLike, threads: int | None = None) -> BoolArray:
+def is_stable(
+    a: npt.ArrayLike,
+    threads: int | None = None,
+    weight: npt.ArrayLike | None = None,
+    gravity: npt.ArrayLike | None = None,
+) -> BoolArray:
     """Stability verdicts of rods ``a`` of shape (..., 3): True where the rod is established
     stable, the same as ``forward(a).stable``, without the margin ``forward`` refines. Where a
     theorem or the sign of det J(1) decides (about two rods in three of the paper's box) it
-    skips the scan of det J(t): about three times as fast as ``forward`` on the paper's box."""
-    arr, shape = _batch("a", a, 3)
-    return _rod_ig.is_stable(arr.reshape(-1), threads=threads).reshape(shape)
+    skips the scan of det J(t): about three times as fast as ``forward`` on the paper's box.
+    ``weight``, ``gravity``: as for ``forward``."""
+    arr, _ = _batch("a", a, 3)
+    flat, shape = _broadcast(arr, *_weight_arrays(weight, gravity))
+    return _rod_ig.is_stable(flat[0], threads=threads, **_weight_kwargs(flat, 1)).reshape(shape)
 
 
-def shape(a: npt.ArrayLike, samples: int = 100, threads: int | None = None) -> FloatArray:
+def shape(
+    a: npt.ArrayLike,
+    samples: int = 100,
+    threads: int | None = None,
+    weight: npt.ArrayLike | None = None,
+    gravity: npt.ArrayLike | None = None,
+) -> FloatArray:
     """Poses (x, y, theta) of rods ``a`` (..., 3) at ``samples`` points from the base (the
-    identity) to the tip: shape (..., samples, 3)."""
+    identity) to the tip: shape (..., samples, 3). ``weight``, ``gravity``: as for ``forward``."""
     if not 2 <= int(samples) <= 1_000_000:
         raise ValueError(f"samples must be in [2, 1000000], got {samples}")
-    arr, batch = _batch("a", a, 3)
-    out = _rod_ig.shape(arr.reshape(-1), int(samples), threads=threads)
+    arr, _ = _batch("a", a, 3)
+    flat, batch = _broadcast(arr, *_weight_arrays(weight, gravity))
+    out = _rod_ig.shape(flat[0], int(samples), threads=threads, **_weight_kwargs(flat, 1))
     return out.reshape(batch + (int(samples), 3))
 
 
@@ -200,18 +254,22 @@ def solve(
     alpha: float | None = None,
     all: bool = False,
     threads: int | None = None,
+    weight: npt.ArrayLike | None = None,
+    gravity: npt.ArrayLike | None = None,
 ) -> SolveResult:
     """Planar inverse geometry: for each target (x, y, theta) of shape (..., 3), a stable rod
     whose tip is there. ``a0`` (broadcast against the targets) starts the search and selects
     the branch; ``objective`` "first" | "least_energy"; ``method`` "robust" | "newton" (the
     paper's alpha-Newton from ``a0``); ``deadline_ms`` per target; ``tolerance`` on the
     position (rod lengths) and angle (rad) errors, in [1e-14, 1e-2]; ``max_iterations`` per
-    start; ``all=True`` also lists every distinct stable solution found."""
+    start; ``all=True`` also lists every distinct stable solution found. ``weight``,
+    ``gravity``: as for ``forward`` (the heavy rod's search: docs/weight.md)."""
     t, _ = _batch("targets", targets, 3)
     arrays = [t]
     if a0 is not None:
         arrays.append(_batch("a0", a0, 3)[0])
-    flat, batch = _broadcast(*arrays)
+    heavy = _weight_arrays(weight, gravity)
+    flat, batch = _broadcast(*arrays, *heavy)
     d = _rod_ig.solve(
         flat[0],
         a0=flat[1] if a0 is not None else None,
@@ -223,6 +281,7 @@ def solve(
         alpha=alpha,
         all=all,
         threads=threads,
+        **_weight_kwargs(flat, len(arrays)),
     )
     return _solve_result(d, batch, 3, all)
 

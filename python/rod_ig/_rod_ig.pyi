@@ -8,10 +8,24 @@ import numpy.typing as npt
 
 __version__: str
 
-def forward(a: npt.NDArray[np.float64], threads: int | None = None) -> dict[str, Any]: ...
-def is_stable(a: npt.NDArray[np.float64], threads: int | None = None) -> npt.NDArray[np.bool_]: ...
+def forward(
+    a: npt.NDArray[np.float64],
+    threads: int | None = None,
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
+) -> dict[str, Any]: ...
+def is_stable(
+    a: npt.NDArray[np.float64],
+    threads: int | None = None,
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
+) -> npt.NDArray[np.bool_]: ...
 def shape(
-    a: npt.NDArray[np.float64], samples: int, threads: int | None = None
+    a: npt.NDArray[np.float64],
+    samples: int,
+    threads: int | None = None,
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
 ) -> npt.NDArray[np.float64]: ...
 def solve(
     targets: npt.NDArray[np.float64],
@@ -24,6 +38,8 @@ def solve(
     alpha: float | None = None,
     all: bool = False,
     threads: int | None = None,
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
 ) -> dict[str, Any]: ...
 def forward3d(
     a: npt.NDArray[np.float64],

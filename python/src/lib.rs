@@ -9,6 +9,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rod_ig_core::plan::{Obstacle, PlanRequest, Planner as CorePlanner};
+use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
 use rod_ig_core::planar::PlanarClosedForm;
 use rod_ig_core::solver::{self, BranchEvent, BranchFollower, Method, Objective, SolveOptions};
 use rod_ig_core::spatial::Spatial;
@@ -75,6 +76,34 @@ fn planar_params(a: &[f64], i: usize) -> PlanarParams {
     PlanarParams::new(a[3 * i], a[3 * i + 1], a[3 * i + 2])
 }
 
+/// The gravity of each of n rods from the flattened `weight` (n) and `gravity` (2n) arrays, or
+/// None when no weight was given (the weightless closed forms). Errors name the rod.
+fn gravities(
+    n: usize,
+    weight: Option<&PyReadonlyArray1<'_, f64>>,
+    gravity: Option<&PyReadonlyArray1<'_, f64>>,
+) -> PyResult<Option<Vec<Gravity>>> {
+    let Some(weight) = weight else {
+        return Ok(None);
+    };
+    let w = weight.as_slice()?;
+    let default = [0.0, -1.0];
+    let g = gravity.map(|g| g.as_slice()).transpose()?;
+    if w.len() != n || g.is_some_and(|g| g.len() != 2 * n) {
+        return Err(PyValueError::new_err(
+            "weight and gravity must broadcast against the batch",
+        ));
+    }
+    (0..n)
+        .map(|i| {
+            let dir = g.map_or(default, |g| [g[2 * i], g[2 * i + 1]]);
+            Gravity::new(w[i], dir)
+                .map_err(|e| PyValueError::new_err(format!("weight/gravity of rod {i}: {e}")))
+        })
+        .collect::<PyResult<Vec<_>>>()
+        .map(Some)
+}
+
 fn f64_out<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
     v.into_pyarray(py)
 }
@@ -83,15 +112,19 @@ fn f64_out<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
 /// θ; columns a3, a4, a5), stable, margin, uncertain, energy. A rod that cannot be evaluated
 /// gets NaN, stable False, uncertain True.
 #[pyfunction]
-#[pyo3(signature = (a, threads=None))]
+#[pyo3(signature = (a, threads=None, weight=None, gravity=None))]
 fn forward<'py>(
     py: Python<'py>,
     a: PyReadonlyArray1<'py, f64>,
     threads: Option<usize>,
+    weight: Option<PyReadonlyArray1<'py, f64>>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let a = a.as_slice()?;
     let n = a.len() / 3;
     let threads = thread_count(threads)?;
+    let g = gravities(n, weight.as_ref(), gravity.as_ref())?;
+    let mut elastic = vec![f64::NAN; n];
     let mut tip = vec![f64::NAN; 3 * n];
     let mut jac = vec![f64::NAN; 9 * n];
     let mut stable = vec![false; n];
@@ -103,9 +136,13 @@ fn forward<'py>(
         n,
         threads,
         FORWARD_BLOCK,
-        |i| planar::evaluate(&planar_params(a, i)).ok(),
+        |i| {
+            let gi = g.as_ref().map_or(Gravity::NONE, |g| g[i]);
+            heavy::evaluate(&planar_params(a, i), &gi).ok()
+        },
         |i, e| {
             if let Some(e) = e {
+                elastic[i] = e.elastic_energy;
                 tip[3 * i..3 * i + 3].copy_from_slice(&[e.tip.x, e.tip.y, e.tip.theta]);
                 for r in 0..3 {
                     for c in 0..3 {
@@ -126,6 +163,7 @@ fn forward<'py>(
     d.set_item("margin", f64_out(py, margin))?;
     d.set_item("uncertain", uncertain.into_pyarray(py))?;
     d.set_item("energy", f64_out(py, energy))?;
+    d.set_item("elastic_energy", f64_out(py, elastic))?;
     Ok(d)
 }
 
@@ -133,15 +171,18 @@ fn forward<'py>(
 /// iff the rod is established stable (what `forward` gives as `stable`), without the margin
 /// it refines. A rod that cannot be evaluated gets false.
 #[pyfunction]
-#[pyo3(signature = (a, threads=None))]
+#[pyo3(signature = (a, threads=None, weight=None, gravity=None))]
 fn is_stable<'py>(
     py: Python<'py>,
     a: PyReadonlyArray1<'py, f64>,
     threads: Option<usize>,
+    weight: Option<PyReadonlyArray1<'py, f64>>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
     let a = a.as_slice()?;
     let n = a.len() / 3;
     let threads = thread_count(threads)?;
+    let g = gravities(n, weight.as_ref(), gravity.as_ref())?;
     let mut stable = vec![false; n];
     batch(
         py,
@@ -150,7 +191,10 @@ fn is_stable<'py>(
         FORWARD_BLOCK,
         |i| {
             let rod = planar_params(a, i);
-            planar::stability_verdict(&rod).is_ok_and(|v| v.is_stable())
+            match &g {
+                Some(g) => heavy::stability(&rod, &g[i]).is_ok_and(|r| r.stable),
+                None => planar::stability_verdict(&rod).is_ok_and(|v| v.is_stable()),
+            }
         },
         |i, s| stable[i] = s,
     )?;
@@ -160,26 +204,30 @@ fn is_stable<'py>(
 /// Shapes of n rods: `samples` poses (x, y, θ) each from the base to the tip (NaN for a rod
 /// that cannot be evaluated).
 #[pyfunction]
-#[pyo3(signature = (a, samples, threads=None))]
+#[pyo3(signature = (a, samples, threads=None, weight=None, gravity=None))]
 fn shape<'py>(
     py: Python<'py>,
     a: PyReadonlyArray1<'py, f64>,
     samples: usize,
     threads: Option<usize>,
+    weight: Option<PyReadonlyArray1<'py, f64>>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let a = a.as_slice()?;
     let n = a.len() / 3;
     let threads = thread_count(threads)?;
+    let g = gravities(n, weight.as_ref(), gravity.as_ref())?;
     let mut out = vec![f64::NAN; 3 * samples * n];
     batch(
         py,
         n,
         threads,
         (FORWARD_BLOCK / samples.max(1)).max(1),
-        |i| {
-            planar::PlanarRod::new(&planar_params(a, i))
+        |i| match &g {
+            Some(g) => heavy::shape(&planar_params(a, i), &g[i], samples).ok(),
+            None => planar::PlanarRod::new(&planar_params(a, i))
                 .ok()
-                .map(|rod| rod.shape(samples))
+                .map(|rod| rod.shape(samples)),
         },
         |i, poses| {
             for (k, p) in poses.into_iter().flatten().enumerate() {
@@ -328,7 +376,8 @@ const SOLVE_BLOCK: usize = 256;
 /// Planar inverse geometry of n targets (x, y, θ) (flattened), optional starts `a0`.
 #[pyfunction]
 #[pyo3(signature = (targets, a0=None, objective="first", method="robust", deadline_ms=None,
-                    tolerance=None, max_iterations=None, alpha=None, all=false, threads=None))]
+                    tolerance=None, max_iterations=None, alpha=None, all=false, threads=None,
+                    weight=None, gravity=None))]
 #[allow(clippy::too_many_arguments)]
 fn solve<'py>(
     py: Python<'py>,
@@ -342,8 +391,11 @@ fn solve<'py>(
     alpha: Option<f64>,
     all: bool,
     threads: Option<usize>,
+    weight: Option<PyReadonlyArray1<'py, f64>>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let t = targets.as_slice()?;
+    let g = gravities(t.len() / 3, weight.as_ref(), gravity.as_ref())?;
     let a0 = a0.as_ref().map(|a| a.as_slice()).transpose()?;
     let base = options(
         SolveOptions::default(),
@@ -357,9 +409,21 @@ fn solve<'py>(
     )?;
     rod_ig_core::planar::ig::warm_up();
     let target_of = |i: usize| Ok(PlanarPose::new(t[3 * i], t[3 * i + 1], t[3 * i + 2]));
+    if let Some(g) = g {
+        return solve_batch(
+            py,
+            |i| HeavyPlanar::new(g[i]),
+            t.len() / 3,
+            a0,
+            base,
+            all,
+            threads,
+            target_of,
+        );
+    }
     solve_batch(
         py,
-        &PlanarClosedForm,
+        |_| PlanarClosedForm,
         t.len() / 3,
         a0,
         base,
@@ -375,7 +439,7 @@ fn solve<'py>(
 #[allow(clippy::too_many_arguments)]
 fn solve_batch<'py, const N: usize, M>(
     py: Python<'py>,
-    model: &M,
+    model_of: impl Fn(usize) -> M + Sync,
     n: usize,
     a0: Option<&[f64]>,
     base: SolveOptions<nalgebra::SVector<f64, N>>,
@@ -398,6 +462,7 @@ where
             let mut o = base;
             o.initial_guess =
                 a0.map(|g| nalgebra::SVector::from_column_slice(&g[N * i..N * (i + 1)]));
+            let model = &model_of(i);
             match target_of(i) {
                 Ok(target) => {
                     let first = solver::solve(model, &target, &o);
@@ -527,7 +592,7 @@ fn solve3d<'py>(
         )
         .map_err(|e| e.to_string())
     };
-    solve_batch(py, &model, p.len() / 3, a0, base, all, threads, target_of)
+    solve_batch(py, |_| model, p.len() / 3, a0, base, all, threads, target_of)
 }
 
 /// Quasi-static motion of the planar rod: the rod follows its equilibrium branch as the tip

@@ -327,3 +327,55 @@ def test_dask_recipe_maps_the_batch_api_over_chunks() -> None:
 
 def test_version() -> None:
     assert isinstance(rod_ig.__version__, str) and rod_ig.__version__.count(".") == 2
+
+
+def gravity_cases() -> list[dict]:
+    lines = (REPO / "data" / "oracle" / "gravity_public.jsonl").read_text().splitlines()
+    return [c for c in map(json.loads, lines) if c["kind"] == "planar"]
+
+
+def test_weight_matches_the_public_gravity_cases() -> None:
+    cases = gravity_cases()
+    a = np.array([c["a"] for c in cases])
+    w = np.array([c["weight"] for c in cases])
+    g = np.array([c["gravity"] for c in cases])
+    r = rod_ig.forward(a, weight=w, gravity=g)
+    tip = np.array([[c["tip"]["x"], c["tip"]["y"], c["tip"]["theta"]] for c in cases])
+    assert np.abs(r.tip - tip).max() < 1e-9
+    assert np.abs(r.jacobian - np.array([c["jacobian"] for c in cases])).max() < 1e-6
+    assert (r.stable == np.array([c["stable"] for c in cases])).all()
+    assert np.allclose(r.energy, [c["energy"] for c in cases], rtol=1e-8, atol=1e-8)
+    assert r.elastic_energy is not None and (r.elastic_energy != r.energy).any()
+    assert (rod_ig.is_stable(a, weight=w, gravity=g) == r.stable).all()
+
+
+def test_weight_broadcasts_and_zero_weight_is_the_weightless_rod() -> None:
+    a = np.array([[2.0, -10.0, 5.0], [3.0, -2.0, -25.0]])
+    plain = rod_ig.forward(a)
+    zero = rod_ig.forward(a, weight=0.0)
+    assert (plain.tip == zero.tip).all() and (plain.energy == zero.energy).all()
+    # A scalar weight, one direction per rod, and a (3, 1) column of weights against 2 rods.
+    r = rod_ig.forward(a, weight=50.0, gravity=[[0.0, -1.0], [1.0, 0.0]])
+    assert r.tip.shape == (2, 3)
+    grid = rod_ig.forward(a, weight=np.array([[1.0], [10.0], [100.0]]))
+    assert grid.tip.shape == (3, 2, 3)
+    poses = rod_ig.shape(a, samples=7, weight=50.0)
+    assert poses.shape == (2, 7, 3)
+    assert np.allclose(poses[:, -1], rod_ig.forward(a, weight=50.0).tip, atol=1e-12)
+
+
+def test_weight_solve_reaches_heavy_targets_and_errors_name_the_argument() -> None:
+    rod_ig.warm_up()
+    s = rod_ig.solve([0.6, 0.0, 0.0], weight=50.0, objective="least_energy")
+    assert bool(s.success)
+    assert abs(float(s.a[2]) + 25.0) < 1e-4  # a rod held level: a5 = -w/2 by symmetry
+    check = rod_ig.forward(s.a, weight=50.0)
+    assert np.abs(check.tip - [0.6, 0.0, 0.0]).max() < 1e-6 and bool(check.stable)
+    with pytest.raises(ValueError, match="weight"):
+        rod_ig.forward([1.0, 2.0, 3.0], weight=-1.0)
+    with pytest.raises(ValueError, match="gravity"):
+        rod_ig.forward([1.0, 2.0, 3.0], weight=1.0, gravity=[0.0, 0.0])
+    with pytest.raises(ValueError, match="gravity"):
+        rod_ig.forward([1.0, 2.0, 3.0], weight=1.0, gravity=[0.0, 0.0, 1.0])
+    with pytest.raises(TypeError, match="weight"):
+        rod_ig.forward([1.0, 2.0, 3.0], weight="heavy")

@@ -5,9 +5,10 @@ use crate::answer::SolveAnswer;
 use crate::jsonl;
 use crate::svg::{Obstacle as DrawnObstacle, SequenceKind, SequenceRod};
 use rod_ig_core::plan::{self, Obstacle, PlanRequest, Planner};
+use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
+use rod_ig_core::planar::ig::SolveOptions;
 use rod_ig_core::planar::PlanarClosedForm;
-use rod_ig_core::planar::PlanarRod;
-use rod_ig_core::solver::{BranchEvent, BranchFollower, SolveOptions};
+use rod_ig_core::solver::{self, BranchEvent, BranchFollower, Move, Objective};
 use rod_ig_core::{PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -24,6 +25,76 @@ struct TrackRequest {
     target: PlanarPose,
     tolerance: Option<f64>,
     deadline_ms: Option<f64>,
+    /// Dimensionless weight from this line on (default: the stream's, at first 0).
+    weight: Option<f64>,
+    /// Direction of gravity from this line on (default: the stream's, at first [0, -1]).
+    gravity: Option<[f64; 2]>,
+}
+
+/// The branch follower of a stream: the weightless closed forms until a line gives weight.
+enum Follower {
+    Weightless(BranchFollower<3, PlanarClosedForm>),
+    Heavy(BranchFollower<3, HeavyPlanar>),
+}
+
+impl Follower {
+    fn new(g: Gravity, options: SolveOptions) -> Self {
+        if g.is_weightless() {
+            Self::Weightless(BranchFollower::new(PlanarClosedForm, options))
+        } else {
+            Self::Heavy(BranchFollower::new(HeavyPlanar::new(g), options))
+        }
+    }
+
+    fn holding(g: Gravity, options: SolveOptions, a: PlanarParams) -> Result<Self, String> {
+        let held = if g.is_weightless() {
+            BranchFollower::holding(PlanarClosedForm, options, a).map(Self::Weightless)
+        } else {
+            BranchFollower::holding(HeavyPlanar::new(g), options, a).map(Self::Heavy)
+        };
+        held.map_err(|e| e.to_string())
+    }
+
+    fn follow(
+        &mut self,
+        target: &PlanarPose,
+        options: SolveOptions,
+    ) -> Move<PlanarParams, PlanarPose> {
+        match self {
+            Self::Weightless(f) => {
+                f.set_options(options);
+                f.follow(target)
+            }
+            Self::Heavy(f) => {
+                f.set_options(options);
+                f.follow(target)
+            }
+        }
+    }
+
+    fn rod(&self) -> Option<PlanarParams> {
+        match self {
+            Self::Weightless(f) => f.rod(),
+            Self::Heavy(f) => f.rod(),
+        }
+    }
+
+    fn gripper(&self) -> Option<PlanarPose> {
+        match self {
+            Self::Weightless(f) => f.gripper(),
+            Self::Heavy(f) => f.gripper(),
+        }
+    }
+}
+
+/// What a change of gravity did to the held rod.
+struct GravityChange {
+    /// The rod before the change, when the branch folded and the rod snapped.
+    snapped_from: Option<PlanarParams>,
+    /// Where the gripper stood when it snapped.
+    gripper: Option<PlanarPose>,
+    /// Total energy released by the snap.
+    energy_released: f64,
 }
 
 /// A `track` answer: the `solve` fields plus the branch event.
@@ -53,7 +124,9 @@ struct TrackAnswer {
 /// The state of a `track` stream: the follower and, for `--svg`, the rods so far.
 #[derive(Default)]
 pub struct Tracking {
-    follower: Option<BranchFollower<3, PlanarClosedForm>>,
+    follower: Option<Follower>,
+    /// The stream's gravity (a line with `weight` or `gravity` changes it for the next lines).
+    gravity: Gravity,
     /// Rods for the picture.
     pub drawn: Vec<SequenceRod>,
     lines: usize,
@@ -63,8 +136,49 @@ fn params3(a: &PlanarParams) -> [f64; 3] {
     [a[0], a[1], a[2]]
 }
 
-fn shape(a: &PlanarParams) -> Vec<PlanarPose> {
-    PlanarRod::new(a).map_or_else(|_| Vec::new(), |r| r.shape(DRAW_SAMPLES))
+fn shape(a: &PlanarParams, g: &Gravity) -> Vec<PlanarPose> {
+    heavy::shape(a, g, DRAW_SAMPLES).unwrap_or_default()
+}
+
+/// Carries the rod `follower` holds from gravity `from` to `to`, the gripper fixed: along its
+/// branch, or, where the branch folds, by a snap to the least-energy stable rod under `to`.
+fn change_gravity(
+    follower: &Follower,
+    from: &Gravity,
+    to: &Gravity,
+    options: SolveOptions,
+) -> Result<(Follower, GravityChange), String> {
+    let (Some(a), Some(gripper)) = (follower.rod(), follower.gripper()) else {
+        return Ok((
+            Follower::new(*to, options),
+            GravityChange {
+                snapped_from: None,
+                gripper: None,
+                energy_released: 0.0,
+            },
+        ));
+    };
+    if let Ok(s) = heavy::carry(&a, from, to, &gripper, &options) {
+        let change = GravityChange {
+            snapped_from: None,
+            gripper: None,
+            energy_released: 0.0,
+        };
+        return Ok((Follower::holding(*to, options, s.a)?, change));
+    }
+    let least = SolveOptions {
+        objective: Objective::LeastEnergy,
+        ..options
+    };
+    let s = solver::solve(&HeavyPlanar::new(*to), &gripper, &least)
+        .map_err(|f| format!("the rod was lost when gravity changed: {}", f.reason))?;
+    let before = heavy::energy(&a, to).map(|e| e.0).unwrap_or(f64::NAN);
+    let change = GravityChange {
+        snapped_from: Some(a),
+        gripper: Some(gripper),
+        energy_released: before - s.energy,
+    };
+    Ok((Follower::holding(*to, options, s.a)?, change))
 }
 
 impl Tracking {
@@ -84,24 +198,44 @@ impl Tracking {
         if let Some(ms) = request.deadline_ms {
             options.deadline = jsonl::deadline_from_ms(ms)?;
         }
+        let gravity = if request.weight.is_some() || request.gravity.is_some() {
+            let d = self.gravity.direction();
+            crate::planar_cmds::gravity_of(
+                Some(request.weight.unwrap_or(self.gravity.weight())),
+                Some(request.gravity.unwrap_or(d)),
+            )?
+        } else {
+            self.gravity
+        };
         if let Some(a0) = request.a0 {
             if self.lines > 1 {
                 return Err("\"a0\" is only accepted on the first line".into());
             }
             let a0 = PlanarParams::from(a0);
-            let follower = BranchFollower::holding(PlanarClosedForm, options, a0)
+            let follower = Follower::holding(gravity, options, a0)
                 .map_err(|e| format!("a0 cannot be held: {e}"))?;
             self.drawn.push(SequenceRod {
-                poses: shape(&a0),
+                poses: shape(&a0, &gravity),
                 kind: SequenceKind::Start,
             });
             self.follower = Some(follower);
+            self.gravity = gravity;
+        }
+        let mut change = None;
+        if gravity != self.gravity {
+            if let Some(f) = &self.follower {
+                let (f, c) = change_gravity(f, &self.gravity, &gravity, options)?;
+                self.follower = Some(f);
+                change = Some(c);
+            } else {
+                self.follower = None;
+            }
+            self.gravity = gravity;
         }
         let follower = self
             .follower
-            .get_or_insert_with(|| BranchFollower::new(PlanarClosedForm, options));
-        follower.set_options(options);
-        let m = follower.follow(&request.target);
+            .get_or_insert_with(|| Follower::new(gravity, options));
+        let m = follower.follow(&request.target, options);
         let solve = match &m.result {
             Ok(s) => SolveAnswer::success(s, params3, |t| *t),
             Err(f) => SolveAnswer::failure(
@@ -132,9 +266,20 @@ impl Tracking {
             answer.critical_a = Some(params3(&critical_a));
             answer.energy_released = Some(energy_released);
             self.drawn.push(SequenceRod {
-                poses: shape(&critical_a),
+                poses: shape(&critical_a, &gravity),
                 kind: SequenceKind::Critical,
             });
+        } else if let Some(GravityChange {
+            snapped_from: Some(from),
+            gripper,
+            energy_released,
+        }) = change
+        {
+            // The gravity change snapped the rod where the gripper stood.
+            answer.event = "snap";
+            answer.critical = gripper;
+            answer.critical_a = Some(params3(&from));
+            answer.energy_released = Some(energy_released);
         }
         if let Ok(s) = &m.result {
             let kind = if matches!(m.event, BranchEvent::Snap { .. }) {
@@ -143,7 +288,7 @@ impl Tracking {
                 SequenceKind::Step
             };
             self.drawn.push(SequenceRod {
-                poses: shape(&s.a),
+                poses: shape(&s.a, &gravity),
                 kind,
             });
         }
@@ -211,7 +356,7 @@ impl Planning {
                     .iter()
                     .enumerate()
                     .map(|(i, a)| SequenceRod {
-                        poses: shape(a),
+                        poses: shape(a, &Gravity::NONE),
                         kind: if i == 0 {
                             SequenceKind::Start
                         } else {

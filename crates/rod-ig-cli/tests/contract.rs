@@ -423,3 +423,39 @@ fn shape_draws_heavy_rods_beside_weightless_ones() {
     assert_eq!(out[0]["poses"][0]["x"], 0.0);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn track_follows_changes_of_weight_and_gravity() {
+    // The gripper holds a rod level at 0.6; the cable gets heavier, then the base turns so that
+    // gravity points along +x, then back: each line answers a stable rod on target.
+    let lines = [
+        "{\"target\": {\"x\": 0.6, \"y\": 0, \"theta\": 0}}",
+        "{\"target\": {\"x\": 0.6, \"y\": 0, \"theta\": 0}, \"weight\": 50}",
+        "{\"target\": {\"x\": 0.55, \"y\": 0.05, \"theta\": 0}}",
+        "{\"target\": {\"x\": 0.55, \"y\": 0.05, \"theta\": 0}, \"gravity\": [1, 0]}",
+        "{\"target\": {\"x\": 0.55, \"y\": 0.05, \"theta\": 0}, \"gravity\": [0, -1]}",
+        "{\"target\": {\"x\": 0.55, \"y\": 0.05, \"theta\": 0}, \"weight\": -3}",
+    ];
+    let out = run(&["track"], &(lines.join("\n") + "\n"));
+    assert_eq!(out.len(), 6);
+    for (i, answer) in out[..5].iter().enumerate() {
+        assert_eq!(answer["success"], true, "line {i}: {answer}");
+        assert_eq!(answer["stable"], true);
+        assert!(answer["position_error"].as_f64().unwrap() < 1e-6);
+    }
+    // The held rod under w = 50, gravity −y at (0.6, 0, 0) is the level rod: a5 = −25.
+    assert!(
+        (out[1]["a"][2].as_f64().unwrap() + 25.0).abs() < 1e-5,
+        "{}",
+        out[1]
+    );
+    // Back to the same gravity and pose: the same branch, hence the same rod.
+    let (a2, a4) = (&out[2]["a"], &out[4]["a"]);
+    for k in 0..3 {
+        assert!(
+            (a2[k].as_f64().unwrap() - a4[k].as_f64().unwrap()).abs() < 1e-4,
+            "{a2} vs {a4}"
+        );
+    }
+    assert!(out[5]["error"].as_str().unwrap().contains("weight"));
+}

@@ -14,8 +14,8 @@
 //!
 //! Without weight (w = 0) every function here is the weightless closed form's
 //! ([`crate::planar`]), bit for bit. With weight the rod and its variational equations are
-//! integrated by Taylor series ([`series`]: polynomial recurrences, dense output), and the
-//! stability test scans det J(t) on the series' polynomials ([`scan`]).
+//! integrated by Taylor series (`series`: polynomial recurrences, dense output), and the
+//! stability test scans det J(t) on the series' polynomials (`scan`).
 
 // `!(x > y)` comparisons deliberately reject NaN; index loops mirror the formulas.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
@@ -24,7 +24,7 @@ mod model;
 pub(crate) mod scan;
 pub(crate) mod series;
 
-pub use model::HeavyPlanar;
+pub use model::{carry, HeavyPlanar};
 
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 use serde::{Deserialize, Serialize};
@@ -86,6 +86,16 @@ impl Gravity {
         })
     }
 
+    /// The gravity whose load per unit length is w ĝ = `load` (direction `fallback` when the
+    /// load is zero).
+    pub fn from_load(load: [f64; 2], fallback: [f64; 2]) -> Result<Self, RodError> {
+        let w = load[0].hypot(load[1]);
+        if w == 0.0 {
+            return Self::new(0.0, fallback);
+        }
+        Self::new(w, load)
+    }
+
     /// The dimensionless weight w.
     pub fn weight(&self) -> f64 {
         self.weight
@@ -140,7 +150,7 @@ pub struct HeavyEvaluation {
     pub energy: f64,
     /// Elastic energy ½∫κ².
     pub elastic_energy: f64,
-    /// Stability verdict and margin ([`scan`]).
+    /// Stability verdict and margin (`scan`).
     pub stability: StabilityReport,
 }
 
@@ -260,7 +270,7 @@ pub fn shape(a: &PlanarParams, g: &Gravity, samples: usize) -> Result<Vec<Planar
     Ok(out)
 }
 
-/// Stability of the heavy rod ([`scan`]; w = 0: [`crate::planar::stability`]).
+/// Stability of the heavy rod (`scan`; w = 0: [`crate::planar::stability`]).
 pub fn stability(a: &PlanarParams, g: &Gravity) -> Result<StabilityReport, RodError> {
     Ok(evaluate(a, g)?.stability)
 }

@@ -106,8 +106,12 @@ impl RodModel<3> for HeavyPlanar {
 const CORRECTOR_ITERATIONS: u32 = 8;
 /// Tolerance of the continuation's intermediate rods.
 const SUBSTEP_TOLERANCE: f64 = 1e-6;
-/// Smallest continuation step in w, relative to the weight.
-const MIN_FRACTION: f64 = 1.0 / 4096.0;
+/// Smallest continuation step, as a fraction of the whole change of load.
+const MIN_FRACTION: f64 = 1.0 / 65536.0;
+/// Largest change of the load w ĝ in one continuation substep.
+const MAX_LOAD_STEP: f64 = 10.0;
+/// Largest relative distance (scale 1) of a corrected substep from its prediction.
+const MAX_CORRECTION: f64 = 0.3;
 /// Halvings of a Newton step in the line search.
 const LINE_SEARCH: u32 = 10;
 
@@ -188,12 +192,22 @@ impl Search<'_> {
         }
     }
 
-    /// Follows the weightless rod `a0` (on target at w = 0) to the weight of `g`.
-    fn continuation(&mut self, g: &Gravity, a0: &PlanarParams) -> Option<PlanarParams> {
-        let w = g.weight();
+    /// Follows the rod `a0`, on target under `from`, to the gravity `to`: the load w ĝ moves
+    /// on the straight line between the two (a change of weight, or the base gripper turning).
+    fn continuation(
+        &mut self,
+        from: &Gravity,
+        to: &Gravity,
+        a0: &PlanarParams,
+    ) -> Option<PlanarParams> {
+        let (l0, l1) = (from.load(), to.load());
+        let load_at = |s: f64| [l0[0] + (l1[0] - l0[0]) * s, l0[1] + (l1[1] - l0[1]) * s];
         let (mut s, mut a) = (0.0f64, *a0);
         let mut prev: Option<(f64, PlanarParams)> = None;
-        let mut ds = 0.25f64;
+        // Substeps change the load by at most MAX_LOAD_STEP (the rod's response is ~ half of it).
+        let change = (l1[0] - l0[0]).hypot(l1[1] - l0[1]);
+        let max_ds = (MAX_LOAD_STEP / change).min(0.5);
+        let mut ds = 0.5 * max_ds;
         while s < 1.0 {
             if self.out_of_time() {
                 return None;
@@ -202,16 +216,23 @@ impl Search<'_> {
             let guess = match prev {
                 Some((sp, ap)) if s > sp => a + (a - ap) * ((s1 - s) / (s - sp)),
                 _ => {
-                    let l = g.load();
-                    a + Vector3::new(0.0, 0.5 * l[0], 0.5 * l[1]) * (s1 - s)
+                    // The symmetric share of the load's change.
+                    let d = [l1[0] - l0[0], l1[1] - l0[1]];
+                    a + Vector3::new(0.0, 0.5 * d[0], 0.5 * d[1]) * (s1 - s)
                 }
             };
-            let gs = g.with_weight(w * s1).ok()?;
-            match self.newton(&gs, &guess, SUBSTEP_TOLERANCE, CORRECTOR_ITERATIONS) {
+            let gs = Gravity::from_load(load_at(s1), to.direction()).ok()?;
+            // A corrector that lands far from its predictor may have jumped to another branch.
+            let corrected = self
+                .newton(&gs, &guess, SUBSTEP_TOLERANCE, CORRECTOR_ITERATIONS)
+                .filter(|next| {
+                    relative_distance(next, &guess, &Vector3::repeat(1.0)) <= MAX_CORRECTION
+                });
+            match corrected {
                 Some(next) => {
                     prev = Some((s, a));
                     (s, a) = (s1, next);
-                    ds = (ds * 1.5).min(0.5);
+                    ds = (ds * 1.5).min(max_ds);
                 }
                 None => {
                     ds *= 0.5;
@@ -276,7 +297,7 @@ impl Search<'_> {
                 return Some(s);
             }
         }
-        let a = self.continuation(g, a0)?;
+        let a = self.continuation(&Gravity::NONE, g, a0)?;
         self.finish(g, &a)
     }
 
@@ -298,6 +319,33 @@ impl Search<'_> {
             last_a: None,
             elapsed_us: 0.0,
         }
+    }
+}
+
+/// Carries the stable rod `a`, which holds the tip gripper at `gripper` under gravity `from`, to
+/// gravity `to` with the gripper fixed: the equilibrium branch followed as the weight or the
+/// direction of gravity changes (the base gripper turning). The rod returned passed the
+/// stability test under `to`. Fails where the branch folds or loses stability on the way (the
+/// rod would snap), or on the deadline of `options`.
+pub fn carry(
+    a: &PlanarParams,
+    from: &Gravity,
+    to: &Gravity,
+    gripper: &PlanarPose,
+    options: &SolveOptions,
+) -> Result<Solution<PlanarParams, PlanarPose>, Failure<PlanarParams>> {
+    let _deadline = crate::solver::deadline::scope(options.deadline);
+    let mut search = Search {
+        target: *gripper,
+        options,
+        work: Work::default(),
+        last_error: None,
+    };
+    search.work.starts = 1;
+    let carried = search.continuation(from, to, a);
+    match carried.and_then(|a| search.finish(to, &a)) {
+        Some(s) => Ok(s),
+        None => Err(search.failure()),
     }
 }
 
