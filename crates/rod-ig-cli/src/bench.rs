@@ -443,6 +443,13 @@ pub fn weight(quick: bool) {
         planar::evaluate(a).map(|e| e.stability.stable)
     });
     pair("tip + J + energy + stability", ev, ev0);
+    heavy_solves(targets);
+    outln!();
+}
+
+/// The robust solve of `targets` targets of stable heavy rods, against the weightless solve of
+/// the same poses.
+fn heavy_solves(targets: usize) {
     // Robust solves of targets reached by stable heavy rods (|p| ≤ 0.98).
     rod_ig_core::planar::ig::warm_up();
     let mut cases = Vec::new();
@@ -487,5 +494,4 @@ pub fn weight(quick: bool) {
         cases.len(),
         100.0 * solved as f64 / cases.len().max(1) as f64
     );
-    outln!();
 }

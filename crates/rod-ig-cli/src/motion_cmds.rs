@@ -198,15 +198,35 @@ impl Tracking {
         if let Some(ms) = request.deadline_ms {
             options.deadline = jsonl::deadline_from_ms(ms)?;
         }
-        let gravity = if request.weight.is_some() || request.gravity.is_some() {
-            let d = self.gravity.direction();
-            crate::planar_cmds::gravity_of(
-                Some(request.weight.unwrap_or(self.gravity.weight())),
-                Some(request.gravity.unwrap_or(d)),
-            )?
-        } else {
-            self.gravity
-        };
+        let gravity = self.requested_gravity(&request)?;
+        let change = self.hold(&request, gravity, options)?;
+        let follower = self
+            .follower
+            .get_or_insert_with(|| Follower::new(gravity, options));
+        let m = follower.follow(&request.target, options);
+        let held_a = follower.rod().map(|a| params3(&a));
+        let answer = self.answer(&m, change, held_a, &gravity);
+        jsonl::to_value(&answer)
+    }
+
+    /// The gravity of a line: the stream's, changed by the line's `weight` and `gravity`.
+    fn requested_gravity(&self, request: &TrackRequest) -> Result<Gravity, String> {
+        if request.weight.is_none() && request.gravity.is_none() {
+            return Ok(self.gravity);
+        }
+        crate::planar_cmds::gravity_of(
+            Some(request.weight.unwrap_or(self.gravity.weight())),
+            Some(request.gravity.unwrap_or(self.gravity.direction())),
+        )
+    }
+
+    /// Takes the line's `a0` (first line only) and carries the held rod to the line's gravity.
+    fn hold(
+        &mut self,
+        request: &TrackRequest,
+        gravity: Gravity,
+        options: SolveOptions,
+    ) -> Result<Option<GravityChange>, String> {
         if let Some(a0) = request.a0 {
             if self.lines > 1 {
                 return Err("\"a0\" is only accepted on the first line".into());
@@ -232,10 +252,19 @@ impl Tracking {
             }
             self.gravity = gravity;
         }
-        let follower = self
-            .follower
-            .get_or_insert_with(|| Follower::new(gravity, options));
-        let m = follower.follow(&request.target, options);
+        Ok(change)
+    }
+
+    /// The answer to a move, with the snap of a change of gravity when the move had none, and
+    /// the rods for the picture.
+    fn answer(
+        &mut self,
+        m: &Move<PlanarParams, PlanarPose>,
+        change: Option<GravityChange>,
+        held_a: Option<[f64; 3]>,
+        gravity: &Gravity,
+    ) -> TrackAnswer {
+        let gravity = *gravity;
         let solve = match &m.result {
             Ok(s) => SolveAnswer::success(s, params3, |t| *t),
             Err(f) => SolveAnswer::failure(
@@ -253,7 +282,7 @@ impl Tracking {
             critical_a: None,
             energy_released: None,
             progress: m.progress,
-            held_a: follower.rod().map(|a| params3(&a)),
+            held_a,
         };
         if let BranchEvent::Snap {
             critical,
@@ -292,7 +321,7 @@ impl Tracking {
                 kind,
             });
         }
-        jsonl::to_value(&answer)
+        answer
     }
 }
 

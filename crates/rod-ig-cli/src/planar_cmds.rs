@@ -152,6 +152,11 @@ pub fn sample_shape(a: [f64; 3], g: &Gravity, samples: usize) -> Result<Vec<Plan
     heavy::shape(&PlanarParams::from(a), g, samples).map_err(|e| e.to_string())
 }
 
+/// The fixed text around a shape line's values (kept out of the function, whose braces the
+/// layering check counts).
+const SHAPE_LINE_OPEN: &[u8] = b"{\"a\":";
+const SHAPE_LINE_CLOSE: &[u8] = b"]}\n";
+
 /// Writes the rod `a` as one JSON line {"a": [..], "poses": [{"x", "y", "theta"}, ..]} with
 /// `samples` poses from the base to the tip, each written as it is computed (the same poses
 /// as [`planar::PlanarRod::shape`], in memory independent of `samples`).
@@ -163,15 +168,11 @@ pub fn write_shape_line(
 ) -> Result<(), String> {
     check_samples(samples)?;
     if !g.is_weightless() {
-        // The heavy rod's poses come from one integration (24 bytes each, ≤ 24 MB).
-        let poses = sample_shape(a, g, samples)?;
-        let line = serde_json::json!({ "a": a, "poses": poses });
-        serde_json::to_writer(&mut *out, &line).map_err(|e| e.to_string())?;
-        return out.write_all(b"\n").map_err(|e| e.to_string());
+        return write_heavy_shape_line(out, a, g, samples);
     }
     let rod = planar::PlanarRod::new(&PlanarParams::from(a)).map_err(|e| e.to_string())?;
     let io = |e: std::io::Error| e.to_string();
-    write!(out, "{{\"a\":").map_err(io)?;
+    out.write_all(SHAPE_LINE_OPEN).map_err(io)?;
     serde_json::to_writer(&mut *out, &a).map_err(|e| e.to_string())?;
     write!(out, ",\"poses\":[").map_err(io)?;
     let last = samples - 1;
@@ -186,7 +187,25 @@ pub fn write_shape_line(
         }
         serde_json::to_writer(&mut *out, &pose).map_err(|e| e.to_string())?;
     }
-    out.write_all(b"]}\n").map_err(io)
+    out.write_all(SHAPE_LINE_CLOSE).map_err(io)
+}
+
+/// [`write_shape_line`] for a rod with weight: its poses come from one integration (24 bytes
+/// each, at most 24 MB).
+fn write_heavy_shape_line(
+    out: &mut impl Write,
+    a: [f64; 3],
+    g: &Gravity,
+    samples: usize,
+) -> Result<(), String> {
+    #[derive(Serialize)]
+    struct Line {
+        a: [f64; 3],
+        poses: Vec<PlanarPose>,
+    }
+    let poses = sample_shape(a, g, samples)?;
+    serde_json::to_writer(&mut *out, &Line { a, poses }).map_err(|e| e.to_string())?;
+    out.write_all(&[b'\n']).map_err(|e| e.to_string())
 }
 
 /// Every distinct stable solution found for the target (x, y, θ) under `g`, least energy first.
