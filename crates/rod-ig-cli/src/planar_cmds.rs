@@ -205,7 +205,7 @@ fn write_heavy_shape_line(
     }
     let poses = sample_shape(a, g, samples)?;
     serde_json::to_writer(&mut *out, &Line { a, poses }).map_err(|e| e.to_string())?;
-    out.write_all(&[b'\n']).map_err(|e| e.to_string())
+    out.write_all(b"\n").map_err(|e| e.to_string())
 }
 
 /// Every distinct stable solution found for the target (x, y, θ) under `g`, least energy first.
