@@ -321,6 +321,9 @@ class Client:
                 pv.type, pv.integer_value = ParameterType.PARAMETER_INTEGER, value
             elif isinstance(value, float):
                 pv.type, pv.double_value = ParameterType.PARAMETER_DOUBLE, value
+            elif isinstance(value, (list, tuple)):
+                pv.type = ParameterType.PARAMETER_DOUBLE_ARRAY
+                pv.double_array_value = [float(v) for v in value]
             else:
                 pv.type, pv.string_value = ParameterType.PARAMETER_STRING, str(value)
             req.parameters.append(Parameter(name=name, value=pv))
@@ -338,7 +341,9 @@ class Client:
             out[name] = {ParameterType.PARAMETER_DOUBLE: v.double_value,
                          ParameterType.PARAMETER_INTEGER: v.integer_value,
                          ParameterType.PARAMETER_STRING: v.string_value,
-                         ParameterType.PARAMETER_BOOL: v.bool_value}.get(v.type)
+                         ParameterType.PARAMETER_BOOL: v.bool_value,
+                         ParameterType.PARAMETER_DOUBLE_ARRAY: list(v.double_array_value),
+                         }.get(v.type)
         return out
 
     def close(self):

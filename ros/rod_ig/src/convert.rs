@@ -3,6 +3,7 @@
 //! parameter `solve_3d`, 3-D poses. No rod mechanics here: only unit scaling by the rod length
 //! L ([`to_normalised`] / [`to_metres`]) and the bending stiffness EI, and quaternion ↔ yaw.
 
+use rod_ig_core::planar::heavy::Gravity;
 use thiserror::Error;
 
 use crate::messages::{
@@ -46,6 +47,9 @@ pub enum TargetError {
         /// Rod length (m).
         length: f64,
     },
+    /// The weight parameters cannot be used (see [`gravity_of`]).
+    #[error("{0}")]
+    Weight(String),
 }
 
 impl TargetError {
@@ -55,7 +59,7 @@ impl TargetError {
         match self {
             Self::OutOfReach { .. } => "unreachable",
             Self::OffPlane { .. } | Self::Tilted { .. } => "non_planar",
-            Self::NonFinite(_) | Self::ZeroQuaternion(_) => "invalid_input",
+            Self::NonFinite(_) | Self::ZeroQuaternion(_) | Self::Weight(_) => "invalid_input",
         }
     }
 
@@ -64,6 +68,40 @@ impl TargetError {
     pub fn is_non_planar(&self) -> bool {
         matches!(self, Self::OffPlane { .. } | Self::Tilted { .. })
     }
+}
+
+/// The rod's weight from the parameters: the dimensionless w = ρA |g| L³ / EI
+/// (`linear_density`, `gravity`, `rod_length`, `bending_stiffness`) along the direction of
+/// `gravity` in the rod's plane (the base frame's x-y plane). No weight when `linear_density`
+/// is 0. Refused with a reason when EI or gravity is missing, when gravity leaves the rod's
+/// plane by more than `planar_tolerance` (rad), or when w exceeds the solver's domain.
+pub fn gravity_of(params: &Params) -> Result<Gravity, TargetError> {
+    let refuse = |why: String| Err(TargetError::Weight(why));
+    if params.linear_density == 0.0 {
+        return Ok(Gravity::NONE);
+    }
+    if params.bending_stiffness <= 0.0 {
+        return refuse("linear_density > 0 needs bending_stiffness (EI, N m^2) > 0 for the rod's dimensionless weight".into());
+    }
+    let [gx, gy, gz] = params.gravity;
+    let g = (gx * gx + gy * gy + gz * gz).sqrt();
+    if g <= 0.0 || !g.is_finite() {
+        return refuse("linear_density > 0 needs the gravity parameter (m/s^2 in the base frame, e.g. [0.0, -9.81, 0.0])".into());
+    }
+    let tilt = (gz / g).abs().asin();
+    if tilt > params.planar_tolerance {
+        return refuse(format!(
+            "gravity leaves the rod's plane by {tilt:.3e} rad (gravity z = {gz} m/s^2; accepted <= planar_tolerance = {} rad): the planar rod with weight hangs in a vertical plane, and the 3-D rod with weight is not implemented yet",
+            params.planar_tolerance
+        ));
+    }
+    let l = params.rod_length;
+    let w = params.linear_density * g * l * l * l / params.bending_stiffness;
+    Gravity::new(w, [gx, gy]).or_else(|e| {
+        refuse(format!(
+            "the rod's dimensionless weight w = rho*A*g*L^3/EI = {w:e}: {e}"
+        ))
+    })
 }
 
 /// A position in metres as normalised coordinates (divided by the rod length).
@@ -372,6 +410,9 @@ struct ModelParts {
     /// Branch event ("" when not followed) and the critical gripper pose after a snap (m).
     event: &'static str,
     critical: Option<Pose>,
+    /// The dimensionless weight and the elastic part of the solution's energy.
+    weight: f64,
+    elastic_energy: f64,
 }
 
 /// Scales a converged answer to physical units (rod length L, bending stiffness EI).
@@ -401,9 +442,9 @@ fn converged_message<P, X>(
         position_error: s.position_error * l,
         orientation_error: s.orientation_error,
         residual: s.residual,
-        elastic_energy: s.energy,
+        elastic_energy: c.elastic_energy,
         elastic_energy_joules: if wrench_valid {
-            s.energy * ei / l
+            c.elastic_energy * ei / l
         } else {
             f64::NAN
         },
@@ -420,6 +461,8 @@ fn converged_message<P, X>(
         a_spatial: c.a_spatial,
         event: c.event.to_string(),
         critical_pose: c.critical.unwrap_or_else(nan_pose),
+        weight: c.weight,
+        total_energy: s.energy,
     }
 }
 
@@ -461,6 +504,8 @@ pub fn solution_message_3d(
         tip: spatial_to_pose(&s.tip, l),
         event: "",
         critical: None,
+        weight: 0.0,
+        elastic_energy: s.energy,
     };
     converged_message(s, parts, header, params, solve_time)
 }
@@ -484,6 +529,8 @@ pub fn solution_message(
         tip: planar_to_pose(&s.tip, l),
         event: solved.event,
         critical: solved.critical.map(|c| planar_to_pose(&c, l)),
+        weight: solved.weight,
+        elastic_energy: solved.elastic_energy,
     };
     converged_message(s, parts, header, params, solve_time)
 }
@@ -531,6 +578,8 @@ pub fn failure_message(
         a_spatial,
         event: failed.map_or("", |f| f.event).to_string(),
         critical_pose: nan_pose(),
+        weight: gravity_of(params).map_or(f64::NAN, |g| g.weight()),
+        total_energy: nan,
     }
 }
 
@@ -705,6 +754,8 @@ mod tests {
             shape: vec![],
             event: "none",
             critical: None,
+            weight: 0.0,
+            elastic_energy: 1.5,
         };
         let p = Params {
             rod_length: 0.5,
@@ -781,5 +832,55 @@ mod tests {
         assert_eq!(m.message, "why");
         assert!(m.a[0].is_nan());
         assert!(!m.spatial && m.a_spatial == [0.0; 6]);
+    }
+
+    #[test]
+    fn weight_from_the_parameters() {
+        // A 30 cm cable of 20 g/m and EI = 3.5e-4 N m^2 under 9.81 m/s^2 along −y:
+        // w = 0.02 * 9.81 * 0.027 / 3.5e-4 ≈ 15.1, gravity along −y.
+        let p = Params {
+            rod_length: 0.3,
+            bending_stiffness: 3.5e-4,
+            linear_density: 0.02,
+            gravity: [0.0, -9.81, 0.0],
+            ..Params::default()
+        };
+        let g = gravity_of(&p).unwrap();
+        assert!((g.weight() - 0.02 * 9.81 * 0.027 / 3.5e-4).abs() < 1e-12);
+        assert_eq!(g.direction(), [0.0, -1.0]);
+        assert!(gravity_of(&Params::default()).unwrap().is_weightless());
+        let refused = |p: Params, words: &str| {
+            let e = gravity_of(&p).unwrap_err();
+            assert!(e.to_string().contains(words), "{e}");
+            assert_eq!(e.key(), "invalid_input");
+        };
+        refused(
+            Params {
+                bending_stiffness: 0.0,
+                ..p.clone()
+            },
+            "bending_stiffness",
+        );
+        refused(
+            Params {
+                gravity: [0.0; 3],
+                ..p.clone()
+            },
+            "gravity parameter",
+        );
+        refused(
+            Params {
+                gravity: [0.0, -9.0, 4.0],
+                ..p.clone()
+            },
+            "rod's plane",
+        );
+        refused(
+            Params {
+                linear_density: 1e3,
+                ..p.clone()
+            },
+            "weight",
+        );
     }
 }

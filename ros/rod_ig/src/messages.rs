@@ -261,6 +261,10 @@ pub struct RodSolution {
     pub event: String,
     /// After a snap: where the old branch ended (m); NaN otherwise.
     pub critical_pose: Pose,
+    /// Dimensionless weight w of the solve (appended field; 0 without weight).
+    pub weight: f64,
+    /// Elastic + gravitational energy, normalised (appended field; NaN on failure).
+    pub total_energy: f64,
 }
 impl Message for RodSolution {}
 
@@ -699,6 +703,8 @@ pub(crate) mod tests {
             a_spatial: [0.5, -0.25, 1.5, -2.25, 3.125, 0.75],
             event: "snap".into(),
             critical_pose: pose(2),
+            weight: 15.1,
+            total_energy: 3.25,
         }
     }
 

@@ -62,6 +62,11 @@ pub struct Params {
     pub method: Method,
     /// `bending_stiffness` EI (N·m²) ≥ 0; 0 = unknown (no wrench or joules reported).
     pub bending_stiffness: f64,
+    /// `linear_density` ρA (kg/m) ≥ 0: the rod's weight per length is ρA·|gravity| (0: no
+    /// weight, the default). With weight, `bending_stiffness` and `gravity` are required.
+    pub linear_density: f64,
+    /// `gravity` (m/s², base frame): gravity's acceleration vector; [0, 0, 0] = not set.
+    pub gravity: [f64; 3],
     /// `planar_tolerance` ≥ 0: largest |z| (m) and tilt out of the plane (rad) accepted.
     pub planar_tolerance: f64,
     /// `publish_marker`: publish the RViz line strip on /rod/marker.
@@ -173,6 +178,8 @@ impl Default for Params {
             max_iterations: 0,
             method: Method::Robust,
             bending_stiffness: 0.0,
+            linear_density: 0.0,
+            gravity: [0.0; 3],
             planar_tolerance: 0.0,
             publish_marker: false,
             marker_width: 0.0,
@@ -245,6 +252,8 @@ enum Kind {
     Bool,
     /// A string, checked by the row's `set`.
     Str,
+    /// Three finite doubles (a vector of the base frame).
+    Vector3,
 }
 
 /// A parameter's default, as written in the table.
@@ -254,6 +263,7 @@ enum DefaultValue {
     Integer(i64),
     Bool(bool),
     Str(&'static str),
+    Vector3([f64; 3]),
 }
 
 /// One row of the parameter table: everything about one parameter, written once. The
@@ -305,7 +315,7 @@ const MAX_DEADLINE_MS: f64 = rod_ig_core::planar::ig::MAX_DEADLINE.as_secs_f64()
 const MAX_PATH_SAMPLES: i64 = 100_000;
 
 /// Every parameter of `rod_ig_node` (beside the `qos_overrides` ones), in declaration order.
-const TABLE: [Spec; 14] = [
+const TABLE: [Spec; 16] = [
     Spec {
         name: "rod_length",
         kind: Kind::Double {
@@ -406,6 +416,34 @@ const TABLE: [Spec; 14] = [
         get: |p| ParameterValue::Double(p.bending_stiffness),
         set: |p, v| {
             p.bending_stiffness = f64_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "linear_density",
+        kind: Kind::Double {
+            lo: 0.0,
+            hi: f64::INFINITY,
+            lo_open: false,
+        },
+        default: DefaultValue::Double(0.0),
+        description: "Mass per length of the rod (kg/m) for its weight; 0 = weightless (needs bending_stiffness and gravity when > 0)",
+        constraints: "",
+        get: |p| ParameterValue::Double(p.linear_density),
+        set: |p, v| {
+            p.linear_density = f64_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "gravity",
+        kind: Kind::Vector3,
+        default: DefaultValue::Vector3([0.0, 0.0, 0.0]),
+        description: "Gravity's acceleration in the base frame (m/s^2), e.g. [0.0, -9.81, 0.0]; [0, 0, 0] = not set",
+        constraints: "",
+        get: |p| ParameterValue::DoubleArray(p.gravity.to_vec()),
+        set: |p, v| {
+            p.gravity = vector3("gravity", v).map_err(|e| e.to_string())?;
             Ok(())
         },
     },
@@ -559,6 +597,7 @@ impl Kind {
                     got: type_name(other),
                 }),
             },
+            Kind::Vector3 => vector3(name, v).map(|_| ()),
         }
     }
 
@@ -573,6 +612,7 @@ impl Kind {
                 format!("in {}{lo}, {hi}]", if lo_open { "(" } else { "[" })
             }
             Kind::Integer { lo, hi } => format!("in [{lo}, {hi}]"),
+            Kind::Vector3 => "three finite numbers [x, y, z]".into(),
             Kind::Bool | Kind::Str => String::new(),
         }
     }
@@ -603,7 +643,30 @@ impl DefaultValue {
             DefaultValue::Integer(i) => ParameterValue::Integer(i),
             DefaultValue::Bool(b) => ParameterValue::Boolean(b),
             DefaultValue::Str(s) => ParameterValue::String(s.into()),
+            DefaultValue::Vector3(v) => ParameterValue::DoubleArray(v.to_vec()),
         }
+    }
+}
+
+/// Three finite numbers (a double or integer array of length 3).
+fn vector3(name: &str, v: &ParameterValue) -> Result<[f64; 3], ParamError> {
+    let values: Vec<f64> = match v {
+        ParameterValue::DoubleArray(d) => d.clone(),
+        ParameterValue::IntegerArray(i) => i.iter().map(|&x| x as f64).collect(),
+        other => {
+            return Err(ParamError::WrongType {
+                name: name.into(),
+                expected: "an array of three numbers",
+                got: type_name(other),
+            })
+        }
+    };
+    match values[..] {
+        [x, y, z] if values.iter().all(|v| v.is_finite()) => Ok([x, y, z]),
+        _ => Err(ParamError::Invalid {
+            name: name.into(),
+            reason: format!("must be three finite numbers [x, y, z], got {values:?}"),
+        }),
     }
 }
 
@@ -947,6 +1010,13 @@ fn yaml_to_value(v: &serde_yaml::Value) -> Option<ParameterValue> {
         }
         Y::String(s) => ParameterValue::String(s.clone()),
         Y::Null => ParameterValue::NotSet,
+        // A list of numbers is a double array (rcl reads [0, -9.81, 0] so too).
+        Y::Sequence(items) => ParameterValue::DoubleArray(
+            items
+                .iter()
+                .map(|i| i.as_f64())
+                .collect::<Option<Vec<f64>>>()?,
+        ),
         _ => return None,
     })
 }

@@ -143,6 +143,8 @@ pub fn settings_of(params: &Params) -> SolverSettings {
         max_iterations: params.max_iterations,
         deadline: std::time::Duration::from_secs_f64(params.deadline_ms / 1e3),
         follow_branch: params.follow_branch,
+        // Unusable weight parameters refuse every target (`process`); the settings keep none.
+        gravity: crate::convert::gravity_of(params).unwrap_or_default(),
     }
 }
 
@@ -205,6 +207,7 @@ impl Processor {
             max_iterations: overrides.max_iterations.unwrap_or(settings.max_iterations),
             deadline: settings.deadline,
             follow_branch: false,
+            gravity: settings.gravity,
         });
         let rejected = |e: crate::convert::TargetError| Outcome {
             failure: e.key(),
@@ -218,6 +221,9 @@ impl Processor {
             path: None,
             marker: None,
         };
+        if let Err(e) = crate::convert::gravity_of(params) {
+            return rejected(e);
+        }
         match target_to_planar(&target.pose, params) {
             Ok(planar) => {
                 let result = self
@@ -234,7 +240,7 @@ impl Processor {
             }
             // Non-planar but otherwise valid: the 3-D solver when enabled (the planar
             // initial guess of a service request is embedded as (0, 0, a3, a4, a5, 0)).
-            Err(e) if e.is_non_planar() && params.solve_3d => {
+            Err(e) if e.is_non_planar() && params.solve_3d && settings.gravity.is_weightless() => {
                 let spatial = match target_to_spatial(&target.pose, params) {
                     Ok(t) => t,
                     Err(e) => return rejected(e),
@@ -249,6 +255,11 @@ impl Processor {
                         s.solution.stable,
                     )
                 })
+            }
+            Err(e) if e.is_non_planar() && params.solve_3d => {
+                rejected(crate::convert::TargetError::Weight(format!(
+                    "{e}; the 3-D solver does not model weight yet (linear_density > 0)"
+                )))
             }
             Err(e) => rejected(e),
         }
@@ -267,7 +278,13 @@ impl Processor {
         held: Option<PlanarParams>,
     ) -> Planned {
         let header = output_header(&request.goal.header, params);
-        let plan = Self::plan_query(request, params, held)
+        let weightless = match crate::convert::gravity_of(params) {
+            Ok(g) if g.is_weightless() => Ok(()),
+            Ok(_) => Err("the planner does not model weight yet (linear_density > 0)".to_string()),
+            Err(e) => Err(e.to_string()),
+        };
+        let plan = weightless
+            .and_then(|()| Self::plan_query(request, params, held))
             .and_then(|query| self.planner.plan(&query).map_err(|e| e.to_string()));
         match plan {
             Ok(plan) => planned(&plan, header, params),

@@ -8,6 +8,7 @@
 //! the solver's normalised units (unit rod length, unit bending stiffness); scaling to metres
 //! happens in [`crate::convert`].
 
+use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
 use rod_ig_core::planar::ig::{self, Failure, Solution, SolveOptions, Tracker};
 use rod_ig_core::planar::PlanarClosedForm;
 use rod_ig_core::planar::PlanarRod;
@@ -34,6 +35,8 @@ pub struct SolverSettings {
     /// Warm-started planar targets move the gripper: the rod follows its branch (parameter
     /// `follow_branch`).
     pub follow_branch: bool,
+    /// The rod's weight (parameters `linear_density`, `gravity`; none by default).
+    pub gravity: Gravity,
 }
 
 /// A converged solve with its sampled shape, normalised units: the core crate's solution
@@ -48,6 +51,10 @@ pub struct WithShape<S, P> {
     pub event: &'static str,
     /// After a snap: the gripper pose where the old branch ended (normalised).
     pub critical: Option<PlanarPose>,
+    /// The dimensionless weight of the solve (0 without weight).
+    pub weight: f64,
+    /// The elastic part of the solution's energy (all of it without weight).
+    pub elastic_energy: f64,
 }
 
 /// A converged planar solve and its shape.
@@ -152,6 +159,11 @@ pub struct RodSolver {
     tracker: Tracker,
     /// The rod held by the grippers (planar targets with `follow_branch`).
     follower: BranchFollower<3, PlanarClosedForm>,
+    /// The same for a rod with weight (when `settings.gravity` has some).
+    heavy_follower: BranchFollower<3, HeavyPlanar>,
+    /// Previous solution of the rod with weight: the warm start of the next target when not
+    /// following the branch.
+    last_heavy: Option<PlanarParams>,
     /// Previous 3-D solution: the warm start of the next 3-D target.
     last_3d: Option<SpatialParams>,
 }
@@ -163,6 +175,11 @@ impl RodSolver {
             settings,
             tracker: Tracker::new(options(&settings, None)),
             follower: BranchFollower::new(PlanarClosedForm, options(&settings, None)),
+            heavy_follower: BranchFollower::new(
+                HeavyPlanar::new(settings.gravity),
+                options(&settings, None),
+            ),
+            last_heavy: None,
             last_3d: None,
         }
     }
@@ -174,6 +191,9 @@ impl RodSolver {
 
     /// The planar rod held now: the branch follower's, else the last warm start.
     pub fn current_rod(&self) -> Option<PlanarParams> {
+        if !self.settings.gravity.is_weightless() {
+            return self.heavy_follower.rod().or(self.last_heavy);
+        }
         self.follower.rod().or_else(|| self.tracker.last())
     }
 
@@ -184,15 +204,54 @@ impl RodSolver {
 
     /// Changes the settings, keeping the warm start.
     pub fn set_settings(&mut self, settings: SolverSettings) {
+        let previous = self.settings.gravity;
         self.settings = settings;
         self.tracker = Tracker::new(options(&settings, self.tracker.last()));
         self.follower.set_options(options(&settings, None));
+        if settings.gravity != previous {
+            self.change_gravity(&previous);
+        } else {
+            self.heavy_follower.set_options(options(&settings, None));
+        }
+    }
+
+    /// A change of weight or of gravity's direction moves the held rod like a gripper move:
+    /// it is carried along its branch with the gripper fixed (`heavy::carry`); where that
+    /// branch folds, the next target starts afresh.
+    fn change_gravity(&mut self, previous: &Gravity) {
+        let to = self.settings.gravity;
+        let o = options(&self.settings, None);
+        let held = if previous.is_weightless() {
+            self.follower.rod().zip(self.follower.gripper())
+        } else {
+            self.heavy_follower.rod().zip(self.heavy_follower.gripper())
+        };
+        let carried =
+            held.and_then(|(a, gripper)| heavy::carry(&a, previous, &to, &gripper, &o).ok());
+        self.last_heavy = carried.map(|s| s.a);
+        self.heavy_follower = match carried {
+            Some(s) if !to.is_weightless() => BranchFollower::holding(HeavyPlanar::new(to), o, s.a)
+                .unwrap_or_else(|_| BranchFollower::new(HeavyPlanar::new(to), o)),
+            _ => BranchFollower::new(HeavyPlanar::new(to), o),
+        };
+        if to.is_weightless() {
+            self.follower = match carried {
+                Some(s) => BranchFollower::holding(PlanarClosedForm, o, s.a)
+                    .unwrap_or_else(|_| BranchFollower::new(PlanarClosedForm, o)),
+                None => BranchFollower::new(PlanarClosedForm, o),
+            };
+        }
     }
 
     /// Forgets the warm starts (planar and 3-D).
     pub fn reset(&mut self) {
         self.tracker.reset();
         self.follower = BranchFollower::new(PlanarClosedForm, options(&self.settings, None));
+        self.heavy_follower = BranchFollower::new(
+            HeavyPlanar::new(self.settings.gravity),
+            options(&self.settings, None),
+        );
+        self.last_heavy = None;
         self.last_3d = None;
     }
 
@@ -236,6 +295,9 @@ impl RodSolver {
         one_off: Option<SolverSettings>,
         samples: usize,
     ) -> Result<Solved, Failed> {
+        if !self.settings.gravity.is_weightless() {
+            return self.solve_heavy(target, initial_guess, one_off, samples);
+        }
         let solution = if initial_guess.is_some() || one_off.is_some() {
             let s = one_off.unwrap_or(self.settings);
             ig::solve(target, &options(&s, initial_guess))?
@@ -269,6 +331,72 @@ impl RodSolver {
     }
 }
 
+impl RodSolver {
+    /// [`RodSolver::solve`] for the rod with weight: the same warm starts and branch
+    /// following, on the model `HeavyPlanar`.
+    fn solve_heavy(
+        &mut self,
+        target: &PlanarPose,
+        initial_guess: Option<PlanarParams>,
+        one_off: Option<SolverSettings>,
+        samples: usize,
+    ) -> Result<Solved, Failed> {
+        let g = self.settings.gravity;
+        let model = HeavyPlanar::new(g);
+        if initial_guess.is_some() || one_off.is_some() {
+            let s = one_off.unwrap_or(self.settings);
+            let solution = rod_solver::solve(&model, target, &options(&s, initial_guess))?;
+            return with_heavy_shape(&solution, &g, samples);
+        }
+        if self.settings.method == Method::Robust && self.settings.follow_branch {
+            let m = self.heavy_follower.follow(target);
+            let (event, critical) = match m.event {
+                BranchEvent::Snap { critical, .. } => ("snap", Some(critical)),
+                BranchEvent::Lost => ("lost", None),
+                BranchEvent::None => ("none", None),
+            };
+            let s = m.result.map_err(|f| Failed {
+                event,
+                ..Failed::from(f)
+            })?;
+            let mut solved = with_heavy_shape(&s, &g, samples)?;
+            solved.event = event;
+            solved.critical = critical;
+            return Ok(solved);
+        }
+        let o = options(&self.settings, self.last_heavy);
+        let solution = rod_solver::solve(&model, target, &o)?;
+        self.last_heavy = Some(solution.a);
+        with_heavy_shape(&solution, &g, samples)
+    }
+}
+
+fn shape_failure(s: &Solution, e: impl std::fmt::Display) -> Failed {
+    Failed {
+        reason: format!("cannot evaluate the solution's shape: {e}"),
+        termination: rod_ig_core::solver::Termination::EvaluationFailed.as_str(),
+        iterations: s.iterations,
+        residual: s.residual,
+        last_a: Some(s.a),
+        last_a_spatial: None,
+        spatial: false,
+        event: "",
+    }
+}
+
+fn with_heavy_shape(s: &Solution, g: &Gravity, samples: usize) -> Result<Solved, Failed> {
+    let shape = heavy::shape(&s.a, g, samples).map_err(|e| shape_failure(s, e))?;
+    let (_, elastic) = heavy::energy(&s.a, g).map_err(|e| shape_failure(s, e))?;
+    Ok(WithShape {
+        solution: *s,
+        shape,
+        event: "",
+        critical: None,
+        weight: g.weight(),
+        elastic_energy: elastic,
+    })
+}
+
 fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
     let rod = PlanarRod::new(&s.a).map_err(|e| Failed {
         reason: format!("cannot evaluate the solution's shape: {e}"),
@@ -285,6 +413,8 @@ fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
         shape: rod.shape(samples),
         event: "",
         critical: None,
+        weight: 0.0,
+        elastic_energy: s.energy,
     })
 }
 
@@ -304,5 +434,7 @@ fn with_shape_3d(s: &Solution3d, samples: usize) -> Result<Solved3d, Failed> {
         shape,
         event: "",
         critical: None,
+        weight: 0.0,
+        elastic_energy: s.energy,
     })
 }
