@@ -291,10 +291,12 @@ pub fn energy(a: &PlanarParams, g: &Gravity) -> Result<(f64, f64), RodError> {
 /// ```
 /// use rod_ig_core::planar::heavy::{self, Gravity};
 /// use rod_ig_core::PlanarParams;
-/// // A rod held level at both ends sags: a5 = −w/2 by symmetry.
-/// let g = Gravity::new(50.0, [0.0, -1.0]).unwrap();
-/// let e = heavy::evaluate(&PlanarParams::new(3.0, -2.0, -25.0), &g).unwrap();
-/// assert!(e.energy < e.elastic_energy); // the rod hangs below its base
+/// // Without moment or force at its base, a heavy rod clamped level curls down under its weight:
+/// // its tip is below the base, and so is its potential energy.
+/// let g = Gravity::new(5.0, [0.0, -1.0]).unwrap();
+/// let e = heavy::evaluate(&PlanarParams::new(0.0, 0.0, 0.0), &g).unwrap();
+/// assert!(e.tip.y < 0.0 && e.energy < e.elastic_energy);
+/// assert_eq!(g.tip_force(&PlanarParams::zeros()), [0.0, 5.0]); // the tip gripper holds it up
 /// ```
 pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyEvaluation, RodError> {
     if g.is_weightless() {
