@@ -5,6 +5,7 @@ use crate::answer::answer;
 use crate::jsonl::{self, Knobs, MethodName, ObjectiveName};
 use nalgebra::Vector3;
 use rod_ig_core::solver::SolveOptions;
+use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
 use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
 use serde::{Deserialize, Serialize};
@@ -51,6 +52,10 @@ struct Forward3dRequest {
     stiffness: Option<[f64; 3]>,
     /// Relative tolerance of the integration (default 1e-8).
     rtol: Option<f64>,
+    /// Dimensionless weight w = ρgAL³/EI (default 0).
+    weight: Option<f64>,
+    /// Direction of gravity in the base frame (default [0, 0, -1]).
+    gravity: Option<[f64; 3]>,
 }
 
 #[derive(Serialize)]
@@ -61,12 +66,41 @@ struct Forward3dAnswer {
     stable: bool,
     energy: f64,
     stability_margin: f64,
+    /// With weight: the elastic part of `energy` (elastic + gravitational).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    elastic_energy: Option<f64>,
+}
+
+/// `forward3d` with a `weight`: the heavy 3-D rod (`spatial::heavy`, rtol 1e-10).
+fn forward3d_heavy(
+    request: &Forward3dRequest,
+    k: &Stiffness,
+    weight: f64,
+) -> Result<Value, String> {
+    if request.rtol.is_some() {
+        return Err("rtol is fixed (1e-10) for the rod with weight".into());
+    }
+    let g = Gravity3::new(weight, request.gravity.unwrap_or([0.0, 0.0, -1.0]))
+        .map_err(|e| e.to_string())?;
+    let a = SpatialParams::from(request.a);
+    let e = heavy3::evaluate(&a, k, &g).map_err(|e| e.to_string())?;
+    jsonl::to_value(&Forward3dAnswer {
+        tip: PoseJson::from_pose(&e.tip),
+        jacobian: std::array::from_fn(|r| std::array::from_fn(|c| e.jacobian[(r, c)])),
+        stable: e.stability.stable,
+        energy: e.energy,
+        stability_margin: e.stability.margin,
+        elastic_energy: Some(e.elastic_energy),
+    })
 }
 
 /// Answers one `forward3d` line.
 pub fn forward3d_line(line: &str) -> Result<Value, String> {
     let request: Forward3dRequest = jsonl::parse(line)?;
     let k = stiffness(request.stiffness)?;
+    if let Some(w) = request.weight.or(request.gravity.map(|_| 0.0)) {
+        return forward3d_heavy(&request, &k, w);
+    }
     let mut opts = StabilityOptions::production();
     if let Some(rtol) = request.rtol {
         if !(rtol.is_finite() && (1e-14..=1e-3).contains(&rtol)) {
@@ -82,6 +116,7 @@ pub fn forward3d_line(line: &str) -> Result<Value, String> {
         stable: e.stability.stable,
         energy: e.energy,
         stability_margin: e.stability.margin,
+        elastic_energy: None,
     })
 }
 

@@ -459,3 +459,25 @@ fn track_follows_changes_of_weight_and_gravity() {
     }
     assert!(out[5]["error"].as_str().unwrap().contains("weight"));
 }
+
+#[test]
+fn forward3d_takes_weight_and_gravity() {
+    // The first 3-D line of data/oracle/gravity_public.jsonl.
+    let line = "{\"a\": [-0.5125436654357536, 2.054283434253289, -2.0221151279950513, 7.275847824793701, 3.653817900748945, -24.609998593465576], \"weight\": 0.10318130992463896, \"gravity\": [-0.036431999446761, -0.3497845171631451, -0.9361215204070764]}\n{\"a\": [0, 0, 1, 0, 0, 0], \"weight\": -1}\n{\"a\": [0, 0, 1, 0, 0, 0], \"weight\": 1, \"rtol\": 1e-6}\n";
+    let out = run(&["forward3d"], line);
+    assert_eq!(out.len(), 3);
+    let p = &out[0]["tip"]["position"];
+    let expected = [
+        0.05030032491968891,
+        0.19973999817185245,
+        0.18362400467299786,
+    ];
+    for (i, e) in expected.iter().enumerate() {
+        assert!((p[i].as_f64().unwrap() - e).abs() < 1e-9, "{}", out[0]);
+    }
+    assert!((out[0]["energy"].as_f64().unwrap() - 14.990809108592806).abs() < 1e-8);
+    assert_eq!(out[0]["stable"], true);
+    assert!(out[0]["elastic_energy"].is_f64());
+    assert!(out[1]["error"].as_str().unwrap().contains("weight"));
+    assert!(out[2]["error"].as_str().unwrap().contains("rtol"));
+}

@@ -210,3 +210,95 @@ fn heavy_inverse_geometry_reaches_targets_of_stable_heavy_rods() {
     eprintln!("solved {solved} of {tried}");
     assert!(solved >= 30, "solved {solved} of {tried}");
 }
+
+#[test]
+fn heavy_3d_matches_the_public_gravity_cases() {
+    use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
+    use rod_ig_core::spatial::{SpatialParams, Stiffness};
+    let text = std::fs::read_to_string(oracle_file("gravity_public.jsonl")).unwrap();
+    let mut n = 0;
+    for v in json_lines(&text).filter(|v| v["kind"] == "3d") {
+        let a = SpatialParams::from_vec(numbers(&v["a"]));
+        let c = numbers(&v["stiffness"]);
+        let k = Stiffness {
+            c1: c[0],
+            c2: c[1],
+            c3: c[2],
+        };
+        let d = numbers(&v["gravity"]);
+        let g = Gravity3::new(v["weight"].as_f64().unwrap(), [d[0], d[1], d[2]]).unwrap();
+        let e = heavy3::evaluate(&a, &k, &g).unwrap();
+        let p = numbers(&v["tip"]["position"]);
+        let q = numbers(&v["tip"]["quaternion"]);
+        let dp = (0..3)
+            .map(|i| (e.tip.position[i] - p[i]).abs())
+            .fold(0.0, f64::max);
+        let ours = e.tip.quaternion_xyzw();
+        let dq = (0..4).map(|i| (ours[i] - q[i]).abs()).fold(0.0, f64::max);
+        assert!(dp < 1e-9 && dq < 1e-9, "{a:?}: tip off by {dp:e} / {dq:e}");
+        let rows: Vec<Vec<f64>> = v["jacobian"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(numbers)
+            .collect();
+        let jref = nalgebra::Matrix6::from_fn(|r, c| rows[r][c]);
+        let dj = (e.jacobian - jref).amax() / jref.amax();
+        assert!(dj < 1e-6, "{a:?}: J off by {dj:e}");
+        let energy = v["energy"].as_f64().unwrap();
+        assert!(
+            (e.energy - energy).abs() < 1e-8 * energy.abs().max(1.0),
+            "{a:?}: energy {} vs {energy}",
+            e.energy
+        );
+        assert_eq!(
+            e.stability.stable,
+            v["stable"].as_bool().unwrap(),
+            "{a:?}: {:?}",
+            e.stability
+        );
+        // Without weight, the weightless 3-D integrator's answers.
+        let (t0, j0) = heavy3::tip_and_jacobian(&a, &k, &Gravity3::NONE).unwrap();
+        let (t1, j1) = rod_ig_core::spatial::tip_and_jacobian(&a, &k, 1e-10).unwrap();
+        assert!((t0.position - t1.position).amax() < 1e-8 && (j0 - j1).amax() < 1e-6 * j1.amax());
+        n += 1;
+    }
+    assert_eq!(n, 10);
+}
+
+#[test]
+fn heavy_3d_in_the_plane_is_the_planar_heavy_rod() {
+    use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
+    use rod_ig_core::spatial::{SpatialParams, Stiffness};
+    let mut rng = SplitMix64::new(43);
+    for _ in 0..60 {
+        let (a, g) = sample(&mut rng);
+        let d = g.direction();
+        let a6 = SpatialParams::new(0.0, 0.0, a[0], a[1], a[2], 0.0);
+        let g3 = Gravity3::new(g.weight(), [d[0], d[1], 0.0]).unwrap();
+        let Ok(e3) = heavy3::evaluate(&a6, &Stiffness::default(), &g3) else {
+            continue;
+        };
+        let e = heavy::evaluate(&a, &g).unwrap();
+        let p = e3.tip.position;
+        let angle = 2.0 * e3.tip.rotation.k.atan2(e3.tip.rotation.w);
+        // The 3-D integration runs at rtol 1e-10: under tension (here |a4| to 200) its error
+        // grows like e^{√F}·rtol, up to ~2e-8 in these samples.
+        assert!((p.x - e.tip.x).abs() < 1e-7 && (p.y - e.tip.y).abs() < 1e-7 && p.z.abs() < 1e-12);
+        let da = rod_ig_core::wrap_angle(angle - e.tip.theta).abs();
+        assert!(
+            da < 1e-7,
+            "{a:?} {g:?}: angle {angle} vs {} ({da:e})",
+            e.tip.theta
+        );
+        assert!((e3.energy - e.energy).abs() < 1e-7 * (1.0 + e.energy.abs()));
+        // In-plane block of J: rows (ω3, v1, v2) = (θ, x, y) against columns (a3, a4, a5),
+        // in the tip's body frame for the 3-D rod: compare det of the in-plane blocks.
+        let block = nalgebra::Matrix3::from_fn(|r, c| e3.jacobian[([2, 3, 4][r], [2, 3, 4][c])]);
+        let (d3, d2) = (block.determinant(), e.jacobian.determinant());
+        assert!(
+            (d3 - d2).abs() <= 1e-6 * d2.abs().max(1e-12),
+            "det {d3} vs {d2}"
+        );
+    }
+}

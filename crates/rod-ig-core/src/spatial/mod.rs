@@ -23,6 +23,7 @@
 // `!(x > y)` comparisons deliberately reject NaN; index loops mirror the formulas.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
+pub mod heavy;
 pub mod ig;
 mod model;
 mod reduced;

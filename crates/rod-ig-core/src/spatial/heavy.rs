@@ -1,0 +1,361 @@
+//! The 3-D rod with weight: the reduced formulation of [`super::reduced`] with gravity.
+//!
+//! With the load w ĝ per unit length (ĝ unit, base frame), the world force and moment are no
+//! longer conserved but known in closed form along the rod:
+//! n(t) = a_f − t w ĝ, and the world moment about the base M(t) = a_m − P(t) × w ĝ with
+//! P(t) = ∫₀ᵗ p (from M' = p × n' = −p × w ĝ). So the body wrench is
+//! f = Rᵀ n(t), m = Rᵀ (M(t) − p × n(t)), and the integrated state gains P (3 values). The
+//! variations gain one term, δm ∋ −Rᵀ (δP × w ĝ), with δP' = δp = R η_v (world frame, 3
+//! values per column). The potential energy w ∫(−ĝ · p) = −w ĝ · P(1) comes for free.
+//!
+//! Stability: det J(t) > 0 on the rule's grid t = i/2000 ∈ [0.02, 1] (FINDINGS3D, the grid of
+//! `shared/oracle/gravity_public.jsonl`'s 3-D lines), by dense output at rtol 1e-10.
+
+use super::{SpatialJacobian, SpatialParams, SpatialPose, Stiffness};
+use crate::ode::{solve, solve_dense, OdeOptions};
+use crate::{RodError, StabilityReport};
+use std::ops::ControlFlow;
+
+/// Base state: q (w, x, y, z), p, elastic energy, P = ∫p.
+const NB: usize = 11;
+/// Base + η (6 rows × 6 columns, row-major) + δP (3 rows × 6 columns, row-major).
+const NV: usize = NB + 36 + 18;
+/// Relative tolerance of every integration here (tip ≤ 1e-9, J ≤ 1e-6 relative).
+pub const HEAVY_RTOL: f64 = 1e-10;
+
+/// Gravity acting on a 3-D rod: the dimensionless weight w = ρgAL³/EI and the unit direction of
+/// gravity in the base frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gravity3 {
+    weight: f64,
+    direction: [f64; 3],
+}
+
+impl Gravity3 {
+    /// No weight.
+    pub const NONE: Gravity3 = Gravity3 {
+        weight: 0.0,
+        direction: [0.0, 0.0, -1.0],
+    };
+
+    /// Weight `weight` ∈ [0, [`crate::planar::heavy::MAX_WEIGHT`]] along `direction` (any
+    /// non-zero finite vector; normalised).
+    pub fn new(weight: f64, direction: [f64; 3]) -> Result<Self, RodError> {
+        RodError::check_finite("weight", &[weight])?;
+        RodError::check_finite("gravity", &direction)?;
+        let max = crate::planar::heavy::MAX_WEIGHT;
+        if !(0.0..=max).contains(&weight) {
+            return Err(RodError::OutOfDomain(format!(
+                "weight must be in [0, {max:e}] (got {weight})"
+            )));
+        }
+        let norm = direction.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(norm > 1e-300 && norm.is_finite()) {
+            return Err(RodError::OutOfDomain(
+                "gravity must be a non-zero vector".into(),
+            ));
+        }
+        Ok(Self {
+            weight,
+            direction: direction.map(|v| v / norm),
+        })
+    }
+
+    /// The dimensionless weight w.
+    pub fn weight(&self) -> f64 {
+        self.weight
+    }
+
+    /// The unit direction ĝ.
+    pub fn direction(&self) -> [f64; 3] {
+        self.direction
+    }
+
+    /// True when w = 0.
+    pub fn is_weightless(&self) -> bool {
+        self.weight == 0.0
+    }
+
+    fn load(&self) -> [f64; 3] {
+        self.direction.map(|v| v * self.weight)
+    }
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// R (row-major) of a quaternion (w, x, y, z), normalised on the fly.
+fn rotmat(w: f64, x: f64, y: f64, z: f64) -> [[f64; 3]; 3] {
+    let n2 = w * w + x * x + y * y + z * z;
+    let s = if n2 > 0.0 { 2.0 / n2 } else { 0.0 };
+    [
+        [
+            1.0 - s * (y * y + z * z),
+            s * (x * y - w * z),
+            s * (x * z + w * y),
+        ],
+        [
+            s * (x * y + w * z),
+            1.0 - s * (x * x + z * z),
+            s * (y * z - w * x),
+        ],
+        [
+            s * (x * z - w * y),
+            s * (y * z + w * x),
+            1.0 - s * (x * x + y * y),
+        ],
+    ]
+}
+
+fn rt(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| r[0][i] * v[0] + r[1][i] * v[1] + r[2][i] * v[2])
+}
+
+fn rv(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2])
+}
+
+/// The right-hand side (module docs); `var`: with the variational equations.
+fn rhs(
+    ci: &[f64; 3],
+    a: &[f64; 6],
+    load: [f64; 3],
+    t: f64,
+    s: &[f64; NV],
+    ds: &mut [f64; NV],
+    var: bool,
+) {
+    let (w, x, y, z) = (s[0], s[1], s[2], s[3]);
+    let p = [s[4], s[5], s[6]];
+    let pp = [s[8], s[9], s[10]];
+    let r = rotmat(w, x, y, z);
+    let n = [a[3] - t * load[0], a[4] - t * load[1], a[5] - t * load[2]];
+    let moment = cross(pp, load);
+    let pxn = cross(p, n);
+    let f = rt(&r, n);
+    let m = rt(
+        &r,
+        [
+            a[0] - moment[0] - pxn[0],
+            a[1] - moment[1] - pxn[1],
+            a[2] - moment[2] - pxn[2],
+        ],
+    );
+    let om = [m[0] * ci[0], m[1] * ci[1], m[2] * ci[2]];
+    ds[0] = -0.5 * (x * om[0] + y * om[1] + z * om[2]);
+    ds[1] = 0.5 * (w * om[0] + y * om[2] - z * om[1]);
+    ds[2] = 0.5 * (w * om[1] + z * om[0] - x * om[2]);
+    ds[3] = 0.5 * (w * om[2] + x * om[1] - y * om[0]);
+    ds[4] = r[0][0];
+    ds[5] = r[1][0];
+    ds[6] = r[2][0];
+    ds[7] = 0.5 * (m[0] * om[0] + m[1] * om[1] + m[2] * om[2]);
+    ds[8] = p[0];
+    ds[9] = p[1];
+    ds[10] = p[2];
+    if !var {
+        return;
+    }
+    let eta = |k: usize, c: usize| s[NB + 6 * k + c];
+    let dp = |k: usize, c: usize| s[NB + 36 + 6 * k + c];
+    for c in 0..6 {
+        // g_c = Rᵀ δa_m − Rᵀ (p × δa_f) − Rᵀ (δP × w ĝ).
+        let mut unit = [0.0; 6];
+        unit[c] = 1.0;
+        let dam = [unit[0], unit[1], unit[2]];
+        let daf = [unit[3], unit[4], unit[5]];
+        let dpp = [dp(0, c), dp(1, c), dp(2, c)];
+        let pxd = cross(p, daf);
+        let dxl = cross(dpp, load);
+        let g = rt(
+            &r,
+            [
+                dam[0] - pxd[0] - dxl[0],
+                dam[1] - pxd[1] - dxl[1],
+                dam[2] - pxd[2] - dxl[2],
+            ],
+        );
+        let e = [eta(0, c), eta(1, c), eta(2, c)];
+        let v = [eta(3, c), eta(4, c), eta(5, c)];
+        let c1 = cross(e, m);
+        let c2 = cross(v, f);
+        let dm = [
+            g[0] - c1[0] - c2[0],
+            g[1] - c1[1] - c2[1],
+            g[2] - c1[2] - c2[2],
+        ];
+        let oxe = cross(om, e);
+        let oxv = cross(om, v);
+        ds[NB + c] = dm[0] * ci[0] - oxe[0];
+        ds[NB + 6 + c] = dm[1] * ci[1] - oxe[1];
+        ds[NB + 12 + c] = dm[2] * ci[2] - oxe[2];
+        // η_v' = −ω × η_v + η_ω × e1, with η_ω × e1 = (0, η_ω3, −η_ω2).
+        ds[NB + 18 + c] = -oxv[0];
+        ds[NB + 24 + c] = -oxv[1] + e[2];
+        ds[NB + 30 + c] = -oxv[2] - e[1];
+        // δP' = δp = R η_v.
+        let dpw = rv(&r, v);
+        ds[NB + 36 + c] = dpw[0];
+        ds[NB + 42 + c] = dpw[1];
+        ds[NB + 48 + c] = dpw[2];
+    }
+}
+
+fn initial() -> [f64; NV] {
+    let mut s = [0.0; NV];
+    s[0] = 1.0;
+    s
+}
+
+fn jac(s: &[f64; NV]) -> SpatialJacobian {
+    SpatialJacobian::from_fn(|r, c| s[NB + 6 * r + c])
+}
+
+fn pose(s: &[f64; NV]) -> SpatialPose {
+    super::pose_from_parts([s[0], s[1], s[2], s[3]], [s[4], s[5], s[6]])
+}
+
+fn options(a: &SpatialParams) -> OdeOptions {
+    super::options_for(a, HEAVY_RTOL, super::default_atol(HEAVY_RTOL))
+}
+
+fn check(a: &SpatialParams, k: &Stiffness) -> Result<(), RodError> {
+    super::check_params(a, k)
+}
+
+/// Tip, J(1, a), energies and stability of a heavy 3-D rod.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeavyEvaluation3d {
+    /// q(1).
+    pub tip: SpatialPose,
+    /// J(1, a) (body twists, rows ω, v).
+    pub jacobian: SpatialJacobian,
+    /// Elastic + gravitational energy.
+    pub energy: f64,
+    /// Elastic energy.
+    pub elastic_energy: f64,
+    /// det J(t) > 0 on the grid (module docs); margin min over t ≥ 0.05 of
+    /// det J(t) / [`super::det_leading_term`] (a normalisation, not a distance).
+    pub stability: StabilityReport,
+}
+
+/// Tip and J(1, a) of the heavy 3-D rod (w = 0: the weightless integration's equations).
+pub fn tip_and_jacobian(
+    a: &SpatialParams,
+    k: &Stiffness,
+    g: &Gravity3,
+) -> Result<(SpatialPose, SpatialJacobian), RodError> {
+    check(a, k)?;
+    let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
+    let (s, _) = solve(
+        |t, s, ds| rhs(&ci, &av, load, t, s, ds, true),
+        0.0,
+        initial(),
+        1.0,
+        &options(a),
+    )?;
+    super::finite(&s)?;
+    Ok((pose(&s), jac(&s)))
+}
+
+/// Tip, J, energies and the stability verdict on the grid (module docs).
+pub fn evaluate(
+    a: &SpatialParams,
+    k: &Stiffness,
+    g: &Gravity3,
+) -> Result<HeavyEvaluation3d, RodError> {
+    check(a, k)?;
+    let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
+    let grid: Vec<f64> = (40..=2000).map(|i| f64::from(i) / 2000.0).collect();
+    let mut last = initial();
+    let (mut margin, mut first, mut prev) = (f64::INFINITY, None, None::<(f64, f64)>);
+    let mut finite = true;
+    solve_dense(
+        |t, s, ds| rhs(&ci, &av, load, t, s, ds, true),
+        0.0,
+        initial(),
+        &grid,
+        &options(a),
+        |_, t, s| {
+            let det = jac(s).determinant();
+            finite &= det.is_finite();
+            if t >= super::stability::MARGIN_T_MIN - 1e-12 {
+                let lead = super::det_leading_term(a, t);
+                if lead > 0.0 {
+                    margin = margin.min(det / lead);
+                }
+            }
+            if first.is_none() && !(det > 0.0) {
+                first = Some(match prev {
+                    Some((tp, dp)) if dp > det => tp + (t - tp) * dp / (dp - det),
+                    _ => t,
+                });
+            }
+            prev = Some((t, det));
+            last = *s;
+            ControlFlow::Continue(())
+        },
+    )?;
+    if !finite {
+        return Err(RodError::Overflow(
+            "non-finite Jacobian of the heavy 3-D rod".into(),
+        ));
+    }
+    super::finite(&last)?;
+    let potential = -(load[0] * last[8] + load[1] * last[9] + load[2] * last[10]);
+    let degenerate = a[1] == 0.0 && a[2] == 0.0 && a[4] == 0.0 && a[5] == 0.0 && {
+        // A straight rod along gravity stays straight: det J ≡ 0.
+        let d = g.direction();
+        g.is_weightless() || (d[1] == 0.0 && d[2] == 0.0)
+    };
+    Ok(HeavyEvaluation3d {
+        tip: pose(&last),
+        jacobian: jac(&last),
+        energy: last[7] + potential,
+        elastic_energy: last[7],
+        stability: StabilityReport {
+            stable: first.is_none() && !degenerate,
+            margin: if margin.is_finite() { margin } else { 0.0 },
+            first_conjugate_t: if degenerate { None } else { first },
+            uncertain: degenerate,
+        },
+    })
+}
+
+/// `samples` poses of the heavy 3-D rod from the base to the tip.
+pub fn shape(
+    a: &SpatialParams,
+    k: &Stiffness,
+    g: &Gravity3,
+    samples: usize,
+) -> Result<Vec<SpatialPose>, RodError> {
+    check(a, k)?;
+    let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
+    let ts: Vec<f64> = (0..samples)
+        .map(|i| {
+            if samples < 2 {
+                0.0
+            } else {
+                i as f64 / (samples - 1) as f64
+            }
+        })
+        .collect();
+    let mut out = Vec::with_capacity(samples);
+    solve_dense(
+        |t, s, ds| rhs(&ci, &av, load, t, s, ds, false),
+        0.0,
+        initial(),
+        &ts,
+        &options(a),
+        |_, _, s| {
+            out.push(pose(s));
+            ControlFlow::Continue(())
+        },
+    )?;
+    Ok(out)
+}
