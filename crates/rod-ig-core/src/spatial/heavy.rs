@@ -1,4 +1,5 @@
-//! The 3-D rod with weight: the reduced formulation of [`super::reduced`] with gravity.
+//! The 3-D rod with weight: the reduced formulation of the weightless 3-D rod (the world
+//! wrench recovered from the pose) with gravity.
 //!
 //! With the load w ĝ per unit length (ĝ unit, base frame), the world force and moment are no
 //! longer conserved but known in closed form along the rod:
@@ -158,9 +159,21 @@ fn rhs(
     ds[8] = p[0];
     ds[9] = p[1];
     ds[10] = p[2];
-    if !var {
-        return;
+    if var {
+        variations(ci, load, &r, (p, f, m, om), s, ds);
     }
+}
+
+/// The variational equations of [`rhs`], given R and the body wrench (p, f, m, ω) there.
+fn variations(
+    ci: &[f64; 3],
+    load: [f64; 3],
+    r: &[[f64; 3]; 3],
+    (p, f, m, om): ([f64; 3], [f64; 3], [f64; 3], [f64; 3]),
+    s: &[f64; NV],
+    ds: &mut [f64; NV],
+) {
+    let r = *r;
     let eta = |k: usize, c: usize| s[NB + 6 * k + c];
     let dp = |k: usize, c: usize| s[NB + 36 + 6 * k + c];
     for c in 0..6 {
