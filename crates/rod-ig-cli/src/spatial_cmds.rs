@@ -6,6 +6,7 @@ use crate::jsonl::{self, Knobs, MethodName, ObjectiveName};
 use nalgebra::Vector3;
 use rod_ig_core::solver::SolveOptions;
 use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
+use rod_ig_core::spatial::HeavySpatial;
 use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
 use serde::{Deserialize, Serialize};
@@ -139,6 +140,10 @@ struct Solve3dRequest {
     stiffness: Option<[f64; 3]>,
     /// Wall-time budget of the request in ms (default 1000, at most 10000).
     deadline_ms: Option<f64>,
+    /// Dimensionless weight w (default 0).
+    weight: Option<f64>,
+    /// Direction of gravity in the base frame (default [0, 0, -1]).
+    gravity: Option<[f64; 3]>,
 }
 
 /// Answers one `solve3d` line (`verbose`: the solver's events on stderr).
@@ -156,6 +161,23 @@ pub fn solve3d_line(line: &str, verbose: bool) -> Result<Value, String> {
         a0: request.a0.map(SpatialParams::from),
     };
     let options = jsonl::solve_options(knobs, SolveOptions::default())?;
+    if let Some(w) = request.weight.or(request.gravity.map(|_| 0.0)) {
+        let gravity = Gravity3::new(w, request.gravity.unwrap_or([0.0, 0.0, -1.0]))
+            .map_err(|e| e.to_string())?;
+        let heavy = HeavySpatial {
+            stiffness: model.stiffness,
+            gravity,
+        };
+        return jsonl::to_value(&answer(
+            &heavy,
+            &target,
+            &options,
+            request.all,
+            verbose,
+            |a| std::array::from_fn::<f64, 6, _>(|i| a[i]),
+            PoseJson::from_pose,
+        ));
+    }
     jsonl::to_value(&answer(
         &model,
         &target,

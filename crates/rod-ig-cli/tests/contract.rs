@@ -481,3 +481,35 @@ fn forward3d_takes_weight_and_gravity() {
     assert!(out[1]["error"].as_str().unwrap().contains("weight"));
     assert!(out[2]["error"].as_str().unwrap().contains("rtol"));
 }
+
+#[test]
+fn solve3d_takes_weight_and_gravity() {
+    let target =
+        "\"target\": {\"position\": [0.5, 0.3, 0.2], \"quaternion\": [0, 0, 0.3827, 0.9239]}";
+    let input = format!(
+        "{{{target}, \"weight\": 20, \"gravity\": [0, 0, -1]}}\n{{{target}}}\n{{{target}, \"weight\": 20, \"gravity\": [0, 0]}}\n"
+    );
+    let out = run(&["solve3d"], &input);
+    assert_eq!(out.len(), 3);
+    assert_eq!(out[0]["success"], true, "{}", out[0]);
+    assert_eq!(out[0]["stable"], true);
+    assert!(out[0]["position_error"].as_f64().unwrap() < 1e-6);
+    // The heavy rod's answer is another rod than the weightless one for the same pose; the
+    // forward map with the same weight puts its tip on the target.
+    let a: Vec<f64> = out[0]["a"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_ne!(out[0]["a"], out[1]["a"]);
+    let check = run(
+        &["forward3d"],
+        &format!("{{\"a\": {a:?}, \"weight\": 20, \"gravity\": [0, 0, -1]}}\n"),
+    );
+    let p = &check[0]["tip"]["position"];
+    for (i, e) in [0.5, 0.3, 0.2].iter().enumerate() {
+        assert!((p[i].as_f64().unwrap() - e).abs() < 1e-6, "{}", check[0]);
+    }
+    assert!(out[2]["error"].is_string());
+}

@@ -302,3 +302,59 @@ fn heavy_3d_in_the_plane_is_the_planar_heavy_rod() {
         );
     }
 }
+
+#[test]
+fn heavy_3d_inverse_geometry_reaches_targets_of_stable_heavy_rods() {
+    use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
+    use rod_ig_core::spatial::{HeavySpatial, SpatialParams, Stiffness};
+    let mut rng = SplitMix64::new(17);
+    let (mut tried, mut solved) = (0, 0);
+    let k = Stiffness::default();
+    while tried < 12 {
+        let a = SpatialParams::from_fn(|i, _| {
+            if i < 3 {
+                rng.range(-3.0, 3.0)
+            } else {
+                rng.range(-15.0, 15.0)
+            }
+        });
+        let w = 10f64.powf(rng.range(-1.0, 1.7));
+        let d = [
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+        ];
+        let Ok(g) = Gravity3::new(w, d) else { continue };
+        let Ok(e) = heavy3::evaluate(&a, &k, &g) else {
+            continue;
+        };
+        if !e.stability.stable || e.tip.position.norm() > 0.95 {
+            continue;
+        }
+        tried += 1;
+        let model = HeavySpatial {
+            stiffness: k,
+            gravity: g,
+        };
+        let t0 = std::time::Instant::now();
+        match solver::solve(&model, &e.tip, &SolveOptions::default()) {
+            Ok(s) => {
+                solved += 1;
+                let check = heavy3::evaluate(&s.a, &k, &g).unwrap();
+                let (dp, dq) = check.tip.distance_to(&e.tip);
+                assert!(
+                    dp < 1e-6 && dq < 1e-6 && check.stability.stable,
+                    "wrong answer"
+                );
+                eprintln!(
+                    "solved in {:?}: w {w:.2}, {} starts",
+                    t0.elapsed(),
+                    s.starts
+                );
+            }
+            Err(f) => eprintln!("not solved: a {a:?}, w {w}: {}", f.reason),
+        }
+    }
+    eprintln!("3-D: solved {solved} of {tried}");
+    assert!(solved >= 10, "solved {solved} of {tried}");
+}

@@ -36,6 +36,7 @@
 mod continuation;
 pub(crate) mod deadline;
 pub(crate) mod globalised;
+pub mod load;
 mod model;
 pub(crate) mod newton;
 mod observer;

@@ -62,6 +62,16 @@ impl Gravity3 {
         })
     }
 
+    /// The gravity whose load per unit length is w ĝ = `load` (direction `fallback` when the
+    /// load is zero).
+    pub fn from_load(load: [f64; 3], fallback: [f64; 3]) -> Result<Self, RodError> {
+        let w = load.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if w == 0.0 {
+            return Self::new(0.0, fallback);
+        }
+        Self::new(w, load)
+    }
+
     /// The dimensionless weight w.
     pub fn weight(&self) -> f64 {
         self.weight
@@ -77,7 +87,8 @@ impl Gravity3 {
         self.weight == 0.0
     }
 
-    fn load(&self) -> [f64; 3] {
+    /// The weight per unit length w ĝ.
+    pub fn load(&self) -> [f64; 3] {
         self.direction.map(|v| v * self.weight)
     }
 }

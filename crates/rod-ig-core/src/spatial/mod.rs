@@ -24,11 +24,13 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
 pub mod heavy;
+mod heavy_model;
 pub mod ig;
 mod model;
 mod reduced;
 mod stability;
 
+pub use heavy_model::HeavySpatial;
 pub use model::Spatial;
 pub use stability::{
     det_leading_term, stability, stability_full_grid, stability_with, StabilityOptions,

@@ -1,0 +1,175 @@
+//! The 3-D rod with weight as a model of the solvers: [`RodModel`], the continuation in load
+//! ([`LoadedModel`]) and its search ([`InverseGeometry`]), which starts from the weightless
+//! 3-D rods that reach the target (the 3-D robust search) and follows each to the weight.
+
+use super::heavy::{self, Gravity3};
+use super::{Spatial, SpatialParams, SpatialPose, Stiffness};
+use crate::solver::load::{self, LoadedModel};
+use crate::solver::{
+    Failure, Found, IgError, InverseGeometry, ModelEvaluation, RodModel, Solution, SolveOptions,
+};
+use crate::RodError;
+use nalgebra::{SMatrix, SVector};
+
+/// The 3-D rod with stiffnesses `stiffness` under `gravity` ([`super::heavy`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeavySpatial {
+    /// Torsion and bending stiffnesses.
+    pub stiffness: Stiffness,
+    /// Weight and direction of gravity.
+    pub gravity: Gravity3,
+}
+
+impl HeavySpatial {
+    /// The weightless rod of the same stiffness, through the heavy integration.
+    fn weightless(&self) -> Self {
+        Self {
+            gravity: Gravity3::NONE,
+            ..*self
+        }
+    }
+
+    fn spatial(&self) -> Spatial {
+        Spatial::with_stiffness(self.stiffness)
+    }
+}
+
+type Options6 = SolveOptions<SVector<f64, 6>>;
+
+impl RodModel<6> for HeavySpatial {
+    type Pose = SpatialPose;
+
+    fn name(&self) -> &'static str {
+        "3-D rod with weight"
+    }
+
+    fn tip(&self, a: &SpatialParams) -> Result<SpatialPose, RodError> {
+        Ok(heavy::tip_and_jacobian(a, &self.stiffness, &self.gravity)?.0)
+    }
+
+    fn evaluate(&self, a: &SpatialParams) -> Result<ModelEvaluation<6, SpatialPose>, RodError> {
+        let e = heavy::evaluate(a, &self.stiffness, &self.gravity)?;
+        Ok(ModelEvaluation {
+            tip: e.tip,
+            jacobian: e.jacobian,
+            energy: e.energy,
+            stability: e.stability,
+            full_accuracy: true,
+        })
+    }
+
+    fn tip_and_jacobian(
+        &self,
+        a: &SpatialParams,
+    ) -> Result<(SpatialPose, SMatrix<f64, 6, 6>), RodError> {
+        heavy::tip_and_jacobian(a, &self.stiffness, &self.gravity)
+    }
+
+    fn param_scale(&self) -> SVector<f64, 6> {
+        self.spatial().param_scale()
+    }
+
+    fn pose_error(&self, tip: &SpatialPose, target: &SpatialPose) -> (f64, f64) {
+        self.spatial().pose_error(tip, target)
+    }
+
+    fn newton_increment(
+        &self,
+        tip: &SpatialPose,
+        jacobian: &SMatrix<f64, 6, 6>,
+        target: &SpatialPose,
+    ) -> Result<SVector<f64, 6>, f64> {
+        self.spatial().newton_increment(tip, jacobian, target)
+    }
+
+    fn check_target(&self, target: &SpatialPose) -> Result<(), IgError> {
+        self.spatial().check_target(target)
+    }
+
+    fn jacobian_det(&self, jacobian: &SMatrix<f64, 6, 6>) -> f64 {
+        jacobian.determinant()
+    }
+
+    fn interpolate(&self, from: &SpatialPose, to: &SpatialPose, s: f64) -> SpatialPose {
+        self.spatial().interpolate(from, to, s)
+    }
+
+    fn check_settings(&self) -> Result<(), IgError> {
+        self.spatial().check_settings()
+    }
+}
+
+impl LoadedModel<6> for HeavySpatial {
+    fn blend(&self, from: &Self, s: f64) -> Result<Self, RodError> {
+        let (l0, l1) = (from.gravity.load(), self.gravity.load());
+        let load = std::array::from_fn(|i| l0[i] + (l1[i] - l0[i]) * s);
+        Ok(Self {
+            gravity: Gravity3::from_load(load, self.gravity.direction())?,
+            ..*self
+        })
+    }
+
+    fn load_change(&self, from: &Self) -> f64 {
+        let (l0, l1) = (from.gravity.load(), self.gravity.load());
+        (0..3).map(|i| (l1[i] - l0[i]).powi(2)).sum::<f64>().sqrt()
+    }
+
+    fn shared_load_step(&self, from: &Self) -> SVector<f64, 6> {
+        let (l0, l1) = (from.gravity.load(), self.gravity.load());
+        let h: [f64; 3] = std::array::from_fn(|i| 0.5 * (l1[i] - l0[i]));
+        SVector::<f64, 6>::new(0.0, 0.0, 0.0, h[0], h[1], h[2])
+    }
+}
+
+/// The weightless 3-D rods on target: the caller's guess, the robust search's first rod, then
+/// every stable weightless solution (least energy first), each asked only when needed.
+fn weightless_starts<'a>(
+    spatial: Spatial,
+    target: &'a SpatialPose,
+    options: &'a Options6,
+) -> impl Iterator<Item = SpatialParams> + 'a {
+    let guess = options.initial_guess.into_iter();
+    let first =
+        std::iter::once_with(move || spatial.robust(target, options).ok().map(|s| s.a)).flatten();
+    let every = std::iter::once_with(move || {
+        let mut sols = spatial.robust_all(target, options).solutions;
+        sols.sort_by(|a, b| a.energy.total_cmp(&b.energy));
+        sols.into_iter().map(|s| s.a)
+    })
+    .flatten();
+    guess.chain(first).chain(every)
+}
+
+impl InverseGeometry<6> for HeavySpatial {
+    fn robust(
+        &self,
+        target: &SpatialPose,
+        options: &Options6,
+    ) -> Result<Solution<SpatialParams, SpatialPose>, Failure<SpatialParams>> {
+        let starts = weightless_starts(self.spatial(), target, options);
+        let (found, search) =
+            load::search_from(&self.weightless(), self, target, options, starts, false);
+        found.into_iter().next().ok_or_else(|| search.failure())
+    }
+
+    fn robust_all(
+        &self,
+        target: &SpatialPose,
+        options: &Options6,
+    ) -> Found<SpatialParams, SpatialPose> {
+        let starts = weightless_starts(self.spatial(), target, options);
+        let (solutions, search) =
+            load::search_from(&self.weightless(), self, target, options, starts, true);
+        Found {
+            solutions,
+            iterations: search.work.iterations,
+            evaluations: search.work.evaluations,
+            starts: search.work.starts,
+        }
+    }
+
+    fn default_start(&self, target: &SpatialPose) -> Option<SpatialParams> {
+        let a = self.spatial().default_start(target)?;
+        Some(a + self.shared_load_step(&self.weightless()))
+    }
+}
