@@ -80,10 +80,11 @@ def _broadcast(*arrays: FloatArray) -> tuple[list[FloatArray], tuple[int, ...]]:
 
 
 def _weight_arrays(
-    weight: npt.ArrayLike | None, gravity: npt.ArrayLike | None
+    weight: npt.ArrayLike | None, gravity: npt.ArrayLike | None, dim: int = 2
 ) -> list[FloatArray]:
-    """``weight`` as (..., 1) and ``gravity`` as (..., 2) arrays to broadcast with the batch;
-    [] when neither is given (the weightless closed forms, bit for bit)."""
+    """``weight`` as (..., 1) and ``gravity`` as (..., dim) arrays to broadcast with the batch;
+    [] when neither is given (the weightless models, bit for bit). Gravity defaults to -y in
+    the plane, -z in 3-D."""
     if weight is None and gravity is None:
         return []
     w = np.asarray(0.0 if weight is None else weight)
@@ -93,8 +94,9 @@ def _weight_arrays(
     w = np.asarray(w, dtype=np.float64)[..., None]
     if not np.isfinite(w).all() or (w < 0).any() or (w > 1e4).any():
         raise ValueError("weight must be finite and in [0, 1e4]")
-    g, _ = _batch("gravity", (0.0, -1.0) if gravity is None else gravity, 2)
-    if (np.hypot(g[..., 0], g[..., 1]) == 0).any():
+    default = (0.0, -1.0) if dim == 2 else (0.0, 0.0, -1.0)
+    g, _ = _batch("gravity", default if gravity is None else gravity, dim)
+    if (np.linalg.norm(g, axis=-1) == 0).any():
         raise ValueError("gravity must be a non-zero vector")
     return [w, g]
 
@@ -290,11 +292,17 @@ def forward3d(
     a: npt.ArrayLike,
     stiffness: tuple[float, float, float] = (1.0, 1.0, 1.0),
     threads: int | None = None,
+    weight: npt.ArrayLike | None = None,
+    gravity: npt.ArrayLike | None = None,
 ) -> Forward3dResult:
     """3-D forward map of rods ``a`` (..., 6) by numerical integration (FINDINGS3D), with
-    stiffness (c1 torsion, c2, c3 bending) each in [1e-6, 1e6]."""
-    arr, batch = _batch("a", a, 6)
-    d = _rod_ig.forward3d(arr.reshape(-1), stiffness=tuple(stiffness), threads=threads)
+    stiffness (c1 torsion, c2, c3 bending) each in [1e-6, 1e6]. ``weight`` and ``gravity``
+    ((..., 3), default (0, 0, -1)) broadcast against the batch: the 3-D rod with weight."""
+    arr, _ = _batch("a", a, 6)
+    flat, batch = _broadcast(arr, *_weight_arrays(weight, gravity, 3))
+    d = _rod_ig.forward3d(
+        flat[0], stiffness=tuple(stiffness), threads=threads, **_weight_kwargs(flat, 1)
+    )
     return Forward3dResult(
         position=d["position"].reshape(batch + (3,)),
         quaternion=d["quaternion"].reshape(batch + (4,)),
@@ -318,13 +326,16 @@ def solve3d(
     stiffness: tuple[float, float, float] = (1.0, 1.0, 1.0),
     all: bool = False,
     threads: int | None = None,
+    weight: npt.ArrayLike | None = None,
+    gravity: npt.ArrayLike | None = None,
 ) -> SolveResult:
     """3-D inverse geometry: targets given by ``position`` (..., 3) and ``quaternion``
-    (..., 4) as (x, y, z, w), broadcast together; the options of :func:`solve`."""
+    (..., 4) as (x, y, z, w), broadcast together; the options of :func:`solve`; ``weight``
+    and ``gravity`` as for :func:`forward3d`."""
     arrays = [_batch("position", position, 3)[0], _batch("quaternion", quaternion, 4)[0]]
     if a0 is not None:
         arrays.append(_batch("a0", a0, 6)[0])
-    flat, batch = _broadcast(*arrays)
+    flat, batch = _broadcast(*arrays, *_weight_arrays(weight, gravity, 3))
     d = _rod_ig.solve3d(
         flat[0],
         flat[1],
@@ -338,6 +349,7 @@ def solve3d(
         stiffness=tuple(stiffness),
         all=all,
         threads=threads,
+        **_weight_kwargs(flat, len(arrays)),
     )
     return _solve_result(d, batch, 6, all)
 

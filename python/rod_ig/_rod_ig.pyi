@@ -45,6 +45,8 @@ def forward3d(
     a: npt.NDArray[np.float64],
     stiffness: tuple[float, ...] = (1.0, 1.0, 1.0),
     threads: int | None = None,
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
 ) -> dict[str, Any]: ...
 def solve3d(
     position: npt.NDArray[np.float64],
@@ -59,6 +61,8 @@ def solve3d(
     stiffness: tuple[float, ...] = (1.0, 1.0, 1.0),
     all: bool = False,
     threads: int | None = None,
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
 ) -> dict[str, Any]: ...
 def warm_up() -> int: ...
 

@@ -12,8 +12,9 @@ use rod_ig_core::plan::{Obstacle, PlanRequest, Planner as CorePlanner};
 use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
 use rod_ig_core::planar::PlanarClosedForm;
 use rod_ig_core::solver::{self, BranchEvent, BranchFollower, Method, Objective, SolveOptions};
-use rod_ig_core::spatial::Spatial;
+use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
 use rod_ig_core::spatial::{self, SpatialPose, StabilityOptions, Stiffness};
+use rod_ig_core::spatial::{HeavySpatial, Spatial};
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use std::time::Duration;
 
@@ -497,20 +498,58 @@ fn stiffness_of(c: (f64, f64, f64)) -> PyResult<Stiffness> {
     Ok(k)
 }
 
+/// What `forward3d` writes of one rod, whichever integration evaluated it.
+struct Evaluated3d {
+    tip: SpatialPose,
+    jacobian: nalgebra::Matrix6<f64>,
+    stability: rod_ig_core::StabilityReport,
+    energy: f64,
+}
+
+/// The 3-D gravity of each of n rods from the flattened `weight` (n) and `gravity` (3n), or
+/// None without weight. Errors name the rod.
+fn gravities3(
+    n: usize,
+    weight: Option<&PyReadonlyArray1<'_, f64>>,
+    gravity: Option<&PyReadonlyArray1<'_, f64>>,
+) -> PyResult<Option<Vec<Gravity3>>> {
+    let Some(weight) = weight else {
+        return Ok(None);
+    };
+    let w = weight.as_slice()?;
+    let g = gravity.map(|g| g.as_slice()).transpose()?;
+    if w.len() != n || g.is_some_and(|g| g.len() != 3 * n) {
+        return Err(PyValueError::new_err(
+            "weight and gravity must broadcast against the batch",
+        ));
+    }
+    (0..n)
+        .map(|i| {
+            let dir = g.map_or([0.0, 0.0, -1.0], |g| [g[3 * i], g[3 * i + 1], g[3 * i + 2]]);
+            Gravity3::new(w[i], dir)
+                .map_err(|e| PyValueError::new_err(format!("weight/gravity of rod {i}: {e}")))
+        })
+        .collect::<PyResult<Vec<_>>>()
+        .map(Some)
+}
+
 /// 3-D forward map of n rods `a` (flattened (n, 6)): position, quaternion (x, y, z, w),
 /// J (6×6, body twists, rows ω1 ω2 ω3 v1 v2 v3), stable, margin, energy.
 #[pyfunction]
-#[pyo3(signature = (a, stiffness=(1.0, 1.0, 1.0), threads=None))]
+#[pyo3(signature = (a, stiffness=(1.0, 1.0, 1.0), threads=None, weight=None, gravity=None))]
 fn forward3d<'py>(
     py: Python<'py>,
     a: PyReadonlyArray1<'py, f64>,
     stiffness: (f64, f64, f64),
     threads: Option<usize>,
+    weight: Option<PyReadonlyArray1<'py, f64>>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let a = a.as_slice()?;
     let n = a.len() / 6;
     let k = stiffness_of(stiffness)?;
     let threads = thread_count(threads)?;
+    let g = gravities3(n, weight.as_ref(), gravity.as_ref())?;
     let opts = StabilityOptions::production();
     let mut position = vec![f64::NAN; 3 * n];
     let mut quaternion = vec![f64::NAN; 4 * n];
@@ -523,8 +562,24 @@ fn forward3d<'py>(
         n,
         threads,
         SOLVE_BLOCK,
-        |i| spatial::evaluate(&Vector6::from_column_slice(&a[6 * i..6 * i + 6]), &k, &opts).ok(),
+        |i| {
+            let ai = Vector6::from_column_slice(&a[6 * i..6 * i + 6]);
+            match &g {
+                Some(g) => heavy3::evaluate(&ai, &k, &g[i])
+                    .ok()
+                    .map(|e| (e.tip, e.jacobian, e.stability, e.energy)),
+                None => spatial::evaluate(&ai, &k, &opts)
+                    .ok()
+                    .map(|e| (e.tip, e.jacobian, e.stability, e.energy)),
+            }
+        },
         |i, e| {
+            let e = e.map(|(tip, jacobian, stability, energy)| Evaluated3d {
+                tip,
+                jacobian,
+                stability,
+                energy,
+            });
             if let Some(e) = e {
                 let p = e.tip.position;
                 position[3 * i..3 * i + 3].copy_from_slice(&[p.x, p.y, p.z]);
@@ -554,7 +609,8 @@ fn forward3d<'py>(
 #[pyfunction]
 #[pyo3(signature = (position, quaternion, a0=None, objective="first", method="robust",
                     deadline_ms=None, tolerance=None, max_iterations=None, alpha=None,
-                    stiffness=(1.0, 1.0, 1.0), all=false, threads=None))]
+                    stiffness=(1.0, 1.0, 1.0), all=false, threads=None, weight=None,
+                    gravity=None))]
 #[allow(clippy::too_many_arguments)]
 fn solve3d<'py>(
     py: Python<'py>,
@@ -570,9 +626,12 @@ fn solve3d<'py>(
     stiffness: (f64, f64, f64),
     all: bool,
     threads: Option<usize>,
+    weight: Option<PyReadonlyArray1<'py, f64>>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = position.as_slice()?;
     let q = quaternion.as_slice()?;
+    let g = gravities3(p.len() / 3, weight.as_ref(), gravity.as_ref())?;
     let a0 = a0.as_ref().map(|a| a.as_slice()).transpose()?;
     let model = Spatial::with_stiffness(stiffness_of(stiffness)?);
     let base = options(
@@ -592,7 +651,23 @@ fn solve3d<'py>(
         )
         .map_err(|e| e.to_string())
     };
-    solve_batch(py, |_| model, p.len() / 3, a0, base, all, threads, target_of)
+    if let Some(g) = g {
+        let heavy = |i: usize| HeavySpatial {
+            stiffness: model.stiffness,
+            gravity: g[i],
+        };
+        return solve_batch(py, heavy, p.len() / 3, a0, base, all, threads, target_of);
+    }
+    solve_batch(
+        py,
+        |_| model,
+        p.len() / 3,
+        a0,
+        base,
+        all,
+        threads,
+        target_of,
+    )
 }
 
 /// Quasi-static motion of the planar rod: the rod follows its equilibrium branch as the tip

@@ -379,3 +379,21 @@ def test_weight_solve_reaches_heavy_targets_and_errors_name_the_argument() -> No
         rod_ig.forward([1.0, 2.0, 3.0], weight=1.0, gravity=[0.0, 0.0, 1.0])
     with pytest.raises(TypeError, match="weight"):
         rod_ig.forward([1.0, 2.0, 3.0], weight="heavy")
+
+
+def test_weight_in_3d_matches_the_public_cases_and_solves() -> None:
+    lines = (REPO / "data" / "oracle" / "gravity_public.jsonl").read_text().splitlines()
+    cases = [c for c in map(json.loads, lines) if c["kind"] == "3d" and c["stiffness"] == [1.0, 1.0, 1.0]]
+    assert cases
+    a = np.array([c["a"] for c in cases])
+    r = rod_ig.forward3d(a, weight=[c["weight"] for c in cases], gravity=[c["gravity"] for c in cases])
+    assert np.abs(r.position - np.array([c["tip"]["position"] for c in cases])).max() < 1e-9
+    assert (r.stable == np.array([c["stable"] for c in cases])).all()
+    # A heavy 3-D rod's own tip, solved back with the same weight.
+    s = rod_ig.solve3d(r.position[0], r.quaternion[0], weight=cases[0]["weight"],
+                       gravity=cases[0]["gravity"])
+    assert bool(s.success)
+    back = rod_ig.forward3d(s.a, weight=cases[0]["weight"], gravity=cases[0]["gravity"])
+    assert np.abs(back.position - r.position[0]).max() < 1e-6
+    with pytest.raises(ValueError, match="gravity"):
+        rod_ig.forward3d(a[0], weight=1.0, gravity=[0.0, -1.0])
