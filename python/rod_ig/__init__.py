@@ -396,9 +396,19 @@ class Tracker:
         a0: Sequence[float] | None = None,
         deadline_ms: float = 250.0,
         tolerance: float | None = None,
+        weight: float = 0.0,
+        gravity: Sequence[float] = (0.0, -1.0),
     ) -> None:
+        """``weight`` and ``gravity`` (2 components): the rod with weight (docs/weight.md)."""
         start = None if a0 is None else [float(v) for v in _batch("a0", a0, 3)[0].reshape(3)]
-        self._inner = _rod_ig.Tracker(a0=start, deadline_ms=deadline_ms, tolerance=tolerance)
+        g = _batch("gravity", gravity, 2)[0].reshape(2)
+        self._inner = _rod_ig.Tracker(
+            a0=start,
+            deadline_ms=deadline_ms,
+            tolerance=tolerance,
+            weight=float(weight),
+            gravity=(float(g[0]), float(g[1])),
+        )
 
     def move(self, target: npt.ArrayLike) -> MoveResult:
         """Moves the tip gripper to ``target`` (x, y, theta) and returns the rod it holds."""

@@ -72,6 +72,8 @@ class Tracker:
         a0: list[float] | None = None,
         deadline_ms: float | None = None,
         tolerance: float | None = None,
+        weight: float = 0.0,
+        gravity: tuple[float, float] = (0.0, -1.0),
     ) -> None: ...
     def move(self, target: list[float]) -> dict[str, Any]: ...
     @property

@@ -674,18 +674,24 @@ fn solve3d<'py>(
 /// gripper moves, and snaps where the branch folds.
 #[pyclass(module = "rod_ig._rod_ig")]
 struct Tracker {
-    follower: BranchFollower<3, PlanarClosedForm>,
+    /// Without weight, `HeavyPlanar` is the closed forms' model in every method.
+    follower: BranchFollower<3, HeavyPlanar>,
 }
 
 #[pymethods]
 impl Tracker {
     #[new]
-    #[pyo3(signature = (a0=None, deadline_ms=None, tolerance=None))]
+    #[pyo3(signature = (a0=None, deadline_ms=None, tolerance=None, weight=0.0, gravity=(0.0, -1.0)))]
     fn new(
         a0: Option<[f64; 3]>,
         deadline_ms: Option<f64>,
         tolerance: Option<f64>,
+        weight: f64,
+        gravity: (f64, f64),
     ) -> PyResult<Self> {
+        let g = Gravity::new(weight, [gravity.0, gravity.1])
+            .map_err(|e| PyValueError::new_err(format!("weight/gravity: {e}")))?;
+        let model = HeavyPlanar::new(g);
         let o = options(
             SolveOptions::default(),
             "robust",
@@ -698,9 +704,9 @@ impl Tracker {
         )?;
         rod_ig_core::planar::ig::warm_up();
         let follower = match a0 {
-            Some(a) => BranchFollower::holding(PlanarClosedForm, o, PlanarParams::from(a))
+            Some(a) => BranchFollower::holding(model, o, PlanarParams::from(a))
                 .map_err(|e| PyValueError::new_err(format!("a0 cannot be held: {e}")))?,
-            None => BranchFollower::new(PlanarClosedForm, o),
+            None => BranchFollower::new(model, o),
         };
         Ok(Tracker { follower })
     }

@@ -397,3 +397,18 @@ def test_weight_in_3d_matches_the_public_cases_and_solves() -> None:
     assert np.abs(back.position - r.position[0]).max() < 1e-6
     with pytest.raises(ValueError, match="gravity"):
         rod_ig.forward3d(a[0], weight=1.0, gravity=[0.0, -1.0])
+
+
+def test_tracker_with_weight_holds_a_heavy_rod() -> None:
+    t = rod_ig.Tracker(weight=50.0)
+    m = t.move([0.6, 0.0, 0.0])
+    assert m.success and m.event == "none"
+    assert t.rod is not None
+    check = rod_ig.forward(t.rod, weight=50.0)
+    assert np.abs(check.tip[:2] - [0.6, 0.0]).max() < 1e-6 and bool(check.stable)
+    # theta is unwrapped (the integral of the curvature): compare modulo 2 pi.
+    assert abs(np.angle(np.exp(1j * check.tip[2]))) < 1e-6
+    m = t.move([0.55, 0.05, 0.1])
+    assert m.success
+    with pytest.raises(ValueError, match="weight"):
+        rod_ig.Tracker(weight=-2.0)

@@ -61,6 +61,37 @@ impl RodModel<3> for HeavyPlanar {
         super::tip_and_jacobian(a, &self.gravity)
     }
 
+    // Without weight, every method is the closed forms' (their cheaper evaluations included),
+    // so that a follower of this model answers as one of `PlanarClosedForm` does.
+
+    fn tip_and_jacobian_for_substep(
+        &self,
+        a: &Vector3<f64>,
+    ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+        if self.gravity.is_weightless() {
+            return PlanarClosedForm.tip_and_jacobian_for_substep(a);
+        }
+        self.tip_and_jacobian(a)
+    }
+
+    fn evaluate_iterate(
+        &self,
+        a: &Vector3<f64>,
+        start: &Vector3<f64>,
+    ) -> Result<ModelEvaluation<3, PlanarPose>, RodError> {
+        if self.gravity.is_weightless() {
+            return PlanarClosedForm.evaluate_iterate(a, start);
+        }
+        self.evaluate(a)
+    }
+
+    fn stability(&self, a: &Vector3<f64>) -> Result<crate::StabilityReport, RodError> {
+        if self.gravity.is_weightless() {
+            return PlanarClosedForm.stability(a);
+        }
+        Ok(self.evaluate(a)?.stability)
+    }
+
     fn energy(&self, a: &Vector3<f64>) -> Result<f64, RodError> {
         Ok(super::energy(a, &self.gravity)?.0)
     }
