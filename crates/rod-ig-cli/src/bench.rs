@@ -444,7 +444,82 @@ pub fn weight(quick: bool) {
     });
     pair("tip + J + energy + stability", ev, ev0);
     heavy_solves(targets);
+    heavy_3d(quick);
     outln!();
+}
+
+/// The 3-D rod with weight against today's weightless 3-D integration (issue 41: forward + J
+/// no slower; robust solve median ≤ 1 ms).
+fn heavy_3d(quick: bool) {
+    use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
+    use rod_ig_core::spatial::{self, HeavySpatial, SpatialParams, Stiffness, PRODUCTION_RTOL};
+    let (n, rounds, targets) = if quick { (16, 3, 10) } else { (128, 7, 60) };
+    let mut rng = SplitMix64::new(43);
+    let k = Stiffness::default();
+    let rods: Vec<(SpatialParams, Gravity3)> = (0..n)
+        .map(|_| {
+            let a = SpatialParams::from_fn(|i, _| {
+                if i < 3 {
+                    rng.range(-3.0, 3.0)
+                } else {
+                    rng.range(-15.0, 15.0)
+                }
+            });
+            let d = [
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            ];
+            let g = Gravity3::new(10f64.powf(rng.range(-1.0, 2.0)), d).expect("a gravity");
+            (a, g)
+        })
+        .collect();
+    let tj = measure(&rods, rounds, |(a, g)| {
+        heavy3::tip_and_jacobian(a, &k, g).map(|(p, _)| p.position.x)
+    });
+    let tj0 = measure(&rods, rounds, |(a, _)| {
+        spatial::tip_and_jacobian(a, &k, PRODUCTION_RTOL).map(|(p, _)| p.position.x)
+    });
+    let ratio = tj.median_ns / tj0.median_ns;
+    outln!(
+        "{:<36} {:>10.2} {:>10.2} {:>12.2} {:>7.1}×   no slower (≤ 1×): {}",
+        "3-D tip + J(1) (heavy at rtol 1e-10)",
+        tj.median_ns / 1e3,
+        tj0.median_ns / 1e3,
+        tj.mean_ns / 1e3,
+        ratio,
+        if ratio <= 1.0 { "met" } else { "NOT met" }
+    );
+    let options = rod_ig_core::solver::SolveOptions::default();
+    let mut times = Vec::new();
+    let mut solved = 0usize;
+    for (a, g) in rods.iter().cycle().take(4 * targets) {
+        if times.len() == targets {
+            break;
+        }
+        let Ok(e) = heavy3::evaluate(a, &k, g) else {
+            continue;
+        };
+        if !e.stability.stable || e.tip.position.norm() > 0.95 {
+            continue;
+        }
+        let t0 = std::time::Instant::now();
+        let model = HeavySpatial {
+            stiffness: k,
+            gravity: *g,
+        };
+        solved += solver::solve(&model, &e.tip, &options).is_ok() as usize;
+        times.push(t0.elapsed().as_secs_f64() * 1e6);
+    }
+    if times.is_empty() {
+        return;
+    }
+    let m = median(&mut times);
+    outln!(
+        "3-D robust solve with weight, {} targets of stable heavy rods: {solved} solved, median {m:.0} µs (goal ≤ 1 ms: {})",
+        times.len(),
+        if m <= 1000.0 { "met" } else { "NOT met" }
+    );
 }
 
 /// The robust solve of `targets` targets of stable heavy rods, against the weightless solve of
