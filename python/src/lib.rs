@@ -77,32 +77,43 @@ fn planar_params(a: &[f64], i: usize) -> PlanarParams {
     PlanarParams::new(a[3 * i], a[3 * i + 1], a[3 * i + 2])
 }
 
-/// The gravity of each of n rods from the flattened `weight` (n) and `gravity` (2n) arrays, or
-/// None when no weight was given (the weightless closed forms). Errors name the rod.
-fn gravities(
+/// The (weight, direction) of each of n rods from the flattened `weight` (n) and `gravity`
+/// (D n) arrays, each made a gravity by `make`; None when no weight was given (the weightless
+/// models). Errors name the rod.
+fn gravities<const D: usize, G>(
     n: usize,
     weight: Option<&PyReadonlyArray1<'_, f64>>,
     gravity: Option<&PyReadonlyArray1<'_, f64>>,
-) -> PyResult<Option<Vec<Gravity>>> {
+    default: [f64; D],
+    make: impl Fn(f64, [f64; D]) -> Result<G, rod_ig_core::RodError>,
+) -> PyResult<Option<Vec<G>>> {
     let Some(weight) = weight else {
         return Ok(None);
     };
     let w = weight.as_slice()?;
-    let default = [0.0, -1.0];
     let g = gravity.map(|g| g.as_slice()).transpose()?;
-    if w.len() != n || g.is_some_and(|g| g.len() != 2 * n) {
+    if w.len() != n || g.is_some_and(|g| g.len() != D * n) {
         return Err(PyValueError::new_err(
             "weight and gravity must broadcast against the batch",
         ));
     }
     (0..n)
         .map(|i| {
-            let dir = g.map_or(default, |g| [g[2 * i], g[2 * i + 1]]);
-            Gravity::new(w[i], dir)
+            let dir = g.map_or(default, |g| std::array::from_fn(|k| g[D * i + k]));
+            make(w[i], dir)
                 .map_err(|e| PyValueError::new_err(format!("weight/gravity of rod {i}: {e}")))
         })
         .collect::<PyResult<Vec<_>>>()
         .map(Some)
+}
+
+/// [`gravities`] of planar rods (default direction −y).
+fn gravities2(
+    n: usize,
+    weight: Option<&PyReadonlyArray1<'_, f64>>,
+    gravity: Option<&PyReadonlyArray1<'_, f64>>,
+) -> PyResult<Option<Vec<Gravity>>> {
+    gravities(n, weight, gravity, [0.0, -1.0], Gravity::new)
 }
 
 fn f64_out<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
@@ -124,7 +135,7 @@ fn forward<'py>(
     let a = a.as_slice()?;
     let n = a.len() / 3;
     let threads = thread_count(threads)?;
-    let g = gravities(n, weight.as_ref(), gravity.as_ref())?;
+    let g = gravities2(n, weight.as_ref(), gravity.as_ref())?;
     let mut elastic = vec![f64::NAN; n];
     let mut tip = vec![f64::NAN; 3 * n];
     let mut jac = vec![f64::NAN; 9 * n];
@@ -183,7 +194,7 @@ fn is_stable<'py>(
     let a = a.as_slice()?;
     let n = a.len() / 3;
     let threads = thread_count(threads)?;
-    let g = gravities(n, weight.as_ref(), gravity.as_ref())?;
+    let g = gravities2(n, weight.as_ref(), gravity.as_ref())?;
     let mut stable = vec![false; n];
     batch(
         py,
@@ -217,7 +228,7 @@ fn shape<'py>(
     let a = a.as_slice()?;
     let n = a.len() / 3;
     let threads = thread_count(threads)?;
-    let g = gravities(n, weight.as_ref(), gravity.as_ref())?;
+    let g = gravities2(n, weight.as_ref(), gravity.as_ref())?;
     let mut out = vec![f64::NAN; 3 * samples * n];
     batch(
         py,
@@ -396,7 +407,7 @@ fn solve<'py>(
     gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let t = targets.as_slice()?;
-    let g = gravities(t.len() / 3, weight.as_ref(), gravity.as_ref())?;
+    let g = gravities2(t.len() / 3, weight.as_ref(), gravity.as_ref())?;
     let a0 = a0.as_ref().map(|a| a.as_slice()).transpose()?;
     let base = options(
         SolveOptions::default(),
@@ -506,31 +517,13 @@ struct Evaluated3d {
     energy: f64,
 }
 
-/// The 3-D gravity of each of n rods from the flattened `weight` (n) and `gravity` (3n), or
-/// None without weight. Errors name the rod.
+/// [`gravities`] of 3-D rods (default direction −z).
 fn gravities3(
     n: usize,
     weight: Option<&PyReadonlyArray1<'_, f64>>,
     gravity: Option<&PyReadonlyArray1<'_, f64>>,
 ) -> PyResult<Option<Vec<Gravity3>>> {
-    let Some(weight) = weight else {
-        return Ok(None);
-    };
-    let w = weight.as_slice()?;
-    let g = gravity.map(|g| g.as_slice()).transpose()?;
-    if w.len() != n || g.is_some_and(|g| g.len() != 3 * n) {
-        return Err(PyValueError::new_err(
-            "weight and gravity must broadcast against the batch",
-        ));
-    }
-    (0..n)
-        .map(|i| {
-            let dir = g.map_or([0.0, 0.0, -1.0], |g| [g[3 * i], g[3 * i + 1], g[3 * i + 2]]);
-            Gravity3::new(w[i], dir)
-                .map_err(|e| PyValueError::new_err(format!("weight/gravity of rod {i}: {e}")))
-        })
-        .collect::<PyResult<Vec<_>>>()
-        .map(Some)
+    gravities(n, weight, gravity, [0.0, 0.0, -1.0], Gravity3::new)
 }
 
 /// 3-D forward map of n rods `a` (flattened (n, 6)): position, quaternion (x, y, z, w),

@@ -138,9 +138,7 @@ pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyReference, RodErro
     let (tip, jacobian, energy, elastic_energy) = tip_and_jacobian(a, g, rtol)?;
     let grid = super::planar_reference::stability_grid();
     let (w, d) = (g.weight(), g.direction());
-    let mut margin = f64::INFINITY;
-    let mut first: Option<f64> = None;
-    let mut prev: Option<(f64, f64)> = None;
+    let mut scan = super::GridScan::new(0.05);
     solve_dense(
         |_, s, ds| rhs(w, d, s, ds, true),
         0.0,
@@ -148,20 +146,7 @@ pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyReference, RodErro
         &grid,
         &opts(rtol),
         |_, t, s| {
-            let det = jacobian_of(s).determinant();
-            if t >= 0.05 - 1e-12 {
-                let lead = det_leading_term(a, g, t);
-                if lead > 0.0 {
-                    margin = margin.min(det / lead);
-                }
-            }
-            if first.is_none() && !(det > 0.0) {
-                first = Some(match prev {
-                    Some((tp, dp)) if dp > det => tp + (t - tp) * dp / (dp - det),
-                    _ => t,
-                });
-            }
-            prev = Some((t, det));
+            scan.push(t, jacobian_of(s).determinant(), det_leading_term(a, g, t));
             ControlFlow::Continue(())
         },
     )?;
@@ -170,11 +155,6 @@ pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyReference, RodErro
         jacobian,
         energy,
         elastic_energy,
-        stability: StabilityReport {
-            stable: first.is_none(),
-            margin: if margin.is_finite() { margin } else { 0.0 },
-            first_conjugate_t: first,
-            uncertain: false,
-        },
+        stability: scan.report(),
     })
 }

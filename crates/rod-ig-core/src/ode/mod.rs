@@ -149,3 +149,53 @@ pub struct OdeStats {
     /// Rejected steps.
     pub rejected: u32,
 }
+
+/// The stability rule on a grid, for the references that sample det J(t) at given t: the
+/// least det J(t)/D0(t) over t ≥ `margin_from` (D0 > 0 the small-t leading term) and the first
+/// crossing (det ≤ 0), placed by linear interpolation with the previous sample.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct GridScan {
+    margin_from: f64,
+    margin: f64,
+    first: Option<f64>,
+    prev: Option<(f64, f64)>,
+}
+
+impl GridScan {
+    pub(crate) fn new(margin_from: f64) -> Self {
+        Self {
+            margin_from,
+            margin: f64::INFINITY,
+            first: None,
+            prev: None,
+        }
+    }
+
+    /// One sample: det J(t) and D0(t).
+    pub(crate) fn push(&mut self, t: f64, det: f64, lead: f64) {
+        if t >= self.margin_from - 1e-12 && lead > 0.0 {
+            self.margin = self.margin.min(det / lead);
+        }
+        if self.first.is_none() && !(det > 0.0) {
+            self.first = Some(match self.prev {
+                Some((tp, dp)) if dp > det => tp + (t - tp) * dp / (dp - det),
+                _ => t,
+            });
+        }
+        self.prev = Some((t, det));
+    }
+
+    /// The verdict: stable iff no crossing; the margin (0 when no sample entered it).
+    pub(crate) fn report(&self) -> crate::StabilityReport {
+        crate::StabilityReport {
+            stable: self.first.is_none(),
+            margin: if self.margin.is_finite() {
+                self.margin
+            } else {
+                0.0
+            },
+            first_conjugate_t: self.first,
+            uncertain: false,
+        }
+    }
+}

@@ -252,9 +252,39 @@ impl<'a, const N: usize, M: LoadedModel<N>> Search<'a, N, M> {
     }
 }
 
+/// The first stable heavy rod followed from `starts` (weightless rods on target under
+/// `weightless`), or why none was.
+pub(crate) fn first<const N: usize, M: LoadedModel<N>>(
+    weightless: &M,
+    heavy: &M,
+    target: &M::Pose,
+    options: &SolveOptions<SVector<f64, N>>,
+    starts: impl Iterator<Item = SVector<f64, N>>,
+) -> Result<SolutionOf<N, M>, FailureOf<N>> {
+    let (found, search) = search_from(weightless, heavy, target, options, starts, false);
+    found.into_iter().next().ok_or_else(|| search.failure())
+}
+
+/// Every distinct stable heavy rod followed from `starts`, and the work it took.
+pub(crate) fn every<const N: usize, M: LoadedModel<N>>(
+    weightless: &M,
+    heavy: &M,
+    target: &M::Pose,
+    options: &SolveOptions<SVector<f64, N>>,
+    starts: impl Iterator<Item = SVector<f64, N>>,
+) -> super::Found<SVector<f64, N>, M::Pose> {
+    let (solutions, search) = search_from(weightless, heavy, target, options, starts, true);
+    super::Found {
+        solutions,
+        iterations: search.work.iterations,
+        evaluations: search.work.evaluations,
+        starts: search.work.starts,
+    }
+}
+
 /// The first stable heavy rod followed from `starts` (weightless rods on target), or every
 /// distinct one when `all`.
-pub(crate) fn search_from<'a, const N: usize, M: LoadedModel<N>>(
+fn search_from<'a, const N: usize, M: LoadedModel<N>>(
     weightless: &M,
     heavy: &M,
     target: &M::Pose,

@@ -12,6 +12,7 @@
 //! Stability: det J(t) > 0 on the rule's grid t = i/2000 ∈ [0.02, 1] (FINDINGS3D, the grid of
 //! `shared/oracle/gravity_public.jsonl`'s 3-D lines), by dense output at rtol 1e-10.
 
+use super::reduced::{cross, rotmat, rt_mul as rt};
 use super::{SpatialJacobian, SpatialParams, SpatialPose, Stiffness};
 use crate::ode::{solve, solve_dense, OdeOptions};
 use crate::{RodError, StabilityReport};
@@ -91,41 +92,6 @@ impl Gravity3 {
     pub fn load(&self) -> [f64; 3] {
         self.direction.map(|v| v * self.weight)
     }
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-/// R (row-major) of a quaternion (w, x, y, z), normalised on the fly.
-fn rotmat(w: f64, x: f64, y: f64, z: f64) -> [[f64; 3]; 3] {
-    let n2 = w * w + x * x + y * y + z * z;
-    let s = if n2 > 0.0 { 2.0 / n2 } else { 0.0 };
-    [
-        [
-            1.0 - s * (y * y + z * z),
-            s * (x * y - w * z),
-            s * (x * z + w * y),
-        ],
-        [
-            s * (x * y + w * z),
-            1.0 - s * (x * x + z * z),
-            s * (y * z - w * x),
-        ],
-        [
-            s * (x * z - w * y),
-            s * (y * z + w * x),
-            1.0 - s * (x * x + y * y),
-        ],
-    ]
-}
-
-fn rt(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
-    std::array::from_fn(|i| r[0][i] * v[0] + r[1][i] * v[1] + r[2][i] * v[2])
 }
 
 fn rv(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
@@ -297,7 +263,7 @@ pub fn evaluate(
     let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
     let grid: Vec<f64> = (40..=2000).map(|i| f64::from(i) / 2000.0).collect();
     let mut last = initial();
-    let (mut margin, mut first, mut prev) = (f64::INFINITY, None, None::<(f64, f64)>);
+    let mut scan = crate::ode::GridScan::new(super::stability::MARGIN_T_MIN);
     let mut finite = true;
     solve_dense(
         |t, s, ds| rhs(&ci, &av, load, t, s, ds, true),
@@ -308,19 +274,7 @@ pub fn evaluate(
         |_, t, s| {
             let det = jac(s).determinant();
             finite &= det.is_finite();
-            if t >= super::stability::MARGIN_T_MIN - 1e-12 {
-                let lead = super::det_leading_term(a, t);
-                if lead > 0.0 {
-                    margin = margin.min(det / lead);
-                }
-            }
-            if first.is_none() && !(det > 0.0) {
-                first = Some(match prev {
-                    Some((tp, dp)) if dp > det => tp + (t - tp) * dp / (dp - det),
-                    _ => t,
-                });
-            }
-            prev = Some((t, det));
+            scan.push(t, det, super::det_leading_term(a, t));
             last = *s;
             ControlFlow::Continue(())
         },
@@ -342,11 +296,15 @@ pub fn evaluate(
         jacobian: jac(&last),
         energy: last[7] + potential,
         elastic_energy: last[7],
-        stability: StabilityReport {
-            stable: first.is_none() && !degenerate,
-            margin: if margin.is_finite() { margin } else { 0.0 },
-            first_conjugate_t: if degenerate { None } else { first },
-            uncertain: degenerate,
+        stability: if degenerate {
+            StabilityReport {
+                stable: false,
+                margin: 0.0,
+                first_conjugate_t: None,
+                uncertain: true,
+            }
+        } else {
+            scan.report()
         },
     })
 }

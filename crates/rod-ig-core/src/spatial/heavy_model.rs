@@ -147,9 +147,7 @@ impl InverseGeometry<6> for HeavySpatial {
         options: &Options6,
     ) -> Result<Solution<SpatialParams, SpatialPose>, Failure<SpatialParams>> {
         let starts = weightless_starts(self.spatial(), target, options);
-        let (found, search) =
-            load::search_from(&self.weightless(), self, target, options, starts, false);
-        found.into_iter().next().ok_or_else(|| search.failure())
+        load::first(&self.weightless(), self, target, options, starts)
     }
 
     fn robust_all(
@@ -158,14 +156,7 @@ impl InverseGeometry<6> for HeavySpatial {
         options: &Options6,
     ) -> Found<SpatialParams, SpatialPose> {
         let starts = weightless_starts(self.spatial(), target, options);
-        let (solutions, search) =
-            load::search_from(&self.weightless(), self, target, options, starts, true);
-        Found {
-            solutions,
-            iterations: search.work.iterations,
-            evaluations: search.work.evaluations,
-            starts: search.work.starts,
-        }
+        load::every(&self.weightless(), self, target, options, starts)
     }
 
     fn default_start(&self, target: &SpatialPose) -> Option<SpatialParams> {

@@ -21,7 +21,7 @@ pub(crate) const NR: usize = NRB + 36;
 pub(crate) const ENERGY: usize = 7;
 
 #[inline(always)]
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -31,7 +31,7 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 
 /// Rotation matrix (row-major r[i][j] = R_ij) of the quaternion, normalised on the fly.
 #[inline(always)]
-fn rotmat(w: f64, x: f64, y: f64, z: f64) -> [[f64; 3]; 3] {
+pub(crate) fn rotmat(w: f64, x: f64, y: f64, z: f64) -> [[f64; 3]; 3] {
     let n2 = w * w + x * x + y * y + z * z;
     let s = if n2 > 0.0 { 2.0 / n2 } else { 0.0 };
     [
@@ -54,7 +54,7 @@ fn rotmat(w: f64, x: f64, y: f64, z: f64) -> [[f64; 3]; 3] {
 }
 
 #[inline(always)]
-fn rt_mul(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+pub(crate) fn rt_mul(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
     [
         r[0][0] * v[0] + r[1][0] * v[1] + r[2][0] * v[2],
         r[0][1] * v[0] + r[1][1] * v[1] + r[2][1] * v[2],

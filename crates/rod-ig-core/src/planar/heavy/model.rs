@@ -225,10 +225,14 @@ impl InverseGeometry<3> for HeavyPlanar {
         if self.gravity.is_weightless() {
             return PlanarClosedForm.robust(target, options);
         }
-        let weightless = HeavyPlanar::new(Gravity::NONE);
         let starts = weightless_starts(target, options);
-        let (found, search) = load::search_from(&weightless, self, target, options, starts, false);
-        found.into_iter().next().ok_or_else(|| search.failure())
+        load::first(
+            &HeavyPlanar::new(Gravity::NONE),
+            self,
+            target,
+            options,
+            starts,
+        )
     }
 
     fn robust_all(
@@ -239,16 +243,14 @@ impl InverseGeometry<3> for HeavyPlanar {
         if self.gravity.is_weightless() {
             return PlanarClosedForm.robust_all(target, options);
         }
-        let weightless = HeavyPlanar::new(Gravity::NONE);
         let starts = weightless_starts(target, options);
-        let (solutions, search) =
-            load::search_from(&weightless, self, target, options, starts, true);
-        Found {
-            solutions,
-            iterations: search.work.iterations,
-            evaluations: search.work.evaluations,
-            starts: search.work.starts,
-        }
+        load::every(
+            &HeavyPlanar::new(Gravity::NONE),
+            self,
+            target,
+            options,
+            starts,
+        )
     }
 
     fn default_start(&self, target: &PlanarPose) -> Option<PlanarParams> {
