@@ -7,6 +7,7 @@ use rod_ig_core::solver::{
     self, observe, Event, InverseGeometry, IterationLog, Solution, SolveOptions,
 };
 use serde::Serialize;
+use std::io::Write;
 
 /// One solve answer. On failure `a`, `tip` and `energy` are null and `reason` says why.
 #[derive(Serialize)]
@@ -122,8 +123,11 @@ where
     };
     let (first, solutions) = if verbose {
         let (r, log) = observe(IterationLog::default(), run);
+        // Diagnostics only: a closed or full stderr must not cost the answer on stdout
+        // (eprintln! would panic and exit 101), so write errors are dropped.
+        let mut err = std::io::stderr().lock();
         for event in &log.events {
-            eprintln!("{}", event_json(event));
+            let _ = writeln!(err, "{}", event_json(event));
         }
         r
     } else {

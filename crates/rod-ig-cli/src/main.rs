@@ -228,7 +228,10 @@ fn shape_command(
         let [x, y, theta] = parse_triple(text, "--target")?;
         title = format!("Stable rods reaching x = {x}, y = {y}, θ = {theta}");
         if !gravity.is_weightless() {
-            title = format!("{title}, with weight {} and without", gravity.weight());
+            title = format!(
+                "Stable rods to x = {x}, y = {y}, θ = {theta}: weight {} (colour), none (grey)",
+                gravity.weight()
+            );
             for a in planar_cmds::all_stable_solutions(x, y, theta, &gravity)? {
                 rods.push((a, gravity));
             }
@@ -260,9 +263,12 @@ fn shape_command(
         }
         Format::Svg => {
             let mut drawn = Vec::with_capacity(rods.len());
+            // Beside heavy rods, the weightless ones are drawn muted.
+            let heavy = !gravity.is_weightless();
             for (a, g) in rods {
                 let poses = planar_cmds::sample_shape(a, &g, samples.min(SVG_POINTS))?;
-                drawn.push(planar_cmds::drawn_rod(a, &g, poses));
+                let muted = heavy && g.is_weightless();
+                drawn.push(planar_cmds::drawn_rod(a, &g, poses, muted));
             }
             out.write_all(svg::draw(&drawn, &title).as_bytes())
                 .map_err(|e| e.to_string())?;

@@ -129,7 +129,6 @@ pub struct Tracking {
     gravity: Gravity,
     /// Rods for the picture.
     pub drawn: Vec<SequenceRod>,
-    lines: usize,
 }
 
 fn params3(a: &PlanarParams) -> [f64; 3] {
@@ -185,7 +184,6 @@ impl Tracking {
     /// Answers one `track` line.
     pub fn line(&mut self, line: &str) -> Result<Value, String> {
         let request: TrackRequest = jsonl::parse(line)?;
-        self.lines += 1;
         let mut options = SolveOptions::default();
         jsonl::apply_newton_knobs(
             (None, None, request.tolerance),
@@ -228,8 +226,12 @@ impl Tracking {
         options: SolveOptions,
     ) -> Result<Option<GravityChange>, String> {
         if let Some(a0) = request.a0 {
-            if self.lines > 1 {
-                return Err("\"a0\" is only accepted on the first line".into());
+            // Only before the stream holds a rod: a first line that was refused does not
+            // lock the start out.
+            if self.follower.is_some() {
+                return Err(
+                    "\"a0\" is only accepted on the first line (before any rod is held)".into(),
+                );
             }
             let a0 = PlanarParams::from(a0);
             let follower = Follower::holding(gravity, options, a0)

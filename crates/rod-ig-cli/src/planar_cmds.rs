@@ -241,7 +241,13 @@ pub fn all_stable_solutions(
 }
 
 /// A rod ready to draw, labelled with its parameters, energy and stability.
-pub fn drawn_rod(a: [f64; 3], g: &Gravity, poses: Vec<PlanarPose>) -> crate::svg::DrawnRod {
+/// `muted`: drawn thin and grey (the weightless rods beside heavy ones).
+pub fn drawn_rod(
+    a: [f64; 3],
+    g: &Gravity,
+    poses: Vec<PlanarPose>,
+    muted: bool,
+) -> crate::svg::DrawnRod {
     let params = PlanarParams::from(a);
     let (energy, stable) = match heavy::evaluate(&params, g) {
         Ok(e) => (e.energy, e.stability.stable),
@@ -267,5 +273,6 @@ pub fn drawn_rod(a: [f64; 3], g: &Gravity, poses: Vec<PlanarPose>) -> crate::svg
             }
         ),
         dashed: !stable,
+        muted,
     }
 }

@@ -11,7 +11,12 @@ pub struct DrawnRod {
     pub label: String,
     /// Drawn dashed (e.g. an unstable equilibrium).
     pub dashed: bool,
+    /// Drawn thin and grey, behind the others (e.g. the weightless rods beside heavy ones).
+    pub muted: bool,
 }
+
+/// The colour of muted rods.
+const MUTED: &str = "#aaaaaa";
 
 const COLOURS: [&str; 6] = [
     "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf",
@@ -50,7 +55,12 @@ pub fn draw(rods: &[DrawnRod], title: &str) -> String {
         0.06 * scale
     );
     for (i, rod) in rods.iter().enumerate() {
-        let colour = COLOURS[i % COLOURS.len()];
+        let colour = if rod.muted {
+            MUTED
+        } else {
+            COLOURS[i % COLOURS.len()]
+        };
+        let width = if rod.muted { 1.5 } else { 3.0 };
         let points: Vec<String> = rod
             .poses
             .iter()
@@ -64,7 +74,7 @@ pub fn draw(rods: &[DrawnRod], title: &str) -> String {
         };
         let _ = write!(
             s,
-            r#"<polyline points="{}" fill="none" stroke="{colour}" stroke-width="3"{dash}/>"#,
+            r#"<polyline points="{}" fill="none" stroke="{colour}" stroke-width="{width}"{dash}/>"#,
             points.join(" ")
         );
         if let Some(tip) = rod.poses.last().filter(|p| p.is_finite()) {
@@ -249,6 +259,7 @@ mod tests {
     #[test]
     fn draws_one_polyline_per_rod_and_escapes_labels() {
         let rod = |label: &str| DrawnRod {
+            muted: false,
             poses: vec![
                 PlanarPose::new(0.0, 0.0, 0.0),
                 PlanarPose::new(1.0, 0.0, 0.0),
@@ -265,6 +276,7 @@ mod tests {
     #[test]
     fn non_finite_poses_are_skipped() {
         let rod = DrawnRod {
+            muted: false,
             poses: vec![
                 PlanarPose::new(0.0, 0.0, 0.0),
                 PlanarPose::new(f64::NAN, 0.0, 0.0),

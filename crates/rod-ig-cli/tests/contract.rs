@@ -513,3 +513,50 @@ fn solve3d_takes_weight_and_gravity() {
     }
     assert!(out[2]["error"].is_string());
 }
+
+#[test]
+fn smaller_contract_mends_of_issue_42() {
+    // An unknown field inside a planar target is refused, as the 3-D pose refuses one.
+    let out = run(
+        &["solve"],
+        "{\"target\": {\"x\": 0.5, \"y\": 0.2, \"theta\": 1.0, \"z\": 5}}\n",
+    );
+    assert!(
+        out[0]["error"].as_str().unwrap().contains("z"),
+        "{}",
+        out[0]
+    );
+    // A refused first `track` line does not lock `a0` out of the next one.
+    let out = run(
+        &["track"],
+        "{\"target\": {\"x\": 0.6, \"y\": 0, \"theta\": 0}, \"tolerance\": -1}\n\
+         {\"target\": {\"x\": 0.6, \"y\": 0.01, \"theta\": 0}, \"a0\": [-0.5422184936207011, 99.66906108365531, 0.0]}\n\
+         {\"target\": {\"x\": 0.6, \"y\": 0, \"theta\": 0}, \"a0\": [0, 1, 0]}\n",
+    );
+    assert!(out[0]["error"].is_string());
+    assert!(out[1].get("error").is_none(), "{}", out[1]);
+    assert!(out[2]["error"].as_str().unwrap().contains("a0"));
+    // `--verbose` with a closed stderr still answers every line on stdout, exit 0.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
+        .args(["solve", "--verbose"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stderr.take());
+    {
+        use std::io::Write;
+        let mut stdin = child.stdin.take().unwrap();
+        for _ in 0..3 {
+            writeln!(
+                stdin,
+                "{{\"target\": {{\"x\": 0.5, \"y\": 0.2, \"theta\": 1.0}}}}"
+            )
+            .unwrap();
+        }
+    }
+    let output = child.wait_with_output().unwrap();
+    assert!(output.status.success(), "{:?}", output.status);
+    assert_eq!(String::from_utf8_lossy(&output.stdout).lines().count(), 3);
+}

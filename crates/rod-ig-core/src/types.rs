@@ -15,6 +15,8 @@ pub type PlanarJacobian = nalgebra::Matrix3<f64>;
 /// `theta` is unwrapped when it comes from the rod (θ(t) = ∫₀ᵗ κ); compare targets modulo 2π
 /// with [`wrap_angle`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+// A target written {"x", "y", "theta", "z": 5} is a mistake to report, not to solve in the plane.
+#[serde(deny_unknown_fields)]
 pub struct PlanarPose {
     /// Position along the base tangent.
     pub x: f64,
