@@ -62,7 +62,8 @@ def rod_solution():
 
 def request():
     return SolveRod.Request(target=pose_stamped(), use_initial_guess=True, initial_guess=[0.1, 0.2, 0.3],
-                            tolerance=1e-8, max_iterations=50, method="newton", path_samples=9)
+                            tolerance=1e-8, max_iterations=50, method="newton", path_samples=9,
+                            move_rod=True)
 
 
 def response():

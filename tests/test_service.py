@@ -131,3 +131,33 @@ def test_service_full_path_loopback_client():
     assert abs(poses[0][0]) < 1e-12 and abs(poses[0][1]) < 1e-12
     assert abs(poses[-1][0] - x) < POS_TOL and abs(poses[-1][1] - y) < POS_TOL
     assert h.angle_diff(poses[-1][2], yaw) < ANG_TOL
+
+
+def test_a_query_leaves_the_held_rod_alone():
+    """/rod/solve is a query unless move_rod: the rod the target stream holds is untouched
+    (issue 43, item 3). The buckled rod at (0.8, 0, 0) snaps when its gripper turns to 1.5 rad;
+    a query for that pose must not make the next stream target start from the snapped rod."""
+    node, c = h.start_node_and_client()
+    try:
+        def stream(x, y, yaw):
+            s = h.next_seq()
+            c.pub.publish(c.make_target(x, y, yaw, s))
+            sol = c.solution_for(s)
+            assert sol.success, sol.message
+            return sol
+        held = stream(0.8, 0.0, 0.0)
+        # Queries, one of which the held rod could only reach by snapping.
+        for yaw in (1.5, -1.5, 0.7):
+            r = c.solve(c.make_target(0.8, 0.0, yaw, h.next_seq()), path_samples=SMALL)
+            assert r.solution.success, r.solution.message
+        again = stream(0.8, 0.0, 0.0)
+        assert again.event == "none"
+        assert max(abs(p - q) for p, q in zip(again.a, held.a)) < 1e-6, (held.a, again.a)
+        # With move_rod the call is a move: the stream goes on from the moved rod.
+        moved = c.solve(c.make_target(0.8, 0.0, 0.3, h.next_seq()), path_samples=SMALL,
+                        move_rod=True).solution
+        assert moved.success and moved.event in ("none", "snap")
+        after = stream(0.8, 0.0, 0.3)
+        assert max(abs(p - q) for p, q in zip(after.a, moved.a)) < 1e-6
+    finally:
+        h.stop_node_and_client(node, c)

@@ -285,6 +285,8 @@ pub struct SolveRodRequest {
     pub method: String,
     /// Path poses override (0 = parameter).
     pub path_samples: u32,
+    /// Move the held rod (appended field; false = a query without side effects).
+    pub move_rod: bool,
 }
 impl Message for SolveRodRequest {}
 
@@ -717,6 +719,7 @@ pub(crate) mod tests {
             max_iterations: 50,
             method: "newton".into(),
             path_samples: 9,
+            move_rod: true,
         }
     }
 

@@ -1109,7 +1109,11 @@ fn serve_solve(
         Ok(overrides) => {
             let started = std::time::Instant::now();
             let (outcome, work) = observe(Counters::default(), || {
-                processor.process(&request.target, params, &overrides)
+                if request.move_rod {
+                    processor.process(&request.target, params, &overrides)
+                } else {
+                    processor.query(&request.target, params, &overrides)
+                }
             });
             report(log, stats, &names.solve, &outcome, &work, started.elapsed());
             SolveRodResponse {

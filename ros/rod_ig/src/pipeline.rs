@@ -265,6 +265,20 @@ impl Processor {
         }
     }
 
+    /// As [`Processor::process`], without side effects: the held rod and the warm starts are
+    /// as they were before the call (`rod/solve` without `move_rod`).
+    pub fn query(
+        &mut self,
+        target: &PoseStamped,
+        params: &Params,
+        overrides: &Overrides,
+    ) -> Outcome {
+        let held = self.solver.clone();
+        let outcome = self.process(target, params, overrides);
+        self.solver = held;
+        outcome
+    }
+
     /// Plans a stable gripper path (`rod/plan`): metres and the base frame in, the core
     /// planner in normalised units, metres out.
     ///

@@ -153,7 +153,9 @@ fn options_3d(s: &SolverSettings, initial_guess: Option<SpatialParams>) -> Solve
     }
 }
 
-/// Inverse-geometry solver with warm start (planar and 3-D kept separately).
+/// Inverse-geometry solver with warm start (planar and 3-D kept separately). Cloned to answer
+/// a query without side effects.
+#[derive(Clone)]
 pub struct RodSolver {
     settings: SolverSettings,
     tracker: Tracker,
