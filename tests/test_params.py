@@ -226,3 +226,29 @@ def test_base_frame_must_be_a_frame_id(node_and_client):
         assert not results[0].successful, bad
         assert "frame id" in results[0].reason, results[0].reason
     assert c.get_params("base_frame") == {"base_frame": "rod_base"}
+
+
+def test_base_wrench_is_published_as_wrench_stamped(node_and_client):
+    """rod/base_wrench (geometry_msgs/WrenchStamped) carries each solution's base wrench when
+    bending_stiffness is set, for plotters and wrench displays (issue 43, item 4)."""
+    from geometry_msgs.msg import WrenchStamped
+    _, c = node_and_client
+    got = []
+    sub = c.node.create_subscription(WrenchStamped, "/rod/base_wrench", got.append, h.topic_qos())
+    try:
+        assert all(r.successful for r in c.set_params(bending_stiffness=2.0, rod_length=0.5))
+        t, sol, _ = solve_topic(c, 0.3, 0.15, 0.5)
+        assert sol.success and sol.wrench_valid
+        assert c.wait_for(lambda: any(w.header.stamp == t.header.stamp for w in got), timeout=5.0)
+        w = next(w for w in got if w.header.stamp == t.header.stamp)
+        assert w.header.frame_id == sol.header.frame_id
+        assert w.wrench.force.x == sol.base_wrench.force.x
+        assert w.wrench.force.y == sol.base_wrench.force.y
+        assert w.wrench.torque.z == sol.base_wrench.torque.z
+        # Without bending_stiffness the wrench is not known in newtons: nothing is published.
+        assert all(r.successful for r in c.set_params(bending_stiffness=0.0, rod_length=1.0))
+        t, sol, _ = solve_topic(c, 0.6, 0.3, 0.5)
+        assert sol.success and not sol.wrench_valid
+        assert not c.wait_for(lambda: any(w.header.stamp == t.header.stamp for w in got), timeout=0.5)
+    finally:
+        c.node.destroy_subscription(sub)

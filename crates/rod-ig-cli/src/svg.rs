@@ -18,6 +18,17 @@ pub struct DrawnRod {
 /// The colour of muted rods.
 const MUTED: &str = "#aaaaaa";
 
+impl DrawnRod {
+    /// Colour and width of the `i`-th rod's line.
+    fn stroke(&self, i: usize) -> (&'static str, f64) {
+        if self.muted {
+            (MUTED, 1.5)
+        } else {
+            (COLOURS[i % COLOURS.len()], 3.0)
+        }
+    }
+}
+
 const COLOURS: [&str; 6] = [
     "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf",
 ];
@@ -55,12 +66,7 @@ pub fn draw(rods: &[DrawnRod], title: &str) -> String {
         0.06 * scale
     );
     for (i, rod) in rods.iter().enumerate() {
-        let colour = if rod.muted {
-            MUTED
-        } else {
-            COLOURS[i % COLOURS.len()]
-        };
-        let width = if rod.muted { 1.5 } else { 3.0 };
+        let (colour, width) = rod.stroke(i);
         let points: Vec<String> = rod
             .poses
             .iter()

@@ -24,4 +24,6 @@ pub mod names {
     pub const PLAN_RODS: &str = "rod/plan_rods";
     /// Diagnostics out (diagnostic_msgs/DiagnosticArray): absolute, as diagnostic_updater's.
     pub const DIAGNOSTICS: &str = "/diagnostics";
+    /// The base wrench out (geometry_msgs/WrenchStamped), with `bending_stiffness` set.
+    pub const BASE_WRENCH: &str = "rod/base_wrench";
 }

@@ -123,6 +123,16 @@ pub struct Wrench {
     pub torque: Vector3,
 }
 
+/// `geometry_msgs/msg/WrenchStamped`: the base wrench for tools that plot or draw wrenches.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct WrenchStamped {
+    /// Stamp and frame.
+    pub header: Header,
+    /// The wrench.
+    pub wrench: Wrench,
+}
+impl Message for WrenchStamped {}
+
 /// `nav_msgs/msg/Path`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Path {
@@ -401,6 +411,10 @@ pub mod type_names {
     /// `nav_msgs/msg/Path`.
     pub fn path() -> MessageTypeName {
         MessageTypeName::new("nav_msgs", "Path")
+    }
+    /// `geometry_msgs/msg/WrenchStamped`.
+    pub fn wrench_stamped() -> MessageTypeName {
+        MessageTypeName::new("geometry_msgs", "WrenchStamped")
     }
     /// `visualization_msgs/msg/Marker`.
     pub fn marker() -> MessageTypeName {

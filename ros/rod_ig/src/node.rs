@@ -53,7 +53,7 @@ use tokio::sync::{mpsc, oneshot, watch};
 use crate::diagnostics::SolveStats;
 use crate::messages::{
     type_names, Marker, Path, PlanRodRequest, PlanRodResponse, PoseStamped, RodSolution,
-    SolveRodRequest, SolveRodResponse,
+    SolveRodRequest, SolveRodResponse, WrenchStamped,
 };
 use crate::params::{Params, Startup};
 use crate::pipeline::{Outcome, Overrides, Processor};
@@ -274,6 +274,8 @@ struct Outputs {
     marker: Publisher<Marker>,
     /// Written by the planner thread.
     plan_rods: Arc<Publisher<Marker>>,
+    /// The base wrench of each solution, when `bending_stiffness` is set.
+    base_wrench: Publisher<WrenchStamped>,
     /// The resolved names, for the logs (remapped and namespaced as the graph shows them).
     names: Names,
 }
@@ -286,6 +288,7 @@ struct Names {
     solution: String,
     marker: String,
     plan_rods: String,
+    base_wrench: String,
     solve: String,
     plan: String,
 }
@@ -502,6 +505,7 @@ fn create_endpoints(
     let marker_topic = topic(node, names::MARKER, type_names::marker())?;
     let plan_rods_topic = topic(node, names::PLAN_RODS, type_names::marker())?;
     let diagnostics_topic = topic(node, names::DIAGNOSTICS, type_names::diagnostic_array())?;
+    let wrench_topic = topic(node, names::BASE_WRENCH, type_names::wrench_stamped())?;
     let (solve_name, solve_full) = resolved_name(identity, names::SOLVE)?;
     let (plan_name, plan_full) = resolved_name(identity, names::PLAN)?;
     let diagnostics = node
@@ -521,12 +525,16 @@ fn create_endpoints(
             node.create_publisher(&plan_rods_topic, out_qos(names::PLAN_RODS))
                 .map_err(create_err("/rod/plan_rods publisher"))?,
         ),
+        base_wrench: node
+            .create_publisher(&wrench_topic, out_qos(names::BASE_WRENCH))
+            .map_err(create_err("/rod/base_wrench publisher"))?,
         names: Names {
             target: resolved[0].clone(),
             path: resolved[1].clone(),
             solution: resolved[2].clone(),
             marker: resolved[3].clone(),
             plan_rods: resolved[4].clone(),
+            base_wrench: resolved[6].clone(),
             solve: solve_full.clone(),
             plan: plan_full.clone(),
         },
@@ -1180,6 +1188,21 @@ fn publish(log: &Logger, outputs: &Outputs, outcome: Outcome) {
     if let Some(path) = outcome.path {
         if let Err(e) = outputs.path.publish(path) {
             node_log!(log, Error, "cannot publish {}: {e:?}", outputs.names.path);
+        }
+    }
+    // The base wrench for wrench displays and plotters, when it is known in newtons.
+    if outcome.solution.success && outcome.solution.wrench_valid {
+        let stamped = WrenchStamped {
+            header: outcome.solution.header.clone(),
+            wrench: outcome.solution.base_wrench,
+        };
+        if let Err(e) = outputs.base_wrench.publish(stamped) {
+            node_log!(
+                log,
+                Error,
+                "cannot publish {}: {e:?}",
+                outputs.names.base_wrench
+            );
         }
     }
     if let Err(e) = outputs.solution.publish(outcome.solution) {

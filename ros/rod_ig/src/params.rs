@@ -107,7 +107,7 @@ pub struct QosOverride {
 
 /// The endpoints whose QoS the `qos_overrides` parameters set: the target subscription, then
 /// the publishers.
-const QOS_ENDPOINTS: [(&str, &str); 6] = {
+const QOS_ENDPOINTS: [(&str, &str); 7] = {
     use crate::graph::names;
     [
         (names::TARGET, "subscription"),
@@ -116,6 +116,7 @@ const QOS_ENDPOINTS: [(&str, &str); 6] = {
         (names::MARKER, "publisher"),
         (names::PLAN_RODS, "publisher"),
         (names::DIAGNOSTICS, "publisher"),
+        (names::BASE_WRENCH, "publisher"),
     ]
 };
 
@@ -975,8 +976,8 @@ pub fn usage() -> String {
     }
     text.push_str(
         "  qos_overrides.TOPIC.ROLE.POLICY  start-up QoS, as rclcpp's: TOPIC /rod/target (ROLE\n\
-         \x20   subscription) or /rod/path, /rod/solution, /rod/marker, /rod/plan_rods, /diagnostics\n\
-         \x20   (ROLE publisher); POLICY reliability (reliable|best_effort), durability\n\
+         \x20   subscription) or /rod/path, /rod/solution, /rod/marker, /rod/plan_rods, /diagnostics,\n\
+         \x20   /rod/base_wrench (ROLE publisher); POLICY reliability (reliable|best_effort), durability\n\
          \x20   (volatile|transient_local), history (keep_last|keep_all), depth (1..10000)\n\
          \x20   (reliable, volatile, keep_last, 10)\n",
     );
