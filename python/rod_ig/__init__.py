@@ -21,7 +21,7 @@ True
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Sequence
+from typing import Any, Literal, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -49,6 +49,23 @@ __all__ = [
 ]
 
 FloatArray = npt.NDArray[np.float64]
+Objective = Literal["first", "least_energy"]
+"""The objective of a solve: the first stable rod found, or the least energetic one."""
+Method = Literal["robust", "newton"]
+"""The solver: the robust search, or the paper's alpha-Newton."""
+
+
+def _integer(name: str, value: Any, lo: int, hi: int) -> int:
+    """``value`` as an int in [lo, hi]; ``TypeError``/``ValueError`` naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} must be an integer, got {value!r}")
+    if not lo <= int(value) <= hi:
+        raise ValueError(f"{name} must be in [{lo}, {hi}], got {value}")
+    return int(value)
+
+
+def _threads(threads: int | None) -> int | None:
+    return None if threads is None else _integer("threads", threads, 1, 1 << 20)
 BoolArray = npt.NDArray[np.bool_]
 
 
@@ -153,6 +170,8 @@ class SolveResult:
     """(..., 3) or (..., 6): the stable rod found (NaN where it failed)."""
     termination: npt.NDArray[np.str_]
     """(...): "converged", "deadline", "no_stable_solution", "unreachable", ... (the CLI's)."""
+    reason: npt.NDArray[np.str_]
+    """(...): why a solve failed, in words ("" where it succeeded): scipy's ``message``."""
     iterations: npt.NDArray[np.uint32]
     margin: FloatArray
     energy: FloatArray
@@ -176,6 +195,7 @@ def _solve_result(
         success=d["success"].reshape(shape),
         a=d["a"].reshape(shape + (dim,)),
         termination=np.array(d["termination"], dtype=str).reshape(shape),
+        reason=np.array(d["reason"], dtype=str).reshape(shape),
         iterations=d["iterations"].reshape(shape),
         margin=d["margin"].reshape(shape),
         energy=d["energy"].reshape(shape),
@@ -200,7 +220,7 @@ def forward(
     (docs/weight.md)."""
     arr, _ = _batch("a", a, 3)
     flat, shape = _broadcast(arr, *_weight_arrays(weight, gravity))
-    d = _rod_ig.forward(flat[0], threads=threads, **_weight_kwargs(flat, 1))
+    d = _rod_ig.forward(flat[0], threads=_threads(threads), **_weight_kwargs(flat, 1))
     return ForwardResult(
         tip=d["tip"].reshape(shape + (3,)),
         jacobian=d["jacobian"].reshape(shape + (3, 3)),
@@ -225,7 +245,7 @@ def is_stable(
     ``weight``, ``gravity``: as for ``forward``."""
     arr, _ = _batch("a", a, 3)
     flat, shape = _broadcast(arr, *_weight_arrays(weight, gravity))
-    return _rod_ig.is_stable(flat[0], threads=threads, **_weight_kwargs(flat, 1)).reshape(shape)
+    return _rod_ig.is_stable(flat[0], threads=_threads(threads), **_weight_kwargs(flat, 1)).reshape(shape)
 
 
 def shape(
@@ -237,19 +257,18 @@ def shape(
 ) -> FloatArray:
     """Poses (x, y, theta) of rods ``a`` (..., 3) at ``samples`` points from the base (the
     identity) to the tip: shape (..., samples, 3). ``weight``, ``gravity``: as for ``forward``."""
-    if not 2 <= int(samples) <= 1_000_000:
-        raise ValueError(f"samples must be in [2, 1000000], got {samples}")
+    samples = _integer("samples", samples, 2, 1_000_000)
     arr, _ = _batch("a", a, 3)
     flat, batch = _broadcast(arr, *_weight_arrays(weight, gravity))
-    out = _rod_ig.shape(flat[0], int(samples), threads=threads, **_weight_kwargs(flat, 1))
+    out = _rod_ig.shape(flat[0], int(samples), threads=_threads(threads), **_weight_kwargs(flat, 1))
     return out.reshape(batch + (int(samples), 3))
 
 
 def solve(
     targets: npt.ArrayLike,
     a0: npt.ArrayLike | None = None,
-    objective: str = "first",
-    method: str = "robust",
+    objective: Objective = "first",
+    method: Method = "robust",
     deadline_ms: float = 250.0,
     tolerance: float | None = None,
     max_iterations: int | None = None,
@@ -279,10 +298,12 @@ def solve(
         method=method,
         deadline_ms=deadline_ms,
         tolerance=tolerance,
-        max_iterations=max_iterations,
+        max_iterations=None
+        if max_iterations is None
+        else _integer("max_iterations", max_iterations, 1, 100_000),
         alpha=alpha,
         all=all,
-        threads=threads,
+        threads=_threads(threads),
         **_weight_kwargs(flat, len(arrays)),
     )
     return _solve_result(d, batch, 3, all)
@@ -301,7 +322,7 @@ def forward3d(
     arr, _ = _batch("a", a, 6)
     flat, batch = _broadcast(arr, *_weight_arrays(weight, gravity, 3))
     d = _rod_ig.forward3d(
-        flat[0], stiffness=tuple(stiffness), threads=threads, **_weight_kwargs(flat, 1)
+        flat[0], stiffness=tuple(stiffness), threads=_threads(threads), **_weight_kwargs(flat, 1)
     )
     return Forward3dResult(
         position=d["position"].reshape(batch + (3,)),
@@ -317,8 +338,8 @@ def solve3d(
     position: npt.ArrayLike,
     quaternion: npt.ArrayLike,
     a0: npt.ArrayLike | None = None,
-    objective: str = "first",
-    method: str = "robust",
+    objective: Objective = "first",
+    method: Method = "robust",
     deadline_ms: float = 1000.0,
     tolerance: float | None = None,
     max_iterations: int | None = None,
@@ -344,11 +365,13 @@ def solve3d(
         method=method,
         deadline_ms=deadline_ms,
         tolerance=tolerance,
-        max_iterations=max_iterations,
+        max_iterations=None
+        if max_iterations is None
+        else _integer("max_iterations", max_iterations, 1, 100_000),
         alpha=alpha,
         stiffness=tuple(stiffness),
         all=all,
-        threads=threads,
+        threads=_threads(threads),
         **_weight_kwargs(flat, len(arrays)),
     )
     return _solve_result(d, batch, 6, all)

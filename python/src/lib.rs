@@ -32,11 +32,12 @@ fn batch<R: Send>(
     work: impl Fn(usize) -> R + Sync,
     mut write: impl FnMut(usize, R),
 ) -> PyResult<()> {
-    let threads = threads.max(1);
+    // No more threads than rods: an idle thread only costs its creation.
+    let threads = threads.min(n).max(1);
     let mut start = 0;
     while start < n {
         let end = (start + block.max(threads)).min(n);
-        let results: Vec<R> = py.detach(|| {
+        let results: Option<Vec<R>> = py.detach(|| {
             let len = end - start;
             let per = len.div_ceil(threads);
             std::thread::scope(|s| {
@@ -48,12 +49,18 @@ fn batch<R: Send>(
                         s.spawn(move || (lo..hi).map(work).collect::<Vec<R>>())
                     })
                     .collect();
-                handles
-                    .into_iter()
-                    .flat_map(|h| h.join().unwrap_or_default())
-                    .collect()
+                // A worker that panicked has no rows: fail the call rather than shift the
+                // rows of the others onto the wrong rods.
+                let mut all = Vec::with_capacity(len);
+                for h in handles {
+                    all.extend(h.join().ok()?);
+                }
+                Some(all)
             })
         });
+        let results = results.ok_or_else(|| {
+            pyo3::exceptions::PyRuntimeError::new_err("a worker thread failed; no result returned")
+        })?;
         for (k, r) in results.into_iter().enumerate() {
             write(start + k, r);
         }
@@ -63,12 +70,21 @@ fn batch<R: Send>(
     Ok(())
 }
 
-/// The number of threads to use: `threads` if given (≥ 1), else every core.
-fn thread_count(threads: Option<usize>) -> PyResult<usize> {
+/// Most threads per core a batch uses: beyond it more threads only cost their creation.
+const THREADS_PER_CORE: usize = 4;
+
+/// The number of threads to use: `threads` if given (≥ 1, capped at [`THREADS_PER_CORE`] per
+/// core), else every core. Negative or zero values raise `ValueError` naming `threads`.
+fn thread_count(threads: Option<i64>) -> PyResult<usize> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     match threads {
-        Some(0) => Err(PyValueError::new_err("threads must be >= 1")),
-        Some(t) => Ok(t),
-        None => Ok(std::thread::available_parallelism().map_or(1, |n| n.get())),
+        Some(t) if t < 1 => Err(PyValueError::new_err(format!(
+            "threads must be >= 1, got {t}"
+        ))),
+        Some(t) => Ok(usize::try_from(t)
+            .unwrap_or(usize::MAX)
+            .min(THREADS_PER_CORE * cores)),
+        None => Ok(cores),
     }
 }
 
@@ -128,7 +144,7 @@ fn f64_out<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
 fn forward<'py>(
     py: Python<'py>,
     a: PyReadonlyArray1<'py, f64>,
-    threads: Option<usize>,
+    threads: Option<i64>,
     weight: Option<PyReadonlyArray1<'py, f64>>,
     gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -187,7 +203,7 @@ fn forward<'py>(
 fn is_stable<'py>(
     py: Python<'py>,
     a: PyReadonlyArray1<'py, f64>,
-    threads: Option<usize>,
+    threads: Option<i64>,
     weight: Option<PyReadonlyArray1<'py, f64>>,
     gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
@@ -221,7 +237,7 @@ fn shape<'py>(
     py: Python<'py>,
     a: PyReadonlyArray1<'py, f64>,
     samples: usize,
-    threads: Option<usize>,
+    threads: Option<i64>,
     weight: Option<PyReadonlyArray1<'py, f64>>,
     gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
@@ -313,6 +329,8 @@ struct SolveOut {
     success: Vec<bool>,
     a: Vec<f64>,
     termination: Vec<&'static str>,
+    /// Why a solve failed ("" when it succeeded), scipy's `message`.
+    reason: Vec<String>,
     iterations: Vec<u32>,
     margin: Vec<f64>,
     energy: Vec<f64>,
@@ -327,6 +345,7 @@ impl SolveOut {
             success: vec![false; n],
             a: vec![f64::NAN; dim * n],
             termination: vec![""; n],
+            reason: vec![String::new(); n],
             iterations: vec![0; n],
             margin: vec![f64::NAN; n],
             energy: vec![f64::NAN; n],
@@ -356,6 +375,7 @@ impl SolveOut {
             }
             Err(f) => {
                 self.termination[i] = f.termination().as_str();
+                self.reason[i] = f.reason.to_string();
                 self.iterations[i] = f.iterations;
             }
         }
@@ -366,6 +386,7 @@ impl SolveOut {
         d.set_item("success", self.success.into_pyarray(py))?;
         d.set_item("a", f64_out(py, self.a))?;
         d.set_item("termination", PyList::new(py, self.termination)?)?;
+        d.set_item("reason", PyList::new(py, self.reason)?)?;
         d.set_item("iterations", self.iterations.into_pyarray(py))?;
         d.set_item("margin", f64_out(py, self.margin))?;
         d.set_item("energy", f64_out(py, self.energy))?;
@@ -402,7 +423,7 @@ fn solve<'py>(
     max_iterations: Option<u32>,
     alpha: Option<f64>,
     all: bool,
-    threads: Option<usize>,
+    threads: Option<i64>,
     weight: Option<PyReadonlyArray1<'py, f64>>,
     gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -456,7 +477,7 @@ fn solve_batch<'py, const N: usize, M>(
     a0: Option<&[f64]>,
     base: SolveOptions<nalgebra::SVector<f64, N>>,
     all: bool,
-    threads: Option<usize>,
+    threads: Option<i64>,
     target_of: impl Fn(usize) -> Result<M::Pose, String> + Sync,
 ) -> PyResult<Bound<'py, PyDict>>
 where
@@ -534,7 +555,7 @@ fn forward3d<'py>(
     py: Python<'py>,
     a: PyReadonlyArray1<'py, f64>,
     stiffness: (f64, f64, f64),
-    threads: Option<usize>,
+    threads: Option<i64>,
     weight: Option<PyReadonlyArray1<'py, f64>>,
     gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -618,7 +639,7 @@ fn solve3d<'py>(
     alpha: Option<f64>,
     stiffness: (f64, f64, f64),
     all: bool,
-    threads: Option<usize>,
+    threads: Option<i64>,
     weight: Option<PyReadonlyArray1<'py, f64>>,
     gravity: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {

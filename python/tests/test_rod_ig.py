@@ -412,3 +412,23 @@ def test_tracker_with_weight_holds_a_heavy_rod() -> None:
     assert m.success
     with pytest.raises(ValueError, match="weight"):
         rod_ig.Tracker(weight=-2.0)
+
+
+def test_the_boundary_raises_and_names_the_argument() -> None:
+    """Issue 42, item 6: integers are integers, threads are bounded, failures say why."""
+    a = np.zeros((3, 3)) + [1.0, 2.0, 3.0]
+    for bad in (-1, 0):
+        with pytest.raises(ValueError, match="threads"):
+            rod_ig.forward(a, threads=bad)
+    with pytest.raises(TypeError, match="threads"):
+        rod_ig.forward(a, threads=1.5)  # type: ignore[arg-type]
+    # A huge thread count is capped (no 50,000 threads for 3 rods), and answers as one thread.
+    assert (rod_ig.forward(a, threads=50_000).tip == rod_ig.forward(a, threads=1).tip).all()
+    with pytest.raises(TypeError, match="samples"):
+        rod_ig.shape(a, samples=2.7)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match="samples"):
+        rod_ig.shape(a, samples="50")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="max_iterations"):
+        rod_ig.solve([0.5, 0.2, 1.0], max_iterations=-1)
+    s = rod_ig.solve([[0.5, 0.2, 1.0], [2.0, 0.0, 0.0]])
+    assert s.reason[0] == "" and "unreachable" in s.reason[1]
