@@ -48,21 +48,35 @@ const NUMBERS: [&str; 28] = [
 ];
 
 const TEMPLATES: [(&str, &[&str]); 6] = [
-    ("forward", &["{\"a\": [#, #, #]}"]),
+    (
+        "forward",
+        &[
+            "{\"a\": [#, #, #]}",
+            "{\"a\": [#, #, #], \"weight\": #, \"gravity\": [#, #]}",
+        ],
+    ),
     (
         "solve",
         &[
             "{\"target\": {\"x\": #, \"y\": #, \"theta\": #}}",
             "{\"target\": {\"x\": #, \"y\": #, \"theta\": #}, \"method\": \"newton\", \"a0\": [#, #, #], \"alpha\": #, \"max_iterations\": #, \"tolerance\": #, \"deadline_ms\": 20}",
             "{\"target\": {\"x\": #, \"y\": #, \"theta\": #}, \"objective\": \"least_energy\", \"all\": true, \"deadline_ms\": #}",
+            "{\"target\": {\"x\": #, \"y\": #, \"theta\": #}, \"weight\": #, \"gravity\": [#, #], \"deadline_ms\": 20}",
         ],
     ),
-    ("forward3d", &["{\"a\": [#, #, #, #, #, #], \"stiffness\": [#, #, #], \"rtol\": #}"]),
+    (
+        "forward3d",
+        &[
+            "{\"a\": [#, #, #, #, #, #], \"stiffness\": [#, #, #], \"rtol\": #}",
+            "{\"a\": [#, #, #, #, #, #], \"weight\": #, \"gravity\": [#, #, #]}",
+        ],
+    ),
     (
         "track",
         &[
             "{\"target\": {\"x\": #, \"y\": #, \"theta\": #}, \"tolerance\": #, \"deadline_ms\": 5}",
             "{\"target\": {\"x\": #, \"y\": #, \"theta\": #}, \"a0\": [#, #, #], \"deadline_ms\": #}",
+            "{\"target\": {\"x\": #, \"y\": #, \"theta\": #}, \"weight\": #, \"gravity\": [#, #], \"deadline_ms\": 5}",
         ],
     ),
     (
@@ -74,7 +88,10 @@ const TEMPLATES: [(&str, &[&str]); 6] = [
     ),
     (
         "solve3d",
-        &["{\"target\": {\"position\": [#, #, #], \"quaternion\": [#, #, #, #]}, \"max_iterations\": #, \"tolerance\": #, \"deadline_ms\": 30}"],
+        &[
+            "{\"target\": {\"position\": [#, #, #], \"quaternion\": [#, #, #, #]}, \"max_iterations\": #, \"tolerance\": #, \"deadline_ms\": 30}",
+            "{\"target\": {\"position\": [#, #, #], \"quaternion\": [#, #, #, #]}, \"weight\": #, \"gravity\": [#, #, #], \"deadline_ms\": 30}",
+        ],
     ),
 ];
 
