@@ -432,3 +432,11 @@ def test_the_boundary_raises_and_names_the_argument() -> None:
         rod_ig.solve([0.5, 0.2, 1.0], max_iterations=-1)
     s = rod_ig.solve([[0.5, 0.2, 1.0], [2.0, 0.0, 0.0]])
     assert s.reason[0] == "" and "unreachable" in s.reason[1]
+
+
+def test_tracker_starts_from_the_straight_rod_at_rest() -> None:
+    t = rod_ig.Tracker(a0=[0.0, 0.0, 0.0])
+    assert t.rod is not None and (t.rod == 0).all()
+    m = t.move([0.9, 0.0, 0.0])
+    assert m.success and m.event == "buckle"
+    assert t.move([0.88, 0.02, 0.05]).event in ("none", "snap")

@@ -80,7 +80,8 @@ enum Command {
     /// Quasi-static motion: the rod follows its equilibrium branch as the tip gripper moves.
     /// Reads JSON lines {"target": {"x", "y", "theta"}, "a0"?: [a3, a4, a5] (first line: the
     /// rod held at the start; without it the first target is a fresh solve), "tolerance"?,
-    /// "deadline_ms"?}; writes the fields of `solve` plus "event": "none" | "snap" | "lost",
+    /// "deadline_ms"?}; writes the fields of `solve` plus "event": "none" | "snap" | "lost" | "buckle" (a0 = 0,
+    /// the rod at rest, buckles on the first move: the least-energy rod found there),
     /// "progress" (the fraction of the move done: 1 when the target was reached), "held_a"
     /// (the rod held after the line: on a deadline the last equilibrium reached, kept for the
     /// next line) and, after a snap, "critical": {"x", "y", "theta"} (where the branch

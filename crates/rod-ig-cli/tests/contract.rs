@@ -560,3 +560,17 @@ fn smaller_contract_mends_of_issue_42() {
     assert!(output.status.success(), "{:?}", output.status);
     assert_eq!(String::from_utf8_lossy(&output.stdout).lines().count(), 3);
 }
+
+#[test]
+fn track_starts_from_the_straight_rod_at_rest() {
+    // a0 = 0: the rod at rest (issue 42, item 7); the first move buckles it, and says so.
+    let out = run(
+        &["track"],
+        "{\"target\": {\"x\": 0.9, \"y\": 0, \"theta\": 0}, \"a0\": [0, 0, 0]}\n\
+         {\"target\": {\"x\": 0.88, \"y\": 0.02, \"theta\": 0.05}}\n",
+    );
+    assert_eq!(out[0]["success"], true, "{}", out[0]);
+    assert_eq!(out[0]["event"], "buckle");
+    assert_eq!(out[1]["success"], true, "{}", out[1]);
+    assert_ne!(out[1]["event"], "buckle");
+}

@@ -73,7 +73,7 @@ fn a_buckled_rod_snaps_when_its_tip_gripper_turns() {
                 assert!(critical.theta > theta - step - 1e-9 && critical.theta <= theta + 1e-9);
                 snap = Some((critical, critical_a, s.a, theta));
             }
-            BranchEvent::Lost => panic!("lost at θ = {theta}"),
+            BranchEvent::Lost | BranchEvent::Buckle => panic!("{:?} at θ = {theta}", m.event),
         }
         before = s.a;
     }
@@ -262,9 +262,9 @@ fn followers_work_on_the_3d_model_and_report_bad_input() {
     assert_eq!(f.termination(), rod_ig_core::solver::Termination::Deadline);
     assert_eq!(follower.rod(), Some(buckled_up()));
     assert_eq!(m.progress, 0.0);
-    // An unstable rod cannot be held.
-    let straight = PlanarParams::zeros();
-    assert!(BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), straight).is_err());
+    // An unstable rod cannot be held (the straight rod at rest can: see below).
+    let unstable = PlanarParams::new(0.0, -40.0, 1.0);
+    assert!(BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), unstable).is_err());
 }
 
 /// Issue 20: a move that runs out of time keeps the last equilibrium reached (event none,
@@ -300,4 +300,52 @@ fn a_move_out_of_time_keeps_the_rod() {
             assert!((tip.x - 0.4).abs() <= 0.475 + 1e-6 && tip.y.abs() <= 0.1 + 1e-6);
         }
     }
+}
+
+#[test]
+fn the_straight_rod_at_rest_is_held_and_buckles_deterministically() {
+    use rod_ig_core::solver::{BranchEvent, BranchFollower};
+    rod_ig_core::planar::ig::warm_up();
+    // a = 0: the rod at rest, straight along x, a neutral equilibrium (verdict uncertain).
+    let mut f = BranchFollower::holding(
+        PlanarClosedForm,
+        SolveOptions::default(),
+        PlanarParams::zeros(),
+    )
+    .expect("the straight rod can be held");
+    assert_eq!(f.rod(), Some(PlanarParams::zeros()));
+    // Pushing the grippers together buckles it into the least-energy stable rod found.
+    let target = PlanarPose::new(0.9, 0.0, 0.0);
+    let m = f.follow(&target);
+    assert!(matches!(m.event, BranchEvent::Buckle), "{:?}", m.event);
+    let s = m.result.expect("a stable rod");
+    assert!(s.stable);
+    for o in rod_ig_core::solver::solve_all(&PlanarClosedForm, &target, &SolveOptions::default()) {
+        assert!(
+            s.energy <= o.energy + 1e-9 * (1.0 + o.energy.abs()),
+            "{} > {}",
+            s.energy,
+            o.energy
+        );
+    }
+    let again = BranchFollower::holding(
+        PlanarClosedForm,
+        SolveOptions::default(),
+        PlanarParams::zeros(),
+    )
+    .unwrap()
+    .follow(&PlanarPose::new(0.9, 0.0, 0.0))
+    .result
+    .unwrap();
+    assert_eq!(again.a, s.a, "the same choice every time");
+    // Then the rod follows its branch as before.
+    let m = f.follow(&PlanarPose::new(0.88, 0.0, 0.05));
+    assert!(matches!(
+        m.event,
+        BranchEvent::None | BranchEvent::Snap { .. }
+    ));
+    // An unstable rod that is not straight is still refused (FINDINGS §5: (0, −40, 1) is past
+    // the first clamped–clamped Euler load).
+    let unstable = PlanarParams::new(0.0, -40.0, 1.0);
+    assert!(BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), unstable).is_err());
 }

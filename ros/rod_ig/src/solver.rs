@@ -311,6 +311,7 @@ impl RodSolver {
                         BranchEvent::Snap { critical, .. } => ("snap", Some(critical)),
                         BranchEvent::Lost => ("lost", None),
                         BranchEvent::None => ("none", None),
+                        BranchEvent::Buckle => ("buckle", None),
                     };
                     let s = m.result.map_err(|f| Failed {
                         event,
@@ -356,6 +357,7 @@ impl RodSolver {
                 BranchEvent::Snap { critical, .. } => ("snap", Some(critical)),
                 BranchEvent::Lost => ("lost", None),
                 BranchEvent::None => ("none", None),
+                BranchEvent::Buckle => ("buckle", None),
             };
             let s = m.result.map_err(|f| Failed {
                 event,

@@ -173,6 +173,10 @@ macro_rules! planar_geometry {
             Vector3::from(PLANAR_SCALE)
         }
 
+        fn is_straight(&self, a: &Vector3<f64>) -> bool {
+            a[0] == 0.0 && a[2] == 0.0
+        }
+
         fn pose_error(&self, tip: &PlanarPose, target: &PlanarPose) -> (f64, f64) {
             planar_pose_error(tip, target)
         }

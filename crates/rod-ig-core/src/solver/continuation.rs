@@ -75,15 +75,22 @@ pub enum BranchEvent<P, X> {
     },
     /// No stable equilibrium to follow or snap into: the rod's state is unknown.
     Lost,
+    /// The rod was held straight (a neutral equilibrium, det J ≡ 0) and buckled on this first
+    /// move: it took the least-energy stable rod the search found at the target, ties (mirror
+    /// images, when both are found) broken toward the rod whose first non-zero parameter is
+    /// positive (planar: a3 > 0). The search is deterministic: the same move buckles the same
+    /// way every time.
+    Buckle,
 }
 
 impl<P, X> BranchEvent<P, X> {
-    /// "none", "snap" or "lost" (the CLI's and the node's `event` field).
+    /// "none", "snap", "lost" or "buckle" (the CLI's and the node's `event` field).
     pub fn as_str(&self) -> &'static str {
         match self {
             Self::None => "none",
             Self::Snap { .. } => "snap",
             Self::Lost => "lost",
+            Self::Buckle => "buckle",
         }
     }
 }
@@ -134,6 +141,8 @@ pub struct BranchFollower<const N: usize, M: RodModel<N>> {
     model: M,
     options: SolveOptions<SVector<f64, N>>,
     held: Option<Held<N, M::Pose>>,
+    /// The straight rod held at rest (a and its tip) before the first move buckles it.
+    straight: Option<(SVector<f64, N>, M::Pose)>,
 }
 
 impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
@@ -143,11 +152,14 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
             model,
             options,
             held: None,
+            straight: None,
         }
     }
 
     /// A follower holding the rod `a0` (the gripper is at its tip). Fails when `a0` is not a
-    /// stable equilibrium (a held rod must be one).
+    /// stable equilibrium (a held rod must be one), except for the exactly straight rod
+    /// ([`RodModel::is_straight`], e.g. a = 0, the rod at rest): a neutral equilibrium the
+    /// first move buckles ([`BranchEvent::Buckle`]).
     pub fn holding(
         model: M,
         options: SolveOptions<SVector<f64, N>>,
@@ -164,12 +176,21 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
             detail: e.to_string(),
         })?;
         if !eval.stability.stable {
+            if eval.stability.uncertain && model.is_straight(&a0) {
+                return Ok(Self {
+                    model,
+                    options,
+                    held: None,
+                    straight: Some((a0, eval.tip)),
+                });
+            }
             return Err(IgError::LeftStableSet { iteration: 0 });
         }
         Ok(Self {
             model,
             options,
             held: Some(Held::of(a0, eval)),
+            straight: None,
         })
     }
 
@@ -180,12 +201,12 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
 
     /// The rod held now, if any.
     pub fn rod(&self) -> Option<SVector<f64, N>> {
-        self.held.map(|h| h.a)
+        self.held.map(|h| h.a).or(self.straight.map(|s| s.0))
     }
 
     /// The gripper pose the rod is held at now, if any.
     pub fn gripper(&self) -> Option<M::Pose> {
-        self.held.map(|h| h.tip)
+        self.held.map(|h| h.tip).or(self.straight.map(|s| s.1))
     }
 
     /// The model.
@@ -208,6 +229,9 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
 
     fn follow_inner(&mut self, target: &M::Pose) -> Move<SVector<f64, N>, M::Pose> {
         let Some(held) = self.held else {
+            if self.straight.is_some() {
+                return self.buckle(target);
+            }
             return self.fresh_solve(target);
         };
         if let Err(e) = self
@@ -362,6 +386,65 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
     }
 
     /// Without a held rod: a fresh solve, whose rod is then held (event `None`, or `Lost`).
+    /// The first move from the straight rod ([`BranchEvent::Buckle`]): the least-energy stable
+    /// rod found at the target, ties broken toward the first non-zero parameter being positive.
+    /// The straight rod stays held when the move fails on its input or its deadline.
+    fn buckle(&mut self, target: &M::Pose) -> Move<SVector<f64, N>, M::Pose> {
+        let least = SolveOptions {
+            objective: super::Objective::LeastEnergy,
+            ..self.options
+        };
+        // One deadline for both searches.
+        let _deadline = crate::solver::deadline::scope(self.options.deadline);
+        let first = solve(&self.model, target, &least);
+        let all = super::solve_all(&self.model, target, &least);
+        let result = match first {
+            Ok(s) => {
+                let lowest = all.iter().map(|o| o.energy).fold(s.energy, f64::min);
+                let tie = 1e-9 * (1.0 + lowest.abs());
+                let leftmost = |a: &SVector<f64, N>| {
+                    a.iter().find(|v| v.abs() > 1e-12).is_some_and(|v| *v > 0.0)
+                };
+                let chosen = all
+                    .iter()
+                    .chain(std::iter::once(&s))
+                    .filter(|o| o.energy <= lowest + tie)
+                    .max_by_key(|o| leftmost(&o.a))
+                    .copied()
+                    .unwrap_or(s);
+                Ok(chosen)
+            }
+            Err(f) => Err(f),
+        };
+        match &result {
+            Ok(s) => {
+                self.straight = None;
+                self.held = self
+                    .model
+                    .tip_and_jacobian(&s.a)
+                    .ok()
+                    .map(|(tip, jacobian)| Held {
+                        a: s.a,
+                        tip,
+                        jacobian,
+                    });
+            }
+            Err(f) if f.termination() == super::Termination::Deadline => {}
+            Err(f) if f.termination() == super::Termination::InvalidInput => {}
+            Err(_) => self.straight = None,
+        }
+        let (event, progress) = match &result {
+            Ok(_) => (BranchEvent::Buckle, 1.0),
+            Err(_) if self.straight.is_some() => (BranchEvent::None, 0.0),
+            Err(_) => (BranchEvent::Lost, 0.0),
+        };
+        Move {
+            result,
+            event,
+            progress,
+        }
+    }
+
     fn fresh_solve(&mut self, target: &M::Pose) -> Move<SVector<f64, N>, M::Pose> {
         let result = solve(&self.model, target, &self.options);
         self.held = result.as_ref().ok().and_then(|s| {

@@ -115,6 +115,14 @@ pub trait RodModel<const N: usize> {
     /// slerp): the gripper path between two targets.
     fn interpolate(&self, from: &Self::Pose, to: &Self::Pose, s: f64) -> Self::Pose;
 
+    /// True for the exactly straight rod of this model: a neutral equilibrium (det J(t) ≡ 0,
+    /// the verdict `uncertain`) that a gripper may still hold at rest, and from which the first
+    /// move buckles ([`crate::solver::BranchFollower`]).
+    fn is_straight(&self, a: &SVector<f64, N>) -> bool {
+        let _ = a;
+        false
+    }
+
     /// Checks the model's own settings (stiffness, integration tolerance).
     fn check_settings(&self) -> Result<(), IgError> {
         Ok(())

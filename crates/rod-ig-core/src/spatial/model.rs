@@ -77,6 +77,10 @@ impl RodModel<6> for Spatial {
         tip.distance_to(target)
     }
 
+    fn is_straight(&self, a: &SVector<f64, 6>) -> bool {
+        a[1] == 0.0 && a[2] == 0.0 && a[4] == 0.0 && a[5] == 0.0
+    }
+
     fn newton_increment(
         &self,
         tip: &SpatialPose,

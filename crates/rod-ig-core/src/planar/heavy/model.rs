@@ -100,6 +100,12 @@ impl RodModel<3> for HeavyPlanar {
         PlanarClosedForm.param_scale()
     }
 
+    /// Straight along its force and along gravity (ĝ along the base tangent, or no weight).
+    fn is_straight(&self, a: &Vector3<f64>) -> bool {
+        PlanarClosedForm.is_straight(a)
+            && (self.gravity.is_weightless() || self.gravity.direction()[1] == 0.0)
+    }
+
     fn pose_error(&self, tip: &PlanarPose, target: &PlanarPose) -> (f64, f64) {
         PlanarClosedForm.pose_error(tip, target)
     }
