@@ -307,20 +307,7 @@ impl RodSolver {
             match self.settings.method {
                 Method::Robust if self.settings.follow_branch => {
                     let m = self.follower.follow(target);
-                    let (event, critical) = match m.event {
-                        BranchEvent::Snap { critical, .. } => ("snap", Some(critical)),
-                        BranchEvent::Lost => ("lost", None),
-                        BranchEvent::None => ("none", None),
-                        BranchEvent::Buckle => ("buckle", None),
-                    };
-                    let s = m.result.map_err(|f| Failed {
-                        event,
-                        ..Failed::from(f)
-                    })?;
-                    let mut solved = with_shape(&s, samples)?;
-                    solved.event = event;
-                    solved.critical = critical;
-                    return Ok(solved);
+                    return followed(m, |s| with_shape(s, samples));
                 }
                 Method::Robust => self.tracker.solve(target)?,
                 Method::Newton => {
@@ -353,26 +340,35 @@ impl RodSolver {
         }
         if self.settings.method == Method::Robust && self.settings.follow_branch {
             let m = self.heavy_follower.follow(target);
-            let (event, critical) = match m.event {
-                BranchEvent::Snap { critical, .. } => ("snap", Some(critical)),
-                BranchEvent::Lost => ("lost", None),
-                BranchEvent::None => ("none", None),
-                BranchEvent::Buckle => ("buckle", None),
-            };
-            let s = m.result.map_err(|f| Failed {
-                event,
-                ..Failed::from(f)
-            })?;
-            let mut solved = with_heavy_shape(&s, &g, samples)?;
-            solved.event = event;
-            solved.critical = critical;
-            return Ok(solved);
+            return followed(m, |s| with_heavy_shape(s, &g, samples));
         }
         let o = options(&self.settings, self.last_heavy);
         let solution = rod_solver::solve(&model, target, &o)?;
         self.last_heavy = Some(solution.a);
         with_heavy_shape(&solution, &g, samples)
     }
+}
+
+/// A followed move as the node answers it: the solution with its shape (`shape`), the branch
+/// event and, after a snap, the critical gripper pose; or the failure with its event.
+fn followed(
+    m: rod_solver::Move<PlanarParams, PlanarPose>,
+    shape: impl FnOnce(&Solution) -> Result<Solved, Failed>,
+) -> Result<Solved, Failed> {
+    let (event, critical) = match m.event {
+        BranchEvent::Snap { critical, .. } => ("snap", Some(critical)),
+        BranchEvent::Lost => ("lost", None),
+        BranchEvent::None => ("none", None),
+        BranchEvent::Buckle => ("buckle", None),
+    };
+    let s = m.result.map_err(|f| Failed {
+        event,
+        ..Failed::from(f)
+    })?;
+    let mut solved = shape(&s)?;
+    solved.event = event;
+    solved.critical = critical;
+    Ok(solved)
 }
 
 fn shape_failure(s: &Solution, e: impl std::fmt::Display) -> Failed {
