@@ -398,16 +398,7 @@ fn with_heavy_shape(s: &Solution, g: &Gravity, samples: usize) -> Result<Solved,
 }
 
 fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
-    let rod = PlanarRod::new(&s.a).map_err(|e| Failed {
-        reason: format!("cannot evaluate the solution's shape: {e}"),
-        termination: rod_ig_core::solver::Termination::EvaluationFailed.as_str(),
-        iterations: s.iterations,
-        residual: s.residual,
-        last_a: Some(s.a),
-        last_a_spatial: None,
-        spatial: false,
-        event: "",
-    })?;
+    let rod = PlanarRod::new(&s.a).map_err(|e| shape_failure(s, e))?;
     Ok(WithShape {
         solution: *s,
         shape: rod.shape(samples),
