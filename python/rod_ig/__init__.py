@@ -177,6 +177,12 @@ class SolveResult:
     energy: FloatArray
     position_error: FloatArray
     orientation_error: FloatArray
+    starts: npt.NDArray[np.uint32]
+    """(...): starts tried by the search (0 where it failed)."""
+    complete: BoolArray
+    """(...): the search ran to its end; False where the deadline cut a least-energy search
+    or the ``all`` list (the rod returned is stable and on target, but one of less energy, or
+    more rods, may exist)."""
     solutions: npt.NDArray[np.object_] | None = None
     """With ``all=True``: (...) object array, each entry an (k, 3) or (k, 6) array of every
     distinct stable solution found, least energy first."""
@@ -201,6 +207,8 @@ def _solve_result(
         energy=d["energy"].reshape(shape),
         position_error=d["position_error"].reshape(shape),
         orientation_error=d["orientation_error"].reshape(shape),
+        starts=d["starts"].reshape(shape),
+        complete=d["complete"].reshape(shape),
         solutions=solutions,
     )
 

@@ -336,6 +336,10 @@ struct SolveOut {
     energy: Vec<f64>,
     position_error: Vec<f64>,
     orientation_error: Vec<f64>,
+    /// Starts tried (0 where the solve failed).
+    starts: Vec<u32>,
+    /// The search ran to its end (a least-energy search or `all` list not cut by the deadline).
+    complete: Vec<bool>,
     solutions: Vec<Vec<f64>>,
 }
 
@@ -351,6 +355,8 @@ impl SolveOut {
             energy: vec![f64::NAN; n],
             position_error: vec![f64::NAN; n],
             orientation_error: vec![f64::NAN; n],
+            starts: vec![0; n],
+            complete: vec![true; n],
             solutions: Vec::new(),
         }
     }
@@ -372,6 +378,8 @@ impl SolveOut {
                 self.energy[i] = s.energy;
                 self.position_error[i] = s.position_error;
                 self.orientation_error[i] = s.orientation_error;
+                self.starts[i] = s.starts;
+                self.complete[i] = s.complete;
             }
             Err(f) => {
                 self.termination[i] = f.termination().as_str();
@@ -392,6 +400,8 @@ impl SolveOut {
         d.set_item("energy", f64_out(py, self.energy))?;
         d.set_item("position_error", f64_out(py, self.position_error))?;
         d.set_item("orientation_error", f64_out(py, self.orientation_error))?;
+        d.set_item("starts", self.starts.into_pyarray(py))?;
+        d.set_item("complete", self.complete.into_pyarray(py))?;
         if all {
             let list = PyList::empty(py);
             for s in self.solutions {
@@ -498,21 +508,32 @@ where
             let model = &model_of(i);
             match target_of(i) {
                 Ok(target) => {
+                    // One deadline for the target: the `all` list gets the time left.
+                    let _deadline = rod_ig_core::deadline::scope(o.deadline);
                     let first = solver::solve(model, &target, &o);
-                    let every = all.then(|| solver::solve_all(model, &target, &o));
+                    let every = all.then(|| solver::solve_every(model, &target, &o));
                     (first, every)
                 }
                 Err(e) => (
                     Err(solver::Failure::early(solver::IgError::InvalidOptions(e))),
-                    all.then(Vec::new),
+                    all.then(|| solver::Every {
+                        solutions: Vec::new(),
+                        complete: true,
+                    }),
                 ),
             }
         },
         |i, (first, every)| {
             out.write(i, &first);
             if let Some(every) = every {
-                out.solutions
-                    .push(every.iter().flat_map(|s| s.a.iter().copied()).collect());
+                out.complete[i] &= every.complete;
+                out.solutions.push(
+                    every
+                        .solutions
+                        .iter()
+                        .flat_map(|s| s.a.iter().copied())
+                        .collect(),
+                );
             }
         },
     )?;

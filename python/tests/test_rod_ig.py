@@ -434,6 +434,16 @@ def test_the_boundary_raises_and_names_the_argument() -> None:
     assert s.reason[0] == "" and "unreachable" in s.reason[1]
 
 
+def test_a_search_cut_by_its_deadline_says_it_is_incomplete() -> None:
+    target = [-0.3, 0.4, 2.5]
+    full = rod_ig.solve(target, objective="least_energy", all=True, deadline_ms=10_000)
+    assert full.success and full.complete and full.starts >= 1
+    # 0.05 ms cannot try every start: the answer, found or not, says so.
+    cut = rod_ig.solve(target, objective="least_energy", all=True, deadline_ms=0.05)
+    assert not cut.complete
+    assert len(cut.solutions[()]) <= len(full.solutions[()])
+
+
 def test_tracker_starts_from_the_straight_rod_at_rest() -> None:
     t = rod_ig.Tracker(a0=[0.0, 0.0, 0.0])
     assert t.rod is not None and (t.rod == 0).all()

@@ -34,6 +34,9 @@ pub struct SolveAnswer<A, T> {
     starts: u32,
     /// Wall time of the request (ms), from its parsed options to its answer.
     elapsed_ms: f64,
+    /// The search the request asked for ran to its end: false when the deadline cut a
+    /// least-energy search or the `all` list (a lower-energy rod, or more rods, may exist).
+    complete: bool,
     /// Every distinct stable solution found (`"all": true`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub solutions: Option<Vec<SolveAnswer<A, T>>>,
@@ -61,6 +64,7 @@ impl<A, T> SolveAnswer<A, T> {
             termination: solver::Termination::Converged.as_str(),
             starts: s.starts,
             elapsed_ms: s.elapsed_us / 1e3,
+            complete: s.complete,
             solutions: None,
         }
     }
@@ -87,6 +91,7 @@ impl<A, T> SolveAnswer<A, T> {
             termination: termination.as_str(),
             starts: 0,
             elapsed_ms: 0.0,
+            complete: true,
             solutions: None,
         }
     }
@@ -117,11 +122,13 @@ where
 {
     let t0 = std::time::Instant::now();
     let run = || {
+        // One deadline for the request: the list of `all` gets the time the solve left.
+        let _deadline = rod_ig_core::deadline::scope(options.deadline);
         let first = solver::solve(model, target, options);
-        let solutions = all.then(|| solver::solve_all(model, target, options));
-        (first, solutions)
+        let every = all.then(|| solver::solve_every(model, target, options));
+        (first, every)
     };
-    let (first, solutions) = if verbose {
+    let (first, every) = if verbose {
         let (r, log) = observe(IterationLog::default(), run);
         // Diagnostics only: a closed or full stderr must not cost the answer on stdout
         // (eprintln! would panic and exit 101), so write errors are dropped.
@@ -143,7 +150,11 @@ where
         ),
     };
     answer.elapsed_ms = t0.elapsed().as_secs_f64() * 1e3;
-    if let Some(solutions) = solutions {
+    if let Some(solver::Every {
+        solutions,
+        complete,
+    }) = every
+    {
         if solutions.is_empty() && answer.success {
             // solve_all includes the first-found answer, so this is unreachable in practice;
             // guarded so that success never comes with an empty list.
@@ -154,6 +165,7 @@ where
                 solver::Termination::NoStableSolution,
             );
         }
+        answer.complete &= complete;
         answer.solutions = Some(
             solutions
                 .iter()

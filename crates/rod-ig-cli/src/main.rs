@@ -19,6 +19,7 @@ macro_rules! outln {
 
 mod answer;
 mod bench;
+mod bench_deadlines;
 mod bench_tails;
 mod jsonl;
 mod motion_cmds;
@@ -56,7 +57,9 @@ enum Command {
     /// most 10000)}; writes one line each:
     /// {"success", "a", "tip", "stable", "iterations", "residual", "energy", "position_error",
     /// "orientation_error", "stability_margin", "reason" (on failure), "termination"
-    /// ("converged", "deadline", "no_stable_solution", ...), "starts", "solutions" (with all)}.
+    /// ("converged", "deadline", "no_stable_solution", ...), "starts", "complete" (false when
+    /// the deadline cut a least-energy search or the list of all), "solutions" (with all)}.
+    /// One deadline holds for the whole line, `all` included.
     Solve {
         /// Print the solver's events (starts, iterations with residual and step, end) on
         /// stderr as JSON lines.
@@ -64,7 +67,8 @@ enum Command {
         verbose: bool,
     },
     /// 3-D forward map by numerical integration. Reads JSON lines {"a": [a1, .., a6],
-    /// "stiffness"?: [c1, c2, c3], "rtol"?}; writes {"tip": {"position": [x, y, z],
+    /// "stiffness"?: [c1, c2, c3], "rtol"?, "weight"?, "gravity"?, "deadline_ms"? (default
+    /// 1000, at most 10000)}; writes {"tip": {"position": [x, y, z],
     /// "quaternion": [qx, qy, qz, qw]}, "jacobian" (6×6, body twists, rows ω1 ω2 ω3 v1 v2 v3),
     /// "stable", "energy", "stability_margin"}.
     Forward3d,
@@ -154,6 +158,8 @@ enum BenchPart {
     Spatial,
     /// Rods with weight against the weightless closed forms (issue 41's ratios).
     Weight,
+    /// Time past their deadline of the requests that once overran it (issue 42).
+    Deadlines,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq)]
@@ -349,6 +355,9 @@ fn bench(quick: bool, ig_cases: &std::path::Path, only: BenchPart) {
     }
     if matches!(only, BenchPart::All | BenchPart::Spatial) {
         bench::spatial(quick);
+    }
+    if matches!(only, BenchPart::All | BenchPart::Deadlines) {
+        bench_deadlines::run(quick);
     }
 }
 

@@ -57,6 +57,8 @@ struct Forward3dRequest {
     weight: Option<f64>,
     /// Direction of gravity in the base frame (default [0, 0, -1]).
     gravity: Option<[f64; 3]>,
+    /// Wall-time budget of the evaluation in ms (default 1000, at most 10000).
+    deadline_ms: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -95,12 +97,27 @@ fn forward3d_heavy(
     })
 }
 
-/// Answers one `forward3d` line.
+/// Answers one `forward3d` line, within its deadline.
 pub fn forward3d_line(line: &str) -> Result<Value, String> {
     let request: Forward3dRequest = jsonl::parse(line)?;
+    let deadline = match request.deadline_ms {
+        Some(ms) => jsonl::deadline_from_ms(ms)?,
+        None => rod_ig_core::solver::DEFAULT_DEADLINE_3D,
+    };
+    if deadline > rod_ig_core::solver::MAX_DEADLINE {
+        return Err(format!(
+            "deadline_ms must be at most {} ms",
+            rod_ig_core::solver::MAX_DEADLINE.as_millis()
+        ));
+    }
+    let _deadline = rod_ig_core::deadline::scope(deadline);
+    forward3d_within(&request)
+}
+
+fn forward3d_within(request: &Forward3dRequest) -> Result<Value, String> {
     let k = stiffness(request.stiffness)?;
     if let Some(w) = request.weight.or(request.gravity.map(|_| 0.0)) {
-        return forward3d_heavy(&request, &k, w);
+        return forward3d_heavy(request, &k, w);
     }
     let mut opts = StabilityOptions::production();
     if let Some(rtol) = request.rtol {

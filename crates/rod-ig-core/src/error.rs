@@ -24,6 +24,13 @@ pub enum RodError {
     /// A numerical integration did not reach its tolerance within its step budget.
     #[error("integration failed: {0}")]
     Integration(String),
+    /// The deadline in force ([`crate::deadline`]) passed during the evaluation, which was
+    /// abandoned at arc length `t`.
+    #[error("deadline passed at t = {t}: evaluation abandoned")]
+    Deadline {
+        /// Arc length reached.
+        t: f64,
+    },
 }
 
 impl RodError {

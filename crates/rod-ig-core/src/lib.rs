@@ -31,6 +31,7 @@
 
 mod angle;
 pub mod dd;
+pub mod deadline;
 mod eft;
 pub mod elliptic;
 mod error;

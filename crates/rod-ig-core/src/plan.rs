@@ -27,7 +27,7 @@ use crate::planar::{self, PlanarRod};
 use crate::{PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use std::collections::{BinaryHeap, HashMap, HashSet};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 use thiserror::Error;
 
 /// Roadmap nodes taken from the atlas (evenly strided).
@@ -44,8 +44,14 @@ pub const MIN_MARGIN: f64 = 1e-3;
 pub const BODY_SAMPLES: usize = 48;
 /// Default planning budget (`rod-ig plan`, the node's service).
 pub const DEFAULT_PLAN_DEADLINE: Duration = Duration::from_millis(500);
-/// Samples between two polls of the deadline along an edge (~1 ms of stability tests).
-const DEADLINE_POLL: usize = 32;
+/// Most stability checks along one edge: a longer edge (a start rod far from every roadmap
+/// node, such as a coil of 10⁶ turns) is not used, so that no edge is sized past this.
+pub const MAX_EDGE_SAMPLES: usize = 4096;
+/// Most obstacles in one request (refused above: the collision test of every rod checked
+/// scales with them).
+pub const MAX_OBSTACLES: usize = 10_000;
+/// Most polygon vertices in one request, over every polygon.
+pub const MAX_VERTICES: usize = 100_000;
 /// Largest obstacle coordinate and disc radius accepted, in rod lengths. The rod lies within
 /// the unit disc, so 1e6 already covers "everything"; the bound keeps every product of the
 /// geometry (≤ 4e12) far from overflow (issue 24: a 1e200 triangle was silently ignored).
@@ -182,10 +188,9 @@ impl Planner {
     /// `request.goal` (module docs).
     pub fn plan(&mut self, request: &PlanRequest) -> Result<Plan, PlanError> {
         check_request(request)?;
-        let t0 = Instant::now();
         // The roadmap comes from the atlas, built once per process in steps charged to the
         // deadline of the query that needs it.
-        let _deadline = crate::solver::deadline::scope(request.deadline);
+        let _deadline = crate::deadline::scope(request.deadline);
         if !self.ensure_roadmap() {
             return Err(PlanError::Deadline { edges_checked: 0 });
         }
@@ -194,8 +199,10 @@ impl Planner {
         if margin < MIN_MARGIN {
             return Err(PlanError::StartUnstable { margin });
         }
-        if collides(&start, &request.obstacles) {
-            return Err(PlanError::StartCollides);
+        match collides(&start, &request.obstacles) {
+            Some(false) => {}
+            Some(true) => return Err(PlanError::StartCollides),
+            None => return Err(PlanError::Deadline { edges_checked: 0 }),
         }
         let options = SolveOptions {
             tolerance: GOAL_TOLERANCE,
@@ -211,12 +218,17 @@ impl Planner {
             return Err(PlanError::GoalUnreachable(reason));
         }
         let found = goals.len();
-        goals.retain(|g| margin_of(&g.a) >= MIN_MARGIN && !collides(&g.a, &request.obstacles));
+        goals.retain(|g| {
+            margin_of(&g.a) >= MIN_MARGIN && collides(&g.a, &request.obstacles) == Some(false)
+        });
+        if crate::deadline::expired() {
+            return Err(PlanError::Deadline { edges_checked: 0 });
+        }
         if goals.is_empty() {
             return Err(PlanError::GoalBlocked { rods: found });
         }
         let goal_rods: Vec<PlanarParams> = goals.iter().map(|g| g.a).collect();
-        let mut query = Query::new(self, start, goal_rods, request, t0);
+        let mut query = Query::new(self, start, goal_rods, request);
         query.run()
     }
 }
@@ -231,6 +243,25 @@ fn check_request(request: &PlanRequest) -> Result<(), PlanError> {
             "deadline {:?} is not in (0, {:?}]",
             request.deadline,
             crate::planar::ig::MAX_DEADLINE
+        )));
+    }
+    if request.obstacles.len() > MAX_OBSTACLES {
+        return Err(PlanError::Invalid(format!(
+            "{} obstacles: at most {MAX_OBSTACLES} are accepted",
+            request.obstacles.len()
+        )));
+    }
+    let vertices: usize = request
+        .obstacles
+        .iter()
+        .map(|o| match o {
+            Obstacle::Polygon { points } => points.len(),
+            Obstacle::Disc { .. } => 0,
+        })
+        .sum();
+    if vertices > MAX_VERTICES {
+        return Err(PlanError::Invalid(format!(
+            "{vertices} polygon vertices: at most {MAX_VERTICES} are accepted"
         )));
     }
     request.obstacles.iter().try_for_each(check_obstacle)
@@ -270,23 +301,42 @@ fn check_obstacle(o: &Obstacle) -> Result<(), PlanError> {
 /// The normalised stability margin of `a` (−∞ when it cannot be evaluated or the verdict is
 /// not "stable").
 fn margin_of(a: &PlanarParams) -> f64 {
+    crate::deadline::charge(crate::deadline::units::STABILITY_REPORT);
     match planar::stability(a) {
         Ok(r) if r.stable => r.margin,
         _ => f64::NEG_INFINITY,
     }
 }
 
-/// True when the rod's body touches an obstacle.
-fn collides(a: &PlanarParams, obstacles: &[Obstacle]) -> bool {
+/// True when the rod's body touches an obstacle; `None` when the deadline passed first (the
+/// tests are charged to [`crate::deadline`], a few obstacles at a time).
+fn collides(a: &PlanarParams, obstacles: &[Obstacle]) -> Option<bool> {
     if obstacles.is_empty() {
-        return false;
+        return Some(false);
     }
     let Ok(rod) = PlanarRod::new(a) else {
-        return true;
+        return Some(true);
     };
     let body = rod.shape(BODY_SAMPLES);
-    body.windows(2)
-        .any(|w| obstacles.iter().any(|o| segment_touches(&w[0], &w[1], o)))
+    let mut tests = 0u64;
+    for o in obstacles {
+        if body.windows(2).any(|w| segment_touches(&w[0], &w[1], o)) {
+            return Some(true);
+        }
+        // A polygon costs one test per edge and segment.
+        tests += match o {
+            Obstacle::Disc { .. } => BODY_SAMPLES as u64,
+            Obstacle::Polygon { points } => (BODY_SAMPLES * points.len()) as u64,
+        };
+        let units = tests / crate::deadline::units::DISC_TESTS_PER_UNIT;
+        if units > 0 {
+            tests %= crate::deadline::units::DISC_TESTS_PER_UNIT;
+            if crate::deadline::charge(units) {
+                return None;
+            }
+        }
+    }
+    Some(false)
 }
 
 fn segment_touches(p: &PlanarPose, q: &PlanarPose, o: &Obstacle) -> bool {
@@ -359,15 +409,18 @@ fn min_norm(a: &PlanarParams, b: &PlanarParams) -> f64 {
 }
 
 /// The rods checked along the edge a → b (a excluded, b included), at spacing
-/// ≤ CHECK_SPACING (1 + |a(s)|).
-fn edge_samples(a: &PlanarParams, b: &PlanarParams) -> Vec<PlanarParams> {
+/// ≤ CHECK_SPACING (1 + |a(s)|); `None` for an edge of more than [`MAX_EDGE_SAMPLES`].
+fn edge_samples(a: &PlanarParams, b: &PlanarParams) -> Option<impl Iterator<Item = PlanarParams>> {
     let spacing = CHECK_SPACING * (1.0 + min_norm(a, b));
-    let n = ((b - a).norm() / spacing).ceil().max(1.0) as usize;
+    let n = ((b - a).norm() / spacing).ceil().max(1.0);
+    if n.is_nan() || n > MAX_EDGE_SAMPLES as f64 {
+        return None;
+    }
+    let n = n as usize;
     // Even, so that the returned rods (every other sample) end exactly at b.
     let n = n + n % 2;
-    (1..=n)
-        .map(|i| a + (b - a) * (i as f64 / n as f64))
-        .collect()
+    let (a, b) = (*a, *b);
+    Some((1..=n).map(move |i| a + (b - a) * (i as f64 / n as f64)))
 }
 
 /// One query: the roadmap plus the query's start (id = nodes.len()) and goal rods.
@@ -380,9 +433,6 @@ struct Query<'p> {
     blocked: HashSet<(NodeId, NodeId)>,
     neighbours: HashMap<NodeId, Vec<NodeId>>,
     edges_checked: usize,
-    /// Smallest margin seen on checked edges of the accepted path.
-    t0: Instant,
-    deadline: Duration,
 }
 
 impl<'p> Query<'p> {
@@ -391,7 +441,6 @@ impl<'p> Query<'p> {
         start: PlanarParams,
         goals: Vec<PlanarParams>,
         request: &'p PlanRequest,
-        t0: Instant,
     ) -> Self {
         Self {
             planner,
@@ -401,8 +450,6 @@ impl<'p> Query<'p> {
             blocked: HashSet::new(),
             neighbours: HashMap::new(),
             edges_checked: 0,
-            t0,
-            deadline: request.deadline,
         }
     }
 
@@ -430,7 +477,7 @@ impl<'p> Query<'p> {
     }
 
     fn expired(&self) -> bool {
-        self.t0.elapsed() >= self.deadline
+        crate::deadline::expired()
     }
 
     /// The nearest roadmap nodes of `id`, and for every node near a goal (or the start) that
@@ -532,15 +579,15 @@ impl<'p> Query<'p> {
         if roadmap_pair && self.planner.edge_stable.get(&key(u, v)) == Some(&false) {
             return None;
         }
-        let samples = edge_samples(&a, &b);
+        let samples = edge_samples(&a, &b)?;
         let mut min_margin = f64::INFINITY;
-        for (i, r) in samples.iter().enumerate() {
-            // Long edges (a start far from the roadmap) hold thousands of samples: the
-            // deadline is polled, and an edge cut short is not cached as unstable.
-            if i % DEADLINE_POLL == 0 && self.expired() {
+        for r in samples {
+            // Long edges (a start far from the roadmap) hold thousands of samples: each is
+            // charged to the deadline, and an edge cut short is not cached as unstable.
+            if self.expired() {
                 return None;
             }
-            let m = margin_of(r);
+            let m = margin_of(&r);
             min_margin = min_margin.min(m);
             if m < MIN_MARGIN {
                 if roadmap_pair {
@@ -552,8 +599,10 @@ impl<'p> Query<'p> {
         if roadmap_pair {
             self.planner.edge_stable.insert(key(u, v), true);
         }
-        if samples.iter().any(|r| collides(r, self.obstacles)) {
-            return None;
+        for r in edge_samples(&a, &b)? {
+            if collides(&r, self.obstacles) != Some(false) {
+                return None;
+            }
         }
         Some(min_margin)
     }
@@ -597,8 +646,10 @@ impl<'p> Query<'p> {
     fn assemble(&self, path: &[NodeId], min_margin: f64) -> Plan {
         let mut rods = vec![self.start];
         for w in path.windows(2) {
-            let samples = edge_samples(&self.node(w[0]), &self.node(w[1]));
-            rods.extend(samples.iter().skip(1).step_by(2));
+            // Every edge of a path was checked, so its samples are bounded.
+            if let Some(samples) = edge_samples(&self.node(w[0]), &self.node(w[1])) {
+                rods.extend(samples.skip(1).step_by(2));
+            }
         }
         let gripper = rods
             .iter()
@@ -624,6 +675,11 @@ mod tests {
     use proptest::prelude::*;
 
     /// A rod drawn from the stable, moderately bent set (the shapes the planner sees).
+    /// `collides` with no deadline in force (it always answers).
+    fn touches(a: &PlanarParams, obstacles: &[Obstacle]) -> bool {
+        collides(a, obstacles).expect("no deadline in force")
+    }
+
     fn rod() -> impl Strategy<Value = PlanarParams> {
         (-6.0..6.0f64, -30.0..30.0f64, -30.0..30.0f64)
             .prop_map(|(a, b, c)| PlanarParams::new(a, b, c))
@@ -654,9 +710,9 @@ mod tests {
         #[test]
         fn obstacles_around_the_base_touch_every_rod(a in rod(), s in scale()) {
             prop_assume!(PlanarRod::new(&a).is_ok());
-            prop_assert!(collides(&a, &[triangle([0.0, 0.0], s)]), "triangle of scale {s:e}");
+            prop_assert!(touches(&a, &[triangle([0.0, 0.0], s)]), "triangle of scale {s:e}");
             let disc = Obstacle::Disc { center: [s / 2.0, 0.0], radius: s };
-            prop_assert!(collides(&a, &[disc]), "disc of radius {s:e}");
+            prop_assert!(touches(&a, &[disc]), "disc of radius {s:e}");
             prop_assert!(check_obstacle(&triangle([0.0, 0.0], s)).is_ok());
         }
 
@@ -667,9 +723,9 @@ mod tests {
             prop_assume!(PlanarRod::new(&a).is_ok());
             let s = s.min(0.4);
             let c = [1.5 * angle.cos(), 1.5 * angle.sin()];
-            prop_assert!(!collides(&a, &[triangle(c, s / 2.0)]), "triangle at {c:?} of scale {s:e}");
+            prop_assert!(!touches(&a, &[triangle(c, s / 2.0)]), "triangle at {c:?} of scale {s:e}");
             let disc = Obstacle::Disc { center: c, radius: s };
-            prop_assert!(!collides(&a, &[disc]));
+            prop_assert!(!touches(&a, &[disc]));
         }
 
         /// A degenerate polygon (three collinear points: a wall of zero area) across the
@@ -682,7 +738,7 @@ mod tests {
             prop_assume!(tip.x.abs() > 0.05);
             let x = tip.x / 2.0;
             let wall = Obstacle::Polygon { points: vec![[x, -h], [x, 0.0], [x, h]] };
-            prop_assert!(collides(&a, &[wall]), "wall at x = {x}, tip {tip:?}");
+            prop_assert!(touches(&a, &[wall]), "wall at x = {x}, tip {tip:?}");
         }
 
         /// Coordinates beyond the bound, or not finite, are refused with the bound named.

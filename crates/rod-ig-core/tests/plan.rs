@@ -80,7 +80,7 @@ fn plans_between_random_stable_rods_are_stable_all_the_way() {
     rod_ig_core::planar::ig::warm_up();
     let mut rng = SplitMix64::new(2026);
     let mut planner = Planner::new();
-    let (mut solved, mut times) = (0, Vec::new());
+    let mut solved = 0;
     let n = 30;
     for i in 0..n {
         let (start, _) = random_stable(&mut rng, 0.01);
@@ -89,12 +89,11 @@ fn plans_between_random_stable_rods_are_stable_all_the_way() {
             start,
             goal,
             obstacles: Vec::new(),
-            deadline: Duration::from_secs(2),
+            // The longest a request may ask: a loaded machine must not change the count
+            // (the planner's speed is measured by `rod-ig bench`).
+            deadline: rod_ig_core::planar::ig::MAX_DEADLINE,
         };
-        let t0 = std::time::Instant::now();
-        let r = planner.plan(&request);
-        times.push(t0.elapsed().as_secs_f64() * 1e3);
-        match r {
+        match planner.plan(&request) {
             Ok(plan) => {
                 assert!(plan.min_margin >= MIN_MARGIN);
                 verify(&plan, &request, true);
@@ -103,12 +102,7 @@ fn plans_between_random_stable_rods_are_stable_all_the_way() {
             Err(e) => println!("query {i}: {e}"),
         }
     }
-    times.sort_by(f64::total_cmp);
-    println!(
-        "plans: {solved}/{n} solved, median {:.1} ms, max {:.1} ms (roadmap reused; the first query builds it)",
-        times[n / 2],
-        times[n - 1]
-    );
+    println!("plans: {solved}/{n} solved");
     assert!(solved * 100 >= n * 95, "{solved}/{n}");
 }
 

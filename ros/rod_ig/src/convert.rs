@@ -750,6 +750,7 @@ mod tests {
                 evaluations: 5,
                 starts: 1,
                 elapsed_us: 3.0,
+                complete: true,
             },
             shape: vec![],
             event: "none",

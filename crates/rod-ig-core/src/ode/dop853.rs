@@ -669,7 +669,8 @@ impl<const N: usize> Dop853<N> {
     ///
     /// Errors: [`OdeError::StepBudget`] when `max_steps` attempts are used up,
     /// [`OdeError::StepSizeUnderflow`] when h falls below the resolution of t (e.g. a state that
-    /// keeps turning non-finite).
+    /// keeps turning non-finite), [`OdeError::Deadline`] when the deadline in force passes
+    /// (each attempt is charged to [`crate::deadline`]).
     #[inline(always)] // so that a caller compiled for wider vectors (crate::simd) gets it all
     pub fn step<F>(&mut self, f: &mut F) -> Result<(), OdeError>
     where
@@ -686,6 +687,9 @@ impl<const N: usize> Dop853<N> {
                 });
             }
             self.stats.attempts += 1;
+            if crate::deadline::charge(crate::deadline::units::DOP853_STEP) {
+                return Err(OdeError::Deadline { t: self.t });
+            }
             let remaining = (self.t_end - self.t).abs();
             let mut habs = self.h.abs().min(self.opts.max_step);
             let last = habs >= remaining * (1.0 - 1e-12);

@@ -53,11 +53,20 @@ pub enum OdeError {
     /// Invalid tolerances, times or step count.
     #[error("invalid integration input: {0}")]
     InvalidInput(String),
+    /// The deadline in force ([`crate::deadline`]) passed: the integration was abandoned.
+    #[error("deadline passed at t = {t}")]
+    Deadline {
+        /// Time reached.
+        t: f64,
+    },
 }
 
 impl From<OdeError> for RodError {
     fn from(e: OdeError) -> Self {
-        RodError::Integration(e.to_string())
+        match e {
+            OdeError::Deadline { t } => RodError::Deadline { t },
+            e => RodError::Integration(e.to_string()),
+        }
     }
 }
 

@@ -580,6 +580,9 @@ impl<T: Measured> TaylorRod<T> {
         // Without dense output one segment is reused by every step, filled in place.
         let mut scratch: Option<Box<Segment<T>>> = None;
         for steps in 1..=max_steps {
+            if crate::deadline::charge(crate::deadline::units::TAYLOR_STEP) {
+                return Err(RodError::Deadline { t: t0 });
+            }
             let mut seg = match scratch.take() {
                 Some(s) => s,
                 None => Box::new(Segment::empty()),

@@ -171,10 +171,9 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                 value: a0[index],
             });
         }
-        let eval = model.evaluate(&a0).map_err(|e| IgError::Evaluation {
-            iteration: 0,
-            detail: e.to_string(),
-        })?;
+        let eval = model
+            .evaluate(&a0)
+            .map_err(|e| IgError::of_evaluation(0, &e))?;
         if !eval.stability.stable {
             if eval.stability.uncertain && model.is_straight(&a0) {
                 return Ok(Self {
@@ -248,7 +247,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
             };
         }
         let target = &self.model.canonical_target(target);
-        let _deadline = crate::solver::deadline::scope(self.options.deadline);
+        let _deadline = crate::deadline::scope(self.options.deadline);
         let mut work = Work::default();
         let mut current = held;
         let mut first_snap: Option<(M::Pose, SVector<f64, N>, f64)> = None;
@@ -395,7 +394,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
             ..self.options
         };
         // One deadline for both searches.
-        let _deadline = crate::solver::deadline::scope(self.options.deadline);
+        let _deadline = crate::deadline::scope(self.options.deadline);
         let first = solve(&self.model, target, &least);
         let all = super::solve_all(&self.model, target, &least);
         let result = match first {
@@ -559,7 +558,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         // tensioned rods).
         let mut first_try = true;
         while s < 1.0 {
-            if crate::solver::deadline::expired() {
+            if crate::deadline::expired() {
                 return Err(Stop::Deadline(current, s));
             }
             let s_new = (s + ds).min(1.0);
@@ -617,7 +616,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         let mut x = *from;
         let mut previous_step = f64::INFINITY;
         for _ in 0..=CORRECTOR_ITERATIONS {
-            if crate::solver::deadline::expired() {
+            if crate::deadline::expired() {
                 return None;
             }
             let (pe, oe) = self.model.pose_error(&x.tip, goal);

@@ -228,7 +228,7 @@ fn stop_before_step<const N: usize, P: Problem<N>>(
         Some(Stop::MaxIterations)
     } else if state.evaluations >= settings.max_evaluations {
         Some(Stop::Budget)
-    } else if super::deadline::expired() {
+    } else if crate::deadline::expired() {
         Some(Stop::Deadline)
     } else {
         None

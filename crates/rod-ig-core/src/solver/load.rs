@@ -60,7 +60,7 @@ impl<'a, const N: usize, M: LoadedModel<N>> Search<'a, N, M> {
     }
 
     pub(crate) fn out_of_time(&self) -> bool {
-        super::deadline::expired()
+        crate::deadline::expired()
     }
 
     fn residual(&self, model: &M, tip: &M::Pose) -> f64 {
@@ -82,10 +82,7 @@ impl<'a, const N: usize, M: LoadedModel<N>> Search<'a, N, M> {
         match model.tip_and_jacobian(a) {
             Ok(v) => Some(v),
             Err(e) => {
-                self.last_error = Some(IgError::Evaluation {
-                    iteration: self.work.iterations,
-                    detail: e.to_string(),
-                });
+                self.last_error = Some(IgError::of_evaluation(self.work.iterations, &e));
                 None
             }
         }
@@ -185,10 +182,7 @@ impl<'a, const N: usize, M: LoadedModel<N>> Search<'a, N, M> {
         let e = match model.evaluate(&a) {
             Ok(e) => e,
             Err(err) => {
-                self.last_error = Some(IgError::Evaluation {
-                    iteration: self.work.iterations,
-                    detail: err.to_string(),
-                });
+                self.last_error = Some(IgError::of_evaluation(self.work.iterations, &err));
                 return None;
             }
         };
@@ -335,7 +329,7 @@ pub fn carry<const N: usize, M: LoadedModel<N>>(
     gripper: &M::Pose,
     options: &SolveOptions<SVector<f64, N>>,
 ) -> Result<SolutionOf<N, M>, FailureOf<N>> {
-    let _deadline = super::deadline::scope(options.deadline);
+    let _deadline = crate::deadline::scope(options.deadline);
     let mut search = Search::new(*gripper, options);
     search.work.starts = 1;
     let carried = search.continuation(from, to, a);

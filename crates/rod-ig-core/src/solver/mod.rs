@@ -34,7 +34,6 @@
 //! ```
 
 mod continuation;
-pub(crate) mod deadline;
 pub(crate) mod globalised;
 pub mod load;
 mod model;
@@ -126,7 +125,7 @@ pub fn solve<const N: usize, M: InverseGeometry<N> + ?Sized>(
     let result = match check(model, target, options) {
         Err(e) => Err(Failure::early(e)),
         Ok(()) => {
-            let _deadline = crate::solver::deadline::scope(options.deadline);
+            let _deadline = crate::deadline::scope(options.deadline);
             dispatch(model, &model.canonical_target(target), options)
         }
     };
@@ -166,7 +165,7 @@ fn dispatch<const N: usize, M: InverseGeometry<N> + ?Sized>(
             else {
                 // No default start: the model's tables were not ready within the deadline, or
                 // it has none for this target.
-                let reason = if crate::solver::deadline::expired() {
+                let reason = if crate::deadline::expired() {
                     IgError::Deadline { iteration: 0 }
                 } else {
                     IgError::NoStableSolution {
@@ -193,11 +192,14 @@ fn dispatch<const N: usize, M: InverseGeometry<N> + ?Sized>(
                 .into_iter()
                 .chain(first.as_ref().ok().copied())
                 .min_by(|a, b| a.energy.total_cmp(&b.energy));
+            // Read once both searches returned: a deadline passed by then may have cut them.
+            let complete = !crate::deadline::expired();
             match best {
                 Some(mut s) => {
                     s.iterations = all.iterations + fi;
                     s.evaluations = all.evaluations + fe;
                     s.starts = all.starts + fs;
+                    s.complete = complete;
                     Ok(s)
                 }
                 None => first,
@@ -206,20 +208,43 @@ fn dispatch<const N: usize, M: InverseGeometry<N> + ?Sized>(
     }
 }
 
-/// All distinct stable solutions found for `target` (the model's starts near the target, the
-/// initial guess first if any), sorted by energy. Never empty where [`solve`] with the same
-/// options succeeds (its solution is included); empty when the target or options are invalid
-/// or no stable solution is found.
+/// Every distinct stable solution a search found ([`solve_every`]), least energy first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Every<P, X> {
+    /// The solutions, sorted by energy.
+    pub solutions: Vec<Solution<P, X>>,
+    /// The search tried every start: false when the deadline passed before it was known to
+    /// have finished (solutions may be missing from the list).
+    pub complete: bool,
+}
+
+/// All distinct stable solutions found for `target` ([`solve_every`] without its `complete`
+/// flag).
 pub fn solve_all<const N: usize, M: InverseGeometry<N> + ?Sized>(
     model: &M,
     target: &M::Pose,
     options: &SolveOptions<SVector<f64, N>>,
 ) -> Vec<SolutionOf<N, M>> {
+    solve_every(model, target, options).solutions
+}
+
+/// All distinct stable solutions found for `target` (the model's starts near the target, the
+/// initial guess first if any), sorted by energy, and whether the search ran to its end.
+/// Never empty where [`solve`] with the same options succeeds (its solution is included);
+/// empty when the target or options are invalid or no stable solution is found.
+pub fn solve_every<const N: usize, M: InverseGeometry<N> + ?Sized>(
+    model: &M,
+    target: &M::Pose,
+    options: &SolveOptions<SVector<f64, N>>,
+) -> Every<SVector<f64, N>, M::Pose> {
     if check(model, target, options).is_err() {
-        return Vec::new();
+        return Every {
+            solutions: Vec::new(),
+            complete: true,
+        };
     }
     let t0 = std::time::Instant::now();
-    let _deadline = crate::solver::deadline::scope(options.deadline);
+    let _deadline = crate::deadline::scope(options.deadline);
     let target = &model.canonical_target(target);
     let found = model.robust_all(target, options);
     let mut solutions = found.solutions;
@@ -238,6 +263,7 @@ pub fn solve_all<const N: usize, M: InverseGeometry<N> + ?Sized>(
         }
     }
     solutions.sort_by(|a, b| a.energy.total_cmp(&b.energy));
+    let complete = !crate::deadline::expired();
     emit(Event::Finished {
         termination: if solutions.is_empty() {
             Termination::NoStableSolution
@@ -248,5 +274,8 @@ pub fn solve_all<const N: usize, M: InverseGeometry<N> + ?Sized>(
         starts,
         elapsed_us: t0.elapsed().as_secs_f64() * 1e6,
     });
-    solutions
+    Every {
+        solutions,
+        complete,
+    }
 }

@@ -55,7 +55,7 @@ fn run<const N: usize, M: RodModel<N> + ?Sized>(
             last_a: Some(a),
             elapsed_us: 0.0,
         };
-        if crate::solver::deadline::expired() {
+        if crate::deadline::expired() {
             return Err(fail(IgError::Deadline { iteration: k }, residual));
         }
         evaluations += 1;
@@ -102,10 +102,7 @@ fn stable_iterate<const N: usize, M: RodModel<N> + ?Sized>(
 ) -> Result<Checked<N, M::Pose>, IgError> {
     let e = model
         .evaluate_iterate(a, a0)
-        .map_err(|err| IgError::Evaluation {
-            iteration: k,
-            detail: format!("evaluation of iterate failed: {err}"),
-        })?;
+        .map_err(|err| IgError::of_evaluation(k, &err))?;
     let errors = model.pose_error(&e.tip, target);
     if !(errors.0.hypot(errors.1).is_finite() && e.jacobian.iter().all(|v| v.is_finite())) {
         return Err(IgError::Evaluation {

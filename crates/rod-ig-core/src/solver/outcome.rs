@@ -35,6 +35,10 @@ pub struct Solution<P, X> {
     pub starts: u32,
     /// Wall time of the solve, µs.
     pub elapsed_us: f64,
+    /// The search the objective asks for ran to its end. Always true for the first-found
+    /// objective; false when the deadline passed before the least-energy search had tried
+    /// every start (the rod is stable and on target, but one of less energy may exist).
+    pub complete: bool,
 }
 
 /// The work a search did, kept in one state and copied into its outcome.
@@ -81,6 +85,7 @@ impl<P, X> Solution<P, X> {
             evaluations: work.evaluations,
             starts: work.starts.max(1),
             elapsed_us: 0.0,
+            complete: true,
         }
     }
 }
@@ -219,6 +224,19 @@ pub enum IgError {
 }
 
 impl IgError {
+    /// The error of an evaluation that failed at `iteration`: [`IgError::Deadline`] when the
+    /// deadline cut it ([`crate::RodError::Deadline`]), else [`IgError::Evaluation`] with the
+    /// detail.
+    pub fn of_evaluation(iteration: u32, error: &crate::RodError) -> Self {
+        match error {
+            crate::RodError::Deadline { .. } => Self::Deadline { iteration },
+            e => Self::Evaluation {
+                iteration,
+                detail: e.to_string(),
+            },
+        }
+    }
+
     /// The typed termination reason of this error.
     pub fn termination(&self) -> Termination {
         match self {

@@ -117,7 +117,7 @@ impl Ctx<'_> {
     }
 
     fn eval(&mut self, a: &SpatialParams, rtol: f64, verify: bool) -> Result<EvalOutcome, IgError> {
-        if crate::solver::deadline::expired() {
+        if crate::deadline::expired() {
             return Err(IgError::Deadline {
                 iteration: self.iterations,
             });
@@ -133,10 +133,7 @@ impl Ctx<'_> {
                 Ok(EvalOutcome::Stable(Box::new(ev)))
             }
             Ok((None, _)) => Ok(EvalOutcome::Unstable),
-            Err(e) => Err(IgError::Evaluation {
-                iteration: self.iterations,
-                detail: e.to_string(),
-            }),
+            Err(e) => Err(IgError::of_evaluation(self.iterations, &e)),
         }
     }
 
@@ -533,7 +530,7 @@ impl InverseGeometry<6> for Spatial {
         let mut solutions: Vec<Solution3d> = Vec::new();
         let (mut seeds, mut last) = (Vec::new(), IgError::LeftStableSet { iteration: 0 });
         for a0 in list {
-            if crate::solver::deadline::expired() {
+            if crate::deadline::expired() {
                 break;
             }
             if let Some((a, ev, _)) = attempt_plain(&mut ctx, a0, rtol0, &mut seeds, &mut last) {

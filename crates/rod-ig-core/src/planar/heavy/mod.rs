@@ -171,9 +171,7 @@ fn stop_error(s: Stop) -> RodError {
             "the heavy rod needs more than {} series steps (stopped at t = {t})",
             series::MAX_STEPS
         )),
-        Stop::Deadline { t } => {
-            RodError::Integration(format!("deadline passed at t = {t} of the heavy rod"))
-        }
+        Stop::Deadline { t } => RodError::Deadline { t },
     }
 }
 

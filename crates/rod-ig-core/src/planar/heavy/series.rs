@@ -330,8 +330,8 @@ pub(crate) fn integrate(
 ) -> Result<State, Stop> {
     let mut state = State::base(&p.a);
     let mut step = Step::zeroed();
-    for n in 0..MAX_STEPS {
-        if n > 0 && crate::solver::deadline::expired() {
+    for _ in 0..MAX_STEPS {
+        if crate::deadline::charge(crate::deadline::units::HEAVY_STEP) {
             return Err(Stop::Deadline { t: state.t });
         }
         step.expand(p, &state, jacobian);

@@ -189,6 +189,9 @@ struct SlabLists {
 
 static BUILDER: Mutex<Option<Builder>> = Mutex::new(None);
 
+/// How long a thread waits for pieces other threads are computing before it asks again.
+const WAIT: Duration = Duration::from_micros(50);
+
 /// What a thread does next for the build.
 enum Step {
     Chunk(usize),
@@ -200,7 +203,7 @@ enum Step {
     Done(Atlas),
 }
 
-/// The atlas, built on first use within the current deadline ([`crate::solver::deadline`]) on every
+/// The atlas, built on first use within the current deadline ([`crate::deadline`]) on every
 /// core: `None` when the deadline passes first. The work done is kept and resumed by the next
 /// call; threads calling it together share the build (each polls the deadline between pieces
 /// of ≈ 0.5 ms).
@@ -208,12 +211,12 @@ pub(crate) fn get() -> Option<&'static Atlas> {
     if let Some(atlas) = ATLAS.get() {
         return Some(atlas);
     }
-    let end = crate::solver::deadline::current();
+    let deadline = crate::deadline::handoff();
     let helpers = std::thread::available_parallelism().map_or(1, |n| n.get()) - 1;
     std::thread::scope(|scope| {
         for _ in 0..helpers {
             scope.spawn(move || {
-                let _deadline = crate::solver::deadline::until(end);
+                let _deadline = deadline.enter();
                 build()
             });
         }
@@ -227,7 +230,7 @@ fn build() -> Option<&'static Atlas> {
         if let Some(atlas) = ATLAS.get() {
             return Some(atlas);
         }
-        if crate::solver::deadline::expired() {
+        if crate::deadline::expired() {
             return None;
         }
         let work = {
@@ -241,6 +244,12 @@ fn build() -> Option<&'static Atlas> {
             }
             work
         };
+        // Each piece is charged before it is done (the deadline polled between pieces).
+        crate::deadline::charge(match work {
+            Step::Wait => WAIT.as_micros() as u64,
+            Step::Done(_) => 0,
+            _ => crate::deadline::units::ATLAS_PIECE,
+        });
         match work {
             Step::Chunk(c) => {
                 let seeds = chunk_seeds(c);
@@ -259,7 +268,7 @@ fn build() -> Option<&'static Atlas> {
                     b.slabs[ix].get_or_insert(lists);
                 }
             }
-            Step::Wait => std::thread::sleep(Duration::from_micros(50)),
+            Step::Wait => std::thread::sleep(WAIT),
             Step::Done(atlas) => {
                 let _ = ATLAS.set(atlas);
             }
@@ -275,7 +284,7 @@ fn lock_builder() -> std::sync::MutexGuard<'static, Option<Builder>> {
 
 /// The atlas, built now if needed whatever the time it takes (no deadline applies).
 pub(crate) fn get_blocking() -> &'static Atlas {
-    let _unbounded = crate::solver::deadline::unbounded();
+    let _unbounded = crate::deadline::unbounded();
     loop {
         if let Some(atlas) = get() {
             return atlas;

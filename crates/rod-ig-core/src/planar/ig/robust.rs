@@ -335,7 +335,7 @@ pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solut
     let mut n = 0;
     let max_starts = options.max_starts.map_or(MAX_STARTS, |m| m.max(1) as usize);
     while n < max_starts {
-        if crate::solver::deadline::expired() {
+        if crate::deadline::expired() {
             return Err(deadline_failure(&counts));
         }
         let Some((start, is_guess)) = starts.next() else {
@@ -443,7 +443,7 @@ pub(crate) fn solve_all(
     let mut solutions: Vec<Solution> = Vec::new();
     let mut starts = 0;
     for start in &list {
-        if crate::solver::deadline::expired() {
+        if crate::deadline::expired() {
             break;
         }
         if total_budget.is_some_and(|b| counts.iterations >= b) && !solutions.is_empty() {

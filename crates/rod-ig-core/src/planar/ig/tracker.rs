@@ -100,7 +100,7 @@ impl Tracker {
     }
 
     fn solve_untimed(&mut self, target: &PlanarPose) -> Result<Solution, Failure> {
-        let _deadline = crate::solver::deadline::scope(self.options.deadline);
+        let _deadline = crate::deadline::scope(self.options.deadline);
         super::check_target(target).map_err(Failure::early)?;
         // The angle reduced exactly (as every entry point does, `RodModel::canonical_target`).
         let target = &PlanarPose::new(target.x, target.y, wrap_angle(target.theta));
