@@ -5,7 +5,7 @@
 
 use nalgebra::{Vector3, Vector6};
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyMemoryError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rod_ig_core::plan::{Obstacle, PlanRequest, Planner as CorePlanner};
@@ -136,6 +136,45 @@ fn f64_out<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
     v.into_pyarray(py)
 }
 
+/// Outputs above this size (bytes) are checked against the memory available first.
+const LARGE_OUTPUT: u64 = 64 << 20;
+
+/// Memory the machine has available (Linux's MemAvailable), if known.
+fn available_bytes() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kb: u64 = info
+        .lines()
+        .find_map(|l| l.strip_prefix("MemAvailable:"))?
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kb.saturating_mul(1024))
+}
+
+/// An output of `rows × per_row` values, each `fill`, sized before it is allocated: an
+/// impossible size raises `MemoryError` naming it (issue 42: it aborted the interpreter).
+fn buffer<T: Clone>(rows: usize, per_row: usize, fill: T) -> PyResult<Vec<T>> {
+    let too_big = || {
+        PyMemoryError::new_err(format!(
+            "cannot allocate the output: {rows} rows × {per_row} values of {} bytes",
+            std::mem::size_of::<T>()
+        ))
+    };
+    let len = rows.checked_mul(per_row).ok_or_else(too_big)?;
+    // Beyond the memory the machine has free the allocation may "succeed" (overcommit) and
+    // the process be killed while it fills: refused first.
+    let bytes = (len as u64).saturating_mul(std::mem::size_of::<T>() as u64);
+    if bytes > LARGE_OUTPUT && available_bytes().is_some_and(|free| bytes > free) {
+        return Err(too_big());
+    }
+    let mut v = Vec::new();
+    v.try_reserve_exact(len).map_err(|_| too_big())?;
+    v.resize(len, fill);
+    Ok(v)
+}
+
 /// Planar forward map of n rods `a` (flattened (n, 3)): tip (x, y, θ unwrapped), J (rows x, y,
 /// θ; columns a3, a4, a5), stable, margin, uncertain, energy. A rod that cannot be evaluated
 /// gets NaN, stable False, uncertain True.
@@ -152,13 +191,13 @@ fn forward<'py>(
     let n = a.len() / 3;
     let threads = thread_count(threads)?;
     let g = gravities2(n, weight.as_ref(), gravity.as_ref())?;
-    let mut elastic = vec![f64::NAN; n];
-    let mut tip = vec![f64::NAN; 3 * n];
-    let mut jac = vec![f64::NAN; 9 * n];
-    let mut stable = vec![false; n];
-    let mut margin = vec![f64::NAN; n];
-    let mut uncertain = vec![true; n];
-    let mut energy = vec![f64::NAN; n];
+    let mut elastic = buffer(n, 1, f64::NAN)?;
+    let mut tip = buffer(n, 3, f64::NAN)?;
+    let mut jac = buffer(n, 9, f64::NAN)?;
+    let mut stable = buffer(n, 1, false)?;
+    let mut margin = buffer(n, 1, f64::NAN)?;
+    let mut uncertain = buffer(n, 1, true)?;
+    let mut energy = buffer(n, 1, f64::NAN)?;
     batch(
         py,
         n,
@@ -211,7 +250,7 @@ fn is_stable<'py>(
     let n = a.len() / 3;
     let threads = thread_count(threads)?;
     let g = gravities2(n, weight.as_ref(), gravity.as_ref())?;
-    let mut stable = vec![false; n];
+    let mut stable = buffer(n, 1, false)?;
     batch(
         py,
         n,
@@ -245,7 +284,7 @@ fn shape<'py>(
     let n = a.len() / 3;
     let threads = thread_count(threads)?;
     let g = gravities2(n, weight.as_ref(), gravity.as_ref())?;
-    let mut out = vec![f64::NAN; 3 * samples * n];
+    let mut out = buffer(n, samples.saturating_mul(3), f64::NAN)?;
     batch(
         py,
         n,
@@ -344,21 +383,21 @@ struct SolveOut {
 }
 
 impl SolveOut {
-    fn new(n: usize, dim: usize) -> Self {
-        SolveOut {
-            success: vec![false; n],
-            a: vec![f64::NAN; dim * n],
-            termination: vec![""; n],
-            reason: vec![String::new(); n],
-            iterations: vec![0; n],
-            margin: vec![f64::NAN; n],
-            energy: vec![f64::NAN; n],
-            position_error: vec![f64::NAN; n],
-            orientation_error: vec![f64::NAN; n],
-            starts: vec![0; n],
-            complete: vec![true; n],
+    fn new(n: usize, dim: usize) -> PyResult<Self> {
+        Ok(SolveOut {
+            success: buffer(n, 1, false)?,
+            a: buffer(n, dim, f64::NAN)?,
+            termination: buffer(n, 1, "")?,
+            reason: buffer(n, 1, String::new())?,
+            iterations: buffer(n, 1, 0)?,
+            margin: buffer(n, 1, f64::NAN)?,
+            energy: buffer(n, 1, f64::NAN)?,
+            position_error: buffer(n, 1, f64::NAN)?,
+            orientation_error: buffer(n, 1, f64::NAN)?,
+            starts: buffer(n, 1, 0)?,
+            complete: buffer(n, 1, true)?,
             solutions: Vec::new(),
-        }
+        })
     }
 
     fn write<P: AsRef<[f64]>, X>(
@@ -495,7 +534,7 @@ where
     M::Pose: Send,
 {
     let threads = thread_count(threads)?;
-    let mut out = SolveOut::new(n, N);
+    let mut out = SolveOut::new(n, N)?;
     batch(
         py,
         n,
@@ -586,12 +625,12 @@ fn forward3d<'py>(
     let threads = thread_count(threads)?;
     let g = gravities3(n, weight.as_ref(), gravity.as_ref())?;
     let opts = StabilityOptions::production();
-    let mut position = vec![f64::NAN; 3 * n];
-    let mut quaternion = vec![f64::NAN; 4 * n];
-    let mut jac = vec![f64::NAN; 36 * n];
-    let mut stable = vec![false; n];
-    let mut margin = vec![f64::NAN; n];
-    let mut energy = vec![f64::NAN; n];
+    let mut position = buffer(n, 3, f64::NAN)?;
+    let mut quaternion = buffer(n, 4, f64::NAN)?;
+    let mut jac = buffer(n, 36, f64::NAN)?;
+    let mut stable = buffer(n, 1, false)?;
+    let mut margin = buffer(n, 1, f64::NAN)?;
+    let mut energy = buffer(n, 1, f64::NAN)?;
     batch(
         py,
         n,
@@ -752,7 +791,7 @@ impl Tracker {
         let pose = PlanarPose::new(target[0], target[1], target[2]);
         let follower = &mut self.follower;
         let m = py.detach(|| follower.follow(&pose));
-        let mut out = SolveOut::new(1, 3);
+        let mut out = SolveOut::new(1, 3)?;
         out.write(0, &m.result);
         let d = PyDict::new(py);
         d.set_item("success", out.success[0])?;

@@ -434,6 +434,17 @@ def test_the_boundary_raises_and_names_the_argument() -> None:
     assert s.reason[0] == "" and "unreachable" in s.reason[1]
 
 
+def test_an_impossible_output_raises_memory_error() -> None:
+    # 2,000 rods × 10⁶ samples × 3 doubles = 48 GB: sized before it is allocated.
+    with pytest.raises(MemoryError, match="cannot allocate"):
+        rod_ig.shape(np.zeros((2000, 3)), samples=10**6)
+    # Above the sample bound, refused by name.
+    with pytest.raises(ValueError, match="samples"):
+        rod_ig.shape(np.zeros((2, 3)), samples=10**18)
+    # The interpreter goes on.
+    assert rod_ig.shape(np.zeros((2, 3)), samples=5).shape == (2, 5, 3)
+
+
 def test_a_search_cut_by_its_deadline_says_it_is_incomplete() -> None:
     target = [-0.3, 0.4, 2.5]
     full = rod_ig.solve(target, objective="least_energy", all=True, deadline_ms=10_000)

@@ -5,6 +5,10 @@ use serde::Serialize;
 use serde_json::Value;
 use std::io::{BufRead, Write};
 
+/// Longest request line accepted (16 MiB: a `plan` at its obstacle and vertex bounds takes
+/// ≈ 4 MB). A longer line is answered with an error and skipped without being buffered whole.
+pub const MAX_LINE_BYTES: usize = 16 << 20;
+
 /// Reads `input` line by line, answers each with `handle`, and writes one JSON line per input
 /// line to `output`, flushing after each so that a client can drive the tool interactively.
 pub fn run<R: BufRead, W: Write>(
@@ -15,17 +19,68 @@ pub fn run<R: BufRead, W: Write>(
     let mut raw = Vec::new();
     loop {
         raw.clear();
-        if input.read_until(b'\n', &mut raw)? == 0 {
-            return Ok(());
-        }
-        let answer = match std::str::from_utf8(&raw) {
-            Err(e) => error_value(format!("line is not UTF-8: {e}")),
-            Ok(line) if line.trim().is_empty() => error_value("empty line".to_string()),
-            Ok(line) => handle(line.trim()).unwrap_or_else(error_value),
+        let answer = match read_line(&mut input, &mut raw)? {
+            Line::End => return Ok(()),
+            Line::TooLong(bytes) => error_value(format!(
+                "line of {bytes} bytes or more refused: at most {MAX_LINE_BYTES} bytes per request"
+            )),
+            Line::Read => match std::str::from_utf8(&raw) {
+                Err(e) => error_value(format!("line is not UTF-8: {e}")),
+                Ok(line) if line.trim().is_empty() => error_value("empty line".to_string()),
+                Ok(line) => handle(line.trim()).unwrap_or_else(error_value),
+            },
         };
         serde_json::to_writer(&mut output, &answer)?;
         output.write_all(b"\n")?;
         output.flush()?;
+    }
+}
+
+/// What [`read_line`] found.
+enum Line {
+    /// End of input.
+    End,
+    /// A line in the buffer (its newline included, if any).
+    Read,
+    /// A line longer than [`MAX_LINE_BYTES`], skipped up to its newline: its length so far.
+    TooLong(usize),
+}
+
+/// Reads one line into `raw`, or skips it when it exceeds [`MAX_LINE_BYTES`] (never holding
+/// more than that).
+fn read_line<R: BufRead>(input: &mut R, raw: &mut Vec<u8>) -> std::io::Result<Line> {
+    let mut skipped = 0usize;
+    loop {
+        let chunk = match input.fill_buf() {
+            Ok(c) => c,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e),
+        };
+        if chunk.is_empty() {
+            return Ok(match (raw.is_empty(), skipped) {
+                (_, n) if n > 0 => Line::TooLong(n),
+                (true, _) => Line::End,
+                (false, _) => Line::Read,
+            });
+        }
+        let (take, done) = match chunk.iter().position(|&b| b == b'\n') {
+            Some(i) => (i + 1, true),
+            None => (chunk.len(), false),
+        };
+        if skipped == 0 && raw.len() + take <= MAX_LINE_BYTES {
+            raw.extend_from_slice(&chunk[..take]);
+        } else {
+            skipped = skipped.max(raw.len()) + take;
+            raw.clear();
+        }
+        input.consume(take);
+        if done {
+            return Ok(if skipped > 0 {
+                Line::TooLong(skipped)
+            } else {
+                Line::Read
+            });
+        }
     }
 }
 

@@ -302,7 +302,7 @@ fn track(
     svg: Option<&std::path::Path>,
 ) -> Result<(), String> {
     warm_up();
-    let mut tracking = motion_cmds::Tracking::default();
+    let mut tracking = motion_cmds::Tracking::new(svg.is_some());
     jsonl::run(stdin, stdout, |line| tracking.line(line)).map_err(|e| e.to_string())?;
     match svg {
         Some(path) => write_svg(

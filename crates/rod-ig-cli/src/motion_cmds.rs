@@ -121,14 +121,71 @@ struct TrackAnswer {
     held_a: Option<[f64; 3]>,
 }
 
+/// Most rods kept for a `track --svg` picture: past it, every other rod along the motion is
+/// dropped (starts, critical and snapped rods are kept), so memory stays flat over any
+/// stream and the picture still spans it.
+pub const MAX_DRAWN_RODS: usize = 1000;
+
 /// The state of a `track` stream: the follower and, for `--svg`, the rods so far.
 #[derive(Default)]
 pub struct Tracking {
     follower: Option<Follower>,
     /// The stream's gravity (a line with `weight` or `gravity` changes it for the next lines).
     gravity: Gravity,
-    /// Rods for the picture.
+    /// Whether rods are kept for a picture (`--svg`).
+    draws: bool,
+    /// Rods for the picture (at most about [`MAX_DRAWN_RODS`]).
     pub drawn: Vec<SequenceRod>,
+    /// Keep one in `stride` of the rods along the motion (doubles each time the list thins).
+    stride: usize,
+    /// Rods along the motion seen since the last one kept.
+    skipped: usize,
+}
+
+impl Tracking {
+    /// A stream's state; `draws`: keep rods for a picture.
+    pub fn new(draws: bool) -> Self {
+        Self {
+            draws,
+            stride: 1,
+            ..Self::default()
+        }
+    }
+
+    /// Keeps rod `a` for the picture (only with `--svg`), thinning the rods along the motion
+    /// to stay within [`MAX_DRAWN_RODS`].
+    fn draw(&mut self, a: &PlanarParams, gravity: &Gravity, kind: SequenceKind) {
+        if !self.draws {
+            return;
+        }
+        if matches!(kind, SequenceKind::Step) {
+            self.skipped += 1;
+            if self.skipped < self.stride {
+                return;
+            }
+            self.skipped = 0;
+        }
+        self.drawn.push(SequenceRod {
+            poses: shape(a, gravity),
+            kind,
+        });
+        if self.drawn.len() >= MAX_DRAWN_RODS {
+            let mut step = 0usize;
+            self.drawn.retain(|r| {
+                step += usize::from(matches!(r.kind, SequenceKind::Step));
+                !matches!(r.kind, SequenceKind::Step) || step % 2 == 1
+            });
+            self.stride *= 2;
+        }
+        if self.drawn.len() >= MAX_DRAWN_RODS {
+            // A stream of snaps alone: every other rod of any kind.
+            let mut i = 0usize;
+            self.drawn.retain(|_| {
+                i += 1;
+                i % 2 == 1
+            });
+        }
+    }
 }
 
 fn params3(a: &PlanarParams) -> [f64; 3] {
@@ -236,10 +293,7 @@ impl Tracking {
             let a0 = PlanarParams::from(a0);
             let follower = Follower::holding(gravity, options, a0)
                 .map_err(|e| format!("a0 cannot be held: {e}"))?;
-            self.drawn.push(SequenceRod {
-                poses: shape(&a0, &gravity),
-                kind: SequenceKind::Start,
-            });
+            self.draw(&a0, &gravity, SequenceKind::Start);
             self.follower = Some(follower);
             self.gravity = gravity;
         }
@@ -296,10 +350,7 @@ impl Tracking {
             answer.critical = Some(critical);
             answer.critical_a = Some(params3(&critical_a));
             answer.energy_released = Some(energy_released);
-            self.drawn.push(SequenceRod {
-                poses: shape(&critical_a, &gravity),
-                kind: SequenceKind::Critical,
-            });
+            self.draw(&critical_a, &gravity, SequenceKind::Critical);
         } else if let Some(GravityChange {
             snapped_from: Some(from),
             gripper,
@@ -318,10 +369,7 @@ impl Tracking {
             } else {
                 SequenceKind::Step
             };
-            self.drawn.push(SequenceRod {
-                poses: shape(&s.a, &gravity),
-                kind,
-            });
+            self.draw(&s.a, &gravity, kind);
         }
         answer
     }
