@@ -20,6 +20,7 @@ True
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 from typing import Any, Literal, Sequence
 
@@ -82,6 +83,13 @@ def _batch(name: str, value: npt.ArrayLike, width: int) -> tuple[FloatArray, tup
         index = tuple(int(i) for i in np.argwhere(bad)[0])
         raise ValueError(f"{name} is not finite at index {index}: {arr[index]}")
     return arr, arr.shape[:-1]
+
+
+def _shaped(values: Any, shape: tuple[int, ...]) -> Any:
+    """``values`` in the batch's shape; a single target's 0-d array becomes a numpy scalar
+    (as numpy's own functions return for scalar input)."""
+    r = np.asarray(values).reshape(shape)
+    return r[()] if shape == () else r
 
 
 def _broadcast(*arrays: FloatArray) -> tuple[list[FloatArray], tuple[int, ...]]:
@@ -196,19 +204,19 @@ def _solve_result(
         solutions = np.empty(len(d["solutions"]), dtype=object)
         for i, s in enumerate(d["solutions"]):
             solutions[i] = s.reshape(-1, dim)
-        solutions = solutions.reshape(shape)
+        solutions = _shaped(solutions, shape)
     return SolveResult(
-        success=d["success"].reshape(shape),
+        success=_shaped(d["success"], shape),
         a=d["a"].reshape(shape + (dim,)),
-        termination=np.array(d["termination"], dtype=str).reshape(shape),
-        reason=np.array(d["reason"], dtype=str).reshape(shape),
-        iterations=d["iterations"].reshape(shape),
-        margin=d["margin"].reshape(shape),
-        energy=d["energy"].reshape(shape),
-        position_error=d["position_error"].reshape(shape),
-        orientation_error=d["orientation_error"].reshape(shape),
-        starts=d["starts"].reshape(shape),
-        complete=d["complete"].reshape(shape),
+        termination=_shaped(np.array(d["termination"], dtype=str), shape),
+        reason=_shaped(np.array(d["reason"], dtype=str), shape),
+        iterations=_shaped(d["iterations"], shape),
+        margin=_shaped(d["margin"], shape),
+        energy=_shaped(d["energy"], shape),
+        position_error=_shaped(d["position_error"], shape),
+        orientation_error=_shaped(d["orientation_error"], shape),
+        starts=_shaped(d["starts"], shape),
+        complete=_shaped(d["complete"], shape),
         solutions=solutions,
     )
 
@@ -232,11 +240,11 @@ def forward(
     return ForwardResult(
         tip=d["tip"].reshape(shape + (3,)),
         jacobian=d["jacobian"].reshape(shape + (3, 3)),
-        stable=d["stable"].reshape(shape),
-        margin=d["margin"].reshape(shape),
-        uncertain=d["uncertain"].reshape(shape),
-        energy=d["energy"].reshape(shape),
-        elastic_energy=d["elastic_energy"].reshape(shape),
+        stable=_shaped(d["stable"], shape),
+        margin=_shaped(d["margin"], shape),
+        uncertain=_shaped(d["uncertain"], shape),
+        energy=_shaped(d["energy"], shape),
+        elastic_energy=_shaped(d["elastic_energy"], shape),
     )
 
 
@@ -245,7 +253,7 @@ def is_stable(
     threads: int | None = None,
     weight: npt.ArrayLike | None = None,
     gravity: npt.ArrayLike | None = None,
-) -> BoolArray:
+) -> BoolArray | np.bool_:
     """Stability verdicts of rods ``a`` of shape (..., 3): True where the rod is established
     stable, the same as ``forward(a).stable``, without the margin ``forward`` refines. Where a
     theorem or the sign of det J(1) decides (about two rods in three of the paper's box) it
@@ -253,7 +261,9 @@ def is_stable(
     ``weight``, ``gravity``: as for ``forward``."""
     arr, _ = _batch("a", a, 3)
     flat, shape = _broadcast(arr, *_weight_arrays(weight, gravity))
-    return _rod_ig.is_stable(flat[0], threads=_threads(threads), **_weight_kwargs(flat, 1)).reshape(shape)
+    verdicts = _rod_ig.is_stable(flat[0], threads=_threads(threads), **_weight_kwargs(flat, 1))
+    out: BoolArray | np.bool_ = _shaped(verdicts, shape)
+    return out
 
 
 def shape(
@@ -415,7 +425,8 @@ class MoveResult:
 
 class Tracker:
     """Quasi-static motion: the rod follows its equilibrium branch as the tip gripper moves,
-    and snaps where the branch folds.
+    and snaps where the branch folds. Safe to share between threads (moves are serialised by a
+    lock); ``pickle`` and ``copy`` give a tracker holding the same rod.
 
     >>> t = Tracker()
     >>> t.move([0.6, 0.2, 0.4]).event
@@ -433,24 +444,36 @@ class Tracker:
         """``weight`` and ``gravity`` (2 components): the rod with weight (docs/weight.md)."""
         start = None if a0 is None else [float(v) for v in _batch("a0", a0, 3)[0].reshape(3)]
         g = _batch("gravity", gravity, 2)[0].reshape(2)
-        self._inner = _rod_ig.Tracker(
-            a0=start,
+        self._settings: dict[str, Any] = dict(
             deadline_ms=deadline_ms,
             tolerance=tolerance,
             weight=float(weight),
             gravity=(float(g[0]), float(g[1])),
         )
+        self._lock = threading.Lock()
+        self._inner = _rod_ig.Tracker(a0=start, **self._settings)
 
     def move(self, target: npt.ArrayLike) -> MoveResult:
         """Moves the tip gripper to ``target`` (x, y, theta) and returns the rod it holds."""
         t = [float(v) for v in _batch("target", target, 3)[0].reshape(3)]
-        return MoveResult(**self._inner.move(t))
+        with self._lock:
+            return MoveResult(**self._inner.move(t))
 
     @property
     def rod(self) -> FloatArray | None:
         """The rod held now (a3, a4, a5), None before the first move or after a loss."""
-        r = self._inner.rod
+        with self._lock:
+            r = self._inner.rod
         return None if r is None else np.array(r)
+
+    def __getstate__(self) -> dict[str, Any]:
+        held = self.rod
+        return {"settings": self._settings, "rod": None if held is None else held.tolist()}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self._settings = state["settings"]
+        self._lock = threading.Lock()
+        self._inner = _rod_ig.Tracker(a0=state["rod"], **self._settings)
 
 
 @dataclass(frozen=True)
@@ -470,10 +493,19 @@ class Planner:
     """Plans stable, collision-free gripper paths for the planar rod over a roadmap of stable
     rods, kept across calls. Obstacles are dicts ``{"type": "disc", "center": [x, y],
     "radius": r}`` or ``{"type": "polygon", "points": [[x, y], ...]}`` in rod lengths, within
-    +-1e6."""
+    +-1e6. Safe to share between threads (plans are serialised by a lock); ``pickle`` and
+    ``copy`` give a planner that rebuilds its roadmap on first use."""
 
     def __init__(self) -> None:
+        self._lock = threading.Lock()
         self._inner = _rod_ig.Planner()
+
+    def __getstate__(self) -> dict[str, Any]:
+        # Not empty: an empty state would skip __setstate__ (the lock and the native planner).
+        return {"roadmap": "rebuilt on first use"}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__()  # type: ignore[misc]
 
     def plan(
         self,
@@ -486,7 +518,8 @@ class Planner:
         theta)."""
         s = [float(v) for v in _batch("start", start, 3)[0]]
         g = [float(v) for v in _batch("goal", goal, 3)[0]]
-        d = self._inner.plan(s, g, obstacles=list(obstacles), deadline_ms=deadline_ms)
+        with self._lock:
+            d = self._inner.plan(s, g, obstacles=list(obstacles), deadline_ms=deadline_ms)
         return PlanResult(
             success=d["success"],
             rods=d["rods"].reshape(-1, 3),

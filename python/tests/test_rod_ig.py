@@ -11,6 +11,7 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -166,8 +167,9 @@ def test_batch_shapes_and_broadcasting() -> None:
     assert s.a.shape == (2, 4, 3) and s.success.shape == (2, 4) and s.termination.shape == (2, 4)
     assert rod_ig.forward(np.array([[1, 2, 3]], dtype=np.int32)).tip.shape == (1, 3)
     s = rod_ig.solve([0.5, 0.2, 1.0], all=True, objective="least_energy")
-    assert s.solutions is not None and s.solutions.shape == ()
-    sols = s.solutions[()]
+    # One target: its (k, 3) array of solutions itself (a batch gets an object array of them).
+    assert s.solutions is not None
+    sols = s.solutions
     assert sols.ndim == 2 and sols.shape[1] == 3 and len(sols) >= 1
     assert np.isclose(rod_ig.forward(sols[0]).energy, s.energy)
 
@@ -325,6 +327,35 @@ def test_dask_recipe_maps_the_batch_api_over_chunks() -> None:
     assert np.array_equal(margin, direct.margin, equal_nan=True)
 
 
+def test_dask_computes_every_output_of_a_chunk_in_one_native_call(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import dask
+    import dask.array as da
+
+    from rod_ig.dask import forward_blocks_full
+
+    calls: list[tuple[int, int | None]] = []
+    native = rod_ig.forward
+
+    def counting(a: Any, threads: int | None = None, **kw: Any) -> Any:
+        calls.append((len(a), threads))
+        return native(a, threads=threads, **kw)
+
+    monkeypatch.setattr(rod_ig, "forward", counting)
+    a = np.random.default_rng(3).uniform(-10, 10, size=(6_000, 3))
+    f = forward_blocks_full(da.from_array(a, chunks=(2_000, 3)))
+    tip, jac, stable, margin, energy = dask.compute(
+        f.tip, f.jacobian, f.stable, f.margin, f.energy, scheduler="threads"
+    )
+    # Three chunks, one call each, one thread each (Dask runs the chunks in parallel).
+    assert sorted(calls) == [(2_000, 1)] * 3
+    direct = native(a)
+    assert np.array_equal(jac, direct.jacobian, equal_nan=True)
+    assert np.array_equal(energy, direct.energy, equal_nan=True)
+    assert np.array_equal(stable, direct.stable) and tip.shape == (6_000, 3)
+
+
 def test_version() -> None:
     assert isinstance(rod_ig.__version__, str) and rod_ig.__version__.count(".") == 2
 
@@ -461,3 +492,37 @@ def test_tracker_starts_from_the_straight_rod_at_rest() -> None:
     m = t.move([0.9, 0.0, 0.0])
     assert m.success and m.event == "buckle"
     assert t.move([0.88, 0.02, 0.05]).event in ("none", "snap")
+
+
+def test_a_tracker_and_a_planner_are_shared_between_threads_and_pickled() -> None:
+    import copy
+    import pickle
+    from concurrent.futures import ThreadPoolExecutor
+
+    t = rod_ig.Tracker()
+    targets = [[0.6 + 0.001 * i, 0.2, 0.4] for i in range(40)]
+    with ThreadPoolExecutor(4) as pool:
+        moves = list(pool.map(t.move, targets))
+    assert all(m.success for m in moves), [m.reason for m in moves if not m.success]
+    held = t.rod
+    assert held is not None
+    for twin in (pickle.loads(pickle.dumps(t)), copy.deepcopy(t), copy.copy(t)):
+        assert np.array_equal(twin.rod, held)
+        assert twin.move([0.62, 0.2, 0.4]).success
+    p = rod_ig.Planner()
+    with ThreadPoolExecutor(2) as pool:
+        plans = list(pool.map(lambda g: p.plan([0.5, 0.1, 0.1], g), [[0.8, 0.3, 0.5]] * 2))
+    assert all(r.success for r in plans), [r.reason for r in plans]
+    assert pickle.loads(pickle.dumps(p)).plan([0.5, 0.1, 0.1], [0.8, 0.3, 0.5]).success
+
+
+def test_one_target_gives_scalars() -> None:
+    s = rod_ig.solve([0.5, 0.2, 1.0])
+    assert isinstance(s.success, (bool, np.bool_)) and s.success
+    assert isinstance(s.energy, (float, np.floating)) and isinstance(s.termination, str)
+    assert s.a.shape == (3,)
+    f = rod_ig.forward([2.0, -10.0, 5.0])
+    assert isinstance(f.stable, (bool, np.bool_)) and isinstance(f.margin, (float, np.floating))
+    assert f.tip.shape == (3,) and f.jacobian.shape == (3, 3)
+    # Batches keep their arrays.
+    assert rod_ig.solve([[0.5, 0.2, 1.0]]).success.shape == (1,)
