@@ -1043,6 +1043,8 @@ async fn solver_loop(
         mut job_rx,
         held_tx,
     } = links;
+    // The parameters as last logged: a change is logged as its differences.
+    let mut logged_params = params_rx.borrow().clone();
     loop {
         tokio::select! {
             biased;
@@ -1059,7 +1061,12 @@ async fn solver_loop(
                 }
                 let Some(target) = target_rx.borrow_and_update().clone() else { continue };
                 if params_rx.has_changed().unwrap_or(false) {
-                    node_log!(log, Info, "parameters now: {:?}", *params_rx.borrow_and_update());
+                    let now = params_rx.borrow_and_update().clone();
+                    let changes = now.changes_from(&logged_params);
+                    if !changes.is_empty() {
+                        node_log!(log, Info, "parameters changed: {}", changes.join(", "));
+                    }
+                    logged_params = now;
                 }
                 let params = params_rx.borrow().clone();
                 let started = std::time::Instant::now();

@@ -671,6 +671,19 @@ fn vector3(name: &str, v: &ParameterValue) -> Result<[f64; 3], ParamError> {
     }
 }
 
+/// A parameter's value as a user writes it (`250`, `true`, `"world"`, `[0, 0, -9.81]`).
+fn value_text(v: &ParameterValue) -> String {
+    match v {
+        ParameterValue::NotSet => "not set".into(),
+        ParameterValue::Boolean(b) => b.to_string(),
+        ParameterValue::Integer(i) => i.to_string(),
+        ParameterValue::Double(d) => d.to_string(),
+        ParameterValue::String(s) => format!("{s:?}"),
+        ParameterValue::DoubleArray(a) => format!("{a:?}"),
+        other => format!("{other:?}"),
+    }
+}
+
 fn type_name(v: &ParameterValue) -> String {
     match v {
         ParameterValue::NotSet => "not set".into(),
@@ -859,6 +872,20 @@ impl Params {
         self.names()
             .into_iter()
             .filter_map(|n| self.get(&n).map(|v| (n, v)))
+            .collect()
+    }
+
+    /// The parameters that differ from `before`, as `name: old → new` (for the log line of a
+    /// change, rather than the whole set).
+    pub fn changes_from(&self, before: &Params) -> Vec<String> {
+        let old: std::collections::HashMap<String, ParameterValue> =
+            before.to_declarations().into_iter().collect();
+        self.to_declarations()
+            .into_iter()
+            .filter_map(|(name, new)| {
+                let was = old.get(&name)?;
+                (*was != new).then(|| format!("{name}: {} → {}", value_text(was), value_text(&new)))
+            })
             .collect()
     }
 
@@ -1234,6 +1261,34 @@ mod tests {
             Command::Run(s) => Ok(s.params),
             Command::Help => panic!("unexpected help"),
         }
+    }
+
+    #[test]
+    fn a_change_is_logged_as_its_differences() {
+        let before = Params::default();
+        let mut after = before.clone();
+        after
+            .apply("deadline_ms", &ParameterValue::Double(100.0))
+            .unwrap();
+        after
+            .apply(
+                "gravity",
+                &ParameterValue::DoubleArray(vec![0.0, -9.81, 0.0]),
+            )
+            .unwrap();
+        let changes = after.changes_from(&before);
+        assert_eq!(changes.len(), 2, "{changes:?}");
+        assert!(
+            changes.contains(&"deadline_ms: 250 → 100".to_string()),
+            "{changes:?}"
+        );
+        assert!(
+            changes
+                .iter()
+                .any(|c| c.starts_with("gravity: ") && c.ends_with("→ [0.0, -9.81, 0.0]")),
+            "{changes:?}"
+        );
+        assert!(after.changes_from(&after).is_empty());
     }
 
     #[test]
