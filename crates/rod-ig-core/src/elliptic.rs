@@ -274,6 +274,10 @@ pub fn inverse_phase<T: Real>(s: T, c: T, _m: T, m1: T, kk: T) -> T {
     }
 }
 
+/// Below this Δ² = c² + m1 s², [`inverse_phase_zeta`] scales Carlson's arguments (its R_D would
+/// overflow near 1e-205).
+const TINY_DELTA2: f64 = 1e-100;
+
 /// The phase inverse of [`inverse_phase`] together with the Jacobi zeta function at the phase,
 /// divided by m: returns (φ, Z(φ|m)/m) with φ = F(ψ|m), ψ = atan2(s, c) ∈ (−π, π).
 ///
@@ -317,9 +321,19 @@ pub fn inverse_phase_zeta<T: Real>(s: T, c: T, m1: T, kk: T, dk: T) -> (T, T) {
         let d = s * s * s * rd / 3.0;
         (phi, phi * dk - d)
     } else {
-        let (rf, rd) = carlson_rf_rd(ms2, m1, delta2);
-        let f_chi = c * rf;
-        let d_chi = c * c2 * rd / 3.0;
+        let (f_chi, d_chi) = if delta2.re() >= TINY_DELTA2 {
+            let (rf, rd) = carlson_rf_rd(ms2, m1, delta2);
+            (c * rf, c * c2 * rd / 3.0)
+        } else {
+            // Near the separatrix at ψ ≈ ±π/2 (m1 and c² tiny: a rod barely bent under
+            // tension) R_D(·, ·, Δ²) ≈ Δ⁻³ overflows while c³R_D stays ≤ 1: the arguments are
+            // scaled by 1/Δ² (R_F, R_D homogeneous of degrees −½, −3/2; DLMF 19.16.1–2) and
+            // the powers of Δ folded into c/Δ ≤ 1.
+            let inv = delta2.recip();
+            let (rf, rd) = carlson_rf_rd(ms2 * inv, m1 * inv, T::from_f64(1.0));
+            let c_over = c * inv.sqrt();
+            (c_over * rf, c_over * c_over * c_over * rd / 3.0)
+        };
         let g = s.abs() * c / delta2.sqrt() + d_chi - f_chi * dk;
         if s.re() < 0.0 {
             (f_chi - kk, -g)

@@ -313,6 +313,11 @@ fn circle_force_terms<T: Real>(c: T, t: f64) -> [T; 6] {
     }
 }
 
+/// Below this m1 a closed form by the separatrix is built only under √F ≤ ln(f64::MAX) (below
+/// about 1e-205 the phase's Carlson integrals overflowed before they were scaled, which kept
+/// such rods out of the closed form).
+const DEEP_SEPARATRIX_M1: f64 = 1e-200;
+
 /// Below this m1 (near the separatrix) the closed form's J error is estimated by
 /// [`SEPARATRIX_J_ULPS`]/√m1 instead of 1/m1: with m's derivatives taken from m1's (see
 /// `complement_near_one`) the remaining loss grows like 1/√m1 — the rod lingers by the
@@ -850,6 +855,15 @@ impl<T: Real> Closed<T> {
             }
         } else {
             s.init_case_iii(&invariants);
+        }
+        if matches!(s.case, Case::I | Case::II)
+            && s.m1 < DEEP_SEPARATRIX_M1
+            && f.re().sqrt() > f64::MAX.ln()
+        {
+            // Deep by the separatrix under a force beyond f64's e^{√F}: J overflows whatever
+            // the form, and the loops outnumber what the phase resolves (left to the refusal
+            // of the fallbacks).
+            return None;
         }
         if matches!(s.case, Case::I | Case::II) {
             let m = s.m.re();

@@ -393,7 +393,12 @@ impl PlanarRod {
             Backend::Series(_)
                 if closed.is_some_and(|c| c.needs_series() == SeriesNeed::IllConditioned) =>
             {
-                ill_conditioned_tip(a).map(|(p, _, _)| [p.x, p.y, p.theta])?
+                // As `tip` does: the small-angle expansion first (a nearly straight rod under
+                // tension), so that forward and shape answer the same rods.
+                match small_angle_tip(a) {
+                    Some(tip) => tip,
+                    None => ill_conditioned_tip(a).map(|(p, _, _)| [p.x, p.y, p.theta])?,
+                }
             }
             Backend::Series(r) => r.tip(),
         };

@@ -476,9 +476,12 @@ pub(crate) fn effective_angle(a3: f64, a4: f64, a5: f64) -> f64 {
     max_angle(a3, a4, a5) * (1.0 + a4.abs().sqrt()).sqrt()
 }
 
-/// Largest tension a4 at which the truncation constants were measured (√a4 = 27, where the
-/// series that served as the reference is still accurate).
-const MAX_TENSION: f64 = 729.0;
+/// Largest tension a4 of the expansion: √a4 = 350, where its x row's ∫S1² ≈ e^{2√a4}/(8a4^{3/2})
+/// still fits in f64 (it overflows past √a4 ≈ 354). The truncation constants were measured
+/// up to √a4 = 27 against the series, and up to 350 against the exact pendulum
+/// (`scripts/gen_tension_truth.py`, `tests/tension.rs`: barely bent rods under tension and
+/// rods at the expansion's edge, Θ from 1e-7 to 1e-2).
+const MAX_TENSION: f64 = 122_500.0;
 
 /// A-priori relative (Frobenius) truncation error of [`pose_and_jacobian`]'s J at the
 /// effective angle `th` ([`effective_angle`]; add its
