@@ -98,7 +98,7 @@ class NodeProcess:
     """rod_ig_node (or another binary) running on its own domain, output to a log file."""
 
     def __init__(self, domain: int, args: list[str] | None = None, binary_name: str = "rod_ig_node",
-                 log_dir: Path | None = None):
+                 log_dir: Path | None = None, env: dict[str, str] | None = None):
         self.domain = domain
         log_dir = log_dir or Path(os.environ.get("ROD_IG_TEST_LOGS", REPO / "build" / "test-logs"))
         log_dir.mkdir(parents=True, exist_ok=True)
@@ -106,9 +106,11 @@ class NodeProcess:
         # logs apart.
         self.log_path = log_dir / f"{binary_name}-domain{domain}-{int(time.time() * 1000)}-{next_seq()}.log"
         self._log = open(self.log_path, "wb")
+        extra_env = env or {}
         env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
                    ROS_DISTRO=os.environ.get("ROS_DISTRO", "kilted"),
                    RUST_LOG=os.environ.get("RUST_LOG", "info,rustdds=error,rustdds::network::udp_listener=off,ros2_client=warn"))
+        env.update(extra_env)
         self.proc = subprocess.Popen([str(binary(binary_name)), *(args or [])], env=env,
                                      stdout=self._log, stderr=subprocess.STDOUT)
 

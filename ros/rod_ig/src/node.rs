@@ -85,13 +85,29 @@ fn create_err<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> NodeE
     }
 }
 
-/// Middleware settings read from the environment.
+/// How far the node looks for peers (`ROS_AUTOMATIC_DISCOVERY_RANGE`, as rcl reads it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DiscoveryRange {
+    /// `OFF`: no automatic discovery at all (the node neither announces itself nor listens).
+    Off,
+    /// `LOCALHOST` (or the deprecated `ROS_LOCALHOST_ONLY=1`): this host only, over loopback.
+    Localhost,
+    /// `SUBNET`, `SYSTEM_DEFAULT` or unset: every network interface (rcl's default).
+    Subnet,
+}
+
+/// Middleware settings read from the environment.
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct MiddlewareConfig {
     /// `ROS_DOMAIN_ID` (default 0).
     pub domain_id: u16,
     /// Loopback only: `ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST` or `ROS_LOCALHOST_ONLY=1`.
     pub localhost_only: bool,
+    /// `ROS_AUTOMATIC_DISCOVERY_RANGE`.
+    pub discovery: DiscoveryRange,
+    /// Warnings to log once the logger runs: settings the node honours only in part
+    /// (`ROS_STATIC_PEERS`, security under the Permissive strategy).
+    pub warnings: Vec<String>,
 }
 
 impl MiddlewareConfig {
@@ -111,11 +127,43 @@ impl MiddlewareConfig {
             },
         };
         let range = get("ROS_AUTOMATIC_DISCOVERY_RANGE").unwrap_or_default();
-        let localhost_only = range.trim().eq_ignore_ascii_case("LOCALHOST")
-            || get("ROS_LOCALHOST_ONLY").is_some_and(|v| v.trim() == "1");
+        let discovery = match range.trim().to_ascii_uppercase().as_str() {
+            "OFF" => DiscoveryRange::Off,
+            "LOCALHOST" => DiscoveryRange::Localhost,
+            "SUBNET" | "SYSTEM_DEFAULT" => DiscoveryRange::Subnet,
+            "" if get("ROS_LOCALHOST_ONLY").is_some_and(|v| v.trim() == "1") => {
+                DiscoveryRange::Localhost
+            }
+            "" => DiscoveryRange::Subnet,
+            other => {
+                return Err(NodeError::Environment(format!(
+                    "ROS_AUTOMATIC_DISCOVERY_RANGE must be OFF, LOCALHOST, SUBNET or \
+                     SYSTEM_DEFAULT, got {other:?}"
+                )))
+            }
+        };
+        let mut warnings = Vec::new();
+        let peers = get("ROS_STATIC_PEERS").unwrap_or_default();
+        if !peers.trim().is_empty() {
+            if discovery == DiscoveryRange::Off {
+                return Err(NodeError::Environment(format!(
+                    "ROS_STATIC_PEERS={peers:?} with ROS_AUTOMATIC_DISCOVERY_RANGE=OFF: this \
+                     node's DDS (RustDDS) has no list of static peers, so it would reach no one"
+                )));
+            }
+            warnings.push(format!(
+                "ROS_STATIC_PEERS={peers:?} is ignored: this node's DDS (RustDDS) has no list of \
+                 static peers; it discovers peers by ROS_AUTOMATIC_DISCOVERY_RANGE only"
+            ));
+        }
+        if let Some(w) = security_check(&get)? {
+            warnings.push(w);
+        }
         Ok(Self {
             domain_id,
-            localhost_only,
+            localhost_only: discovery == DiscoveryRange::Localhost,
+            discovery,
+            warnings,
         })
     }
 
@@ -123,6 +171,30 @@ impl MiddlewareConfig {
     pub fn from_env() -> Result<Self, NodeError> {
         Self::from_lookup(|k| std::env::var(k).ok())
     }
+}
+
+/// rcl's security settings: `ROS_SECURITY_ENABLE=true` with `ROS_SECURITY_STRATEGY=Enforce`
+/// requires DDS security, which this node's DDS build does not carry, so it refuses to start
+/// (as rcl does without a usable keystore) rather than run unsecured; under Permissive (or no
+/// strategy) it runs unsecured and says so.
+fn security_check(get: &impl Fn(&str) -> Option<String>) -> Result<Option<String>, NodeError> {
+    if get("ROS_SECURITY_ENABLE").as_deref().map(str::trim) != Some("true") {
+        return Ok(None);
+    }
+    let strategy = get("ROS_SECURITY_STRATEGY").unwrap_or_default();
+    if strategy.trim() == "Enforce" {
+        return Err(NodeError::Environment(
+            "ROS_SECURITY_ENABLE=true with ROS_SECURITY_STRATEGY=Enforce: this node cannot run \
+             DDS security (its DDS, RustDDS, is built without it), and Enforce forbids running \
+             unsecured; unset ROS_SECURITY_ENABLE or use ROS_SECURITY_STRATEGY=Permissive"
+                .into(),
+        ));
+    }
+    Ok(Some(
+        "ROS_SECURITY_ENABLE=true: running WITHOUT DDS security (strategy Permissive; this \
+         node's DDS, RustDDS, is built without it)"
+            .into(),
+    ))
 }
 
 /// QoS of the topics and the service: reliable, volatile, keep last 10 (rclpy's
@@ -296,8 +368,17 @@ struct Names {
 /// Creates the DDS context for `mw` (domain, loopback restriction).
 fn create_context(mw: &MiddlewareConfig) -> Result<Context, NodeError> {
     let mut builder = DomainParticipantBuilder::new(mw.domain_id);
-    if mw.localhost_only {
-        builder = builder.with_only_networks([std::net::Ipv4Addr::LOCALHOST]);
+    match mw.discovery {
+        DiscoveryRange::Localhost => {
+            builder = builder.with_only_networks([std::net::Ipv4Addr::LOCALHOST]);
+        }
+        // No interface to announce on or listen from, and no loopback announcements.
+        DiscoveryRange::Off => {
+            builder = builder
+                .with_only_networks(std::iter::empty::<std::net::IpAddr>())
+                .same_host_loopback(false);
+        }
+        DiscoveryRange::Subnet => {}
     }
     let participant = builder.build().map_err(create_err("DDS participant"))?;
     Context::from_domain_participant(participant).map_err(create_err("ROS context"))
@@ -455,10 +536,10 @@ fn ready_message(
          subscribed {}, publishing {}, services {}",
         identity.fully_qualified_name(),
         mw.domain_id,
-        if mw.localhost_only {
-            " (loopback only)"
-        } else {
-            ""
+        match mw.discovery {
+            DiscoveryRange::Localhost => " (loopback only)",
+            DiscoveryRange::Off => " (discovery off)",
+            DiscoveryRange::Subnet => "",
         },
         params.rod_length,
         params.path_samples,
@@ -741,6 +822,9 @@ async fn start(startup: Startup, mw: MiddlewareConfig) -> Result<Running, NodeEr
         &[solve_full, plan_full],
     );
     node_log!(logger, Info, "{ready}");
+    for warning in &mw.warnings {
+        node_log!(logger, Warn, "{warning}");
+    }
     Ok(Running {
         logger,
         stats,
@@ -1243,29 +1327,63 @@ mod tests {
     #[test]
     fn middleware_from_environment() {
         let c = MiddlewareConfig::from_lookup(env(&[])).unwrap();
-        assert_eq!(
-            c,
-            MiddlewareConfig {
-                domain_id: 0,
-                localhost_only: false
-            }
-        );
+        assert_eq!((c.domain_id, c.localhost_only), (0, false));
+        assert_eq!(c.discovery, DiscoveryRange::Subnet);
         let c = MiddlewareConfig::from_lookup(env(&[
             ("ROS_DOMAIN_ID", "42"),
             ("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST"),
         ]))
         .unwrap();
-        assert_eq!(
-            c,
-            MiddlewareConfig {
-                domain_id: 42,
-                localhost_only: true
-            }
-        );
+        assert_eq!((c.domain_id, c.localhost_only), (42, true));
         let c = MiddlewareConfig::from_lookup(env(&[("ROS_LOCALHOST_ONLY", "1")])).unwrap();
         assert!(c.localhost_only);
         assert!(MiddlewareConfig::from_lookup(env(&[("ROS_DOMAIN_ID", "300")])).is_err());
         assert!(MiddlewareConfig::from_lookup(env(&[("ROS_DOMAIN_ID", "x")])).is_err());
+        let off = [("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")];
+        assert_eq!(
+            MiddlewareConfig::from_lookup(env(&off)).unwrap().discovery,
+            DiscoveryRange::Off
+        );
+        let bad = [("ROS_AUTOMATIC_DISCOVERY_RANGE", "GALAXY")];
+        assert!(MiddlewareConfig::from_lookup(env(&bad)).is_err());
+        let peers = [
+            ("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF"),
+            ("ROS_STATIC_PEERS", "10.0.0.2"),
+        ];
+        assert!(MiddlewareConfig::from_lookup(env(&peers)).is_err());
+        let peers = [("ROS_STATIC_PEERS", "10.0.0.2")];
+        assert_eq!(
+            MiddlewareConfig::from_lookup(env(&peers))
+                .unwrap()
+                .warnings
+                .len(),
+            1
+        );
+    }
+
+    #[test]
+    fn security_enforce_refuses_and_permissive_warns() {
+        let enforce = [
+            ("ROS_SECURITY_ENABLE", "true"),
+            ("ROS_SECURITY_STRATEGY", "Enforce"),
+        ];
+        let e = MiddlewareConfig::from_lookup(env(&enforce)).unwrap_err();
+        assert!(e.to_string().contains("Enforce"), "{e}");
+        let permissive = [
+            ("ROS_SECURITY_ENABLE", "true"),
+            ("ROS_SECURITY_STRATEGY", "Permissive"),
+        ];
+        let c = MiddlewareConfig::from_lookup(env(&permissive)).unwrap();
+        assert!(c.warnings[0].contains("WITHOUT DDS security"));
+        // rcl reads "true" only.
+        let other = [
+            ("ROS_SECURITY_ENABLE", "1"),
+            ("ROS_SECURITY_STRATEGY", "Enforce"),
+        ];
+        assert!(MiddlewareConfig::from_lookup(env(&other))
+            .unwrap()
+            .warnings
+            .is_empty());
     }
 
     #[test]
