@@ -57,6 +57,18 @@ fi
 # its own packages.
 touch "$VENV/COLCON_IGNORE"
 
+# --- 1b. a Jazzy client venv: the node serves Jazzy clients too (tests/test_distros.py) ------
+JAZZY_VENV="${ROD_IG_JAZZY_VENV:-$REPO/build/jazzy-venv}"
+JAZZY_PACKAGES=(ros-jazzy-rclpy ros-jazzy-rmw-fastrtps-cpp ros-jazzy-geometry-msgs ros-jazzy-nav-msgs)
+jazzy_want="$(printf '%s\n' "${JAZZY_PACKAGES[@]}" "$("$PYTHON" --version 2>&1)")"
+if [ ! -x "$JAZZY_VENV/bin/python3" ] || [ "$(cat "$JAZZY_VENV/.rod-ig-packages" 2>/dev/null)" != "$jazzy_want" ]; then
+    log "creating the Jazzy client venv $JAZZY_VENV"
+    [ -x "$JAZZY_VENV/bin/python3" ] || "$PYTHON" -m venv "$JAZZY_VENV"
+    "$JAZZY_VENV/bin/python3" -m pip install --quiet --disable-pip-version-check "${JAZZY_PACKAGES[@]}"
+    printf '%s' "$jazzy_want" > "$JAZZY_VENV/.rod-ig-packages"
+fi
+touch "$JAZZY_VENV/COLCON_IGNORE"
+
 # The wheels' exported CMake files hard-code the wheel builder's Python and numpy include
 # paths: point them at this venv's own.
 venv_py_include="$("$VENV/bin/python3" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')"
