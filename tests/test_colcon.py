@@ -58,3 +58,47 @@ def test_installed_node_serves_the_example_client(workspace):
         assert run.returncode == 0 and "solved:" in run.stdout, run.stdout + run.stderr
     finally:
         assert node.stop() == 0
+
+
+def test_the_package_installs_its_launch_files_and_parameters(workspace):
+    """`ros2 launch rod_ig rod_ig.launch.py` finds its files in share/rod_ig (issue 43, item 7).
+    launch_ros has no wheel, so the launch files are checked by parsing them: each starts the
+    node as a ROS package's executable, Node(package='rod_ig', executable='rod_ig_node')."""
+    import ast
+
+    share = ws_share = workspace[0] / "install" / "rod_ig" / "share" / "rod_ig"
+    for f in ("package.xml", "launch/rod_ig.launch.py", "launch/two_arms.launch.py",
+              "config/rod_ig_params.yaml"):
+        assert (ws_share / f).is_file(), f"{f} not installed in {share}"
+    for launch in ("rod_ig.launch.py", "two_arms.launch.py"):
+        tree = ast.parse((share / "launch" / launch).read_text())
+        nodes = [c for c in ast.walk(tree)
+                 if isinstance(c, ast.Call) and getattr(c.func, "id", "") == "Node"]
+        assert nodes, f"{launch}: no launch_ros Node"
+        for call in nodes:
+            kw = {k.arg: k.value for k in call.keywords}
+            assert ast.literal_eval(kw["package"]) == "rod_ig", launch
+            assert ast.literal_eval(kw["executable"]) == "rod_ig_node", launch
+        names = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+        assert "ExecuteProcess" not in names and "generate_launch_description" in {
+            f.name for f in tree.body if isinstance(f, ast.FunctionDef)}, launch
+
+
+def test_the_installed_parameters_apply_in_a_namespace_without_warnings(workspace):
+    """The installed params file serves a namespaced node (as two_arms.launch.py starts it)
+    with no WARN line: every key applies (before, its QoS keys named unresolved topics and
+    drew three warnings per node)."""
+    ws, _ = workspace
+    exe = ws / "install" / "rod_ig" / "lib" / "rod_ig" / "rod_ig_node"
+    params = ws / "install" / "rod_ig" / "share" / "rod_ig" / "config" / "rod_ig_params.yaml"
+    os.environ["ROD_IG_RUN_BIN"] = str(exe)
+    node = h.NodeProcess(h.free_domain(), ["--ros-args", "-r", "__ns:=/left",
+                                           "--params-file", str(params)],
+                         binary_name="rod_ig_run")
+    try:
+        assert node.wait_log("ready", 30), node.log_text()[-2000:]
+        log = node.log_text()
+        assert "/left/rod_ig_node" in log, log
+        assert " WARN " not in log and "ERROR" not in log, log
+    finally:
+        assert node.stop() == 0
