@@ -17,7 +17,14 @@ fn main() -> ExitCode {
         env_logger::Env::default().default_filter_or(DEFAULT_LOG_FILTER),
     );
     let ros = rod_ig_node::ros_args::parse(&args).ok();
-    if let Some(f) = ros.as_ref().and_then(|a| a.log_filter()) {
+    let own_logger = ros
+        .as_ref()
+        .and_then(|a| a.identity(rod_ig_node::graph::NODE_NAME, "/").ok())
+        .map_or_else(
+            || rod_ig_node::graph::NODE_NAME.to_string(),
+            |i| i.logger_name(),
+        );
+    if let Some(f) = ros.as_ref().and_then(|a| a.log_filter(&own_logger)) {
         logger.parse_filters(&f);
     }
     if ros.as_ref().and_then(|a| a.stdout_logs) == Some(false) {

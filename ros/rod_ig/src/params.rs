@@ -1099,10 +1099,11 @@ where
         identity.logger_name(),
         ros.level_of(&identity.logger_name()),
     );
+    let log_filter = ros.log_filter(&identity.logger_name());
     Ok(Command::Run(Box::new(Startup {
         params,
         identity,
-        log_filter: ros.log_filter(),
+        log_filter,
         rosout_logs: ros.rosout_logs.unwrap_or(true),
         logger,
     })))

@@ -317,6 +317,9 @@ pub struct NodeIdentity {
     rules: Vec<(String, String)>,
 }
 
+/// The Rust log target of the node's own modules (its library crate, `rod_ig_node::...`).
+pub const NODE_LOG_TARGET: &str = "rod_ig_node";
+
 impl RosArgs {
     /// The node's identity: `default_name` in `default_namespace`, renamed by the last
     /// `__node`/`__name` and moved by the last `__ns` rule that applies to it (a rule with a
@@ -359,7 +362,10 @@ impl RosArgs {
 
     /// An `env_logger` filter from the `--log-level` settings (global first, then per logger;
     /// ROS logger names use `.` where Rust modules use `::`), or `None` when there are none.
-    pub fn log_filter(&self) -> Option<String> {
+    /// The node's own ROS logger (`own_logger`, e.g. `left.rod_ig_node` for a namespaced or
+    /// renamed node) sets the level of the node's Rust modules ([`NODE_LOG_TARGET`]) on the
+    /// console too, as it does on /rosout.
+    pub fn log_filter(&self, own_logger: &str) -> Option<String> {
         if self.log_levels.is_empty() {
             return None;
         }
@@ -368,6 +374,9 @@ impl RosArgs {
             .iter()
             .map(|(logger, level)| match logger {
                 None => level.as_filter().to_string(),
+                Some(l) if l == own_logger => {
+                    format!("{NODE_LOG_TARGET}={}", level.as_filter())
+                }
                 Some(l) => format!("{}={}", l.replace('.', "::"), level.as_filter()),
             })
             .collect();
@@ -547,10 +556,19 @@ mod tests {
                 },
             ]
         );
-        assert_eq!(a.log_filter().unwrap(), "debug,rustdds=error");
+        assert_eq!(a.log_filter("rod_ig_node").unwrap(), "debug,rustdds=error");
         assert_eq!(a.unparsed, vec!["user_arg".to_string()]);
         let a = args("--ros-args --log-level ros2_client.node:=warn").unwrap();
-        assert_eq!(a.log_filter().unwrap(), "ros2_client::node=warn");
+        assert_eq!(
+            a.log_filter("rod_ig_node").unwrap(),
+            "ros2_client::node=warn"
+        );
+        // A namespaced, renamed node: its own logger sets the console level of its modules.
+        let a =
+            args("--ros-args -r __ns:=/left -r __node:=arm --log-level left.arm:=debug").unwrap();
+        let own = a.identity("rod_ig_node", "/").unwrap().logger_name();
+        assert_eq!(own, "left.arm");
+        assert_eq!(a.log_filter(&own).unwrap(), "rod_ig_node=debug");
     }
 
     #[test]
