@@ -424,6 +424,7 @@ impl SolveOut {
                 self.termination[i] = f.termination().as_str();
                 self.reason[i] = f.reason.to_string();
                 self.iterations[i] = f.iterations;
+                self.starts[i] = f.starts;
             }
         }
     }

@@ -103,6 +103,12 @@ impl<A, T> SolveAnswer<A, T> {
         self.elapsed_ms = us / 1e3;
         self
     }
+
+    /// The same answer with the number of starts the search tried.
+    pub fn with_starts(mut self, starts: u32) -> Self {
+        self.starts = starts;
+        self
+    }
 }
 
 /// Solves one request on `model` and writes the answer: the solve with `options`, then, with
@@ -147,7 +153,8 @@ where
             f.residual,
             f.reason.to_string(),
             f.termination(),
-        ),
+        )
+        .with_starts(f.starts),
     };
     answer.elapsed_ms = t0.elapsed().as_secs_f64() * 1e3;
     if let Some(solver::Every {

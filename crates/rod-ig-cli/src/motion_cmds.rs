@@ -329,6 +329,7 @@ impl Tracking {
                 f.reason.to_string(),
                 f.termination(),
             )
+            .with_starts(f.starts)
             .with_elapsed_us(f.elapsed_us),
         };
         let mut answer = TrackAnswer {

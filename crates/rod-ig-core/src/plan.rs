@@ -167,7 +167,7 @@ impl Planner {
         if !self.nodes.is_empty() {
             return true;
         }
-        let Some(atlas) = ig::atlas::get() else {
+        let Some(atlas) = ig::atlas::get(ig::atlas::Tier::Box) else {
             return false;
         };
         let n = atlas.len();

@@ -294,7 +294,7 @@ fn boundary_targets() {
         let b = PlanarPose::new(r * 0.6, r * 0.8, th);
         // The search ends by itself: a deadline would end it with IgError::Deadline.
         let f = ig::solve(&b, &o).unwrap_err();
-        assert!(matches!(f.reason, IgError::NoStableSolution { .. }), "{f}");
+        assert!(matches!(f.reason, IgError::SearchExhausted(_)), "{f}");
     }
     // Reachable near-boundary targets: tips of stable, nearly straight rods.
     for a in [

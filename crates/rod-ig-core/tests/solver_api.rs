@@ -212,12 +212,25 @@ fn a_failed_multistart_says_why_its_last_start_failed() {
     // The atlas, once per process, outside the deadlines under test.
     rod_ig_core::planar::ig::warm_up();
     // On the reach boundary (|p| → 1 with a bent tip), no stable rod exists: the robust
-    // search ends with NoStableSolution and the last start's own reason.
+    // search ends with what it searched (SearchExhausted, termination NoStableSolution) and
+    // the last start's own reason.
     let target = PlanarPose::new(0.9999, 0.0, 2.5);
     let f = solver::solve(&PlanarClosedForm, &target, &SolveOptions::default()).unwrap_err();
+    assert_eq!(f.termination(), Termination::NoStableSolution);
     match &f.reason {
-        IgError::NoStableSolution { starts, last } => {
+        IgError::SearchExhausted(searched) => {
+            let (starts, branches, last) = (&searched.starts, &searched.branches, &searched.last);
             assert!(*starts > 0);
+            assert_eq!(
+                f.starts,
+                starts + branches,
+                "the failure counts every start"
+            );
+            let text = f.reason.to_string();
+            assert!(
+                text.contains("|a3| <=") && text.contains("branches followed"),
+                "{text}"
+            );
             let last = last.as_ref().expect("the last start's reason is kept");
             assert!(matches!(
                 last.termination(),
@@ -228,7 +241,7 @@ fn a_failed_multistart_says_why_its_last_start_failed() {
             ));
             assert!(f.reason.to_string().contains("last start"));
         }
-        other => panic!("expected NoStableSolution, got {other}"),
+        other => panic!("expected SearchExhausted, got {other}"),
     }
 }
 

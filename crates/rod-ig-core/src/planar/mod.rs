@@ -370,9 +370,15 @@ fn case_without_closed(a: &PlanarParams) -> Case {
 
 impl PlanarRod {
     /// Precomputes the rod for a. Errors: [`RodError::NonFinite`] if a component of a is NaN
-    /// or ±∞, [`RodError::Overflow`] if the shape cannot be represented in f64.
+    /// or ±∞, [`RodError::Overflow`] if the shape cannot be represented in f64 (as for
+    /// [`pose_and_jacobian`], √‖(a4, a5)‖ > ln(f64::MAX)).
     pub fn new(a: &PlanarParams) -> Result<Self, RodError> {
         check_params(a)?;
+        // Forward's domain (its J overflows there): the poses between base and tip, at phases
+        // of ~1e8 loops, came out NaN where the tip did not (a = (−8e−65, 5e16, 0)).
+        if crate::scalar::fast_hypot(a[1], a[2]).sqrt() > LN_F64_MAX {
+            return Err(overflow_force());
+        }
         let closed = if series_first(a) {
             None
         } else {

@@ -126,6 +126,41 @@ impl<const N: usize, X> Held<N, X> {
     }
 }
 
+/// The stable rod `a0`'s branch followed, without snapping, as its gripper moves from `a0`'s
+/// tip to `target` ([`RodModel::interpolate`]): the rod of that branch at `target`, or `None`
+/// when the branch folds first (or cannot be evaluated) or the deadline passes. The robust
+/// searches' last stage: a branch reaches targets whose rods are too sensitive for Newton's
+/// basin to hold any seed (issue 42). The rod returned has det J(1, a) of `a0`'s sign but is
+/// not stability-tested: the caller does the full test. At most `max_steps` continuation
+/// steps, each of at most [`CORRECTOR_ITERATIONS`] + 1 corrections.
+pub(crate) fn branch_to<const N: usize, M: InverseGeometry<N>>(
+    model: M,
+    options: &SolveOptions<SVector<f64, N>>,
+    max_steps: u32,
+    a0: &SVector<f64, N>,
+    target: &M::Pose,
+    work: &mut Work,
+) -> Option<SVector<f64, N>> {
+    let (tip, jacobian) = model.tip_and_jacobian(a0).ok()?;
+    work.evaluations += 1;
+    let follower = BranchFollower {
+        model,
+        options: *options,
+        held: None,
+        straight: None,
+        step_cap: max_steps,
+    };
+    let held = Held {
+        a: *a0,
+        tip,
+        jacobian,
+    };
+    follower
+        .continue_to(&held, target, work)
+        .ok()
+        .map(|end| end.a)
+}
+
 /// Why a continuation stopped before the target.
 enum Stop<const N: usize, X> {
     /// The branch folded: the last stable rod, at gripper pose fraction `s`.
@@ -143,6 +178,10 @@ pub struct BranchFollower<const N: usize, M: RodModel<N>> {
     held: Option<Held<N, M::Pose>>,
     /// The straight rod held at rest (a and its tip) before the first move buckles it.
     straight: Option<(SVector<f64, N>, M::Pose)>,
+    /// Continuation steps (tried, each at most [`CORRECTOR_ITERATIONS`] + 1 corrections) one
+    /// move may take ([`branch_to`]: the search's `max_iterations`; a follower: unbounded but
+    /// by its deadline).
+    step_cap: u32,
 }
 
 impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
@@ -153,6 +192,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
             options,
             held: None,
             straight: None,
+            step_cap: u32::MAX,
         }
     }
 
@@ -181,6 +221,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                     options,
                     held: None,
                     straight: Some((a0, eval.tip)),
+                    step_cap: u32::MAX,
                 });
             }
             return Err(IgError::LeftStableSet { iteration: 0 });
@@ -190,6 +231,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
             options,
             held: Some(Held::of(a0, eval)),
             straight: None,
+            step_cap: u32::MAX,
         })
     }
 
@@ -377,6 +419,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                 iterations: work.iterations,
                 residual: pe.hypot(oe),
                 last_a: Some(at.a),
+                starts: work.starts,
                 elapsed_us: 0.0,
             }),
             event: BranchEvent::None,
@@ -499,6 +542,7 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
                 iterations: work.iterations,
                 residual: f64::INFINITY,
                 last_a: Some(last),
+                starts: work.starts,
                 elapsed_us: 0.0,
             }),
             event: BranchEvent::Lost,
@@ -557,10 +601,15 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         // fails again: one wasted corrector run per step, each a few ms on strongly
         // tensioned rods).
         let mut first_try = true;
+        let mut steps = 0;
         while s < 1.0 {
             if crate::deadline::expired() {
                 return Err(Stop::Deadline(current, s));
             }
+            if steps >= self.step_cap {
+                return Err(Stop::Fold(current, s));
+            }
+            steps += 1;
             let s_new = (s + ds).min(1.0);
             let last = s_new >= 1.0;
             let goal = if last {

@@ -241,6 +241,7 @@ impl<'a, const N: usize, M: LoadedModel<N>> Search<'a, N, M> {
             iterations: self.work.iterations,
             residual: f64::INFINITY,
             last_a: None,
+            starts: self.work.starts,
             elapsed_us: 0.0,
         }
     }

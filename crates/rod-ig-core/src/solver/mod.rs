@@ -42,6 +42,7 @@ mod observer;
 mod options;
 mod outcome;
 
+pub(crate) use continuation::branch_to;
 pub use continuation::{
     BranchEvent, BranchFollower, Move, CORRECTOR_ITERATIONS, MAX_SNAPS, MIN_STEP, SUBSTEP_TOLERANCE,
 };
@@ -53,7 +54,7 @@ pub use options::{
     DEFAULT_MAX_ITERATIONS, DEFAULT_TOLERANCE, MAX_DEADLINE, MAX_ITERATIONS_LIMIT, MAX_TOLERANCE,
     MIN_TOLERANCE,
 };
-pub use outcome::{Failure, IgError, Solution, Termination, Verified, Work};
+pub use outcome::{Failure, IgError, Searched, Solution, Termination, Verified, Work};
 
 use nalgebra::SVector;
 
@@ -132,7 +133,7 @@ pub fn solve<const N: usize, M: InverseGeometry<N> + ?Sized>(
     let elapsed_us = t0.elapsed().as_secs_f64() * 1e6;
     let (termination, iterations, starts) = match &result {
         Ok(s) => (Termination::Converged, s.iterations, s.starts),
-        Err(f) => (f.termination(), f.iterations, 0),
+        Err(f) => (f.termination(), f.iterations, f.starts),
     };
     emit(Event::Finished {
         termination,

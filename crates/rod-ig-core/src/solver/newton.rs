@@ -53,6 +53,7 @@ fn run<const N: usize, M: RodModel<N> + ?Sized>(
             iterations: k,
             residual,
             last_a: Some(a),
+            starts: 1,
             elapsed_us: 0.0,
         };
         if crate::deadline::expired() {

@@ -35,8 +35,9 @@ pub struct SolveOptions<P> {
     /// from this value.
     pub alpha: f64,
     /// Iteration budget of one run from one start: Newton, the run; the robust search, each of
-    /// its starts (the final polish of the best iterate included), so a robust solve makes at
-    /// most `max_iterations` × its starts iterations in all. In [1, [`MAX_ITERATIONS_LIMIT`]].
+    /// its Newton starts (the final polish of the best iterate included). A branch that the
+    /// planar search's last stage follows is bounded by its steps instead
+    /// ([`crate::planar::ig::BRANCH_STEPS`]). In [1, [`MAX_ITERATIONS_LIMIT`]].
     pub max_iterations: u32,
     /// Tolerance on the position error and on the orientation error (rod lengths, rad). In
     /// [[`MIN_TOLERANCE`], [`MAX_TOLERANCE`]].

@@ -221,6 +221,33 @@ pub enum IgError {
         /// Why the last start failed, when known.
         last: Option<Box<IgError>>,
     },
+    /// The planar robust search ran every start and followed every branch it had without
+    /// reaching a stable rod: what it searched (a stable rod outside that search may exist).
+    #[error("{0}")]
+    SearchExhausted(Box<Searched>),
+}
+
+/// What an exhausted search searched ([`IgError::SearchExhausted`]).
+#[derive(Clone, Debug, PartialEq, Error)]
+#[error(
+    "no stable rod found by {starts} Newton starts from stable rods with |a3| <= {a3_max}, \
+     |a4|, |a5| <= {a45_max} and {branches} of their branches followed to the target, in \
+     {elapsed_ms:.1} ms{}",
+    last.as_ref().map(|l| format!("; last start: {l}")).unwrap_or_default()
+)]
+pub struct Searched {
+    /// Newton starts run.
+    pub starts: u32,
+    /// Branches followed from stable seeds toward the target.
+    pub branches: u32,
+    /// Largest |a3| of the seeds.
+    pub a3_max: f64,
+    /// Largest |a4| and |a5| of the seeds.
+    pub a45_max: f64,
+    /// Time the search took, ms.
+    pub elapsed_ms: f64,
+    /// Why the last Newton start failed, when known.
+    pub last: Option<IgError>,
 }
 
 impl IgError {
@@ -249,7 +276,9 @@ impl IgError {
             Self::Stalled { .. } => Termination::Stalled,
             Self::MaxIterations { .. } => Termination::IterationLimit,
             Self::Deadline { .. } => Termination::Deadline,
-            Self::NoStableSolution { .. } => Termination::NoStableSolution,
+            Self::NoStableSolution { .. } | Self::SearchExhausted(_) => {
+                Termination::NoStableSolution
+            }
             Self::Evaluation { .. } => Termination::EvaluationFailed,
         }
     }
@@ -268,6 +297,8 @@ pub struct Failure<P> {
     pub residual: f64,
     /// That best iterate (possibly a converged but unstable point), when there was one.
     pub last_a: Option<P>,
+    /// Starts tried (Newton runs from distinct initial points, branches followed included).
+    pub starts: u32,
     /// Wall time, µs.
     pub elapsed_us: f64,
 }
@@ -280,6 +311,7 @@ impl<P> Failure<P> {
             iterations: 0,
             residual: f64::INFINITY,
             last_a: None,
+            starts: 0,
             elapsed_us: 0.0,
         }
     }

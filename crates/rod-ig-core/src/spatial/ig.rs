@@ -177,6 +177,7 @@ impl Ctx<'_> {
             iterations: self.iterations,
             residual: self.best.0,
             last_a: self.best.1,
+            starts: self.starts,
             elapsed_us: 0.0,
         }
     }

@@ -24,19 +24,81 @@ use std::time::{Duration, Instant};
 const NXY: usize = 40;
 /// Cells in θ ∈ [−π, π).
 const NT: usize = 40;
-/// Seeds kept per cell.
-const K: usize = 4;
 /// Length of the per-cell short lists.
 const NEAR: usize = 6;
-/// Ray end-points.
-const RAYS: usize = 8000;
-/// Ray end-points near the separatrix λ4 = 0.
-const SEPARATRIX_RAYS: usize = 8000;
-/// RK4 steps per ray.
-const STEPS: usize = 128;
-/// Half-widths of the end-point box.
-const A3_MAX: f64 = 14.0;
-const A45_MAX: f64 = 150.0;
+/// Largest |a3| of any atlas seed (the beyond-the-box tier's rays).
+pub(crate) const SEED_A3_MAX: f64 = 36.0;
+/// Largest |a4|, |a5| of any atlas seed.
+pub(crate) const SEED_A45_MAX: f64 = 300.0;
+
+/// Which atlas: the paper's box, which every robust solve uses, or the shell beyond it, built
+/// only when a solve needs it (issue 42: 13 % of reachable workspace targets have stable rods
+/// only beyond the box, |a3| up to ~30, |F| up to ~500, too sensitive for a start inside it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Tier {
+    /// Rays of |a3| ≤ 14, |a4|, |a5| ≤ 150 (somewhat larger than the public box).
+    Box,
+    /// Rays of |a3| ≤ 36, |a4|, |a5| ≤ 300 (and as many near the separatrix), seeds kept
+    /// only outside the first tier's box.
+    Beyond,
+}
+
+/// How a tier's rays are drawn and integrated.
+struct Spec {
+    /// Ray end-points, a Halton sample of the box.
+    rays: usize,
+    /// Ray end-points near the separatrix λ4 = 0.
+    separatrix_rays: usize,
+    /// RK4 steps per ray, at least...
+    steps: usize,
+    /// ... this many per unit of the ray's curvature scale max(|a3|, √‖F‖), so that h |a3|
+    /// and h √‖F‖ stay ≲ 0.1 on the long rays beyond the box (0: `steps` alone).
+    steps_per_scale: f64,
+    /// Half-widths of the end-point box.
+    a3_max: f64,
+    a45_max: f64,
+    /// Seeds (distinct branches) kept per cell.
+    per_cell: usize,
+    /// Seeds inside this box (a3, a4 and a5 half-widths) are left to the tier that has them.
+    inner: Option<(f64, f64)>,
+}
+
+impl Tier {
+    fn spec(self) -> &'static Spec {
+        match self {
+            Tier::Box => &Spec {
+                rays: 8000,
+                separatrix_rays: 8000,
+                steps: 128,
+                steps_per_scale: 0.0,
+                a3_max: 14.0,
+                a45_max: 150.0,
+                per_cell: 4,
+                inner: None,
+            },
+            Tier::Beyond => &Spec {
+                rays: 16000,
+                separatrix_rays: 16000,
+                steps: 128,
+                steps_per_scale: 10.0,
+                a3_max: SEED_A3_MAX,
+                a45_max: SEED_A45_MAX,
+                per_cell: 6,
+                inner: Some((14.0, 150.0)),
+            },
+        }
+    }
+
+    fn index(self) -> usize {
+        self as usize
+    }
+
+    /// Chunks of rays.
+    fn chunks(self) -> usize {
+        let spec = self.spec();
+        (spec.rays + spec.separatrix_rays).div_ceil(RAYS_PER_CHUNK)
+    }
+}
 /// Weight of the angle in the target-space distance.
 pub(crate) const W_THETA: f64 = 0.5;
 
@@ -66,7 +128,7 @@ pub(crate) struct Atlas {
     near: Vec<u32>,
 }
 
-static ATLAS: OnceLock<Atlas> = OnceLock::new();
+static ATLASES: [OnceLock<Atlas>; 2] = [OnceLock::new(), OnceLock::new()];
 
 #[inline]
 fn cell_of(x: f64, y: f64, th: f64) -> Option<(usize, usize, usize)> {
@@ -102,7 +164,7 @@ pub(crate) fn tip_distance2(p: &[f64; 3], q: &[f64; 3]) -> f64 {
 }
 
 /// Same solution branch (for keeping distinct seeds in a cell).
-fn same_branch(a: &[f64; 3], b: &[f64; 3]) -> bool {
+pub(crate) fn same_branch(a: &[f64; 3], b: &[f64; 3]) -> bool {
     (a[0] - b[0]).abs() / 2.0 + (a[1] - b[1]).abs() / 20.0 + (a[2] - b[2]).abs() / 20.0 < 1.0
 }
 
@@ -110,11 +172,11 @@ fn same_branch(a: &[f64; 3], b: &[f64; 3]) -> bool {
 /// the boundary between cases I and II, where m → 1 and the tip depends on a so sharply that
 /// uniform sampling leaves its neighbourhood without seeds). λ4 scales as s⁴ along a ray, so the
 /// whole ray stays at the same relative offset from the separatrix. Offsets are log-uniform.
-fn separatrix_endpoint(i: u64) -> Option<PlanarParams> {
+fn separatrix_endpoint(spec: &Spec, i: u64) -> Option<PlanarParams> {
     // a3 denser near 0 (nearly straight, tensioned rods are the most sensitive there).
     let w = 2.0 * halton(i, 2) - 1.0;
-    let a3 = w * w.abs() * A3_MAX;
-    let a4 = (2.0 * halton(i, 3) - 1.0) * A45_MAX;
+    let a3 = w * w.abs() * spec.a3_max;
+    let a4 = (2.0 * halton(i, 3) - 1.0) * spec.a45_max;
     let base = a3 * a3 * (a3 * a3 / 4.0 + a4);
     let u = halton(i, 5);
     let v = halton(i, 7);
@@ -127,7 +189,7 @@ fn separatrix_endpoint(i: u64) -> Option<PlanarParams> {
         return None;
     }
     let a5 = a5sq.sqrt() * if (2.0 * v).fract() < 0.5 { -1.0 } else { 1.0 };
-    (a5.abs() <= A45_MAX).then(|| PlanarParams::new(a3, a4, a5))
+    (a5.abs() <= spec.a45_max).then(|| PlanarParams::new(a3, a4, a5))
 }
 
 /// Radical inverse in base `b` (Halton sequence).
@@ -146,8 +208,6 @@ fn halton(mut i: u64, b: u64) -> f64 {
 /// Rays integrated per chunk of the build (≈ 0.5 ms of work: the granularity at which a
 /// request's deadline is polled while the atlas is being built).
 const RAYS_PER_CHUNK: usize = 32;
-/// Chunks of rays.
-const CHUNKS: usize = (RAYS + SEPARATRIX_RAYS).div_ceil(RAYS_PER_CHUNK);
 /// A piece of work still missing this long after it was handed out is handed out again.
 const LOST_WORK: Duration = Duration::from_millis(200);
 /// Cells whose seeds one piece of the gathering moves into the atlas (one x slab, ≈ 0.5 ms):
@@ -163,8 +223,12 @@ const CELLS_PER_GATHER: usize = NXY * NT;
 /// the lock (the gathering's pieces under it). Seeds are filed in ray order whatever thread
 /// computed them, so the atlas is the same on every run.
 struct Builder {
+    /// [`Tier::chunks`].
+    chunks: usize,
+    /// [`Spec::per_cell`].
+    per_cell: usize,
     cells: Vec<Vec<(Seed, f64)>>,
-    /// Pieces handed out so far: chunks 0..CHUNKS, then slabs (the gathering between them is
+    /// Pieces handed out so far: chunks 0..chunks, then slabs (the gathering between them is
     /// done by whichever thread asks next, under the lock).
     handed_out: usize,
     /// When each piece was (last) handed out.
@@ -187,7 +251,7 @@ struct SlabLists {
     near: Vec<u32>,
 }
 
-static BUILDER: Mutex<Option<Builder>> = Mutex::new(None);
+static BUILDERS: [Mutex<Option<Builder>>; 2] = [Mutex::new(None), Mutex::new(None)];
 
 /// How long a thread waits for pieces other threads are computing before it asks again.
 const WAIT: Duration = Duration::from_micros(50);
@@ -207,8 +271,8 @@ enum Step {
 /// core: `None` when the deadline passes first. The work done is kept and resumed by the next
 /// call; threads calling it together share the build (each polls the deadline between pieces
 /// of ≈ 0.5 ms).
-pub(crate) fn get() -> Option<&'static Atlas> {
-    if let Some(atlas) = ATLAS.get() {
+pub(crate) fn get(tier: Tier) -> Option<&'static Atlas> {
+    if let Some(atlas) = ATLASES[tier.index()].get() {
         return Some(atlas);
     }
     let deadline = crate::deadline::handoff();
@@ -217,28 +281,29 @@ pub(crate) fn get() -> Option<&'static Atlas> {
         for _ in 0..helpers {
             scope.spawn(move || {
                 let _deadline = deadline.enter();
-                build()
+                build(tier)
             });
         }
-        build()
+        build(tier)
     })
 }
 
 /// Builds pieces of the atlas until it is complete or the deadline passes.
-fn build() -> Option<&'static Atlas> {
+fn build(tier: Tier) -> Option<&'static Atlas> {
+    let slot = &ATLASES[tier.index()];
     loop {
-        if let Some(atlas) = ATLAS.get() {
+        if let Some(atlas) = slot.get() {
             return Some(atlas);
         }
         if crate::deadline::expired() {
             return None;
         }
         let work = {
-            let mut guard = lock_builder();
-            if ATLAS.get().is_some() {
+            let mut guard = lock_builder(tier);
+            if slot.get().is_some() {
                 continue;
             }
-            let work = guard.get_or_insert_with(Builder::new).next_work();
+            let work = guard.get_or_insert_with(|| Builder::new(tier)).next_work();
             if matches!(work, Step::Done(_)) {
                 *guard = None;
             }
@@ -252,25 +317,25 @@ fn build() -> Option<&'static Atlas> {
         });
         match work {
             Step::Chunk(c) => {
-                let seeds = chunk_seeds(c);
-                if let Some(b) = lock_builder().as_mut() {
+                let seeds = chunk_seeds(tier, c);
+                if let Some(b) = lock_builder(tier).as_mut() {
                     b.file_chunk(c, seeds);
                 }
             }
             Step::Gather => {
-                if let Some(b) = lock_builder().as_mut() {
+                if let Some(b) = lock_builder(tier).as_mut() {
                     b.gather_piece();
                 }
             }
             Step::Slab(ix, seeded) => {
                 let lists = seeded.short_lists(ix);
-                if let Some(b) = lock_builder().as_mut() {
+                if let Some(b) = lock_builder(tier).as_mut() {
                     b.slabs[ix].get_or_insert(lists);
                 }
             }
             Step::Wait => std::thread::sleep(WAIT),
             Step::Done(atlas) => {
-                let _ = ATLAS.set(atlas);
+                let _ = slot.set(atlas);
             }
         }
     }
@@ -278,26 +343,31 @@ fn build() -> Option<&'static Atlas> {
 
 /// The builder's lock. A panic in another thread leaves a consistent state (a piece handed
 /// out and never delivered is handed out again, [`Builder::next_work`]).
-fn lock_builder() -> std::sync::MutexGuard<'static, Option<Builder>> {
-    BUILDER.lock().unwrap_or_else(|p| p.into_inner())
+fn lock_builder(tier: Tier) -> std::sync::MutexGuard<'static, Option<Builder>> {
+    BUILDERS[tier.index()]
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
 }
 
 /// The atlas, built now if needed whatever the time it takes (no deadline applies).
-pub(crate) fn get_blocking() -> &'static Atlas {
+pub(crate) fn get_blocking(tier: Tier) -> &'static Atlas {
     let _unbounded = crate::deadline::unbounded();
     loop {
-        if let Some(atlas) = get() {
+        if let Some(atlas) = get(tier) {
             return atlas;
         }
     }
 }
 
 impl Builder {
-    fn new() -> Self {
+    fn new(tier: Tier) -> Self {
+        let chunks = tier.chunks();
         Self {
+            chunks,
+            per_cell: tier.spec().per_cell,
             cells: vec![Vec::new(); NXY * NXY * NT],
             handed_out: 0,
-            handed_at: Vec::with_capacity(CHUNKS + NXY),
+            handed_at: Vec::with_capacity(chunks + NXY),
             pending: BTreeMap::new(),
             filed: 0,
             gathering: None,
@@ -309,10 +379,10 @@ impl Builder {
     /// The next piece of work.
     fn next_work(&mut self) -> Step {
         let now = Instant::now();
-        if self.handed_out < CHUNKS {
+        if self.handed_out < self.chunks {
             return self.hand_out(now);
         }
-        if self.filed < CHUNKS {
+        if self.filed < self.chunks {
             return self.missing(self.filed, now, Step::Chunk(self.filed));
         }
         let Some(seeded) = self.seeded.clone() else {
@@ -322,13 +392,13 @@ impl Builder {
                 Step::Wait
             };
         };
-        if self.handed_out < CHUNKS + NXY {
-            let ix = self.handed_out - CHUNKS;
+        if self.handed_out < self.chunks + NXY {
+            let ix = self.handed_out - self.chunks;
             self.hand_out(now);
             return Step::Slab(ix, seeded);
         }
         if let Some(ix) = self.slabs.iter().position(Option::is_none) {
-            return self.missing(CHUNKS + ix, now, Step::Slab(ix, seeded));
+            return self.missing(self.chunks + ix, now, Step::Slab(ix, seeded));
         }
         Step::Done(self.assemble(seeded))
     }
@@ -358,11 +428,11 @@ impl Builder {
         }
         while let Some(seeds) = self.pending.remove(&self.filed) {
             for seed in seeds {
-                file_seed(&mut self.cells, seed);
+                file_seed(&mut self.cells, seed, self.per_cell);
             }
             self.filed += 1;
         }
-        if self.filed == CHUNKS && self.seeded.is_none() && self.gathering.is_none() {
+        if self.filed == self.chunks && self.seeded.is_none() && self.gathering.is_none() {
             let total = self.cells.iter().map(Vec::len).sum();
             let atlas = Atlas {
                 offsets: Vec::with_capacity(self.cells.len() + 1),
@@ -422,33 +492,41 @@ impl Builder {
 }
 
 /// The candidate seeds of chunk `c`'s rays, in ray order.
-fn chunk_seeds(c: usize) -> Vec<Seed> {
+fn chunk_seeds(tier: Tier, c: usize) -> Vec<Seed> {
+    let spec = tier.spec();
     let mut out = Vec::new();
-    let mut buf = Vec::with_capacity(STEPS);
-    let end = ((c + 1) * RAYS_PER_CHUNK).min(RAYS + SEPARATRIX_RAYS);
+    let mut buf = Vec::with_capacity(spec.steps);
+    let end = ((c + 1) * RAYS_PER_CHUNK).min(spec.rays + spec.separatrix_rays);
     for i in c * RAYS_PER_CHUNK..end {
-        ray_seeds(i as u64, &mut buf, &mut out);
+        ray_seeds(spec, i as u64, &mut buf, &mut out);
     }
     out
 }
 
 /// Integrates ray `i` and appends its stable rods as seeds.
-fn ray_seeds(i: u64, buf: &mut Vec<(f64, f64, f64, f64, Matrix3<f64>)>, out: &mut Vec<Seed>) {
-    let a = if (i as usize) < RAYS {
+fn ray_seeds(
+    spec: &Spec,
+    i: u64,
+    buf: &mut Vec<(f64, f64, f64, f64, Matrix3<f64>)>,
+    out: &mut Vec<Seed>,
+) {
+    let a = if (i as usize) < spec.rays {
         PlanarParams::new(
-            (2.0 * halton(i + 1, 2) - 1.0) * A3_MAX,
-            (2.0 * halton(i + 1, 3) - 1.0) * A45_MAX,
-            (2.0 * halton(i + 1, 5) - 1.0) * A45_MAX,
+            (2.0 * halton(i + 1, 2) - 1.0) * spec.a3_max,
+            (2.0 * halton(i + 1, 3) - 1.0) * spec.a45_max,
+            (2.0 * halton(i + 1, 5) - 1.0) * spec.a45_max,
         )
     } else {
-        match separatrix_endpoint(i + 1) {
+        match separatrix_endpoint(spec, i + 1) {
             Some(a) => a,
             None => return,
         }
     };
     buf.clear();
     let mut t1 = f64::INFINITY;
-    let ok = scan::integrate(&a, STEPS, |t, x, y, th, j, det| {
+    let scale = a[0].abs().max(a[1].hypot(a[2]).sqrt());
+    let steps = spec.steps.max((spec.steps_per_scale * scale) as usize);
+    let ok = scan::integrate(&a, steps, |t, x, y, th, j, det| {
         if t >= crate::STABILITY_T_MIN && det <= 0.0 {
             t1 = t;
             return false;
@@ -462,6 +540,12 @@ fn ray_seeds(i: u64, buf: &mut Vec<(f64, f64, f64, f64, Matrix3<f64>)>, out: &mu
     for &(t, x, y, th, j) in buf.iter() {
         // Keep a margin from the first conjugate point (seeds deep inside A_stable).
         if t < 0.05 || t > 0.985 * t1 {
+            continue;
+        }
+        let inside = |(m3, m45): (f64, f64)| {
+            (t * a[0]).abs() <= m3 && (t * t * a[1]).abs() <= m45 && (t * t * a[2]).abs() <= m45
+        };
+        if spec.inner.is_some_and(inside) {
             continue;
         }
         out.extend(scaled_seed(&a, t, x, y, th, &j));
@@ -490,8 +574,8 @@ fn scaled_seed(
 }
 
 /// Files `seed` into its cell: one seed per branch, the one nearest the cell centre, at most
-/// [`K`] branches (the farthest replaced).
-fn file_seed(cells: &mut [Vec<(Seed, f64)>], seed: Seed) {
+/// `per_cell` branches (the farthest replaced).
+fn file_seed(cells: &mut [Vec<(Seed, f64)>], seed: Seed, per_cell: usize) {
     let Some((ix, iy, it)) = cell_of(seed.tip[0], seed.tip[1], seed.tip[2]) else {
         return;
     };
@@ -501,7 +585,7 @@ fn file_seed(cells: &mut [Vec<(Seed, f64)>], seed: Seed) {
         if d < slot.1 {
             *slot = (seed, d);
         }
-    } else if cell.len() < K {
+    } else if cell.len() < per_cell {
         cell.push((seed, d));
     } else if let Some(worst) = cell
         .iter_mut()
@@ -649,7 +733,7 @@ impl Atlas {
 /// The atlas seed nearest `target` in tip space (searching up to 3 cells away).
 /// `None` too when the deadline passes before the atlas is built.
 pub(crate) fn nearest(target: &PlanarPose) -> Option<PlanarParams> {
-    let atlas = get()?;
+    let atlas = get(Tier::Box)?;
     let mut v = Vec::new();
     atlas.near_list(target, &mut v);
     for r in 1..=3 {

@@ -35,6 +35,7 @@ use crate::planar::{PlanarClosedForm, PlanarReference};
 use crate::solver::{Found, InverseGeometry};
 use crate::{PlanarParams, PlanarPose};
 
+pub use robust::BRANCH_STEPS;
 pub use tracker::Tracker;
 
 /// The inverse-geometry error of every model ([`crate::solver::IgError`]).
@@ -158,5 +159,5 @@ impl InverseGeometry<3> for PlanarReference {
 /// [`Termination::Deadline`] and the next calls resume the build. A process that serves
 /// requests calls this at start-up (or on a background thread: requests share the build).
 pub fn warm_up() -> usize {
-    atlas::get_blocking().len()
+    atlas::get_blocking(atlas::Tier::Box).len() + atlas::get_blocking(atlas::Tier::Beyond).len()
 }

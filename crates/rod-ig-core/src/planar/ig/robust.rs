@@ -8,7 +8,7 @@ use super::{
     SolveOptions,
 };
 use crate::planar::model;
-use crate::solver::{emit, Event, Termination};
+use crate::solver::{emit, Event, Searched, Termination};
 use crate::{PlanarParams, PlanarPose};
 
 /// Total start budget of one robust solve, unless `SolveOptions::max_starts` says otherwise.
@@ -35,8 +35,10 @@ struct Counts {
     best: (f64, Option<PlanarParams>),
     /// Why the last start that did not produce a solution stopped.
     last_stop: Option<IgError>,
-    /// Starts run (the observer's start index).
+    /// Starts run (the observer's start index), branches followed included.
     starts: u32,
+    /// Branches followed ([`by_continuation`]).
+    branches: u32,
 }
 
 impl Default for Counts {
@@ -47,6 +49,7 @@ impl Default for Counts {
             best: (f64::INFINITY, None),
             last_stop: None,
             starts: 0,
+            branches: 0,
         }
     }
 }
@@ -320,65 +323,227 @@ fn deadline_failure(counts: &Counts) -> Failure {
         iterations: counts.iterations,
         residual: counts.best.0,
         last_a: counts.best.1,
+        starts: counts.starts,
         elapsed_us: 0.0,
     }
 }
 
 pub(crate) fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Failure> {
+    let t0 = std::time::Instant::now();
     let mut counts = Counts::default();
     // The atlas is built on first use, in steps charged to this call's deadline.
-    let Some(atlas) = atlas::get() else {
+    let Some(atlas) = atlas::get(atlas::Tier::Box) else {
         return Err(deadline_failure(&counts));
     };
+    let limit = options.max_starts.map(|m| m.max(1) as usize);
+    let box_starts = limit.unwrap_or(MAX_STARTS);
+    if let Some(done) = box_stage(target, atlas, options, box_starts, &mut counts) {
+        return done;
+    }
+    if let Some(s) = polish_stage(target, options, &mut counts) {
+        return Ok(s);
+    }
+    let left = limit.map_or(BEYOND_STARTS + BRANCH_STARTS, |m| {
+        m.saturating_sub(counts.starts as usize)
+    });
+    if left > 0 {
+        if let Some(done) = beyond_stage(target, atlas, options, left, &mut counts) {
+            return done;
+        }
+    }
+    Err(Failure {
+        reason: IgError::SearchExhausted(Box::new(Searched {
+            starts: counts.starts - counts.branches,
+            branches: counts.branches,
+            a3_max: atlas::SEED_A3_MAX,
+            a45_max: atlas::SEED_A45_MAX,
+            elapsed_ms: t0.elapsed().as_secs_f64() * 1e3,
+            last: counts.last_stop,
+        })),
+        iterations: counts.iterations,
+        residual: counts.best.0,
+        last_a: counts.best.1,
+        starts: counts.starts,
+        elapsed_us: 0.0,
+    })
+}
+
+/// A stage's end: `Some` when the solve is over (a solution, or the deadline).
+type StageEnd = Option<Result<Solution, Failure>>;
+
+/// The solution `s` found by the search so far, with its work.
+fn found_after(mut s: Solution, counts: &Counts) -> Solution {
+    s.iterations = counts.iterations;
+    s.evaluations = counts.evaluations;
+    s.starts = counts.starts;
+    s
+}
+
+/// The first stage: the guess, the model's starts and the box atlas's seeds
+/// ([`Starts`]), at most `max_starts` of them.
+fn box_stage(
+    target: &PlanarPose,
+    atlas: &'static atlas::Atlas,
+    options: &SolveOptions,
+    max_starts: usize,
+    counts: &mut Counts,
+) -> StageEnd {
     let mut starts = Starts::new(target, atlas, options);
     let budget = per_start_budget(options);
-    let mut n = 0;
-    let max_starts = options.max_starts.map_or(MAX_STARTS, |m| m.max(1) as usize);
-    while n < max_starts {
+    while (counts.starts as usize) < max_starts {
         if crate::deadline::expired() {
-            return Err(deadline_failure(&counts));
+            return Some(Err(deadline_failure(counts)));
         }
-        let Some((start, is_guess)) = starts.next() else {
-            break;
-        };
-        n += 1;
+        let (start, is_guess) = starts.next()?;
         let b = if is_guess {
             budget.min(GUESS_BUDGET)
         } else {
             budget
         };
-        if let Some(mut s) = try_start(target, &start, options, b, &mut counts) {
-            s.iterations = counts.iterations;
-            s.evaluations = counts.evaluations;
-            s.starts = n as u32;
-            return Ok(s);
+        if let Some(s) = try_start(target, &start, options, b, counts) {
+            return Some(Ok(found_after(s, counts)));
         }
     }
-    // Last resort: the most promising iterate (smallest residual over every start) is polished
-    // with a long run of the globalised Newton / LM steps. Near the separatrix λ4 = 0 and near
-    // folds, convergence there is linear and slow but steady.
-    if let (r, Some(a)) = counts.best {
-        if r < POLISH_BELOW {
-            let start = atlas::Start { a, predicted: None };
-            let budget = POLISH_BUDGET.min(options.max_iterations);
-            if let Some(mut s) = try_start(target, &start, options, budget, &mut counts) {
-                s.iterations = counts.iterations;
-                s.evaluations = counts.evaluations;
-                s.starts = n as u32 + 1;
-                return Ok(s);
-            }
+    None
+}
+
+/// The most promising iterate (smallest residual over every start) polished with a long run
+/// of the globalised Newton / LM steps. Near the separatrix λ4 = 0 and near folds,
+/// convergence there is linear and slow but steady.
+fn polish_stage(
+    target: &PlanarPose,
+    options: &SolveOptions,
+    counts: &mut Counts,
+) -> Option<Solution> {
+    let (r, Some(a)) = counts.best else {
+        return None;
+    };
+    if r >= POLISH_BELOW {
+        return None;
+    }
+    let start = atlas::Start { a, predicted: None };
+    let budget = POLISH_BUDGET.min(options.max_iterations);
+    try_start(target, &start, options, budget, counts).map(|s| found_after(s, counts))
+}
+
+/// Beyond the box: the second atlas's seeds nearest the target, then the branches of both
+/// atlases' seeds, `left` starts in all.
+fn beyond_stage(
+    target: &PlanarPose,
+    atlas: &'static atlas::Atlas,
+    options: &SolveOptions,
+    left: usize,
+    counts: &mut Counts,
+) -> StageEnd {
+    // Built on first need, in steps charged to this call's deadline, like the box atlas.
+    let Some(beyond) = atlas::get(atlas::Tier::Beyond) else {
+        return Some(Err(deadline_failure(counts)));
+    };
+    let mut list = Vec::new();
+    beyond.near_list(target, &mut list);
+    beyond.candidates(target, 1, &mut list);
+    let mut served = Vec::new();
+    let budget = per_start_budget(options);
+    for &(_, k) in &list {
+        if served.len() >= BEYOND_STARTS.min(left) {
+            break;
+        }
+        if served.contains(&k) {
+            continue;
+        }
+        served.push(k);
+        if crate::deadline::expired() {
+            return Some(Err(deadline_failure(counts)));
+        }
+        if let Some(s) = try_start(target, &beyond.start(k, target), options, budget, counts) {
+            return Some(Ok(found_after(s, counts)));
         }
     }
-    Err(Failure {
-        reason: IgError::NoStableSolution {
-            starts: n as u32,
-            last: counts.last_stop.map(Box::new),
-        },
-        iterations: counts.iterations,
-        residual: counts.best.0,
-        last_a: counts.best.1,
-        elapsed_us: 0.0,
-    })
+    let branches = BRANCH_STARTS.min(left - served.len());
+    if let Some(s) = by_continuation(target, &[atlas, beyond], options, branches, counts) {
+        return Some(Ok(found_after(s, counts)));
+    }
+    crate::deadline::expired().then(|| Err(deadline_failure(counts)))
+}
+
+/// Newton starts from the beyond-the-box atlas (its short list, then its seeds one cell away).
+const BEYOND_STARTS: usize = 24;
+/// Seeds whose branches the continuation stage follows at most.
+const BRANCH_STARTS: usize = 64;
+/// Continuation steps per branch the robust search's last stage follows (each at most
+/// [`crate::solver::CORRECTOR_ITERATIONS`] + 1 corrections): the bound of such a start, for
+/// which `SolveOptions::max_iterations` (a Newton run's budget) is not meant. 4,096 steps
+/// cover the whole move at the continuation's smallest step ([`crate::solver::MIN_STEP`]);
+/// at 1,000 the search found 13 fewer of 600 workspace targets.
+pub const BRANCH_STEPS: u32 = 4096;
+/// Cells around the target's whose seeds the continuation stage follows.
+const BRANCH_RADIUS: usize = 3;
+
+/// The last stage: the branches of the atlas seeds nearest the target (within
+/// [`BRANCH_RADIUS`] cells, one seed per branch, at most `branches`), each followed as its tip
+/// moves straight to the target ([`crate::solver::branch_to`]). Where the stable rods at the
+/// target are so sensitive (|J| ~ 500) that no seed lies in Newton's basin, a branch through a
+/// seed still leads there. Each branch counts as a start.
+fn by_continuation(
+    target: &PlanarPose,
+    atlases: &[&'static atlas::Atlas],
+    options: &SolveOptions,
+    branches: usize,
+    counts: &mut Counts,
+) -> Option<Solution> {
+    let mut candidates: Vec<(f64, PlanarParams)> = Vec::new();
+    let mut found = Vec::new();
+    for atlas in atlases {
+        found.clear();
+        atlas.candidates(target, BRANCH_RADIUS, &mut found);
+        candidates.extend(
+            found
+                .iter()
+                .map(|&(d, k)| (d, atlas.seed_params(k as usize))),
+        );
+    }
+    candidates.sort_by(|p, q| p.0.total_cmp(&q.0));
+    let mut followed: Vec<PlanarParams> = Vec::new();
+    for (_, a0) in candidates {
+        if crate::deadline::expired() || followed.len() >= branches {
+            break;
+        }
+        if followed
+            .iter()
+            .any(|b| atlas::same_branch(&(*b).into(), &a0.into()))
+        {
+            continue;
+        }
+        followed.push(a0);
+        let index = counts.starts;
+        counts.starts += 1;
+        counts.branches += 1;
+        emit(Event::StartBegun {
+            index,
+            a0_norm: a0.norm(),
+        });
+        let mut work = crate::solver::Work::default();
+        let model = crate::planar::PlanarClosedForm;
+        let end = crate::solver::branch_to(model, options, BRANCH_STEPS, &a0, target, &mut work);
+        counts.iterations += work.iterations;
+        counts.evaluations += work.evaluations;
+        let verified = end.and_then(|a| {
+            let (e, st) = newton::verify_with_stability(&a, target, options.tolerance)?;
+            st.stable
+                .then(|| make_solution(&a, &e, true, st.margin, work.iterations))
+        });
+        emit(Event::StartEnded {
+            index,
+            termination: match verified {
+                Some(_) => Termination::Converged,
+                None => Termination::NoStableSolution,
+            },
+        });
+        if verified.is_some() {
+            return verified;
+        }
+    }
+    None
 }
 
 pub(crate) struct All {
@@ -408,7 +573,7 @@ pub(crate) fn solve_all(
 ) -> All {
     let mut counts = Counts::default();
     let budget = per_start_budget(options);
-    let Some(atlas) = atlas::get() else {
+    let Some(atlas) = atlas::get(atlas::Tier::Box) else {
         return All {
             solutions: Vec::new(),
             iterations: 0,

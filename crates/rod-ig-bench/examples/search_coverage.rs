@@ -1,0 +1,217 @@
+//! How complete the planar robust search is (issue 42, item 1), and the independent search
+//! that the test data of `rod-ig-core/tests/search.rs` comes from.
+//!
+//! ```text
+//! cargo run --release -p rod-ig-bench --example search_coverage -- box N SEED
+//!     stable rods with |a3| <= 100, |F| <= 500 (log-scale magnitudes, exact zeros): their
+//!     tips solved from no guess; prints the misses and the count
+//! cargo run --release -p rod-ig-bench --example search_coverage -- workspace N SEED
+//!     N random targets, |p| <= 0.95 uniform in the disc, theta uniform: prints `nf x,y,theta`
+//!     for each target not solved, the count and the solve times
+//! cargo run --release -p rod-ig-bench --example search_coverage -- reference FILE
+//!     for each `nf` line of FILE: the branch follower from the 40 stable rods, out of a
+//!     million sampled with |a3| <= 100, |F| <= 2000, whose tips are nearest the target;
+//!     prints `x,y,theta,a3,a4,a5` where one reaches it (slow: ~10 s a target)
+//! cargo run --release -p rod-ig-bench --example search_coverage -- evidence FILE
+//!     for each `x,y,theta,a3,a4,a5` line: the rod polished onto the target (its branch
+//!     followed, else Newton from it) and checked by the DOP853 reference (tip 2e-6, stable):
+//!     JSON lines {"target", "a"}
+//! ```
+use rod_ig_core::ode::planar_reference;
+use rod_ig_core::planar::{self, ig, PlanarClosedForm};
+use rod_ig_core::rng::SplitMix64;
+use rod_ig_core::solver::BranchFollower;
+use rod_ig_core::{wrap_angle, PlanarParams, PlanarPose, StabilityVerdict};
+use std::f64::consts::PI;
+use std::time::{Duration, Instant};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let num = |i: usize, default: u64| args.get(i).and_then(|s| s.parse().ok()).unwrap_or(default);
+    ig::warm_up();
+    match args.first().map(String::as_str) {
+        Some("box") => goal_box(num(1, 2000) as usize, num(2, 1)),
+        Some("workspace") => workspace(num(1, 600) as usize, num(2, 11)),
+        Some("reference") => reference(&read(args.get(1))),
+        Some("evidence") => evidence(&read(args.get(1))),
+        _ => eprintln!("usage: search_coverage box|workspace N SEED | reference|evidence FILE"),
+    }
+}
+
+fn read(path: Option<&String>) -> String {
+    std::fs::read_to_string(path.expect("a file")).expect("readable file")
+}
+
+/// |a3| ≤ 100, |F| ≤ 500: magnitudes log-uniform from 1e-3, 10 % exact zeros, half the
+/// forces along an axis.
+fn log_scale_rod(r: &mut SplitMix64) -> PlanarParams {
+    let a3 = match r.next_u64() % 10 {
+        0 => 0.0,
+        _ => r.signed_pow10(-3.0, 2.0),
+    };
+    let f = match r.next_u64() % 10 {
+        0 => 0.0,
+        _ => 10f64.powf(r.range(-3.0, 500f64.log10())),
+    };
+    let (a4, a5) = match r.next_u64() % 8 {
+        0 => (f, 0.0),
+        1 => (-f, 0.0),
+        2 => (0.0, f),
+        3 => (0.0, -f),
+        _ => {
+            let phi = r.range(-PI, PI);
+            (f * phi.cos(), f * phi.sin())
+        }
+    };
+    PlanarParams::new(a3, a4, a5)
+}
+
+fn goal_box(n: usize, seed: u64) {
+    let mut r = SplitMix64::new(seed);
+    let (mut tried, mut missed) = (0, 0);
+    while tried < n {
+        let a = log_scale_rod(&mut r);
+        if planar::stability_verdict(&a) != Ok(StabilityVerdict::Stable) {
+            continue;
+        }
+        let Ok(tip) = planar::tip(&a) else { continue };
+        tried += 1;
+        if let Err(f) = ig::solve(&tip, &ig::SolveOptions::default()) {
+            missed += 1;
+            println!("missed a = {:?}: {}", a.as_slice(), f.reason);
+        }
+    }
+    println!("goal box: {tried} stable rods, {missed} tips not solved");
+}
+
+fn workspace(n: usize, seed: u64) {
+    let mut r = SplitMix64::new(seed);
+    let mut times = Vec::with_capacity(n);
+    let mut found = 0;
+    for _ in 0..n {
+        let (rho, phi) = (0.95 * r.uniform().sqrt(), r.range(-PI, PI));
+        let t = PlanarPose::new(rho * phi.cos(), rho * phi.sin(), r.range(-PI, PI));
+        let t0 = Instant::now();
+        let result = ig::solve(&t, &ig::SolveOptions::default());
+        times.push(t0.elapsed().as_secs_f64() * 1e6);
+        match result {
+            Ok(_) => found += 1,
+            Err(f) => println!("nf {:.6},{:.6},{:.6} {}", t.x, t.y, t.theta, f.reason),
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    println!(
+        "workspace: {found} of {n} solved; time median {:.0} µs, p90 {:.0} µs, max {:.0} µs",
+        times[n / 2],
+        times[n * 9 / 10],
+        times[n - 1]
+    );
+}
+
+/// The targets of the `nf x,y,theta` lines.
+fn targets(text: &str) -> Vec<PlanarPose> {
+    text.lines()
+        .filter_map(|l| l.strip_prefix("nf "))
+        .map(|l| {
+            let v: Vec<f64> = l
+                .split_whitespace()
+                .next()
+                .unwrap_or("")
+                .split(',')
+                .map(|x| x.parse().expect("number"))
+                .collect();
+            PlanarPose::new(v[0], v[1], v[2])
+        })
+        .collect()
+}
+
+fn reference(text: &str) {
+    let mut r = SplitMix64::new(99);
+    let mut pool: Vec<(PlanarParams, [f64; 3])> = Vec::new();
+    while pool.len() < 1_000_000 {
+        let a = match pool.len() % 3 {
+            0 => log_scale_rod(&mut r),
+            1 => PlanarParams::new(
+                r.range(-100.0, 100.0),
+                r.range(-500.0, 500.0),
+                r.range(-500.0, 500.0),
+            ),
+            _ => PlanarParams::new(
+                r.range(-40.0, 40.0),
+                r.range(-300.0, 100.0),
+                r.range(-200.0, 200.0),
+            ),
+        };
+        if planar::stability_verdict(&a) != Ok(StabilityVerdict::Stable) {
+            continue;
+        }
+        if let Ok(t) = planar::tip(&a) {
+            pool.push((a, [t.x, t.y, wrap_angle(t.theta)]));
+        }
+    }
+    for t in targets(text) {
+        let d = |p: &[f64; 3]| {
+            let dt = 0.5 * wrap_angle(p[2] - t.theta);
+            (p[0] - t.x).powi(2) + (p[1] - t.y).powi(2) + dt * dt
+        };
+        let mut idx: Vec<usize> = (0..pool.len()).collect();
+        idx.select_nth_unstable_by(40, |&i, &j| d(&pool[i].1).total_cmp(&d(&pool[j].1)));
+        idx[..40].sort_by(|&i, &j| d(&pool[i].1).total_cmp(&d(&pool[j].1)));
+        let options = ig::SolveOptions {
+            deadline: Duration::from_millis(300),
+            ..Default::default()
+        };
+        let reached = idx[..40].iter().find_map(|&i| {
+            let mut f = BranchFollower::holding(PlanarClosedForm, options, pool[i].0).ok()?;
+            f.follow(&t).result.ok().filter(|s| s.stable)
+        });
+        if let Some(s) = reached {
+            println!(
+                "{:?},{:?},{:?},{:?},{:?},{:?}",
+                t.x, t.y, t.theta, s.a[0], s.a[1], s.a[2]
+            );
+        }
+    }
+}
+
+fn evidence(text: &str) {
+    let options = ig::SolveOptions {
+        deadline: Duration::from_secs(5),
+        max_iterations: 2000,
+        ..Default::default()
+    };
+    for line in text.lines() {
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|x| x.trim().parse().expect("number"))
+            .collect();
+        let t = PlanarPose::new(v[0], v[1], v[2]);
+        let hint = PlanarParams::new(v[3], v[4], v[5]);
+        let followed = BranchFollower::holding(PlanarClosedForm, options, hint)
+            .ok()
+            .and_then(|mut f| f.follow(&t).result.ok());
+        let polished = || {
+            let o = ig::SolveOptions {
+                initial_guess: Some(hint),
+                ..options
+            };
+            ig::solve(&t, &o).ok()
+        };
+        let Some(a) = followed.or_else(polished).map(|s| s.a) else {
+            eprintln!("no rod from {line}");
+            continue;
+        };
+        let (tip, _) = planar_reference::tip_and_jacobian(&a, 1e-12).expect("reference tip");
+        let on_target = (tip.x - t.x).hypot(tip.y - t.y) <= 2e-6
+            && wrap_angle(tip.theta - t.theta).abs() <= 2e-6;
+        let stable = planar_reference::stability(&a).is_ok_and(|s| s.stable);
+        if !(on_target && stable) {
+            eprintln!("the reference disagrees on {line}");
+            continue;
+        }
+        println!(
+            "{{\"target\":[{:?},{:?},{:?}],\"a\":[{:?},{:?},{:?}]}}",
+            t.x, t.y, t.theta, a[0], a[1], a[2]
+        );
+    }
+}
