@@ -396,8 +396,8 @@ def solve3d(
 
 
 def warm_up() -> int:
-    """Builds the planar solver's atlas of stable rods now (about 0.15 s on two cores; done
-    otherwise by the first solve). Returns its number of seeds."""
+    """Builds the planar solver's atlases of stable rods now (about 0.45 s on two cores; done
+    otherwise by the first solves that need them). Returns their number of seeds."""
     return _rod_ig.warm_up()
 
 

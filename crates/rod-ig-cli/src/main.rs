@@ -288,7 +288,7 @@ fn write_svg(path: &std::path::Path, text: &str) -> Result<(), String> {
     std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// Builds the planar solver's atlas (≈ 0.15 s on two cores) before the first line is read:
+/// Builds the planar solver's atlases (≈ 0.45 s on two cores) before the first line is read:
 /// a process that serves a stream pays it once at start-up, and every request's deadline then
 /// counts from its own line (issue 24).
 fn warm_up() {

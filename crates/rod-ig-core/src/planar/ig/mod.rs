@@ -11,13 +11,16 @@
 //!   rejected, since the stable set can only be left through det J(1, a) = 0), multi-started
 //!   from a precomputed atlas of stable rods indexed by their tip (each seed carrying J⁻¹, so the
 //!   first step is free), with small-angle starts for targets near full extension and a final
-//!   polishing of the best iterate; the stability test (FINDINGS §5) is applied to every
-//!   solution before it is returned. The caller's initial guess goes first when its residual is
-//!   no larger than the nearest seed's (it then selects the solution branch).
+//!   polishing of the best iterate; where that fails, Newton from a second atlas of the rods
+//!   beyond the box (|a3| ≤ 36, |a4|, |a5| ≤ 300), then the branches of the seeds nearest the
+//!   target followed to it ([`BRANCH_STEPS`]). The stability test (FINDINGS §5) is applied to
+//!   every solution before it is returned. The caller's initial guess goes first when its
+//!   residual is no larger than the nearest seed's (it then selects the solution branch). A
+//!   failure says what was searched ([`IgError::SearchExhausted`]).
 //!
-//! The atlas (~80 k seeds, ~10 MB) is built once per process on first use, in about a quarter
-//! of a second, in steps charged to the deadline of the call that needs it; call [`warm_up`]
-//! at start-up to take that cost out of the first solves.
+//! The atlases (~78 k and ~98 k seeds, ~20 MB) are built once per process on first need, in
+//! steps charged to the deadline of the call that needs them; call [`warm_up`] at start-up to
+//! take that cost (≈ 0.45 s on two cores) out of the first solves.
 //!
 //! [`solve_all`] lists the distinct stable solutions found; [`Objective::LeastEnergy`] returns the
 //! least elastic energy among them. [`Tracker`] follows a stream of nearby targets.
@@ -151,11 +154,12 @@ impl InverseGeometry<3> for PlanarReference {
     }
 }
 
-/// Builds the solver's atlas of stable rods now, whatever the time it takes (≈ 0.25 s on one
-/// core). Returns its number of entries.
+/// Builds the solver's two atlases of stable rods now, whatever the time it takes (≈ 0.45 s on
+/// two cores). Returns their number of entries.
 ///
-/// Without it the atlas is built on the first robust solve, in steps of ≈ 0.5 ms charged to
-/// that call's deadline: a first call with a short deadline returns
+/// Without it the box atlas is built on the first robust solve, and the one beyond the box
+/// on the first solve that needs it, in steps of ≈ 0.5 ms charged to that call's deadline: a
+/// first call with a short deadline returns
 /// [`Termination::Deadline`] and the next calls resume the build. A process that serves
 /// requests calls this at start-up (or on a background thread: requests share the build).
 pub fn warm_up() -> usize {
