@@ -182,3 +182,83 @@ fn every_line_gets_one_json_answer() {
         }
     }
 }
+
+/// The bounds of issue 42 at their edges, in one `plan` stream: obstacles at and one past
+/// [`MAX_OBSTACLES`], polygon vertices one past [`MAX_VERTICES`], a line one byte past the
+/// 16 MiB line bound, `deadline_ms` at and past its maximum. Every line gets its answer in
+/// order; a refusal names the bound; what is within the bounds is not refused for them.
+#[test]
+fn bounds_are_answered_at_their_edges() {
+    use rod_ig_core::plan::{MAX_OBSTACLES, MAX_VERTICES};
+    const MAX_LINE_BYTES: usize = 16 << 20;
+    let request = |obstacles: &str, deadline_ms: u64| {
+        format!(
+            "{{\"start\": [0.5, 0.1, 0.1], \"goal\": {{\"x\": 0.6, \"y\": 0.3, \"theta\": 0.5}}, \
+             \"obstacles\": [{obstacles}], \"deadline_ms\": {deadline_ms}}}"
+        )
+    };
+    let discs =
+        |n: usize| vec!["{\"type\": \"disc\", \"center\": [5, 5], \"radius\": 0.01}"; n].join(", ");
+    let polygon = |n: usize| {
+        let points: Vec<String> = (0..n)
+            .map(|i| {
+                let phi = i as f64 * std::f64::consts::TAU / n as f64;
+                format!("[{}, {}]", 5.0 + 0.1 * phi.cos(), 5.0 + 0.1 * phi.sin())
+            })
+            .collect();
+        format!(
+            "{{\"type\": \"polygon\", \"points\": [{}]}}",
+            points.join(", ")
+        )
+    };
+    let mut long = request("", 50);
+    long.insert_str(1, &" ".repeat(MAX_LINE_BYTES + 1 - long.len()));
+    let lines = [
+        request(&discs(MAX_OBSTACLES), 2000),
+        request(&discs(MAX_OBSTACLES + 1), 2000),
+        request(&polygon(MAX_VERTICES + 1), 2000),
+        long,
+        request("", 10_000),
+        request("", 10_001),
+    ];
+    let input: String = lines.iter().map(|l| format!("{l}\n")).collect();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
+        .arg("plan")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("rod-ig starts");
+    let mut stdin = child.stdin.take().expect("stdin");
+    let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
+    let out = child.wait_with_output().expect("rod-ig exits");
+    writer.join().expect("writer").expect("stdin written");
+    assert!(out.status.success());
+    let answers: Vec<Value> = String::from_utf8(out.stdout)
+        .expect("UTF-8")
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("JSON answer"))
+        .collect();
+    assert_eq!(answers.len(), lines.len(), "{answers:?}");
+    let reason = |a: &Value| {
+        a["reason"]
+            .as_str()
+            .or_else(|| a["error"].as_str())
+            .unwrap_or("")
+            .to_string()
+    };
+    assert!(!reason(&answers[0]).contains("accepted"), "{}", answers[0]);
+    assert!(
+        reason(&answers[1]).contains(&format!("at most {MAX_OBSTACLES}")),
+        "{}",
+        answers[1]
+    );
+    assert!(
+        reason(&answers[2]).contains(&format!("at most {MAX_VERTICES}")),
+        "{}",
+        answers[2]
+    );
+    assert!(reason(&answers[3]).contains("bytes"), "{}", answers[3]);
+    assert_eq!(answers[4]["success"], true, "{}", answers[4]);
+    assert!(reason(&answers[5]).contains("deadline"), "{}", answers[5]);
+}
