@@ -11,6 +11,7 @@
 //! - [`diagnostics`]: the solve statistics reported on `/diagnostics`.
 //! - [`graph`]: the node's name and its topic and service names.
 //! - [`node`]: DDS context, topics, service, parameters and tasks.
+//! - [`tf_buffer`]: transforms from `/tf` and `/tf_static` with tf2's semantics.
 #![warn(missing_docs)]
 
 pub mod convert;
@@ -22,3 +23,4 @@ pub mod params;
 pub mod pipeline;
 pub mod ros_args;
 pub mod solver;
+pub mod tf_buffer;
