@@ -12,6 +12,9 @@
 //!     for each `nf` line of FILE: the branch follower from the 40 stable rods, out of a
 //!     million sampled with |a3| <= 100, |F| <= 2000, whose tips are nearest the target;
 //!     prints `x,y,theta,a3,a4,a5` where one reaches it (slow: ~10 s a target)
+//! cargo run --release -p rod-ig-bench --example search_coverage -- solves N
+//!     N stable rods of the paper's box solved from their tips (for callgrind's instruction
+//!     counts of the search: `--toggle-collect='rod_ig_core::planar::ig::solve'`)
 //! cargo run --release -p rod-ig-bench --example search_coverage -- evidence FILE
 //!     for each `x,y,theta,a3,a4,a5` line: the rod polished onto the target (its branch
 //!     followed, else Newton from it) and checked by the DOP853 reference (tip 2e-6, stable):
@@ -34,6 +37,7 @@ fn main() {
         Some("workspace") => workspace(num(1, 600) as usize, num(2, 11)),
         Some("reference") => reference(&read(args.get(1))),
         Some("evidence") => evidence(&read(args.get(1))),
+        Some("solves") => solves(num(1, 500) as usize),
         _ => eprintln!("usage: search_coverage box|workspace N SEED | reference|evidence FILE"),
     }
 }
@@ -214,4 +218,24 @@ fn evidence(text: &str) {
             t.x, t.y, t.theta, a[0], a[1], a[2]
         );
     }
+}
+
+fn solves(n: usize) {
+    let mut r = SplitMix64::new(2024);
+    let mut solved = 0;
+    let mut tried = 0;
+    while tried < n {
+        let a = PlanarParams::new(
+            r.range(-2.0 * PI, 2.0 * PI),
+            r.range(-100.0, 100.0),
+            r.range(-100.0, 100.0),
+        );
+        if planar::stability_verdict(&a) != Ok(StabilityVerdict::Stable) {
+            continue;
+        }
+        let Ok(tip) = planar::tip(&a) else { continue };
+        tried += 1;
+        solved += usize::from(ig::solve(&tip, &ig::SolveOptions::default()).is_ok());
+    }
+    println!("{solved} of {n} solved");
 }
