@@ -78,32 +78,37 @@ venv_np_include="$("$VENV/bin/python3" -c 'import numpy; print(numpy.get_include
         -e "s#/opt/python/cp311-cp311/lib/python3.11/site-packages/numpy/_core/include#$venv_np_include#g" \
         -e "s#/opt/python/cp311-cp311/include/python3.11#$venv_py_include#g"
 
-# --- 2. the interface package rod_ig_msgs --------------------------------------------------
-MSG_SRC="$REPO/msg"
-MSG_BUILD="$BUILD/rod_ig_msgs/build"
-MSG_PREFIX="$BUILD/rod_ig_msgs/install"
-msg_hash="$(cat "$MSG_SRC/package.xml" "$MSG_SRC/CMakeLists.txt" "$MSG_SRC"/msg/*.msg "$MSG_SRC"/srv/*.srv \
-    "$stamp" | sha256sum | cut -d' ' -f1)"
-msg_stamp="$MSG_PREFIX/.rod-ig-msgs-hash"
-if [ "$(cat "$msg_stamp" 2>/dev/null)" != "$msg_hash" ] \
-    || [ ! -d "$MSG_PREFIX/lib/python3.11/site-packages/rod_ig_msgs" ]; then
-    log "building rod_ig_msgs into $MSG_PREFIX"
-    rm -rf "$MSG_BUILD" "$MSG_PREFIX"
-    mkdir -p "$MSG_BUILD"
+# --- 2. the interface packages: rod_ig_msgs (msg/), and tf2_msgs' TFMessage for the test clients
+# build_interfaces NAME SRC: builds the package in SRC with cmake into $BUILD/NAME/install,
+# unless it is there and its sources (and the venv) are unchanged.
+build_interfaces() {
+    local name=$1 src=$2
+    local build="$BUILD/$name/build" prefix="$BUILD/$name/install"
+    local hash
+    hash="$(cat "$src/package.xml" "$src/CMakeLists.txt" "$src"/msg/*.msg \
+        $(ls "$src"/srv/*.srv 2>/dev/null) "$stamp" | sha256sum | cut -d' ' -f1)"
+    if [ "$(cat "$prefix/.rod-ig-msgs-hash" 2>/dev/null)" = "$hash" ] \
+        && [ -d "$prefix/lib/python3.11/site-packages/$name" ]; then
+        log "$name up to date in $prefix"
+        return
+    fi
+    log "building $name into $prefix"
+    rm -rf "$build" "$prefix"
+    mkdir -p "$build"
     (
         export AMENT_PREFIX_PATH="$VENV"
         export PATH="$VENV/bin:$PATH"
         export LD_LIBRARY_PATH="$VENV/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-        "$VENV/bin/cmake" -S "$MSG_SRC" -B "$MSG_BUILD" \
-            -DCMAKE_PREFIX_PATH="$VENV" -DCMAKE_INSTALL_PREFIX="$MSG_PREFIX" \
+        "$VENV/bin/cmake" -S "$src" -B "$build" \
+            -DCMAKE_PREFIX_PATH="$VENV" -DCMAKE_INSTALL_PREFIX="$prefix" \
             -DPython3_EXECUTABLE="$VENV/bin/python3" -DBUILD_TESTING=OFF \
-            -DCMAKE_BUILD_TYPE=Release >"$BUILD/rod_ig_msgs/cmake.log" 2>&1 \
-        && "$VENV/bin/cmake" --build "$MSG_BUILD" -j 2 >>"$BUILD/rod_ig_msgs/cmake.log" 2>&1 \
-        && "$VENV/bin/cmake" --install "$MSG_BUILD" >>"$BUILD/rod_ig_msgs/cmake.log" 2>&1
-    ) || { log "ERROR: building rod_ig_msgs failed; last lines of $BUILD/rod_ig_msgs/cmake.log:";
-           tail -n 30 "$BUILD/rod_ig_msgs/cmake.log" >&2; exit 1; }
-    printf '%s' "$msg_hash" > "$msg_stamp"
-else
-    log "rod_ig_msgs up to date in $MSG_PREFIX"
-fi
+            -DCMAKE_BUILD_TYPE=Release >"$BUILD/$name/cmake.log" 2>&1 \
+        && "$VENV/bin/cmake" --build "$build" -j 2 >>"$BUILD/$name/cmake.log" 2>&1 \
+        && "$VENV/bin/cmake" --install "$build" >>"$BUILD/$name/cmake.log" 2>&1
+    ) || { log "ERROR: building $name failed; last lines of $BUILD/$name/cmake.log:";
+           tail -n 30 "$BUILD/$name/cmake.log" >&2; exit 1; }
+    printf '%s' "$hash" > "$prefix/.rod-ig-msgs-hash"
+}
+build_interfaces rod_ig_msgs "$REPO/msg"
+build_interfaces tf2_msgs "$REPO/tests/interfaces/tf2_msgs"
 log "done; use: source $REPO/scripts/env.sh"

@@ -217,7 +217,8 @@ def test_diagnostics_report_solves_failures_and_latency(node_and_client):
         assert any(k.startswith("failed: ") and "reach" in k for k in values), values
         # Issue 20: failure keys are typed reasons (a bounded set), never free text or numbers.
         typed = {"unreachable", "non_planar", "invalid_input", "deadline", "no_stable_solution",
-                 "iteration_limit", "singular", "left_stable_set", "stalled", "evaluation_failed"}
+                 "iteration_limit", "singular", "left_stable_set", "stalled", "evaluation_failed",
+                 "tf_lookup"}
         reasons = [k.removeprefix("failed: ") for k in values if k.startswith("failed: ")]
         assert set(reasons) <= typed, reasons
         assert st.hardware_id == "/rod_ig_node", st.hardware_id

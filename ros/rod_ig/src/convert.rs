@@ -50,13 +50,28 @@ pub enum TargetError {
     /// The weight parameters cannot be used (see [`gravity_of`]).
     #[error("{0}")]
     Weight(String),
+    /// The target's frame could not be transformed into `base_frame` (`use_tf`).
+    #[error(
+        "cannot transform the target from frame {frame:?} to {base:?} within {timeout} s: {why}"
+    )]
+    Frame {
+        /// The target's frame.
+        frame: String,
+        /// `base_frame`.
+        base: String,
+        /// `tf_timeout` (s).
+        timeout: f64,
+        /// What TF said.
+        why: String,
+    },
 }
 
 impl TargetError {
     /// The bounded key the diagnostics count this refusal by: "unreachable" as the solver
-    /// says it, "non_planar", or "invalid_input" (non-finite, not a rotation).
+    /// says it, "non_planar", "invalid_input" (non-finite, not a rotation) or "tf_lookup".
     pub fn key(&self) -> &'static str {
         match self {
+            Self::Frame { .. } => "tf_lookup",
             Self::OutOfReach { .. } => "unreachable",
             Self::OffPlane { .. } | Self::Tilted { .. } => "non_planar",
             Self::NonFinite(_) | Self::ZeroQuaternion(_) | Self::Weight(_) => "invalid_input",

@@ -70,6 +70,33 @@ pub struct Vector3 {
     pub z: f64,
 }
 
+/// `geometry_msgs/msg/Transform`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Transform {
+    /// Translation (m).
+    pub translation: Vector3,
+    /// Rotation.
+    pub rotation: Quaternion,
+}
+
+/// `geometry_msgs/msg/TransformStamped`: the pose of `child_frame_id` in `header.frame_id`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TransformStamped {
+    /// Stamp and parent frame.
+    pub header: Header,
+    /// Child frame.
+    pub child_frame_id: String,
+    /// The child's pose in the parent.
+    pub transform: Transform,
+}
+
+/// `tf2_msgs/msg/TFMessage`, what `/tf` and `/tf_static` carry.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TfMessage {
+    /// The transforms.
+    pub transforms: Vec<TransformStamped>,
+}
+
 /// `geometry_msgs/msg/Quaternion` (x, y, z, w order on the wire).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Quaternion {
@@ -132,6 +159,7 @@ pub struct WrenchStamped {
     pub wrench: Wrench,
 }
 impl Message for WrenchStamped {}
+impl Message for TfMessage {}
 
 /// `nav_msgs/msg/Path`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -404,6 +432,10 @@ impl Message for DiagnosticArray {}
 pub mod type_names {
     use super::*;
 
+    /// `tf2_msgs/msg/TFMessage`.
+    pub fn tf_message() -> MessageTypeName {
+        MessageTypeName::new("tf2_msgs", "TFMessage")
+    }
     /// `geometry_msgs/msg/PoseStamped`.
     pub fn pose_stamped() -> MessageTypeName {
         MessageTypeName::new("geometry_msgs", "PoseStamped")

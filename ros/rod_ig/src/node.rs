@@ -53,11 +53,12 @@ use tokio::sync::{mpsc, oneshot, watch};
 use crate::diagnostics::SolveStats;
 use crate::messages::{
     type_names, Marker, Path, PlanRodRequest, PlanRodResponse, PoseStamped, RodSolution,
-    SolveRodRequest, SolveRodResponse, WrenchStamped,
+    SolveRodRequest, SolveRodResponse, TfMessage, WrenchStamped,
 };
 use crate::params::{Params, Startup};
 use crate::pipeline::{Outcome, Overrides, Processor};
 use crate::ros_args::{LogLevel as RosLevel, NodeIdentity};
+use crate::tf_buffer::TfBuffer;
 use ros2_client::rosout::RosoutRaw;
 
 pub use crate::graph::{names, NODE_NAME};
@@ -211,6 +212,19 @@ pub fn topic_qos() -> QosProfile {
 /// DDS does not), so a client that takes "the next solution" would get the previous one.
 pub fn output_qos() -> QosProfile {
     topic_qos()
+}
+
+/// QoS of `/tf` (reliable, volatile, keep last 100) and `/tf_static` (transient local, so that
+/// the transforms published before the node started reach it), as tf2's listener.
+pub fn tf_qos(is_static: bool) -> QosProfile {
+    QosProfile::publisher_default()
+        .reliability_reliable(WhenFull::DEFAULT)
+        .durability(if is_static {
+            Durability::TransientLocal
+        } else {
+            Durability::Volatile
+        })
+        .history(History::KeepLast { depth: 100 })
 }
 
 /// QoS of an endpoint, from its `qos_overrides` parameters.
@@ -487,6 +501,8 @@ fn spawn_solver_thread(
 /// it holds, for `use_current` plans).
 struct SolverLinks {
     params_rx: watch::Receiver<Params>,
+    /// What `/tf` and `/tf_static` said ([`receive_tf`]).
+    tf: Arc<std::sync::Mutex<TfBuffer>>,
     target_rx: watch::Receiver<Option<PoseStamped>>,
     job_rx: mpsc::Receiver<SolveJob>,
     held_tx: watch::Sender<Option<PlanarParams>>,
@@ -558,6 +574,8 @@ fn ready_message(
 /// The node's topics and output publishers, created before the solver warms up.
 struct Endpoints {
     target_topic: ros2_client::dds::rustdds::Topic,
+    /// `/tf` and `/tf_static` (tf2_msgs/TFMessage).
+    tf_topics: [ros2_client::dds::rustdds::Topic; 2],
     solve_name: Name,
     plan_name: Name,
     diagnostics: Publisher<crate::messages::DiagnosticArray>,
@@ -587,6 +605,17 @@ fn create_endpoints(
     let plan_rods_topic = topic(node, names::PLAN_RODS, type_names::marker())?;
     let diagnostics_topic = topic(node, names::DIAGNOSTICS, type_names::diagnostic_array())?;
     let wrench_topic = topic(node, names::BASE_WRENCH, type_names::wrench_stamped())?;
+    // Absolute, as tf2's: not under the node's namespace (remappable).
+    let tf_topic = |name: &str| -> Result<_, NodeError> {
+        let (n, _) = resolved_name(identity, name)?;
+        node.create_topic(
+            &n,
+            type_names::tf_message(),
+            &tf_qos(name == names::TF_STATIC),
+        )
+        .map_err(create_err("topic"))
+    };
+    let tf_topics = [tf_topic(names::TF)?, tf_topic(names::TF_STATIC)?];
     let (solve_name, solve_full) = resolved_name(identity, names::SOLVE)?;
     let (plan_name, plan_full) = resolved_name(identity, names::PLAN)?;
     let diagnostics = node
@@ -622,6 +651,7 @@ fn create_endpoints(
     };
     let endpoints = Endpoints {
         target_topic,
+        tf_topics,
         solve_name,
         plan_name,
         diagnostics,
@@ -631,9 +661,11 @@ fn create_endpoints(
     Ok((endpoints, outputs))
 }
 
-/// The node's inputs: the target subscription and the two services.
+/// The node's inputs: the target subscription, the two services and TF.
 struct Inputs {
     targets: ros2_client::Subscription<PoseStamped>,
+    /// `/tf`, then `/tf_static`.
+    tf: [ros2_client::Subscription<TfMessage>; 2],
     /// The resolved target topic (for the logs).
     target_name: String,
     solve: ros2_client::Server<SolveRodRequest, SolveRodResponse>,
@@ -649,7 +681,17 @@ fn create_inputs(
     params: &Params,
 ) -> Result<Inputs, NodeError> {
     let qos = topic_qos();
+    let [tf, tf_static] = &endpoints.tf_topics;
+    let mut tf_subscription = |topic, is_static| {
+        node.create_subscription::<TfMessage>(topic, Some(tf_qos(is_static)))
+            .map_err(create_err("/tf subscription"))
+    };
+    let tf = [
+        tf_subscription(tf, false)?,
+        tf_subscription(tf_static, true)?,
+    ];
     Ok(Inputs {
+        tf,
         target_name: endpoints.resolved[0].clone(),
         targets: node
             .create_subscription::<PoseStamped>(
@@ -680,16 +722,23 @@ fn create_inputs(
 
 /// Spawns the node's tasks: the subscriber (newest target into the slot), the two services
 /// (requests to the solver thread) and the diagnostics reporter.
+#[allow(clippy::too_many_arguments)]
 fn spawn_tasks(
     node: &Arc<ros2_client::Node>,
     inputs: Inputs,
+    tf: &Arc<std::sync::Mutex<TfBuffer>>,
     (diagnostics, diag_name): (Publisher<crate::messages::DiagnosticArray>, String),
     target_tx: watch::Sender<Option<PoseStamped>>,
     (solve_tx, plan_tx): (mpsc::Sender<SolveJob>, mpsc::Sender<PlanJob>),
     stats: &Arc<Stats>,
     log: &Logger,
-) -> [tokio::task::JoinHandle<()>; 4] {
+) -> [tokio::task::JoinHandle<()>; 6] {
     let logger = || log.clone();
+    let [tf_dynamic, tf_static] = inputs.tf;
+    let tf_tasks = [
+        tokio::spawn(receive_tf(tf_dynamic, Arc::clone(tf), false, logger())),
+        tokio::spawn(receive_tf(tf_static, Arc::clone(tf), true, logger())),
+    ];
     let subscriber = tokio::spawn(receive_targets(
         inputs.targets,
         target_tx,
@@ -724,7 +773,8 @@ fn spawn_tasks(
             stamp_if_zero(&mut request.target, || ros_now(&solve_clock))
         },
     ));
-    [subscriber, solve, plan, reporter]
+    let [tf_task, tf_static_task] = tf_tasks;
+    [subscriber, solve, plan, reporter, tf_task, tf_static_task]
 }
 
 /// Runs the node until SIGINT or SIGTERM.
@@ -761,7 +811,7 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
 struct Running {
     logger: Logger,
     stats: Arc<Stats>,
-    tasks: [tokio::task::JoinHandle<()>; 4],
+    tasks: [tokio::task::JoinHandle<()>; 6],
     threads: [std::thread::JoinHandle<()>; 2],
     node: Arc<ros2_client::Node>,
     spin_task: tokio::task::JoinHandle<()>,
@@ -804,6 +854,7 @@ async fn start(startup: Startup, mw: MiddlewareConfig) -> Result<Running, NodeEr
     let tasks = spawn_tasks(
         &node,
         inputs,
+        &workers.tf,
         (
             endpoints.diagnostics,
             format!("{}: inverse geometry", identity.fully_qualified_name()),
@@ -841,6 +892,8 @@ struct Workers {
     threads: [std::thread::JoinHandle<()>; 2],
     /// Fires when the solver's atlas is built (with its number of seeds).
     warm: oneshot::Receiver<usize>,
+    /// The transform buffer the TF tasks fill and the solver thread reads.
+    tf: Arc<std::sync::Mutex<TfBuffer>>,
     target_tx: watch::Sender<Option<PoseStamped>>,
     jobs: (mpsc::Sender<SolveJob>, mpsc::Sender<PlanJob>),
 }
@@ -857,6 +910,7 @@ fn start_workers(
     logger: &Logger,
 ) -> Result<Workers, NodeError> {
     let (target_tx, target_rx) = watch::channel::<Option<PoseStamped>>(None);
+    let tf = Arc::new(std::sync::Mutex::new(TfBuffer::new(TF_CACHE_SECONDS)));
     let (solve_tx, solve_rx) = mpsc::channel::<SolveJob>(16);
     let (plan_tx, plan_rx) = mpsc::channel::<PlanJob>(16);
     let (held_tx, held_rx) = watch::channel::<Option<PlanarParams>>(None);
@@ -870,6 +924,7 @@ fn start_workers(
     )?;
     let links = SolverLinks {
         params_rx,
+        tf: Arc::clone(&tf),
         target_rx,
         job_rx: solve_rx,
         held_tx,
@@ -884,6 +939,7 @@ fn start_workers(
     Ok(Workers {
         threads: [solver, planner],
         warm,
+        tf,
         target_tx,
         jobs: (solve_tx, plan_tx),
     })
@@ -905,7 +961,7 @@ fn log_shutdown(logger: &Logger, signal: &str, stats: &Stats) {
 /// Stops the tasks, lets the solver thread finish its solve in progress (bounded by its
 /// deadline), then drops the node and waits for the spinner.
 async fn shut_down(
-    tasks: [tokio::task::JoinHandle<()>; 4],
+    tasks: [tokio::task::JoinHandle<()>; 6],
     threads: [std::thread::JoinHandle<()>; 2],
     node: Arc<ros2_client::Node>,
     spin_task: tokio::task::JoinHandle<()>,
@@ -986,6 +1042,74 @@ async fn receive_targets(
                 target_tx.send_replace(Some(msg));
             }
             Err(e) => node_log!(log, Warn, "{topic}: dropped a bad message: {e:?}"),
+        }
+    }
+}
+
+/// Transforms kept per dynamic frame (tf2's default cache).
+const TF_CACHE_SECONDS: f64 = 10.0;
+/// How often a target waiting for its transform looks again.
+const TF_POLL: std::time::Duration = std::time::Duration::from_millis(5);
+
+/// A TF task: every transform of `/tf` (or `/tf_static`) into the buffer; one that tf2 would
+/// refuse (empty or '/'-led frame id, non-finite, not a rotation) is logged and skipped.
+async fn receive_tf(
+    subscription: ros2_client::Subscription<TfMessage>,
+    buffer: Arc<std::sync::Mutex<TfBuffer>>,
+    is_static: bool,
+    log: Logger,
+) {
+    let topic = if is_static {
+        names::TF_STATIC
+    } else {
+        names::TF
+    };
+    let mut stream = pin!(subscription.async_stream());
+    while let Some(item) = stream.next().await {
+        let msg = match item {
+            Ok((msg, _info)) => msg,
+            Err(e) => {
+                node_log!(log, Warn, "{topic}: dropped a bad message: {e:?}");
+                continue;
+            }
+        };
+        let Ok(mut b) = buffer.lock() else { break };
+        for t in &msg.transforms {
+            if let Err(e) = b.insert(&crate::tf_buffer::from_message(t), is_static) {
+                log::debug!("{topic}: {e}");
+            }
+        }
+    }
+}
+
+/// The target in `base_frame` when `use_tf` is on and it is stamped in another frame: its
+/// transform at its stamp, waited for up to `tf_timeout`; else the target as it is.
+async fn resolve_frame(
+    target: &PoseStamped,
+    params: &Params,
+    buffer: &std::sync::Mutex<TfBuffer>,
+) -> Result<PoseStamped, crate::convert::TargetError> {
+    let frame = &target.header.frame_id;
+    if !params.use_tf || frame.is_empty() || *frame == params.base_frame {
+        return Ok(target.clone());
+    }
+    let until = std::time::Instant::now() + std::time::Duration::from_secs_f64(params.tf_timeout);
+    loop {
+        let looked_up = match buffer.lock() {
+            Ok(b) => crate::tf_buffer::pose_in_frame(&b, &params.base_frame, target),
+            Err(_) => return Ok(target.clone()),
+        };
+        match looked_up {
+            Ok(t) => return Ok(t),
+            Err(e) if std::time::Instant::now() >= until => {
+                return Err(crate::convert::TargetError::Frame {
+                    frame: frame.clone(),
+                    base: params.base_frame.clone(),
+                    timeout: params.tf_timeout,
+                    why: e.to_string(),
+                })
+            }
+            Err(_) => tokio::time::sleep(TF_POLL).await,
         }
     }
 }
@@ -1123,6 +1247,7 @@ async fn solver_loop(
 ) {
     let SolverLinks {
         mut params_rx,
+        tf,
         mut target_rx,
         mut job_rx,
         held_tx,
@@ -1133,10 +1258,25 @@ async fn solver_loop(
         tokio::select! {
             biased;
             job = job_rx.recv() => {
-                let Some((request, reply)) = job else { break };
+                let Some((mut request, reply)) = job else { break };
                 let params = params_rx.borrow_and_update().clone();
-                let response =
-                    serve_solve(&mut processor, &request, &params, &stats, &log, &outputs.names);
+                let response = match resolve_frame(&request.target, &params, &tf).await {
+                    Ok(target) => {
+                        request.target = target;
+                        serve_solve(&mut processor, &request, &params, &stats, &log, &outputs.names)
+                    }
+                    Err(e) => {
+                        node_log!(log, Warn, "{}: {e}", outputs.names.solve);
+                        let outcome = Processor::refused(&request.target, &params, e);
+                        SolveRodResponse {
+                            path: Path {
+                                header: outcome.solution.header.clone(),
+                                poses: Vec::new(),
+                            },
+                            solution: outcome.solution,
+                        }
+                    }
+                };
                 let _ = reply.send(response); // the caller may have gone
             }
             changed = target_rx.changed() => {
@@ -1154,6 +1294,16 @@ async fn solver_loop(
                 }
                 let params = params_rx.borrow().clone();
                 let started = std::time::Instant::now();
+                let target = match resolve_frame(&target, &params, &tf).await {
+                    Ok(t) => t,
+                    Err(e) => {
+                        let outcome = Processor::refused(&target, &params, e);
+                        let work = Counters::default();
+                        report(&log, &stats, &outputs.names.target, &outcome, &work, started.elapsed());
+                        publish(&log, &outputs, outcome);
+                        continue;
+                    }
+                };
                 let (outcome, work) = observe(Counters::default(), || {
                     processor.process(&target, &params, &Overrides::default())
                 });

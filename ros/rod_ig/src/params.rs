@@ -86,6 +86,14 @@ pub struct Params {
     /// `use_sim_time` (rclcpp's built-in): stamp outputs of targets stamped zero with the time
     /// of `/clock` (rosgraph_msgs/msg/Clock) instead of the system clock.
     pub use_sim_time: bool,
+    /// `use_tf`: a target stamped in another frame than `base_frame` is transformed into it
+    /// through TF (`/tf`, `/tf_static`) at its stamp (stamp zero: the latest transform), and
+    /// the outputs carry `base_frame`; false (default): a target's frame is taken as the base
+    /// gripper's and echoed.
+    pub use_tf: bool,
+    /// `tf_timeout` in [0, 10] s: how long a target waits for its transform before it is
+    /// refused with the frame named (default 0.2 s).
+    pub tf_timeout: f64,
     /// `qos_overrides.<topic>.{subscription,publisher}.{reliability,durability,history,depth}`:
     /// the QoS of the target subscription and of every publisher, read-only (set at
     /// start-up), as rclcpp's `QosOverridingOptions`. Topics by their resolved names.
@@ -188,6 +196,8 @@ impl Default for Params {
             follow_branch: false,
             deadline_ms: 0.0,
             use_sim_time: false,
+            use_tf: false,
+            tf_timeout: 0.0,
             qos_overrides: QosOverride::for_node(|n| {
                 Ok::<_, std::convert::Infallible>(if n.starts_with('/') {
                     n.to_string()
@@ -316,7 +326,7 @@ const MAX_DEADLINE_MS: f64 = rod_ig_core::planar::ig::MAX_DEADLINE.as_secs_f64()
 const MAX_PATH_SAMPLES: i64 = 100_000;
 
 /// Every parameter of `rod_ig_node` (beside the `qos_overrides` ones), in declaration order.
-const TABLE: [Spec; 16] = [
+const TABLE: [Spec; 18] = [
     Spec {
         name: "rod_length",
         kind: Kind::Double {
@@ -545,6 +555,35 @@ const TABLE: [Spec; 16] = [
         get: |p| ParameterValue::Boolean(p.use_sim_time),
         set: |p, v| {
             p.use_sim_time = bool_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "use_tf",
+        kind: Kind::Bool,
+        default: DefaultValue::Bool(false),
+        description: "Transform targets stamped in another frame into base_frame through TF \
+                      (/tf, /tf_static) at their stamp; false: a target's frame is the base's",
+        constraints: "",
+        get: |p| ParameterValue::Boolean(p.use_tf),
+        set: |p, v| {
+            p.use_tf = bool_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "tf_timeout",
+        kind: Kind::Double {
+            lo: 0.0,
+            hi: 10.0,
+            lo_open: false,
+        },
+        default: DefaultValue::Double(0.2),
+        description: "How long a target waits for its transform (s) before it is refused",
+        constraints: "",
+        get: |p| ParameterValue::Double(p.tf_timeout),
+        set: |p, v| {
+            p.tf_timeout = f64_of(v);
             Ok(())
         },
     },
@@ -1543,7 +1582,8 @@ mod tests {
     /// the node does not have is skipped.
     #[test]
     fn params_file_sections_as_rcl_reads_them() {
-        let dir = std::env::temp_dir().join(format!("rod_ig_params_{}", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("rod_ig_params_sections_{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let cases: [(&str, &[&str], Option<i64>); 9] = [
             (

@@ -265,6 +265,26 @@ impl Processor {
         }
     }
 
+    /// The answer to a target refused before any solve (its frame could not be resolved):
+    /// the failure with its reason and key, no path, in `base_frame` as every output under
+    /// `use_tf`.
+    pub fn refused(
+        target: &PoseStamped,
+        params: &Params,
+        e: crate::convert::TargetError,
+    ) -> Outcome {
+        let mut header = output_header(&target.header, params);
+        if params.use_tf {
+            header.frame_id.clone_from(&params.base_frame);
+        }
+        Outcome {
+            failure: e.key(),
+            solution: failure_message(e.to_string(), None, &header, params, 0.0),
+            path: None,
+            marker: None,
+        }
+    }
+
     /// As [`Processor::process`], without side effects: the held rod and the warm starts are
     /// as they were before the call (`rod/solve` without `move_rod`).
     pub fn query(

@@ -358,6 +358,57 @@ fn isometry(t: &StampedTransform) -> Option<Isometry3<f64>> {
     ))
 }
 
+/// The target `pose` (stamped in its frame) in frame `base` at its stamp (stamp zero: the
+/// latest transforms, tf2's time 0), its header's frame then `base`.
+pub fn pose_in_frame(
+    buffer: &TfBuffer,
+    base: &str,
+    pose: &crate::messages::PoseStamped,
+) -> Result<crate::messages::PoseStamped, LookupError> {
+    let stamp = &pose.header.stamp;
+    let time = (stamp.sec != 0 || stamp.nanosec != 0)
+        .then(|| i64::from(stamp.sec) * 1_000_000_000 + i64::from(stamp.nanosec));
+    let t = buffer.lookup(base, &pose.header.frame_id, time)?;
+    let p = &pose.pose.position;
+    let q = &pose.pose.orientation;
+    let norm = Quaternion::new(q.w, q.x, q.y, q.z).norm();
+    if !(norm.is_finite() && norm > 1e-9 && [p.x, p.y, p.z].iter().all(|v| v.is_finite())) {
+        // Left as it is for the target's own checks to refuse (non-finite, not a rotation).
+        let mut out = pose.clone();
+        out.header.frame_id = base.to_string();
+        return Ok(out);
+    }
+    let position = t * nalgebra::Point3::new(p.x, p.y, p.z);
+    let rotation = t.rotation * UnitQuaternion::new_normalize(Quaternion::new(q.w, q.x, q.y, q.z));
+    let mut out = pose.clone();
+    out.header.frame_id = base.to_string();
+    out.pose.position = crate::messages::Point {
+        x: position.x,
+        y: position.y,
+        z: position.z,
+    };
+    let r = rotation.quaternion();
+    out.pose.orientation = crate::messages::Quaternion {
+        x: r.i,
+        y: r.j,
+        z: r.k,
+        w: r.w,
+    };
+    Ok(out)
+}
+
+/// A `/tf` or `/tf_static` transform as the buffer takes it.
+pub fn from_message(t: &crate::messages::TransformStamped) -> StampedTransform {
+    let (tr, r) = (&t.transform.translation, &t.transform.rotation);
+    StampedTransform {
+        parent: t.header.frame_id.clone(),
+        child: t.child_frame_id.clone(),
+        stamp: i64::from(t.header.stamp.sec) * 1_000_000_000 + i64::from(t.header.stamp.nanosec),
+        translation: [tr.x, tr.y, tr.z],
+        rotation: [r.x, r.y, r.z, r.w],
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -493,6 +544,54 @@ mod tests {
         b.insert(&nan, false).unwrap();
         let t = b.lookup("w", "a", None).unwrap();
         assert!((t.rotation.quaternion().norm() - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_target_pose_is_expressed_in_the_base_frame() {
+        use crate::messages::{Header, Point, Pose, PoseStamped, Quaternion as Q, Time};
+        let mut b = TfBuffer::new(10.0);
+        // world → rod_base: 1 m along world x, turned 90° (rod_base x = world y).
+        b.insert(
+            &tf("world", "rod_base", 0, [1.0, 0.0, 0.0], FRAC_PI_2),
+            true,
+        )
+        .unwrap();
+        let yaw = 0.3f64;
+        let target = PoseStamped {
+            header: Header {
+                stamp: Time { sec: 5, nanosec: 0 },
+                frame_id: "world".into(),
+            },
+            pose: Pose {
+                position: Point {
+                    x: 1.0,
+                    y: 0.6,
+                    z: 0.0,
+                },
+                orientation: Q {
+                    x: 0.0,
+                    y: 0.0,
+                    z: (yaw / 2.0).sin(),
+                    w: (yaw / 2.0).cos(),
+                },
+            },
+        };
+        let t = pose_in_frame(&b, "rod_base", &target).unwrap();
+        assert_eq!(t.header.frame_id, "rod_base");
+        assert_eq!(t.header.stamp, target.header.stamp);
+        let p = &t.pose.position;
+        assert!(
+            (p.x - 0.6).abs() < 1e-12 && p.y.abs() < 1e-12 && p.z.abs() < 1e-12,
+            "{p:?}"
+        );
+        let o = &t.pose.orientation;
+        let got = 2.0 * o.z.atan2(o.w);
+        assert!((got - (yaw - FRAC_PI_2)).abs() < 1e-12, "{got}");
+        // An unknown frame names itself.
+        let mut lost = target.clone();
+        lost.header.frame_id = "camera".into();
+        let e = pose_in_frame(&b, "rod_base", &lost).unwrap_err();
+        assert!(e.to_string().contains("camera"));
     }
 
     #[test]

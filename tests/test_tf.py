@@ -1,0 +1,112 @@
+"""TF (issue 43, item 1): with `use_tf`, a target stamped in another frame is transformed into
+`base_frame` through /tf and /tf_static at its stamp, the outputs carry `base_frame`, and a
+frame TF cannot resolve within `tf_timeout` is refused with the frame named. Without it (the
+default) a target's frame is echoed as before.
+
+The broadcasters are tf2's: /tf_static transient local (published before the node looks),
+/tf volatile, both reliable with depth 100; tf2_msgs' TFMessage is built from its one-line
+definition (tests/interfaces/tf2_msgs), as the package index carries no tf2_msgs wheel."""
+import math
+
+import pytest
+from geometry_msgs.msg import TransformStamped
+from rclpy.qos import QoSDurabilityPolicy, QoSHistoryPolicy, QoSProfile, QoSReliabilityPolicy
+from tf2_msgs.msg import TFMessage
+
+import rodig_harness as h
+
+POS_TOL = 1e-5
+
+
+def tf_qos(static: bool) -> QoSProfile:
+    durability = QoSDurabilityPolicy.TRANSIENT_LOCAL if static else QoSDurabilityPolicy.VOLATILE
+    return QoSProfile(reliability=QoSReliabilityPolicy.RELIABLE, durability=durability,
+                      history=QoSHistoryPolicy.KEEP_LAST, depth=100)
+
+
+def transform(parent: str, child: str, xyz, yaw: float, sec: int = 0, nanosec: int = 0):
+    t = TransformStamped()
+    t.header.frame_id, t.child_frame_id = parent, child
+    t.header.stamp.sec, t.header.stamp.nanosec = sec, nanosec
+    t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = map(float, xyz)
+    t.transform.rotation.z, t.transform.rotation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+    return t
+
+
+@pytest.fixture(scope="module")
+def tf_node():
+    node, client = h.start_node_and_client(["--ros-args", "-p", "use_tf:=true", "-p", "tf_timeout:=0.5"])
+    static_pub = client.node.create_publisher(TFMessage, "/tf_static", tf_qos(True))
+    dynamic_pub = client.node.create_publisher(TFMessage, "/tf", tf_qos(False))
+    # world -> rod_base: the base gripper 0.3 m along world x, turned +90 deg about z.
+    static_pub.publish(TFMessage(transforms=[transform("world", "rod_base", (0.3, 0.0, 0.0), math.pi / 2)]))
+    try:
+        yield node, client, dynamic_pub
+    finally:
+        h.stop_node_and_client(node, client)
+
+
+def world_target(c, x, y, yaw, seq, frame="world"):
+    return c.make_target(x, y, yaw, seq, frame=frame)
+
+
+def test_a_target_in_world_is_solved_in_the_base_frame(tf_node):
+    node, c, _ = tf_node
+    # In rod_base (x = world y, y = -world x, origin at world (0.3, 0)): the point
+    # (0.6, 0.2) of rod_base is world (0.3 - 0.2, 0.6) = (0.1, 0.6); its yaw 0.5 is world 0.5 + pi/2.
+    s = h.next_seq()
+    c.pub.publish(world_target(c, 0.1, 0.6, 0.5 + math.pi / 2, s))
+    sol = c.solution_for(s)
+    assert sol is not None and sol.success, sol and sol.message
+    assert sol.header.frame_id == "rod_base"
+    assert abs(sol.tip.position.x - 0.6) < POS_TOL and abs(sol.tip.position.y - 0.2) < POS_TOL
+    assert abs(h.quaternion_yaw(sol.tip.orientation) - 0.5) < POS_TOL
+    path = c.path_for(s)
+    assert path.header.frame_id == "rod_base"
+    # The service resolves frames the same way.
+    r = c.solve(world_target(c, 0.1, 0.6, 0.5 + math.pi / 2, h.next_seq()))
+    assert r.solution.success and r.solution.header.frame_id == "rod_base"
+    assert abs(r.solution.tip.position.x - 0.6) < POS_TOL
+
+
+def test_an_unknown_frame_is_refused_with_its_name(tf_node):
+    _, c, _ = tf_node
+    s = h.next_seq()
+    c.pub.publish(world_target(c, 0.6, 0.2, 0.5, s, frame="camera_link"))
+    sol = c.solution_for(s)
+    assert sol is not None and not sol.success
+    assert "camera_link" in sol.message and "rod_base" in sol.message, sol.message
+    assert sol.header.frame_id == "rod_base"
+
+
+def test_dynamic_transforms_are_interpolated_at_the_stamp(tf_node):
+    _, c, tf_pub = tf_node
+    # rod_base -> gripper_cam moves from x = 0 at t = 1000 s to x = 0.2 at t = 1002 s.
+    tf_pub.publish(TFMessage(transforms=[transform("rod_base", "gripper_cam", (0.0, 0.0, 0.0), 0.0, sec=1000)]))
+    tf_pub.publish(TFMessage(transforms=[transform("rod_base", "gripper_cam", (0.2, 0.0, 0.0), 0.0, sec=1002)]))
+    # make_target stamps seq s at 1000 s + s ns: at ~1000 s, x offset ~0 ... so stamp it at
+    # 1001 s by hand: the offset there is 0.1.
+    s = h.next_seq()
+    t = world_target(c, 0.5, 0.2, 0.3, s, frame="gripper_cam")
+    t.header.stamp.sec, t.header.stamp.nanosec = 1001, 0
+    c.pub.publish(t)
+    sol = c.wait_for(lambda: next((m for m in c.solutions
+                                   if (m.header.stamp.sec, m.header.stamp.nanosec) == (1001, 0)), None))
+    assert sol is not None and sol.success, sol and sol.message
+    assert abs(sol.tip.position.x - 0.6) < POS_TOL and abs(sol.tip.position.y - 0.2) < POS_TOL
+    # Past the last transform: extrapolation, refused with the frame named.
+    t.header.stamp.sec = 1005
+    r = c.solve(t)
+    assert not r.solution.success and "gripper_cam" in r.solution.message, r.solution.message
+
+
+def test_without_use_tf_the_frame_is_echoed():
+    node, c = h.start_node_and_client()
+    try:
+        s = h.next_seq()
+        c.pub.publish(c.make_target(0.6, 0.2, 0.5, s, frame="world"))
+        sol = c.solution_for(s)
+        assert sol is not None and sol.success and sol.header.frame_id == "world"
+        assert abs(sol.tip.position.x - 0.6) < POS_TOL
+    finally:
+        h.stop_node_and_client(node, c)
