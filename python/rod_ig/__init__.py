@@ -186,7 +186,7 @@ class SolveResult:
     position_error: FloatArray
     orientation_error: FloatArray
     starts: npt.NDArray[np.uint32]
-    """(...): starts tried by the search (0 where it failed)."""
+    """(...): starts tried by the search (branches followed included), also where it failed."""
     complete: BoolArray
     """(...): the search ran to its end; False where the deadline cut a least-energy search
     or the ``all`` list (the rod returned is stable and on target, but one of less energy, or

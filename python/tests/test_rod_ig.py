@@ -526,3 +526,11 @@ def test_one_target_gives_scalars() -> None:
     assert f.tip.shape == (3,) and f.jacobian.shape == (3, 3)
     # Batches keep their arrays.
     assert rod_ig.solve([[0.5, 0.2, 1.0]]).success.shape == (1,)
+
+
+def test_a_failure_counts_its_starts_and_says_what_was_searched() -> None:
+    # Within reach but bent back on itself at full extension: no stable rod gets there.
+    r = rod_ig.solve(np.array([0.999, 0.0, 3.0]))
+    assert not r.success and r.termination == "no_stable_solution"
+    assert r.starts > 0
+    assert "Newton starts" in r.reason and "branches followed" in r.reason
