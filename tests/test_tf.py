@@ -7,6 +7,7 @@ The broadcasters are tf2's: /tf_static transient local (published before the nod
 /tf volatile, both reliable with depth 100; tf2_msgs' TFMessage is built from its one-line
 definition (tests/interfaces/tf2_msgs), as the package index carries no tf2_msgs wheel."""
 import math
+import time
 
 import pytest
 from geometry_msgs.msg import TransformStamped
@@ -108,5 +109,38 @@ def test_without_use_tf_the_frame_is_echoed():
         sol = c.solution_for(s)
         assert sol is not None and sol.success and sol.header.frame_id == "world"
         assert abs(sol.tip.position.x - 0.6) < POS_TOL
+    finally:
+        h.stop_node_and_client(node, c)
+
+
+def test_the_node_follows_the_tip_frame():
+    node, c = h.start_node_and_client(["--ros-args", "-p", "use_tf:=true", "-p", "tip_frame:=tip_gripper",
+                                       "-p", "tf_rate:=50.0"])
+    try:
+        pub = c.node.create_publisher(TFMessage, "/tf", tf_qos(False))
+
+        def tip_solution(x, y, yaw, sec, z=0.0):
+            t = transform("rod_base", "tip_gripper", (x, y, z), yaw, sec=sec)
+            # Published until the node answers (its subscription may still be matching).
+            deadline = time.monotonic() + 10
+            while time.monotonic() < deadline:
+                pub.publish(TFMessage(transforms=[t]))
+                sol = c.wait_for(lambda: next((m for m in c.solutions if m.header.stamp.sec == sec), None), 0.2)
+                if sol is not None:
+                    return sol
+            return None
+
+        sol = tip_solution(0.6, 0.2, 0.5, 2001)
+        assert sol is not None and sol.success, sol and sol.message
+        assert sol.header.frame_id == "rod_base"
+        assert abs(sol.tip.position.x - 0.6) < POS_TOL and abs(sol.tip.position.y - 0.2) < POS_TOL
+        assert abs(h.quaternion_yaw(sol.tip.orientation) - 0.5) < POS_TOL
+        # The gripper moves: the rod follows (the stream's branch following, event set).
+        sol = tip_solution(0.55, 0.25, 0.6, 2002)
+        assert sol is not None and sol.success and sol.event in ("none", "snap")
+        assert abs(sol.tip.position.x - 0.55) < POS_TOL
+        # Out of the base's plane, without solve_3d: refused with its offset.
+        sol = tip_solution(0.55, 0.25, 0.6, 2003, z=0.05)
+        assert sol is not None and not sol.success and "not planar" in sol.message, sol and sol.message
     finally:
         h.stop_node_and_client(node, c)

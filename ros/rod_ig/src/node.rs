@@ -726,18 +726,26 @@ fn create_inputs(
 fn spawn_tasks(
     node: &Arc<ros2_client::Node>,
     inputs: Inputs,
-    tf: &Arc<std::sync::Mutex<TfBuffer>>,
+    (tf, params_rx): (&Arc<std::sync::Mutex<TfBuffer>>, watch::Receiver<Params>),
     (diagnostics, diag_name): (Publisher<crate::messages::DiagnosticArray>, String),
     target_tx: watch::Sender<Option<PoseStamped>>,
     (solve_tx, plan_tx): (mpsc::Sender<SolveJob>, mpsc::Sender<PlanJob>),
     stats: &Arc<Stats>,
     log: &Logger,
-) -> [tokio::task::JoinHandle<()>; 6] {
+) -> [tokio::task::JoinHandle<()>; 7] {
     let logger = || log.clone();
+    let target_tx = Arc::new(target_tx);
     let [tf_dynamic, tf_static] = inputs.tf;
     let tf_tasks = [
         tokio::spawn(receive_tf(tf_dynamic, Arc::clone(tf), false, logger())),
         tokio::spawn(receive_tf(tf_static, Arc::clone(tf), true, logger())),
+        tokio::spawn(follow_tip_frame(
+            params_rx,
+            Arc::clone(tf),
+            Arc::clone(&target_tx),
+            Arc::clone(stats),
+            logger(),
+        )),
     ];
     let subscriber = tokio::spawn(receive_targets(
         inputs.targets,
@@ -773,8 +781,16 @@ fn spawn_tasks(
             stamp_if_zero(&mut request.target, || ros_now(&solve_clock))
         },
     ));
-    let [tf_task, tf_static_task] = tf_tasks;
-    [subscriber, solve, plan, reporter, tf_task, tf_static_task]
+    let [tf_task, tf_static_task, follow_task] = tf_tasks;
+    [
+        subscriber,
+        solve,
+        plan,
+        reporter,
+        tf_task,
+        tf_static_task,
+        follow_task,
+    ]
 }
 
 /// Runs the node until SIGINT or SIGTERM.
@@ -811,7 +827,7 @@ pub async fn run(startup: Startup, mw: MiddlewareConfig) -> Result<(), NodeError
 struct Running {
     logger: Logger,
     stats: Arc<Stats>,
-    tasks: [tokio::task::JoinHandle<()>; 6],
+    tasks: [tokio::task::JoinHandle<()>; 7],
     threads: [std::thread::JoinHandle<()>; 2],
     node: Arc<ros2_client::Node>,
     spin_task: tokio::task::JoinHandle<()>,
@@ -854,7 +870,7 @@ async fn start(startup: Startup, mw: MiddlewareConfig) -> Result<Running, NodeEr
     let tasks = spawn_tasks(
         &node,
         inputs,
-        &workers.tf,
+        (&workers.tf, params_tx.subscribe()),
         (
             endpoints.diagnostics,
             format!("{}: inverse geometry", identity.fully_qualified_name()),
@@ -961,7 +977,7 @@ fn log_shutdown(logger: &Logger, signal: &str, stats: &Stats) {
 /// Stops the tasks, lets the solver thread finish its solve in progress (bounded by its
 /// deadline), then drops the node and waits for the spinner.
 async fn shut_down(
-    tasks: [tokio::task::JoinHandle<()>; 6],
+    tasks: [tokio::task::JoinHandle<()>; 7],
     threads: [std::thread::JoinHandle<()>; 2],
     node: Arc<ros2_client::Node>,
     spin_task: tokio::task::JoinHandle<()>,
@@ -1019,7 +1035,7 @@ fn start_spinner(
 /// unstamped targets get the node's clock time.
 async fn receive_targets(
     subscription: ros2_client::Subscription<PoseStamped>,
-    target_tx: watch::Sender<Option<PoseStamped>>,
+    target_tx: Arc<watch::Sender<Option<PoseStamped>>>,
     stats: Arc<Stats>,
     log: Logger,
     clock_node: Arc<ros2_client::Node>,
@@ -1050,6 +1066,90 @@ async fn receive_targets(
 const TF_CACHE_SECONDS: f64 = 10.0;
 /// How often a target waiting for its transform looks again.
 const TF_POLL: std::time::Duration = std::time::Duration::from_millis(5);
+
+/// The `tip_frame` task: at `tf_rate`, the tip gripper's frame in `base_frame` at the latest
+/// time TF knows it; each new pose goes to the solver as a target on `rod/target` would (so the
+/// rod follows its branch, and an out-of-plane pose is solved in 3-D or refused as a target
+/// is). Stamped with the transform's time (a static chain: the system time when it changes).
+async fn follow_tip_frame(
+    mut params_rx: watch::Receiver<Params>,
+    buffer: Arc<std::sync::Mutex<TfBuffer>>,
+    target_tx: Arc<watch::Sender<Option<PoseStamped>>>,
+    stats: Arc<Stats>,
+    log: Logger,
+) {
+    let mut last: Option<(Option<i64>, nalgebra::Isometry3<f64>)> = None;
+    let mut last_error = String::new();
+    loop {
+        let params = params_rx.borrow_and_update().clone();
+        if params.tip_frame.is_empty() {
+            last = None;
+            if params_rx.changed().await.is_err() {
+                break;
+            }
+            continue;
+        }
+        let looked_up = match buffer.lock() {
+            Ok(b) => b.lookup_latest(&params.base_frame, &params.tip_frame),
+            Err(_) => break,
+        };
+        match looked_up {
+            // A new pose (the same pose at a later stamp is not a new target).
+            Ok(now) if last.as_ref().map(|l| l.1) != Some(now.1) => {
+                last_error.clear();
+                let target = tip_target(&params.base_frame, now.0, &now.1);
+                stats.received.fetch_add(1, Ordering::Relaxed);
+                target_tx.send_replace(Some(target));
+                last = Some(now);
+            }
+            Ok(_) => {}
+            Err(e) => {
+                let e = e.to_string();
+                if e != last_error {
+                    node_log!(log, Warn, "tip_frame {:?}: {e}", params.tip_frame);
+                    last_error = e;
+                }
+            }
+        }
+        let period = std::time::Duration::from_secs_f64(1.0 / params.tf_rate);
+        tokio::select! {
+            _ = tokio::time::sleep(period) => {}
+            changed = params_rx.changed() => if changed.is_err() { break },
+        }
+    }
+}
+
+/// The tip frame's pose as a target in `base_frame`.
+fn tip_target(base: &str, time: Option<i64>, pose: &nalgebra::Isometry3<f64>) -> PoseStamped {
+    let nanos = time.unwrap_or_else(|| {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX))
+    });
+    let (t, q) = (&pose.translation.vector, pose.rotation.quaternion());
+    PoseStamped {
+        header: crate::messages::Header {
+            stamp: crate::messages::Time {
+                sec: i32::try_from(nanos.div_euclid(1_000_000_000)).unwrap_or(i32::MAX),
+                nanosec: nanos.rem_euclid(1_000_000_000) as u32,
+            },
+            frame_id: base.to_string(),
+        },
+        pose: crate::messages::Pose {
+            position: crate::messages::Point {
+                x: t.x,
+                y: t.y,
+                z: t.z,
+            },
+            orientation: crate::messages::Quaternion {
+                x: q.i,
+                y: q.j,
+                z: q.k,
+                w: q.w,
+            },
+        },
+    }
+}
 
 /// A TF task: every transform of `/tf` (or `/tf_static`) into the buffer; one that tf2 would
 /// refuse (empty or '/'-led frame id, non-finite, not a rotation) is logged and skipped.

@@ -94,6 +94,12 @@ pub struct Params {
     /// `tf_timeout` in [0, 10] s: how long a target waits for its transform before it is
     /// refused with the frame named (default 0.2 s).
     pub tf_timeout: f64,
+    /// `tip_frame`: when set, the node follows this TF frame (the tip gripper's) relative to
+    /// `base_frame`, solving for each new pose as for a target on `rod/target` (default
+    /// empty: off).
+    pub tip_frame: String,
+    /// `tf_rate` in (0, 1000] Hz: how often `tip_frame` is looked up (default 30).
+    pub tf_rate: f64,
     /// `qos_overrides.<topic>.{subscription,publisher}.{reliability,durability,history,depth}`:
     /// the QoS of the target subscription and of every publisher, read-only (set at
     /// start-up), as rclcpp's `QosOverridingOptions`. Topics by their resolved names.
@@ -198,6 +204,8 @@ impl Default for Params {
             use_sim_time: false,
             use_tf: false,
             tf_timeout: 0.0,
+            tip_frame: String::new(),
+            tf_rate: 0.0,
             qos_overrides: QosOverride::for_node(|n| {
                 Ok::<_, std::convert::Infallible>(if n.starts_with('/') {
                     n.to_string()
@@ -326,7 +334,7 @@ const MAX_DEADLINE_MS: f64 = rod_ig_core::planar::ig::MAX_DEADLINE.as_secs_f64()
 const MAX_PATH_SAMPLES: i64 = 100_000;
 
 /// Every parameter of `rod_ig_node` (beside the `qos_overrides` ones), in declaration order.
-const TABLE: [Spec; 18] = [
+const TABLE: [Spec; 20] = [
     Spec {
         name: "rod_length",
         kind: Kind::Double {
@@ -584,6 +592,40 @@ const TABLE: [Spec; 18] = [
         get: |p| ParameterValue::Double(p.tf_timeout),
         set: |p, v| {
             p.tf_timeout = f64_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "tip_frame",
+        kind: Kind::Str,
+        default: DefaultValue::Str(""),
+        description: "Follow this TF frame (the tip gripper's) relative to base_frame: each new \
+                      pose is solved as a target on rod/target; empty: off",
+        constraints: "empty, or a TF frame id",
+        get: |p| ParameterValue::String(p.tip_frame.clone()),
+        set: |p, v| {
+            let id = str_of(v);
+            p.tip_frame = if id.is_empty() {
+                String::new()
+            } else {
+                check_frame_id(id)?.to_string()
+            };
+            Ok(())
+        },
+    },
+    Spec {
+        name: "tf_rate",
+        kind: Kind::Double {
+            lo: 0.0,
+            hi: 1000.0,
+            lo_open: true,
+        },
+        default: DefaultValue::Double(30.0),
+        description: "How often tip_frame is looked up in TF (Hz)",
+        constraints: "",
+        get: |p| ParameterValue::Double(p.tf_rate),
+        set: |p, v| {
+            p.tf_rate = f64_of(v);
             Ok(())
         },
     },

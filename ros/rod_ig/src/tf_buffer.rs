@@ -233,6 +233,22 @@ impl TfBuffer {
         Ok(up_to(&up_target, j).inverse() * up_to(&up_source, i))
     }
 
+    /// The transform at the latest time every link of the chain is known (tf2's time 0),
+    /// with that time (`None`: the chain is static, valid at every time).
+    pub fn lookup_latest(
+        &self,
+        target: &str,
+        source: &str,
+    ) -> Result<(Option<Nanos>, Isometry3<f64>), LookupError> {
+        for f in [target, source] {
+            if !self.exists(f) {
+                return Err(LookupError::UnknownFrame(f.to_string()));
+            }
+        }
+        let time = self.latest_common_time(target, source)?;
+        Ok((time, self.lookup(target, source, time)?))
+    }
+
     fn exists(&self, frame: &str) -> bool {
         self.frames.contains_key(frame)
             || self.frames.values().any(|l| match l {
