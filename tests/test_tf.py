@@ -39,6 +39,11 @@ def tf_node():
     node, client = h.start_node_and_client(["--ros-args", "-p", "use_tf:=true", "-p", "tf_timeout:=0.5"])
     static_pub = client.node.create_publisher(TFMessage, "/tf_static", tf_qos(True))
     dynamic_pub = client.node.create_publisher(TFMessage, "/tf", tf_qos(False))
+    # The node's TF subscriptions matched first: a volatile /tf message sent before is lost.
+    deadline = time.monotonic() + 10
+    while min(static_pub.get_subscription_count(), dynamic_pub.get_subscription_count()) == 0:
+        assert time.monotonic() < deadline, "rod_ig_node did not subscribe to /tf and /tf_static"
+        time.sleep(0.05)
     # world -> rod_base: the base gripper 0.3 m along world x, turned +90 deg about z.
     static_pub.publish(TFMessage(transforms=[transform("world", "rod_base", (0.3, 0.0, 0.0), math.pi / 2)]))
     try:
@@ -142,5 +147,37 @@ def test_the_node_follows_the_tip_frame():
         # Out of the base's plane, without solve_3d: refused with its offset.
         sol = tip_solution(0.55, 0.25, 0.6, 2003, z=0.05)
         assert sol is not None and not sol.success and "not planar" in sol.message, sol and sol.message
+    finally:
+        h.stop_node_and_client(node, c)
+
+
+def test_gravity_comes_from_the_world_frame():
+    # The base gripper turned +90 deg about world x: world's down (-z) is the base's -y.
+    tilted = transform("world", "rod_base", (0.0, 0.0, 0.0), 0.0)
+    tilted.transform.rotation.x, tilted.transform.rotation.z = math.sin(math.pi / 4), 0.0
+    tilted.transform.rotation.w = math.cos(math.pi / 4)
+    node, c = h.start_node_and_client(["--ros-args", "-p", "world_frame:=world",
+                                       "-p", "linear_density:=0.005", "-p", "bending_stiffness:=0.01"])
+    try:
+        pub = c.node.create_publisher(TFMessage, "/tf_static", tf_qos(True))
+        pub.publish(TFMessage(transforms=[tilted]))
+        target = c.make_target(0.6, 0.2, 0.5, h.next_seq())
+        deadline = time.monotonic() + 10
+        while True:  # until the node's /tf_static subscription has matched the publisher
+            from_tf = c.solve(target)
+            if "does not exist" not in from_tf.solution.message or time.monotonic() > deadline:
+                break
+            time.sleep(0.1)
+        assert from_tf.solution.success, from_tf.solution.message
+        assert from_tf.solution.weight > 1.0  # w = 0.005 * 9.80665 / 0.01 = 4.9
+        # The same gravity set by hand: the same rod.
+        assert all(r.successful for r in c.set_params(world_frame="", gravity=[0.0, -9.80665, 0.0]))
+        by_hand = c.solve(target)
+        assert by_hand.solution.success
+        assert max(abs(p - q) for p, q in zip(from_tf.solution.a, by_hand.solution.a)) < 1e-6
+        # A world frame TF does not know: refused by name.
+        assert all(r.successful for r in c.set_params(world_frame="earth"))
+        r = c.solve(target)
+        assert not r.solution.success and "earth" in r.solution.message, r.solution.message
     finally:
         h.stop_node_and_client(node, c)

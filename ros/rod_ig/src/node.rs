@@ -1182,36 +1182,70 @@ async fn receive_tf(
     }
 }
 
-/// The target in `base_frame` when `use_tf` is on and it is stamped in another frame: its
-/// transform at its stamp, waited for up to `tf_timeout`; else the target as it is.
-async fn resolve_frame(
+/// Standard gravity (m/s²), the magnitude `world_frame` gives gravity.
+const STANDARD_GRAVITY: f64 = 9.80665;
+
+/// What TF answers to `f`, waited for up to `timeout` s (its last error once it passes).
+async fn wait_for_tf<T>(
+    buffer: &std::sync::Mutex<TfBuffer>,
+    timeout: f64,
+    f: impl Fn(&TfBuffer) -> Result<T, crate::tf_buffer::LookupError>,
+) -> Result<T, crate::tf_buffer::LookupError> {
+    let until = std::time::Instant::now() + std::time::Duration::from_secs_f64(timeout);
+    loop {
+        let looked_up = match buffer.lock() {
+            Ok(b) => f(&b),
+            Err(p) => f(&p.into_inner()),
+        };
+        match looked_up {
+            Err(_) if std::time::Instant::now() < until => tokio::time::sleep(TF_POLL).await,
+            done => return done,
+        }
+    }
+}
+
+/// The target and the parameters to solve it with, through TF: the target in `base_frame`
+/// when `use_tf` is on and it is stamped in another frame (its transform at its stamp), and
+/// gravity from `world_frame` (−9.80665 m/s² along the world's z, in `base_frame` at the
+/// target's stamp) when that is set and the rod has weight. Each waits up to `tf_timeout`.
+async fn through_tf(
     target: &PoseStamped,
     params: &Params,
     buffer: &std::sync::Mutex<TfBuffer>,
-) -> Result<PoseStamped, crate::convert::TargetError> {
-    let frame = &target.header.frame_id;
-    if !params.use_tf || frame.is_empty() || *frame == params.base_frame {
-        return Ok(target.clone());
-    }
-    let until = std::time::Instant::now() + std::time::Duration::from_secs_f64(params.tf_timeout);
-    loop {
-        let looked_up = match buffer.lock() {
-            Ok(b) => crate::tf_buffer::pose_in_frame(&b, &params.base_frame, target),
-            Err(_) => return Ok(target.clone()),
+) -> Result<(PoseStamped, Params), crate::convert::TargetError> {
+    let refused =
+        |frame: &str, e: crate::tf_buffer::LookupError| crate::convert::TargetError::Frame {
+            frame: frame.to_string(),
+            base: params.base_frame.clone(),
+            timeout: params.tf_timeout,
+            why: e.to_string(),
         };
-        match looked_up {
-            Ok(t) => return Ok(t),
-            Err(e) if std::time::Instant::now() >= until => {
-                return Err(crate::convert::TargetError::Frame {
-                    frame: frame.clone(),
-                    base: params.base_frame.clone(),
-                    timeout: params.tf_timeout,
-                    why: e.to_string(),
-                })
-            }
-            Err(_) => tokio::time::sleep(TF_POLL).await,
-        }
+    let frame = &target.header.frame_id;
+    let target = if !params.use_tf || frame.is_empty() || *frame == params.base_frame {
+        target.clone()
+    } else {
+        wait_for_tf(buffer, params.tf_timeout, |b| {
+            crate::tf_buffer::pose_in_frame(b, &params.base_frame, target)
+        })
+        .await
+        .map_err(|e| refused(frame, e))?
+    };
+    let world = &params.world_frame;
+    if world.is_empty() || params.linear_density == 0.0 {
+        return Ok((target, params.clone()));
     }
+    let stamp = &target.header.stamp;
+    let time = (stamp.sec != 0 || stamp.nanosec != 0)
+        .then(|| i64::from(stamp.sec) * 1_000_000_000 + i64::from(stamp.nanosec));
+    let world_in_base = wait_for_tf(buffer, params.tf_timeout, |b| {
+        b.lookup(&params.base_frame, world, time)
+    })
+    .await
+    .map_err(|e| refused(world, e))?;
+    let g = world_in_base.rotation * nalgebra::Vector3::new(0.0, 0.0, -STANDARD_GRAVITY);
+    let mut with_gravity = params.clone();
+    with_gravity.gravity = [g.x, g.y, g.z];
+    Ok((target, with_gravity))
 }
 
 /// The diagnostics task: one DiagnosticArray per [`DIAGNOSTICS_PERIOD`] from the solve record.
@@ -1360,8 +1394,8 @@ async fn solver_loop(
             job = job_rx.recv() => {
                 let Some((mut request, reply)) = job else { break };
                 let params = params_rx.borrow_and_update().clone();
-                let response = match resolve_frame(&request.target, &params, &tf).await {
-                    Ok(target) => {
+                let response = match through_tf(&request.target, &params, &tf).await {
+                    Ok((target, params)) => {
                         request.target = target;
                         serve_solve(&mut processor, &request, &params, &stats, &log, &outputs.names)
                     }
@@ -1394,8 +1428,8 @@ async fn solver_loop(
                 }
                 let params = params_rx.borrow().clone();
                 let started = std::time::Instant::now();
-                let target = match resolve_frame(&target, &params, &tf).await {
-                    Ok(t) => t,
+                let (target, params) = match through_tf(&target, &params, &tf).await {
+                    Ok(resolved) => resolved,
                     Err(e) => {
                         let outcome = Processor::refused(&target, &params, e);
                         let work = Counters::default();

@@ -100,6 +100,10 @@ pub struct Params {
     pub tip_frame: String,
     /// `tf_rate` in (0, 1000] Hz: how often `tip_frame` is looked up (default 30).
     pub tf_rate: f64,
+    /// `world_frame`: when set (and `linear_density` > 0), gravity is −9.80665 m/s² along this
+    /// TF frame's z, expressed in `base_frame` at each target's stamp (it replaces `gravity`);
+    /// default empty: `gravity` as set.
+    pub world_frame: String,
     /// `qos_overrides.<topic>.{subscription,publisher}.{reliability,durability,history,depth}`:
     /// the QoS of the target subscription and of every publisher, read-only (set at
     /// start-up), as rclcpp's `QosOverridingOptions`. Topics by their resolved names.
@@ -206,6 +210,7 @@ impl Default for Params {
             tf_timeout: 0.0,
             tip_frame: String::new(),
             tf_rate: 0.0,
+            world_frame: String::new(),
             qos_overrides: QosOverride::for_node(|n| {
                 Ok::<_, std::convert::Infallible>(if n.starts_with('/') {
                     n.to_string()
@@ -334,7 +339,7 @@ const MAX_DEADLINE_MS: f64 = rod_ig_core::planar::ig::MAX_DEADLINE.as_secs_f64()
 const MAX_PATH_SAMPLES: i64 = 100_000;
 
 /// Every parameter of `rod_ig_node` (beside the `qos_overrides` ones), in declaration order.
-const TABLE: [Spec; 20] = [
+const TABLE: [Spec; 21] = [
     Spec {
         name: "rod_length",
         kind: Kind::Double {
@@ -626,6 +631,24 @@ const TABLE: [Spec; 20] = [
         get: |p| ParameterValue::Double(p.tf_rate),
         set: |p, v| {
             p.tf_rate = f64_of(v);
+            Ok(())
+        },
+    },
+    Spec {
+        name: "world_frame",
+        kind: Kind::Str,
+        default: DefaultValue::Str(""),
+        description: "With weight: gravity is -9.80665 m/s^2 along this TF frame's z, in \
+                      base_frame at each target's stamp (replaces gravity); empty: gravity",
+        constraints: "empty, or a TF frame id",
+        get: |p| ParameterValue::String(p.world_frame.clone()),
+        set: |p, v| {
+            let id = str_of(v);
+            p.world_frame = if id.is_empty() {
+                String::new()
+            } else {
+                check_frame_id(id)?.to_string()
+            };
             Ok(())
         },
     },
