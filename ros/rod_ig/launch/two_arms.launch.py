@@ -4,7 +4,8 @@
 Each instance runs in its own namespace, so its topics, services and parameter services move
 with it: /left/rod/target, /left/rod/path, /left/rod/solve, /left/rod_ig_node/set_parameters,
 and the same under /right. The right arm's targets come from a planner topic of its own (a
-remap) and its rod is 0.8 m; both can follow a simulator's /clock (use_sim_time:=true).
+remap) and its rod is 0.8 m; each base gripper is its own TF frame (left_rod_base,
+right_rod_base); both can follow a simulator's /clock (use_sim_time:=true).
 """
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
@@ -34,7 +35,10 @@ def generate_launch_description():
             description="ROS 2 parameters file (its /**/rod_ig_node section serves both nodes)"),
         DeclareLaunchArgument("use_sim_time", default_value="false",
                               description="stamp zero-stamped targets with /clock time"),
-        rod_node("left", {}),
+        # Each rod's base gripper is its own TF frame (the params file's use_tf: targets in
+        # any frame of the robot's tree are expressed in it).
+        rod_node("left", {"base_frame": "left_rod_base"}),
         # The right arm's planner publishes on /right_planner/goal: remap the relative name.
-        rod_node("right", {"rod_length": 0.8}, remappings=[("rod/target", "/right_planner/goal")]),
+        rod_node("right", {"rod_length": 0.8, "base_frame": "right_rod_base"},
+                 remappings=[("rod/target", "/right_planner/goal")]),
     ])
