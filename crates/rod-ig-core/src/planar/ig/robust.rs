@@ -2,6 +2,11 @@
 //! (brought into the stable set by weighted scaling if needed) and from the atlas entries nearest
 //! the target; every converged point is checked with the stability test (FINDINGS §5) before it
 //! is returned.
+//!
+//! Stages, each run only when the ones before found nothing: the box stage (the guess, the
+//! model's starts, the box atlas), the polish of the best iterate, then beyond the box: Newton
+//! from the second atlas's seeds and the branches of both atlases' seeds followed to the target
+//! ([`crate::solver::branch_to`]). A failure says what was searched.
 
 use super::{
     atlas, fronts, local, newton, newton::make_solution, straight, Failure, IgError, Solution,
