@@ -67,6 +67,25 @@ fn solve_contract() {
     assert!(out[4]["error"].as_str().unwrap().contains("unknown field"));
 }
 
+/// A target no stable rod reaches (within reach, bent back at full extension): the answer says
+/// what was searched, and `starts` counts it (issue 42: it read 0 beside "from 19 starts").
+#[test]
+fn a_failed_search_says_what_it_searched() {
+    let out = run(
+        &["solve"],
+        "{\"target\": {\"x\": 0.999, \"y\": 0, \"theta\": 3.0}}\n",
+    );
+    let answer = &out[0];
+    assert_eq!(answer["success"], false, "{answer}");
+    assert_eq!(answer["termination"], "no_stable_solution");
+    let reason = answer["reason"].as_str().unwrap();
+    assert!(
+        reason.contains("Newton starts") && reason.contains("branches followed"),
+        "{reason}"
+    );
+    assert!(answer["starts"].as_u64().unwrap() > 0, "{answer}");
+}
+
 #[test]
 fn shape_svg_and_json() {
     let dir = std::env::temp_dir().join(format!("rod-ig-cli-test-{}", std::process::id()));
