@@ -609,12 +609,7 @@ const TABLE: [Spec; 21] = [
         constraints: "empty, or a TF frame id",
         get: |p| ParameterValue::String(p.tip_frame.clone()),
         set: |p, v| {
-            let id = str_of(v);
-            p.tip_frame = if id.is_empty() {
-                String::new()
-            } else {
-                check_frame_id(id)?.to_string()
-            };
+            p.tip_frame = optional_frame_id(str_of(v))?;
             Ok(())
         },
     },
@@ -643,12 +638,7 @@ const TABLE: [Spec; 21] = [
         constraints: "empty, or a TF frame id",
         get: |p| ParameterValue::String(p.world_frame.clone()),
         set: |p, v| {
-            let id = str_of(v);
-            p.world_frame = if id.is_empty() {
-                String::new()
-            } else {
-                check_frame_id(id)?.to_string()
-            };
+            p.world_frame = optional_frame_id(str_of(v))?;
             Ok(())
         },
     },
@@ -662,6 +652,15 @@ fn spec(name: &str) -> Option<&'static Spec> {
 /// The names of all parameters (beside `qos_overrides`), in declaration order.
 pub fn names() -> impl Iterator<Item = &'static str> {
     TABLE.iter().map(|s| s.name)
+}
+
+/// An optional TF frame id: empty (off), or one [`check_frame_id`] accepts.
+fn optional_frame_id(id: &str) -> Result<String, String> {
+    if id.is_empty() {
+        Ok(String::new())
+    } else {
+        check_frame_id(id).map(str::to_string)
+    }
 }
 
 /// Checks a TF frame id (REP 105 names such as `base_link`, `arm/base`): non-empty, letters,
