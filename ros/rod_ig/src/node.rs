@@ -1288,8 +1288,10 @@ async fn report_diagnostics(
 }
 
 /// A service task: each request (stamped by `prepare` when unstamped) goes to its worker
-/// thread, and its answer goes back to the caller from a task of its own, so that the next
-/// request is taken while a large answer is still being written.
+/// thread, and its answer goes back to the caller while the next request is taken, so a
+/// large answer still being written queues nothing. The answers in flight are polled inside
+/// this task, not spawned: aborting the task at shutdown drops them with the server, before
+/// the node (a detached answer outlived the participant and RustDDS logged ERRORs).
 async fn serve_requests<Req, Resp>(
     server: ros2_client::Server<Req, Resp>,
     job_tx: mpsc::Sender<(Req, oneshot::Sender<Resp>)>,
@@ -1301,12 +1303,14 @@ async fn serve_requests<Req, Resp>(
     Resp: ros2_client::Message + Send + Sync + 'static,
     ros2_client::Server<Req, Resp>: Send + Sync,
 {
-    let server = Arc::new(server);
-    // Dropped (and so aborted) with this task at shutdown.
-    let mut replies = tokio::task::JoinSet::new();
-    let mut stream = pin!(server.receive_request_stream());
-    while let Some(item) = stream.next().await {
-        while replies.try_join_next().is_some() {} // reap the answers sent
+    let mut replies = futures::stream::FuturesUnordered::new();
+    let mut requests = pin!(server.receive_request_stream());
+    loop {
+        let item = tokio::select! {
+            item = requests.next() => item,
+            Some(()) = replies.next(), if !replies.is_empty() => continue,
+        };
+        let Some(item) = item else { break };
         let (id, mut request) = match item {
             Ok(r) => r,
             Err(e) => {
@@ -1320,9 +1324,8 @@ async fn serve_requests<Req, Resp>(
         if job_tx.send((request, reply_tx)).await.is_err() {
             break; // worker gone: shutting down
         }
-        let server = Arc::clone(&server);
-        let log = log.clone();
-        replies.spawn(async move {
+        let (server, log) = (&server, &log);
+        replies.push(async move {
             let Ok(response) = reply_rx.await else { return };
             if let Err(e) = server.async_send_response(id, response).await {
                 node_log!(log, Warn, "service: cannot send the response: {e:?}");
