@@ -164,6 +164,28 @@ def test_clock_subscribed_only_with_sim_time_and_by_the_node():
             assert node.stop() == 0
 
 
+def test_clock_subscribed_at_run_time_is_the_nodes():
+    """use_sim_time turned on at run time subscribes /clock under the node's name (it was
+    listed under _NODE_NAME_UNKNOWN_: the spinner made it through the context), and turned off
+    again drops it from the graph (issue 43, item 8)."""
+    node, c = h.start_node_and_client()
+    try:
+        assert c.node.get_subscriptions_info_by_topic("/clock") == []
+        assert c.set_params(use_sim_time=True)[0].successful
+        assert _wait(lambda: c.node.get_subscriptions_info_by_topic("/clock"), 10)
+        # The entry that names the reader may follow the reader's own discovery.
+        assert _wait(lambda: [i.node_name for i in c.node.get_subscriptions_info_by_topic("/clock")]
+                     == ["rod_ig_node"], 5), c.node.get_subscriptions_info_by_topic("/clock")
+        assert c.set_params(use_sim_time=False)[0].successful
+        assert _wait(lambda: c.node.get_subscriptions_info_by_topic("/clock") == [], 10), \
+            c.node.get_subscriptions_info_by_topic("/clock")
+        assert c.set_params(use_sim_time=True)[0].successful
+        assert _wait(lambda: [i.node_name for i in c.node.get_subscriptions_info_by_topic("/clock")]
+                     == ["rod_ig_node"], 10), c.node.get_subscriptions_info_by_topic("/clock")
+    finally:
+        h.stop_node_and_client(node, c)
+
+
 def test_parameter_events_on_every_change(node_and_client):
     """Every accepted change is announced on /parameter_events (rclcpp's behaviour, which
     `ros2 param` watchers and dynamic reconfigure GUIs rely on); a refused one is not."""
