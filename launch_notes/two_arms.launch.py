@@ -4,7 +4,9 @@ with a full ROS 2 install and `ros2 launch`).
 Each instance runs in its own namespace, so its topics, service and parameter services move
 with it: /left/rod/target, /left/rod/path, /left/rod/solve, /left/rod_ig_node/set_parameters,
 and the same under /right. The right arm's targets come from a planner topic of its own
-(a remap), and both can follow a simulator's /clock. Usage, from the repository root after
+(a remap), and both can follow a simulator's /clock. Each base gripper is its own frame
+(left_rod_base, right_rod_base): the frame of the outputs, and with `use_tf:=true` the TF frame
+that targets in any frame of the robot's tree are expressed in. Usage, from the repository root after
 `scripts/run-node.sh --help` (or `scripts/patch-deps.sh && cargo build --release`):
 
     ros2 launch launch_notes/two_arms.launch.py
@@ -49,8 +51,9 @@ def generate_launch_description():
                               description="ROS 2 parameters file (its /** section serves both nodes)"),
         DeclareLaunchArgument("use_sim_time", default_value="false",
                               description="stamp zero-stamped targets with /clock time"),
-        rod_node("left", node_bin, params_file, use_sim_time),
+        rod_node("left", node_bin, params_file, use_sim_time, extra=("-p", "base_frame:=left_rod_base")),
         # The right arm's planner publishes on /right_planner/goal: remap the relative name.
         rod_node("right", node_bin, params_file, use_sim_time,
-                 extra=("-r", "rod/target:=/right_planner/goal", "-p", "rod_length:=0.8")),
+                 extra=("-r", "rod/target:=/right_planner/goal", "-p", "rod_length:=0.8",
+                        "-p", "base_frame:=right_rod_base")),
     ])
