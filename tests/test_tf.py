@@ -181,3 +181,31 @@ def test_gravity_comes_from_the_world_frame():
         assert not r.solution.success and "earth" in r.solution.message, r.solution.message
     finally:
         h.stop_node_and_client(node, c)
+
+
+def test_the_tip_frame_is_looked_up_on_tf_updates():
+    """The follower looks up after each TF message (at most tf_rate times a second), not on a
+    clock of its own: with tf_rate 0.2 Hz, a pose published once 5.5 s after the last answer is
+    answered at once (measured: milliseconds), where a 5 s poll would answer ~4.5 s later. The
+    3 s bound separates the two by far on a loaded machine."""
+    node, c = h.start_node_and_client(["--ros-args", "-p", "use_tf:=true", "-p", "tip_frame:=tip_gripper",
+                                       "-p", "tf_rate:=0.2"])
+    try:
+        pub = c.node.create_publisher(TFMessage, "/tf", tf_qos(False))
+
+        def answered(sec, timeout):
+            return c.wait_for(lambda: next((m for m in c.solutions if m.header.stamp.sec == sec), None), timeout)
+
+        deadline = time.monotonic() + 15
+        first = None
+        while first is None and time.monotonic() < deadline:
+            pub.publish(TFMessage(transforms=[transform("rod_base", "tip_gripper", (0.6, 0.2, 0.0), 0.5, sec=3001)]))
+            first = answered(3001, 0.5)
+        assert first is not None and first.success
+        time.sleep(5.5)
+        sent = time.monotonic()
+        pub.publish(TFMessage(transforms=[transform("rod_base", "tip_gripper", (0.55, 0.25, 0.0), 0.6, sec=3002)]))
+        second = answered(3002, 3.0)
+        assert second is not None and second.success, f"not answered {time.monotonic() - sent:.2f} s after the update"
+    finally:
+        h.stop_node_and_client(node, c)

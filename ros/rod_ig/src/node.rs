@@ -502,7 +502,7 @@ fn spawn_solver_thread(
 struct SolverLinks {
     params_rx: watch::Receiver<Params>,
     /// What `/tf` and `/tf_static` said ([`receive_tf`]).
-    tf: Arc<std::sync::Mutex<TfBuffer>>,
+    tf: Arc<SharedTf>,
     target_rx: watch::Receiver<Option<PoseStamped>>,
     job_rx: mpsc::Receiver<SolveJob>,
     held_tx: watch::Sender<Option<PlanarParams>>,
@@ -726,7 +726,7 @@ fn create_inputs(
 fn spawn_tasks(
     node: &Arc<ros2_client::Node>,
     inputs: Inputs,
-    (tf, params_rx): (&Arc<std::sync::Mutex<TfBuffer>>, watch::Receiver<Params>),
+    (tf, params_rx): (&Arc<SharedTf>, watch::Receiver<Params>),
     (diagnostics, diag_name): (Publisher<crate::messages::DiagnosticArray>, String),
     target_tx: watch::Sender<Option<PoseStamped>>,
     (solve_tx, plan_tx): (mpsc::Sender<SolveJob>, mpsc::Sender<PlanJob>),
@@ -737,11 +737,11 @@ fn spawn_tasks(
     let target_tx = Arc::new(target_tx);
     let [tf_dynamic, tf_static] = inputs.tf;
     let tf_tasks = [
-        tokio::spawn(receive_tf(tf_dynamic, Arc::clone(tf), false, logger())),
-        tokio::spawn(receive_tf(tf_static, Arc::clone(tf), true, logger())),
+        tokio::spawn(receive_tf(tf_dynamic, tf.clone(), false, logger())),
+        tokio::spawn(receive_tf(tf_static, tf.clone(), true, logger())),
         tokio::spawn(follow_tip_frame(
             params_rx,
-            Arc::clone(tf),
+            tf.clone(),
             Arc::clone(&target_tx),
             Arc::clone(stats),
             logger(),
@@ -909,7 +909,7 @@ struct Workers {
     /// Fires when the solver's atlas is built (with its number of seeds).
     warm: oneshot::Receiver<usize>,
     /// The transform buffer the TF tasks fill and the solver thread reads.
-    tf: Arc<std::sync::Mutex<TfBuffer>>,
+    tf: Arc<SharedTf>,
     target_tx: watch::Sender<Option<PoseStamped>>,
     jobs: (mpsc::Sender<SolveJob>, mpsc::Sender<PlanJob>),
 }
@@ -926,7 +926,7 @@ fn start_workers(
     logger: &Logger,
 ) -> Result<Workers, NodeError> {
     let (target_tx, target_rx) = watch::channel::<Option<PoseStamped>>(None);
-    let tf = Arc::new(std::sync::Mutex::new(TfBuffer::new(TF_CACHE_SECONDS)));
+    let tf = Arc::new(SharedTf::new());
     let (solve_tx, solve_rx) = mpsc::channel::<SolveJob>(16);
     let (plan_tx, plan_rx) = mpsc::channel::<PlanJob>(16);
     let (held_tx, held_rx) = watch::channel::<Option<PlanarParams>>(None);
@@ -1064,16 +1064,33 @@ async fn receive_targets(
 
 /// Transforms kept per dynamic frame (tf2's default cache).
 const TF_CACHE_SECONDS: f64 = 10.0;
+
+/// The transforms `/tf` and `/tf_static` said, shared by the TF tasks and the solver thread.
+struct SharedTf {
+    transforms: std::sync::Mutex<TfBuffer>,
+    /// Signalled after each TF message (one stored permit: no update is missed).
+    updated: tokio::sync::Notify,
+}
+
+impl SharedTf {
+    fn new() -> Self {
+        Self {
+            transforms: std::sync::Mutex::new(TfBuffer::new(TF_CACHE_SECONDS)),
+            updated: tokio::sync::Notify::new(),
+        }
+    }
+}
 /// How often a target waiting for its transform looks again.
 const TF_POLL: std::time::Duration = std::time::Duration::from_millis(5);
 
-/// The `tip_frame` task: at `tf_rate`, the tip gripper's frame in `base_frame` at the latest
-/// time TF knows it; each new pose goes to the solver as a target on `rod/target` would (so the
+/// The `tip_frame` task: on each TF update (at most `tf_rate` times a second; a lookup
+/// depends on nothing else, so none is wasted between updates), the tip gripper's frame in
+/// `base_frame` at the latest time TF knows it; each new pose goes to the solver as a target on `rod/target` would (so the
 /// rod follows its branch, and an out-of-plane pose is solved in 3-D or refused as a target
 /// is). Stamped with the transform's time (a static chain: the system time when it changes).
 async fn follow_tip_frame(
     mut params_rx: watch::Receiver<Params>,
-    buffer: Arc<std::sync::Mutex<TfBuffer>>,
+    buffer: Arc<SharedTf>,
     target_tx: Arc<watch::Sender<Option<PoseStamped>>>,
     stats: Arc<Stats>,
     log: Logger,
@@ -1089,7 +1106,7 @@ async fn follow_tip_frame(
             }
             continue;
         }
-        let looked_up = match buffer.lock() {
+        let looked_up = match buffer.transforms.lock() {
             Ok(b) => b.lookup_latest(&params.base_frame, &params.tip_frame),
             Err(_) => break,
         };
@@ -1111,9 +1128,14 @@ async fn follow_tip_frame(
                 }
             }
         }
+        // At most tf_rate lookups a second, then the next TF update (or a parameter change,
+        // which is looked at at once).
         let period = std::time::Duration::from_secs_f64(1.0 / params.tf_rate);
         tokio::select! {
-            _ = tokio::time::sleep(period) => {}
+            () = async {
+                tokio::time::sleep(period).await;
+                buffer.updated.notified().await;
+            } => {}
             changed = params_rx.changed() => if changed.is_err() { break },
         }
     }
@@ -1155,7 +1177,7 @@ fn tip_target(base: &str, time: Option<i64>, pose: &nalgebra::Isometry3<f64>) ->
 /// refuse (empty or '/'-led frame id, non-finite, not a rotation) is logged and skipped.
 async fn receive_tf(
     subscription: ros2_client::Subscription<TfMessage>,
-    buffer: Arc<std::sync::Mutex<TfBuffer>>,
+    buffer: Arc<SharedTf>,
     is_static: bool,
     log: Logger,
 ) {
@@ -1173,12 +1195,17 @@ async fn receive_tf(
                 continue;
             }
         };
-        let Ok(mut b) = buffer.lock() else { break };
-        for t in &msg.transforms {
-            if let Err(e) = b.insert(&crate::tf_buffer::from_message(t), is_static) {
-                log::debug!("{topic}: {e}");
+        {
+            let Ok(mut b) = buffer.transforms.lock() else {
+                break;
+            };
+            for t in &msg.transforms {
+                if let Err(e) = b.insert(&crate::tf_buffer::from_message(t), is_static) {
+                    log::debug!("{topic}: {e}");
+                }
             }
         }
+        buffer.updated.notify_one();
     }
 }
 
@@ -1397,7 +1424,7 @@ async fn solver_loop(
             job = job_rx.recv() => {
                 let Some((mut request, reply)) = job else { break };
                 let params = params_rx.borrow_and_update().clone();
-                let response = match through_tf(&request.target, &params, &tf).await {
+                let response = match through_tf(&request.target, &params, &tf.transforms).await {
                     Ok((target, params)) => {
                         request.target = target;
                         serve_solve(&mut processor, &request, &params, &stats, &log, &outputs.names)
@@ -1431,7 +1458,7 @@ async fn solver_loop(
                 }
                 let params = params_rx.borrow().clone();
                 let started = std::time::Instant::now();
-                let (target, params) = match through_tf(&target, &params, &tf).await {
+                let (target, params) = match through_tf(&target, &params, &tf.transforms).await {
                     Ok(resolved) => resolved,
                     Err(e) => {
                         let outcome = Processor::refused(&target, &params, e);

@@ -98,7 +98,8 @@ pub struct Params {
     /// `base_frame`, solving for each new pose as for a target on `rod/target` (default
     /// empty: off).
     pub tip_frame: String,
-    /// `tf_rate` in (0, 1000] Hz: how often `tip_frame` is looked up (default 30).
+    /// `tf_rate` in (0, 1000] Hz: at most how often `tip_frame` is looked up, after TF updates
+    /// (default 30).
     pub tf_rate: f64,
     /// `world_frame`: when set (and `linear_density` > 0), gravity is −9.80665 m/s² along this
     /// TF frame's z, expressed in `base_frame` at each target's stamp (it replaces `gravity`);
@@ -621,7 +622,7 @@ const TABLE: [Spec; 21] = [
             lo_open: true,
         },
         default: DefaultValue::Double(30.0),
-        description: "How often tip_frame is looked up in TF (Hz)",
+        description: "At most how often tip_frame is looked up in TF, after its updates (Hz)",
         constraints: "",
         get: |p| ParameterValue::Double(p.tf_rate),
         set: |p, v| {
