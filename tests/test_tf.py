@@ -114,6 +114,12 @@ def test_without_use_tf_the_frame_is_echoed():
         sol = c.solution_for(s)
         assert sol is not None and sol.success and sol.header.frame_id == "world"
         assert abs(sol.tip.position.x - 0.6) < POS_TOL
+        # Not silently (issue 43, item 1): one WARN per frame says how the target was taken.
+        s2 = h.next_seq()
+        c.pub.publish(c.make_target(0.6, 0.2, 0.5, s2, frame="world"))
+        assert c.solution_for(s2) is not None
+        log = node.log_text()
+        assert log.count('targets in frame "world" are taken as in the base gripper') == 1, log[-2000:]
     finally:
         h.stop_node_and_client(node, c)
 

@@ -1231,6 +1231,34 @@ async fn wait_for_tf<T>(
     }
 }
 
+/// Frames of targets taken as the base gripper's without TF (`use_tf` off), each warned
+/// about once, so that a target stamped in `world` is not silently solved in the wrong frame.
+#[derive(Default)]
+struct UntransformedFrames {
+    warned: std::collections::HashSet<String>,
+}
+
+impl UntransformedFrames {
+    /// At most this many distinct frames are remembered (a flood of frame names stays bounded).
+    const KEEP: usize = 64;
+
+    /// Warns once per frame that a target in `frame` is taken as in `base_frame`.
+    fn note(&mut self, frame: &str, params: &Params, log: &Logger) {
+        if params.use_tf || frame.is_empty() || frame == params.base_frame {
+            return;
+        }
+        if self.warned.len() < Self::KEEP && self.warned.insert(frame.to_string()) {
+            node_log!(
+                log,
+                Warn,
+                "targets in frame {frame:?} are taken as in the base gripper's frame {:?}: \
+                 use_tf is off (set use_tf:=true to transform them through TF)",
+                params.base_frame
+            );
+        }
+    }
+}
+
 /// The target and the parameters to solve it with, through TF: the target in `base_frame`
 /// when `use_tf` is on and it is stamped in another frame (its transform at its stamp), and
 /// gravity from `world_frame` (−9.80665 m/s² along the world's z, in `base_frame` at the
@@ -1418,12 +1446,14 @@ async fn solver_loop(
     } = links;
     // The parameters as last logged: a change is logged as its differences.
     let mut logged_params = params_rx.borrow().clone();
+    let mut untransformed = UntransformedFrames::default();
     loop {
         tokio::select! {
             biased;
             job = job_rx.recv() => {
                 let Some((mut request, reply)) = job else { break };
                 let params = params_rx.borrow_and_update().clone();
+                untransformed.note(&request.target.header.frame_id, &params, &log);
                 let response = match through_tf(&request.target, &params, &tf.transforms).await {
                     Ok((target, params)) => {
                         request.target = target;
@@ -1458,6 +1488,7 @@ async fn solver_loop(
                 }
                 let params = params_rx.borrow().clone();
                 let started = std::time::Instant::now();
+                untransformed.note(&target.header.frame_id, &params, &log);
                 let (target, params) = match through_tf(&target, &params, &tf.transforms).await {
                     Ok(resolved) => resolved,
                     Err(e) => {
