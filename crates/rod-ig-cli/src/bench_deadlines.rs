@@ -57,11 +57,11 @@ fn requests() -> Vec<(&'static str, Request)> {
             }),
         ),
         (
-            "Newton from (3e6, 0, 0)",
+            "Newton from (3e3, 1, 1)",
             Box::new(|d| {
                 let o = SolveOptions {
                     method: ig::Method::Newton,
-                    initial_guess: Some(PlanarParams::new(3e6, 0.0, 0.0)),
+                    initial_guess: Some(PlanarParams::new(3e3, 1.0, 1.0)),
                     deadline: d,
                     ..SolveOptions::default()
                 };

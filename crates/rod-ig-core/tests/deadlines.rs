@@ -87,14 +87,17 @@ fn newton_from_a_tight_coil_stops_inside_its_series() {
     let target = PlanarPose::new(0.5, 0.3, 0.7);
     let options = SolveOptions {
         method: ig::Method::Newton,
-        initial_guess: Some(PlanarParams::new(3e6, 0.0, 0.0)),
+        // A coil of ~480 turns under a small force: its stability scan is a long series
+        // (~30 ms). (The exact circle (3e6, 0, 0) served before; a theorem now decides it in
+        // ~40 µs, see tests/circles.rs.)
+        initial_guess: Some(PlanarParams::new(3e3, 1.0, 1.0)),
         ..far_deadline()
     };
     for budget in [10, 200, 1_000] {
         let (r, charged) = counted(budget, || ig::solve(&target, &options));
         let f = r.expect_err("the budget is far too small for a 2,000-step series");
         assert_eq!(f.termination(), Termination::Deadline, "{}", f.reason);
-        assert_within("Newton from (3e6, 0, 0)", budget, charged);
+        assert_within("Newton from (3e3, 1, 1)", budget, charged);
     }
 }
 

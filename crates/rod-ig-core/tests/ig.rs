@@ -282,7 +282,13 @@ fn unreachable_and_non_finite_targets_fail_fast_with_typed_errors() {
 
 #[test]
 fn boundary_targets() {
-    let o = SolveOptions::default();
+    // The farthest deadline: the search must end by itself (a failed search takes 30-145 ms
+    // on a quiet machine, which the default 250 ms deadline did not always cover on a loaded
+    // 2-core one).
+    let o = SolveOptions {
+        deadline: rod_ig_core::solver::MAX_DEADLINE,
+        ..SolveOptions::default()
+    };
     let _ = ig::warm_up();
     // Near the boundary ‖(x, y)‖ → 1 with a tip angle that no nearly straight rod can have:
     // no stable solution, reported quickly.
