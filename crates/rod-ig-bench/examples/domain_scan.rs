@@ -1,6 +1,6 @@
 //! Which rods each planar entry point answers: `cargo run --release -p rod-ig-bench --example
-//! domain_scan -- N SEED` samples N rods with log-uniform magnitudes (|a3|, |a4|, |a5| from
-//! 1e-300 to 1e12, signs, 10 % exact zeros) and counts those that `evaluate` (forward),
+//! domain_scan -- N SEED [F_MAX]` samples N rods with log-uniform magnitudes (|a3| from 1e-300
+//! to 1e12, |a4|, |a5| to F_MAX (1e12), signs, 10 % exact zeros) and counts those that `evaluate` (forward),
 //! `PlanarRod::new` (shape), `tip_and_jacobian` and `stability` answer differently
 //! (issue 42, item 2: one refusal domain), listing the first of each kind.
 use rod_ig_core::planar::{self, PlanarRod};
@@ -8,11 +8,11 @@ use rod_ig_core::rng::SplitMix64;
 use rod_ig_core::PlanarParams;
 use std::collections::BTreeMap;
 
-fn component(r: &mut SplitMix64) -> f64 {
+fn component(r: &mut SplitMix64, max: f64) -> f64 {
     if r.range(0.0, 1.0) < 0.1 {
         return 0.0;
     }
-    let m = 10f64.powf(r.range(-300.0, 12.0));
+    let m = 10f64.powf(r.range(-300.0, max.log10()));
     if r.range(0.0, 1.0) < 0.5 {
         -m
     } else {
@@ -24,17 +24,27 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let n: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(10_000);
     let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1);
+    // Largest |a4|, |a5| sampled (|a3| always up to 1e12).
+    let f_max: f64 = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1e12);
     let mut r = SplitMix64::new(seed);
     let mut kinds: BTreeMap<String, (usize, String)> = BTreeMap::new();
     let mut refused = 0;
     // (√‖F‖, |a3|) of every rod some entry point refuses: where refusals live.
     let mut refusing: Vec<(f64, f64)> = Vec::new();
     for _ in 0..n {
-        let a = PlanarParams::new(component(&mut r), component(&mut r), component(&mut r));
+        let a = PlanarParams::new(
+            component(&mut r, 1e12),
+            component(&mut r, f_max),
+            component(&mut r, f_max),
+        );
         let forward = planar::evaluate(&a);
         let answers = [
             ("forward", forward.is_ok()),
-            ("shape", PlanarRod::new(&a).is_ok()),
+            // Drawn: built, and every pose of a 17-sample shape finite.
+            (
+                "shape",
+                PlanarRod::new(&a).is_ok_and(|r| r.shape(17).iter().all(|p| p.is_finite())),
+            ),
             ("tip_and_jacobian", planar::tip_and_jacobian(&a).is_ok()),
             ("stability", planar::stability(&a).is_ok()),
         ];

@@ -14,7 +14,7 @@ use rod_ig_core::{PlanarParams, StabilityVerdict};
 /// Exact tip and J (rows x, y, θ; columns a3, a4, a5) of the circle of curvature c.
 fn exact(c: f64) -> ([f64; 3], [[f64; 3]; 3]) {
     let (s, co) = c.sin_cos();
-    let (c2, c3) = (c * c, c * c * c);
+    let c2 = c * c;
     let (s2, one_minus) = ((2.0 * c).sin(), 1.0 - co);
     let tip = [s / c, one_minus / c, c];
     // ∫ t sin(ct), ∫ sin², ∫ t cos(ct), ∫ sin cos, ∫ sin, ∫ cos, ∫ cos² over [0, 1].
@@ -58,10 +58,13 @@ fn circles_of_any_curvature_are_answered_by_forward_and_shape_alike() {
             (e.tip.theta - c).abs() <= 1e-15 * c.abs()
                 && (rod.tip().theta - c).abs() <= 1e-15 * c.abs()
         );
-        for col in 0..3 {
-            let norm = (0..3).map(|k| j[k][col] * j[k][col]).sum::<f64>().sqrt();
-            let err = (0..3)
-                .map(|k| (e.jacobian[(k, col)] - j[k][col]).powi(2))
+        let columns: [[f64; 3]; 3] = std::array::from_fn(|col| std::array::from_fn(|k| j[k][col]));
+        for (col, want) in columns.iter().enumerate() {
+            let norm = want.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let err = want
+                .iter()
+                .enumerate()
+                .map(|(k, v)| (e.jacobian[(k, col)] - v).powi(2))
                 .sum::<f64>()
                 .sqrt();
             assert!(

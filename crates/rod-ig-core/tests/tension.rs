@@ -8,9 +8,9 @@
 //! central differences; cross-checked against a Taylor integration of the ODE). Every rod is
 //! answered within the issue's tolerances (tip 1e-9 absolute, J 1e-6 relative (Frobenius),
 //! energy 1e-9 relative or 1e-200 absolute) or refused with a reason, and every tip `shape` (`PlanarRod`) draws
-//! is right. (That forward and shape refuse the same rods is not reached yet: shape draws some
-//! straight rods under tension whose stability forward cannot certify; issue 44's one
-//! dispatcher is where that domain gets decided once.)
+//! is right; shape refuses every rod forward refuses (one domain: beyond √‖F‖ = 25 the full
+//! evaluation decides for every entry point; before, shape drew 12 of these rods whose
+//! stability forward could not certify).
 
 use rod_ig_core::planar::{self, PlanarRod};
 use rod_ig_core::{PlanarJacobian, PlanarParams};
@@ -112,4 +112,5 @@ fn barely_bent_rods_under_tension_are_answered_right_or_refused() {
          ({shape_only} of them drawn right by shape)"
     );
     assert!(wrong.is_empty(), "wrong answers:\n{}", wrong.join("\n"));
+    assert_eq!(shape_only, 0, "shape draws rods forward refuses");
 }

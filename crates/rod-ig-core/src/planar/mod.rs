@@ -56,6 +56,34 @@ pub(crate) const STABILITY_DD_MAX_ROOT_F: f64 = 120.0;
 /// ln(f64::MAX): under tension F the rod's J grows like e^{√F t}; beyond this √F it overflows.
 const LN_F64_MAX: f64 = 709.7;
 
+/// ‖(a4, a5)‖ up to which every planar entry point answers every finite a (none refused on
+/// 180,000 rods of log-scale |a3| up to 1e12 and |a4|, |a5| up to this, with exact zeros:
+/// `examples/domain_scan.rs`). Beyond (√‖F‖ > 25), by a strong force, a formulation may refuse
+/// what another answers (the first refusals measured: √‖F‖ ≈ 27, a barely bent rod under
+/// tension), so the full evaluation decides for all of them.
+const ORDINARY_FORCE: f64 = 625.0;
+
+/// The one refusal domain of the planar rod, shared by [`evaluate`] (forward), [`tip`],
+/// [`pose_and_jacobian`], [`stability`], [`stability_verdict`], [`energy`] and
+/// [`PlanarRod::new`] (shape): the full evaluation's. Below [`ORDINARY_FORCE`] it refuses only
+/// non-finite a, so the entry points check nothing more (one comparison: this function);
+/// beyond, they take [`domain_evaluation`]'s refusal, or its answer as theirs. Squared, so no
+/// square root on every call; an overflow to +∞ or a NaN counts as beyond (and `evaluate`
+/// refuses NaN).
+#[inline]
+fn beyond_ordinary_force(a: &PlanarParams) -> bool {
+    let f2 = a[1] * a[1] + a[2] * a[2];
+    f2 > ORDINARY_FORCE * ORDINARY_FORCE || f2.is_nan()
+}
+
+/// The full evaluation that decides the domain beyond [`ORDINARY_FORCE`]: out of line, so that
+/// the entry points' fast paths stay as they were.
+#[cold]
+#[inline(never)]
+fn domain_evaluation(a: &PlanarParams) -> Result<Evaluation, RodError> {
+    evaluate(a)
+}
+
 /// ρ = max(|a3|, √‖(a4, a5)‖): the rod's curvature scale (its Taylor terms grow like ρᵏ/k!).
 pub(crate) fn curvature_scale(a: &PlanarParams) -> f64 {
     a[0].abs().max(crate::scalar::fast_hypot(a[1], a[2]).sqrt())
@@ -374,25 +402,33 @@ impl PlanarRod {
     /// [`pose_and_jacobian`], √‖(a4, a5)‖ > ln(f64::MAX)).
     pub fn new(a: &PlanarParams) -> Result<Self, RodError> {
         check_params(a)?;
-        // Forward's domain (its J overflows there): the poses between base and tip, at phases
-        // of ~1e8 loops, came out NaN where the tip did not (a = (−8e−65, 5e16, 0)).
-        if crate::scalar::fast_hypot(a[1], a[2]).sqrt() > LN_F64_MAX {
-            return Err(overflow_force());
-        }
+        // Forward's refusals are the shape's too (one domain); its tip is the shape's.
+        let known = if beyond_ordinary_force(a) {
+            Some(domain_evaluation(a)?)
+        } else {
+            None
+        };
         let closed = if series_first(a) {
             None
         } else {
             Closed::new(a[0], a[1], a[2])
         };
+        // Where the series stands in for the closed form, beyond √‖F‖ = ln(f64::MAX) its poses
+        // between base and tip overflow (NaN at phases of ~1e8 loops where the tip did not, a =
+        // (−8e−65, 5e16, 0), which forward refuses too).
+        let series = || {
+            if crate::scalar::fast_hypot(a[1], a[2]).sqrt() > LN_F64_MAX {
+                return Err(overflow_force());
+            }
+            series_f64(a, true)
+        };
         let (case, backend) = match closed {
             Some(c) if !c.needs_reference() => (c.case, Backend::Closed(c)),
-            Some(c) => (c.case, Backend::Series(series_f64(a, true)?)),
-            None => (
-                case_without_closed(a),
-                Backend::Series(series_f64(a, true)?),
-            ),
+            Some(c) => (c.case, Backend::Series(series()?)),
+            None => (case_without_closed(a), Backend::Series(series()?)),
         };
         let tip = match &backend {
+            _ if let Some(e) = &known => [e.tip.x, e.tip.y, e.tip.theta],
             Backend::Closed(c) => c.pose(1.0),
             // Near the separatrix the f64 series' tip drifts: the double-double one (at small
             // m the f64 series is exact to ~1e-14 and serves as is).
@@ -698,6 +734,9 @@ pub(crate) fn tip_by_closed_form(a: &PlanarParams) -> Option<PlanarPose> {
 pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
     // Same checks as `PlanarRod::new`, without building (and copying) the rod.
     check_params(a)?;
+    if beyond_ordinary_force(a) {
+        return domain_evaluation(a).map(|e| e.tip);
+    }
     let [x, y, th] = if series_first(a) {
         series_f64(a, false)?.tip()
     } else {
@@ -735,6 +774,12 @@ pub fn pose_and_jacobian(
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     RodError::check_finite("t", &[t])?;
     check_params(a)?;
+    if beyond_ordinary_force(a) {
+        let e = domain_evaluation(a)?;
+        if t == 1.0 {
+            return Ok((e.tip, e.jacobian));
+        }
+    }
     if series_first(a) {
         return series_pose_and_jac(a, t);
     }
@@ -832,6 +877,9 @@ pub fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian)
 /// before the first conjugate point can come are rounding and carry no sign in the scan.
 pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
     check_params(a)?;
+    if beyond_ordinary_force(a) {
+        return domain_evaluation(a).map(|e| e.stability);
+    }
     if series_first(a) {
         return stability_by_series(a);
     }
@@ -864,6 +912,9 @@ pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
 /// ```
 pub fn stability_verdict(a: &PlanarParams) -> Result<StabilityVerdict, RodError> {
     check_params(a)?;
+    if beyond_ordinary_force(a) {
+        return domain_evaluation(a).map(|e| e.stability.verdict());
+    }
     if series_first(a) {
         return stability_by_series(a).map(|r| r.verdict());
     }
@@ -896,6 +947,9 @@ fn theorem_verdict(a: &PlanarParams) -> Option<StabilityVerdict> {
 /// Elastic energy ½∫₀¹κ² (FINDINGS §1 identity λ2/2 − a4 x(1) − a5 y(1)).
 pub fn energy(a: &PlanarParams) -> Result<f64, RodError> {
     check_params(a)?;
+    if beyond_ordinary_force(a) {
+        return domain_evaluation(a).map(|e| e.energy);
+    }
     if let Some(e) = small_angle_energy(a) {
         return Ok(e);
     }
