@@ -4,9 +4,10 @@
 //! to 1e12, both signs, exact zeros). Before, 657 of 20,000 such rods were answered by some
 //! entry points and refused by others (`examples/domain_scan.rs`).
 //!
-//! The one gap left, stated: shape cannot draw some rods that forward answers by the
-//! small-angle or pendulum forms under forces beyond √‖F‖ = ln(f64::MAX) (its series overflows
-//! there); it refuses them with the reason, never the reverse.
+//! The one gap left, stated: beyond √‖F‖ = ln(f64::MAX) = 709.7, forward answers some barely
+//! bent rods under tension by the f64 closed form, whose J estimate is not consulted above
+//! max(a3², |a4|, |a5|) = 1e6 (no series could stand in), and shape cannot draw them (its poses
+//! between base and tip overflow); it refuses them with the reason, never the reverse.
 use rod_ig_core::planar::{self, PlanarRod};
 use rod_ig_core::rng::SplitMix64;
 use rod_ig_core::PlanarParams;
@@ -84,4 +85,23 @@ fn every_entry_point_refuses_the_rods_forward_refuses_and_no_other() {
         refused >= 10 && shape_gap <= 20,
         "{refused} refused, {shape_gap} in the gap"
     );
+}
+
+#[test]
+fn shape_draws_a_compressed_rod_beyond_the_series_reach_as_forward_answers_it() {
+    // √‖F‖ = 918 under compression, bending 1e-150: forward answers by the small-angle
+    // expansion; the shape's series would overflow, so it draws the same expansion.
+    let a = PlanarParams::new(-3.2027762049664173e-150, -843631.0246268973, -5.1e-163);
+    let e = planar::evaluate(&a).expect("forward answers");
+    let rod = PlanarRod::new(&a).expect("shape draws it");
+    assert_eq!(rod.tip(), e.tip);
+    let poses = rod.shape(9);
+    assert_eq!(poses[0], rod_ig_core::PlanarPose::new(0.0, 0.0, 0.0));
+    assert!(poses.iter().all(|p| p.is_finite()), "{poses:?}");
+    // Nearly straight: x = t, and the curvature stays of the order of the bending.
+    for (i, p) in poses.iter().enumerate() {
+        assert!((p.x - i as f64 / 8.0).abs() < 1e-12, "{p:?}");
+    }
+    assert!(rod.curvature(0.5).is_finite() && rod.curvature(0.5).abs() < 1e-140);
+    assert!(rod.energy().is_finite());
 }

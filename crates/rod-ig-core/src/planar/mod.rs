@@ -380,6 +380,9 @@ pub struct PlanarRod {
 enum Backend {
     Closed(Closed<f64>),
     Series(TaylorRod<f64>),
+    /// The small-angle expansion (or the pendulum), where forward answers by it and the series
+    /// cannot stand in (beyond √‖F‖ = ln(f64::MAX), a nearly straight rod under compression).
+    SmallAngle,
 }
 
 /// The closed-form case of a when the series is used without building the closed form (the
@@ -422,10 +425,16 @@ impl PlanarRod {
             }
             series_f64(a, true)
         };
+        // As forward does, the small-angle expansion before a series that cannot run.
+        let series_or_small_angle = || match series() {
+            Err(e) if small_angle_tip(a).is_none() => Err(e),
+            Err(_) => Ok(Backend::SmallAngle),
+            Ok(r) => Ok(Backend::Series(r)),
+        };
         let (case, backend) = match closed {
             Some(c) if !c.needs_reference() => (c.case, Backend::Closed(c)),
-            Some(c) => (c.case, Backend::Series(series()?)),
-            None => (case_without_closed(a), Backend::Series(series()?)),
+            Some(c) => (c.case, series_or_small_angle()?),
+            None => (case_without_closed(a), series_or_small_angle()?),
         };
         let tip = match &backend {
             _ if let Some(e) = &known => [e.tip.x, e.tip.y, e.tip.theta],
@@ -443,6 +452,7 @@ impl PlanarRod {
                 }
             }
             Backend::Series(r) => r.tip(),
+            Backend::SmallAngle => small_angle_tip(a).ok_or_else(overflow)?,
         };
         let tip = PlanarPose::new(tip[0], tip[1], tip[2]);
         if !tip.is_finite() {
@@ -475,6 +485,10 @@ impl PlanarRod {
             Backend::Closed(c) => c.pose(t),
             Backend::Series(r) if t.is_nan() => [t; 3],
             Backend::Series(r) => r.pose(t.clamp(0.0, 1.0)).unwrap_or([f64::NAN; 3]),
+            // The base is the identity (the expansion's J is 0/0 there).
+            Backend::SmallAngle if t <= 0.0 => [0.0; 3],
+            Backend::SmallAngle => small_angle_pose_and_jac(&self.a, t.min(1.0))
+                .map_or([f64::NAN; 3], |(p, _)| [p.x, p.y, p.theta]),
         };
         PlanarPose::new(p[0], p[1], p[2])
     }
@@ -489,6 +503,7 @@ impl PlanarRod {
         match &self.backend {
             Backend::Closed(c) => c.curvature(t),
             Backend::Series(r) => r.curvature(t.clamp(0.0, 1.0)).unwrap_or(f64::NAN),
+            Backend::SmallAngle => small_angle_curvature(&self.a, t.clamp(0.0, 1.0)),
         }
     }
 
@@ -522,8 +537,26 @@ impl PlanarRod {
             Backend::Closed(c) => closed_energy(c, &self.a, &self.tip).unwrap_or(f64::INFINITY),
             // ½∫κ² integrated along: the identity cancels for a nearly straight rod under force.
             Backend::Series(r) => r.energy(),
+            Backend::SmallAngle => small_angle_energy(&self.a).unwrap_or(f64::INFINITY),
         }
     }
+}
+
+/// κ(t) = θ′ of the linearised rod, θ = a3 S1 − a5 S2 (`small_angle`): a3 S0 − a5 S1, with
+/// S0 = cosh(wt), cos(wt) or 1 and S1 = sinh(wt)/w, sin(wt)/w or t (w = √|a4|) under tension,
+/// compression or no axial force.
+fn small_angle_curvature(a: &PlanarParams, t: f64) -> f64 {
+    let (a3, a4, a5) = (a[0], a[1], a[2]);
+    let w = a4.abs().sqrt();
+    let (s0, s1) = if a4 > 0.0 {
+        ((w * t).cosh(), (w * t).sinh() / w)
+    } else if a4 < 0.0 {
+        let (s, c) = (w * t).sin_cos();
+        (c, s / w)
+    } else {
+        (1.0, t)
+    };
+    a3 * s0 - a5 * s1
 }
 
 fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {

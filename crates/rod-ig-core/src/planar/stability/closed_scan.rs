@@ -25,44 +25,8 @@ pub(crate) fn stability_of_with(
     if let Some(report) = small_angle_report(a)? {
         return Ok(report);
     }
-    // Near the separatrix under a strong force the closed form's J(t) entries far below ‖J‖
-    // (the x row while the rod lingers by the straight equilibrium) are not accurate relative
-    // to themselves: with entry-wise error bounds two verdicts in 720 were wrong on the
-    // rigorous reference (scripts/gen_separatrix_truth.py). The scan there bounds every entry
-    // norm-wise and hands what it cannot decide to a second pass in double-double, then to the
-    // double-double series.
     if c.needs_precise_series() {
-        let report = closed_scan(c, a, true, None)?;
-        if !report.uncertain {
-            return Ok(report);
-        }
-        // Again with the closed form in double-double where the f64 one is far off (a rod
-        // lingering by the straight equilibrium before its loop, where the f64 values are noise
-        // of either sign): 150–480 µs where the double-double series takes 3–9 ms.
-        let mut undecided = None;
-        let built;
-        let dd = match extended {
-            Some(dd) => Some(dd),
-            None => {
-                built = crate::planar::extended::seeded_within_reach(a);
-                built.as_ref()
-            }
-        };
-        if let Some(dd) = dd {
-            let report = closed_scan(c, a, true, Some(dd))?;
-            if !report.uncertain {
-                return Ok(report);
-            }
-            undecided = Some(report);
-        }
-        // Beyond the double-double series' reach the verdict stays uncertain (with the second
-        // pass's margin), rather than refusing a rod whose forward map is certified.
-        if let Some(report) = undecided {
-            if a[1].hypot(a[2]).sqrt() > crate::planar::STABILITY_DD_MAX_ROOT_F {
-                return Ok(report);
-            }
-        }
-        return series_after_small_angle(a, None, Some(c.wavelength()), Some(c));
+        return precise_scan(c, a, extended);
     }
     // A theorem decides the verdict (circles, case II) and no series can reach the tip: the
     // closed scan's margin stands, uncertain or not (a near-circle of ~10⁴ turns under a small
@@ -105,6 +69,50 @@ pub(crate) fn stability_of_with(
         return or_theorem(c, a, Some(report), series);
     }
     Ok(report)
+}
+
+/// The stability of a rod by the separatrix under a strong force. There the closed form's
+/// J(t) entries far below ‖J‖ (the x row while the rod lingers by the straight equilibrium)
+/// are not accurate relative to themselves: with entry-wise error bounds two verdicts in 720
+/// were wrong on the rigorous reference (scripts/gen_separatrix_truth.py). The scan bounds
+/// every entry norm-wise and hands what it cannot decide to a second pass in double-double,
+/// then to the double-double series.
+fn precise_scan(
+    c: &Closed<Dual3>,
+    a: &PlanarParams,
+    extended: Option<&Closed<DualDd>>,
+) -> Result<StabilityReport, RodError> {
+    let report = closed_scan(c, a, true, None)?;
+    if !report.uncertain {
+        return Ok(report);
+    }
+    // Again with the closed form in double-double where the f64 one is far off (a rod
+    // lingering by the straight equilibrium before its loop, where the f64 values are noise
+    // of either sign): 150–480 µs where the double-double series takes 3–9 ms.
+    let mut undecided = None;
+    let built;
+    let dd = match extended {
+        Some(dd) => Some(dd),
+        None => {
+            built = crate::planar::extended::seeded_within_reach(a);
+            built.as_ref()
+        }
+    };
+    if let Some(dd) = dd {
+        let report = closed_scan(c, a, true, Some(dd))?;
+        if !report.uncertain {
+            return Ok(report);
+        }
+        undecided = Some(report);
+    }
+    // Beyond the double-double series' reach the verdict stays uncertain (with the second
+    // pass's margin), rather than refusing a rod whose forward map is certified.
+    if let Some(report) = undecided {
+        if a[1].hypot(a[2]).sqrt() > crate::planar::STABILITY_DD_MAX_ROOT_F {
+            return Ok(report);
+        }
+    }
+    series_after_small_angle(a, None, Some(c.wavelength()), Some(c))
 }
 
 /// The series' report, unless it ran out of steps on a rod whose verdict a theorem decides:
