@@ -401,8 +401,10 @@ fn case_without_closed(a: &PlanarParams) -> Case {
 
 impl PlanarRod {
     /// Precomputes the rod for a. Errors: [`RodError::NonFinite`] if a component of a is NaN
-    /// or ±∞, [`RodError::Overflow`] if the shape cannot be represented in f64 (as for
-    /// [`pose_and_jacobian`], √‖(a4, a5)‖ > ln(f64::MAX)).
+    /// or ±∞; every refusal of [`evaluate`] (one domain: beyond ‖(a4, a5)‖ = 625 the full
+    /// evaluation runs first, and its tip is the shape's); [`RodError::Overflow`] where the
+    /// shape cannot be represented in f64 (its series beyond √‖(a4, a5)‖ = ln(f64::MAX), the
+    /// one kind of rod forward answers and the shape does not: `tests/domain.rs`).
     pub fn new(a: &PlanarParams) -> Result<Self, RodError> {
         check_params(a)?;
         // Forward's refusals are the shape's too (one domain); its tip is the shape's.
