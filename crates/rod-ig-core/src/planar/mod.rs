@@ -108,6 +108,18 @@ pub(crate) fn series_dual(a: &PlanarParams, dense: bool) -> Result<TaylorRod<Dua
     )
 }
 
+/// Refuses, as the domain says, a rod under tension beyond √‖F‖ = ln(f64::MAX) whose closed
+/// form cannot be built (deep by the separatrix): its rounding grows like e^{√‖F‖ t} in any
+/// f64 integration, whose answer is then wrong without overflowing (a = (8.9e-220, 1.05e6,
+/// −1.4e-103) came out θ = 20π, x = 0.922 where the exact pendulum has θ = 1.8e-104,
+/// x = 0.992). Compressed rods (a4 ≤ 0) stay near their stable equilibrium and pass.
+fn tension_within_f64(a: &PlanarParams) -> Result<(), RodError> {
+    if a[1] > 0.0 && crate::scalar::fast_hypot(a[1], a[2]).sqrt() > LN_F64_MAX {
+        return Err(overflow_force());
+    }
+    Ok(())
+}
+
 fn overflow_force() -> RodError {
     RodError::Overflow(format!(
         "planar rod: under this force J(t, a) grows like e^(sqrt|F| t) and exceeds f64 \
@@ -308,6 +320,7 @@ fn with_seeded<R>(
     } else {
         // The closed form's intermediate ratios overflowed (e.g. a tiny moment against a
         // moderate force): the series has its own overflow detection.
+        tension_within_f64(a)?;
         series()
     }
 }
@@ -779,6 +792,7 @@ pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
         // the phase where the addition theorems place the tip instead (~18 % of q(1)).
         let mut closed = Closed::<f64>::straight(a[0], a[1], a[2]);
         if !closed.complete(a[0], a[1], a[2], false) {
+            tension_within_f64(a)?;
             return finite_tip(series_f64(a, false)?.tip());
         }
         match closed.needs_series() {
