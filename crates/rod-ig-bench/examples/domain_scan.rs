@@ -3,22 +3,11 @@
 //! to 1e12, |a4|, |a5| to F_MAX (1e12), signs, 10 % exact zeros) and counts those that `evaluate` (forward),
 //! `PlanarRod::new` (shape), `tip_and_jacobian` and `stability` answer differently
 //! (issue 42, item 2: one refusal domain), listing the first of each kind.
+use rod_ig_bench::planar::log_scale_component;
 use rod_ig_core::planar::{self, PlanarRod};
 use rod_ig_core::rng::SplitMix64;
 use rod_ig_core::PlanarParams;
 use std::collections::BTreeMap;
-
-fn component(r: &mut SplitMix64, max: f64) -> f64 {
-    if r.range(0.0, 1.0) < 0.1 {
-        return 0.0;
-    }
-    let m = 10f64.powf(r.range(-300.0, max.log10()));
-    if r.range(0.0, 1.0) < 0.5 {
-        -m
-    } else {
-        m
-    }
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -33,9 +22,9 @@ fn main() {
     let mut refusing: Vec<(f64, f64)> = Vec::new();
     for _ in 0..n {
         let a = PlanarParams::new(
-            component(&mut r, 1e12),
-            component(&mut r, f_max),
-            component(&mut r, f_max),
+            log_scale_component(&mut r, 1e12),
+            log_scale_component(&mut r, f_max),
+            log_scale_component(&mut r, f_max),
         );
         let forward = planar::evaluate(&a);
         let answers = [

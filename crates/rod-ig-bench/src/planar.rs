@@ -135,6 +135,20 @@ fn pct(k: usize, n: usize) -> f64 {
     }
 }
 
+/// A component of a as users produce them: 10 % exact zeros, else a magnitude log-uniform from
+/// 1e-300 to `max` with either sign (the refusal-domain scan and its test).
+pub fn log_scale_component(r: &mut rod_ig_core::rng::SplitMix64, max: f64) -> f64 {
+    if r.range(0.0, 1.0) < 0.1 {
+        return 0.0;
+    }
+    let m = 10f64.powf(r.range(-300.0, max.log10()));
+    if r.range(0.0, 1.0) < 0.5 {
+        -m
+    } else {
+        m
+    }
+}
+
 /// Independent re-check of a returned solution: stable by the stability test (FINDINGS §5)
 /// and Υ(a) within `tolerance` of the target (position and wrapped angle).
 pub fn verify(target: &PlanarPose, a: &PlanarParams, tolerance: f64) -> bool {

@@ -8,28 +8,23 @@
 //! draws compressed rods by the small-angle expansion, as forward answers them, and barely bent
 //! rods under tension there are refused by both (forward answered some by an f64 series whose
 //! rounding grows like e^{√‖F‖}: wrong tips, see the last test).
+mod workloads;
+
 use rod_ig_core::planar::{self, PlanarRod};
 use rod_ig_core::rng::SplitMix64;
 use rod_ig_core::PlanarParams;
-
-fn component(r: &mut SplitMix64) -> f64 {
-    if r.range(0.0, 1.0) < 0.1 {
-        return 0.0;
-    }
-    let m = 10f64.powf(r.range(-300.0, 12.0));
-    if r.range(0.0, 1.0) < 0.5 {
-        -m
-    } else {
-        m
-    }
-}
+use workloads::planar::log_scale_component;
 
 #[test]
 fn every_entry_point_refuses_the_rods_forward_refuses_and_no_other() {
     let mut r = SplitMix64::new(20261128);
     let mut refused = 0;
     for _ in 0..3000 {
-        let a = PlanarParams::new(component(&mut r), component(&mut r), component(&mut r));
+        let a = PlanarParams::new(
+            log_scale_component(&mut r, 1e12),
+            log_scale_component(&mut r, 1e12),
+            log_scale_component(&mut r, 1e12),
+        );
         let forward = planar::evaluate(&a);
         let answered = [
             ("tip", planar::tip(&a).is_ok()),
