@@ -57,8 +57,13 @@ fn stable_rods_beyond_the_box_are_found() {
     for (target, rod) in &targets {
         // A stable rod exists there: the reference says so of the independent search's.
         check_by_reference(target, rod);
-        // The search alone, from no guess.
-        match ig::solve(target, &SolveOptions::default()) {
+        // The search alone, from no guess. Its failures take up to ~200 ms, near the default
+        // deadline: the far one keeps a loaded machine's clock out of a count of coverage.
+        let options = SolveOptions {
+            deadline: rod_ig_core::solver::MAX_DEADLINE,
+            ..Default::default()
+        };
+        match ig::solve(target, &options) {
             Ok(s) => check_by_reference(target, &s.a),
             Err(f) => {
                 assert_eq!(f.termination(), Termination::NoStableSolution, "{f}");
@@ -69,9 +74,9 @@ fn stable_rods_beyond_the_box_are_found() {
     for (t, why) in &missed {
         eprintln!("missed {t:?}: {why}");
     }
-    // The previous release found none of them; this one misses 2 (rods with |a3| ≈ 30–33 by
+    // The previous release found none of them; this one misses 1 (a rod with |a3| ≈ 30–35 by
     // the separatrix, where the atlas beyond the box holds too few seeds).
-    assert!(missed.len() <= 2, "{} of 77 missed", missed.len());
+    assert!(missed.len() <= 1, "{} of 77 missed", missed.len());
 }
 
 #[test]

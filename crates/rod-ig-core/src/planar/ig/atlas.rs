@@ -38,8 +38,8 @@ pub(crate) const SEED_A45_MAX: f64 = 300.0;
 pub(crate) enum Tier {
     /// Rays of |a3| ≤ 14, |a4|, |a5| ≤ 150 (somewhat larger than the public box).
     Box,
-    /// Rays of |a3| ≤ 36, |a4|, |a5| ≤ 300 (and as many near the separatrix), seeds kept
-    /// only outside the first tier's box.
+    /// Rays of |a3| ≤ 36, |a4|, |a5| ≤ 300 (and twice as many near the separatrix),
+    /// seeds kept only outside the first tier's box.
     Beyond,
 }
 
@@ -49,6 +49,8 @@ struct Spec {
     rays: usize,
     /// Ray end-points near the separatrix λ4 = 0.
     separatrix_rays: usize,
+    /// Their relative offsets from it: log-uniform over this many decades below 1.
+    separatrix_decades: f64,
     /// RK4 steps per ray, at least...
     steps: usize,
     /// ... this many per unit of the ray's curvature scale max(|a3|, √‖F‖), so that h |a3|
@@ -69,6 +71,7 @@ impl Tier {
             Tier::Box => &Spec {
                 rays: 8000,
                 separatrix_rays: 8000,
+                separatrix_decades: 6.0,
                 steps: 128,
                 steps_per_scale: 0.0,
                 a3_max: 14.0,
@@ -78,7 +81,13 @@ impl Tier {
             },
             Tier::Beyond => &Spec {
                 rays: 16000,
-                separatrix_rays: 16000,
+                // The last stable rods it missed lie 3e-7 (relative) from the separatrix with
+                // |J(1, a)| ~ 2e5 and no Newton basin 1e-4 wide: reached only from seeds on
+                // their own ray. 9 decades and twice the rays found 6 more of 2,600 workspace
+                // targets; 3× found 10 more but its build peaks past a `track` stream's 64 MB
+                // bound (76 MB; 57 MB with 2×); 6× found none more than 3×.
+                separatrix_rays: 32000,
+                separatrix_decades: 9.0,
                 steps: 128,
                 steps_per_scale: 10.0,
                 a3_max: SEED_A3_MAX,
@@ -180,10 +189,10 @@ fn separatrix_endpoint(spec: &Spec, i: u64) -> Option<PlanarParams> {
     let base = a3 * a3 * (a3 * a3 / 4.0 + a4);
     let u = halton(i, 5);
     let v = halton(i, 7);
-    // Relative offset ±10^(−6..0) of the scale a3⁴/4 + |a4| a3² (+1 to stay away from 0).
+    // Relative offset ±10^(−decades..0) of the scale a3⁴/4 + |a4| a3² (+1 to stay away from 0).
     let scale = a3 * a3 * (a3 * a3 / 4.0 + a4.abs()) + 1.0;
     let sign = if v < 0.5 { -1.0 } else { 1.0 };
-    let l4 = sign * scale * 10f64.powf(-6.0 * u);
+    let l4 = sign * scale * 10f64.powf(-spec.separatrix_decades * u);
     let a5sq = base + l4;
     if a5sq.is_nan() || a5sq <= 0.0 {
         return None;
