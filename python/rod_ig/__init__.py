@@ -513,13 +513,18 @@ class Planner:
         goal: Sequence[float],
         obstacles: Sequence[dict[str, Any]] = (),
         deadline_ms: float = 500.0,
+        weight: float = 0.0,
+        gravity: Sequence[float] = (0.0, -1.0),
     ) -> PlanResult:
         """Plans from the rod ``start`` (a3, a4, a5) to a rod whose tip is ``goal`` (x, y,
-        theta)."""
+        theta); ``weight`` and ``gravity`` (2 components): the rod with weight
+        (docs/weight.md), whose margins, bodies and goal rods the plan then uses."""
         s = [float(v) for v in _batch("start", start, 3)[0]]
         g = [float(v) for v in _batch("goal", goal, 3)[0]]
+        down = _batch("gravity", gravity, 2)[0].reshape(2)
         with self._lock:
-            d = self._inner.plan(s, g, obstacles=list(obstacles), deadline_ms=deadline_ms)
+            d = self._inner.plan(s, g, obstacles=list(obstacles), deadline_ms=deadline_ms,
+                                 weight=float(weight), gravity=(float(down[0]), float(down[1])))
         return PlanResult(
             success=d["success"],
             rods=d["rods"].reshape(-1, 3),

@@ -87,6 +87,8 @@ class Planner:
         goal: list[float],
         obstacles: list[dict[str, Any]] = ...,
         deadline_ms: float = 500.0,
+        weight: float = 0.0,
+        gravity: tuple[float, float] = (0.0, -1.0),
     ) -> dict[str, Any]: ...
     @property
     def roadmap_size(self) -> int: ...

@@ -851,8 +851,10 @@ impl Planner {
 
     /// Plans from the rod `start` to a rod whose tip is `goal` (x, y, θ) around `obstacles`
     /// (dicts {"type": "disc", "center": [x, y], "radius": r} or {"type": "polygon",
-    /// "points": [[x, y], ...]}).
-    #[pyo3(signature = (start, goal, obstacles=Vec::new(), deadline_ms=500.0))]
+    /// "points": [[x, y], ...]}), for the rod with `weight` along `gravity` (0: weightless).
+    #[pyo3(signature = (start, goal, obstacles=Vec::new(), deadline_ms=500.0, weight=0.0,
+                        gravity=(0.0, -1.0)))]
+    #[allow(clippy::too_many_arguments)] // the Python keyword arguments, one each
     fn plan<'py>(
         &mut self,
         py: Python<'py>,
@@ -860,7 +862,11 @@ impl Planner {
         goal: [f64; 3],
         obstacles: Vec<Bound<'py, PyDict>>,
         deadline_ms: f64,
+        weight: f64,
+        gravity: (f64, f64),
     ) -> PyResult<Bound<'py, PyDict>> {
+        let gravity = Gravity::new(weight, [gravity.0, gravity.1])
+            .map_err(|e| PyValueError::new_err(format!("weight/gravity: {e}")))?;
         let obstacles = obstacles
             .iter()
             .map(obstacle_of)
@@ -875,6 +881,7 @@ impl Planner {
             goal: PlanarPose::new(goal[0], goal[1], goal[2]),
             obstacles,
             deadline: Duration::from_secs_f64(deadline_ms / 1e3),
+            gravity,
         };
         let planner = &mut self.planner;
         let r = py.detach(|| {

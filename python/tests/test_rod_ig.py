@@ -445,6 +445,23 @@ def test_tracker_with_weight_holds_a_heavy_rod() -> None:
         rod_ig.Tracker(weight=-2.0)
 
 
+def test_planner_with_weight_plans_the_heavy_rod() -> None:
+    start = [1.7939773444075664, -11.347913785723009, 2.39993152353178]
+    goal = [0.2413, -0.7694, -1.5494]
+    p = rod_ig.Planner()
+    r = p.plan(start, goal, weight=15.0, gravity=(0.0, -1.0))
+    assert r.success, r.reason
+    # Every rod of the plan is a stable heavy rod, and the last one's tip is the goal.
+    check = rod_ig.forward(r.rods, weight=15.0, gravity=(0.0, -1.0))
+    assert bool(np.all(check.stable))
+    assert np.abs(check.tip[-1, :2] - goal[:2]).max() < 1e-6
+    assert np.abs(r.gripper[-1, :2] - goal[:2]).max() < 1e-6
+    # Weightless, the last rod's tip is elsewhere: the weight was planned for.
+    assert np.abs(rod_ig.forward(r.rods[-1]).tip[:2] - goal[:2]).max() > 1e-2
+    with pytest.raises(ValueError, match="weight"):
+        p.plan(start, goal, weight=-1.0)
+
+
 def test_the_boundary_raises_and_names_the_argument() -> None:
     """Issue 42, item 6: integers are integers, threads are bounded, failures say why."""
     a = np.zeros((3, 3)) + [1.0, 2.0, 3.0]

@@ -97,6 +97,7 @@ fn requests() -> Vec<(&'static str, Request)> {
                     goal: PlanarPose::new(0.8, 0.3, 0.5),
                     obstacles: discs.clone(),
                     deadline: d,
+                    gravity: rod_ig_core::planar::heavy::Gravity::NONE,
                 });
             }),
         ),

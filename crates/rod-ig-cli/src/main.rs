@@ -97,7 +97,7 @@ enum Command {
     },
     /// Plans a stable gripper path. Reads JSON lines {"start": [a3, a4, a5], "goal": {"x",
     /// "y", "theta"}, "obstacles"?: [{"type": "disc", "center": [x, y], "radius": r} |
-    /// {"type": "polygon", "points": [[x, y], ...]}], "deadline_ms"? (default 500)}; writes
+    /// {"type": "polygon", "points": [[x, y], ...]}], "deadline_ms"? (default 500), "weight"?, "gravity"? (as `solve`)}; writes
     /// {"success", "rods": [[a3, a4, a5], ...], "gripper": [{"x", "y", "theta"}, ...],
     /// "min_margin", "reason" (on failure), "elapsed_ms"}. One roadmap serves every line.
     Plan {

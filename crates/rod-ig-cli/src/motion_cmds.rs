@@ -385,6 +385,10 @@ struct PlanLine {
     #[serde(default)]
     obstacles: Vec<Obstacle>,
     deadline_ms: Option<f64>,
+    /// Dimensionless weight w = ρgAL³/EI (default 0).
+    weight: Option<f64>,
+    /// Direction of gravity in the base frame (default [0, -1]).
+    gravity: Option<[f64; 2]>,
 }
 
 /// A `plan` answer.
@@ -420,11 +424,13 @@ impl Planning {
             Some(ms) => jsonl::deadline_from_ms(ms)?,
             None => plan::DEFAULT_PLAN_DEADLINE,
         };
+        let gravity = crate::planar_cmds::gravity_of(request.weight, request.gravity)?;
         let query = PlanRequest {
             start: PlanarParams::from(request.start),
             goal: request.goal,
             obstacles: request.obstacles,
             deadline,
+            gravity,
         };
         let t0 = std::time::Instant::now();
         let result = self.planner.plan(&query);
@@ -436,7 +442,7 @@ impl Planning {
                     .iter()
                     .enumerate()
                     .map(|(i, a)| SequenceRod {
-                        poses: shape(a, &Gravity::NONE),
+                        poses: shape(a, &gravity),
                         kind: if i == 0 {
                             SequenceKind::Start
                         } else {

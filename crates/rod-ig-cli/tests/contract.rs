@@ -480,6 +480,41 @@ fn track_follows_changes_of_weight_and_gravity() {
 }
 
 #[test]
+fn plan_takes_weight_and_gravity() {
+    // A cable of weight 15 held by a stable heavy rod, planned to a pose below: the gripper path
+    // ends at the goal with the heavy rod's tip; the same request weightless is another plan;
+    // a negative weight is refused naming it.
+    let start = "\"start\": [1.7939773444075664, -11.347913785723009, 2.39993152353178]";
+    let goal = "\"goal\": {\"x\": 0.2413, \"y\": -0.7694, \"theta\": -1.5494}";
+    let lines = [
+        format!("{{{start}, {goal}, \"weight\": 15, \"gravity\": [0, -1]}}"),
+        format!("{{{start}, {goal}}}"),
+        format!("{{{start}, {goal}, \"weight\": -1}}"),
+    ];
+    let out = run(&["plan"], &(lines.join("\n") + "\n"));
+    assert_eq!(out.len(), 3);
+    for answer in &out[..2] {
+        assert_eq!(answer["success"], true, "{answer}");
+        let last = answer["gripper"]
+            .as_array()
+            .unwrap()
+            .last()
+            .unwrap()
+            .clone();
+        let (x, y) = (last["x"].as_f64().unwrap(), last["y"].as_f64().unwrap());
+        assert!((x - 0.2413).hypot(y + 0.7694) < 1e-6, "{answer}");
+        assert!(answer["min_margin"].as_f64().unwrap() >= 1e-3);
+    }
+    let end = |k: usize| out[k]["rods"].as_array().unwrap().last().unwrap().clone();
+    let (heavy, light) = (end(0), end(1));
+    let gap = (0..3)
+        .map(|i| (heavy[i].as_f64().unwrap() - light[i].as_f64().unwrap()).abs())
+        .fold(0.0, f64::max);
+    assert!(gap > 1.0, "the weight changed nothing: {heavy} vs {light}");
+    assert!(out[2]["error"].as_str().unwrap().contains("weight"));
+}
+
+#[test]
 fn forward3d_takes_weight_and_gravity() {
     // The first 3-D line of data/oracle/gravity_public.jsonl.
     let line = "{\"a\": [-0.5125436654357536, 2.054283434253289, -2.0221151279950513, 7.275847824793701, 3.653817900748945, -24.609998593465576], \"weight\": 0.10318130992463896, \"gravity\": [-0.036431999446761, -0.3497845171631451, -0.9361215204070764]}\n{\"a\": [0, 0, 1, 0, 0, 0], \"weight\": -1}\n{\"a\": [0, 0, 1, 0, 0, 0], \"weight\": 1, \"rtol\": 1e-6}\n";

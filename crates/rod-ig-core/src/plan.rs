@@ -20,8 +20,14 @@
 //! the checked rods between them are its midpoints. Obstacles (discs, polygons) must not touch
 //! the rod's body, sampled at [`BODY_SAMPLES`] points.
 //!
+//! A rod with weight (`PlanRequest::gravity`, [`crate::planar::heavy`]) is planned the same
+//! way: its margins, bodies, tips and goal rods are the heavy rod's, the roadmap nodes the same
+//! rods of the atlas (a node that is not a stable heavy rod fails its edges' checks), and the
+//! edge verdicts kept across queries are dropped when the weight or its direction changes.
+//!
 //! [`solve_all`]: crate::planar::ig::solve_all
 
+use crate::planar::heavy::{self, Gravity, HeavyPlanar};
 use crate::planar::ig::{self, SolveOptions};
 use crate::planar::{self, PlanarRod};
 use crate::{PlanarParams, PlanarPose};
@@ -88,6 +94,8 @@ pub struct PlanRequest {
     pub obstacles: Vec<Obstacle>,
     /// Wall-time budget.
     pub deadline: Duration,
+    /// The rod's weight and gravity's direction ([`Gravity::NONE`]: the weightless rod).
+    pub gravity: Gravity,
 }
 
 /// A plan: rods from the start to a rod whose tip is the goal, and the gripper poses.
@@ -150,6 +158,8 @@ pub struct Planner {
     nodes: Vec<PlanarParams>,
     /// Stability verdicts of edges (node pairs, smaller index first): true = stable.
     edge_stable: HashMap<(usize, usize), bool>,
+    /// The weight those verdicts hold for.
+    gravity: Gravity,
 }
 
 /// A node of one query's graph: a roadmap node or one of the query's own rods.
@@ -194,12 +204,17 @@ impl Planner {
         if !self.ensure_roadmap() {
             return Err(PlanError::Deadline { edges_checked: 0 });
         }
+        let g = request.gravity;
+        if g != self.gravity {
+            self.edge_stable.clear();
+            self.gravity = g;
+        }
         let start = request.start;
-        let margin = margin_of(&start);
+        let margin = margin_of(&start, &g);
         if margin < MIN_MARGIN {
             return Err(PlanError::StartUnstable { margin });
         }
-        match collides(&start, &request.obstacles) {
+        match collides(&start, &g, &request.obstacles) {
             Some(false) => {}
             Some(true) => return Err(PlanError::StartCollides),
             None => return Err(PlanError::Deadline { edges_checked: 0 }),
@@ -209,17 +224,10 @@ impl Planner {
             deadline: request.deadline.min(crate::planar::ig::MAX_DEADLINE),
             ..SolveOptions::default()
         };
-        let mut goals = ig::solve_all(&request.goal, &options);
-        if goals.is_empty() {
-            let reason = match ig::solve(&request.goal, &options) {
-                Err(f) => f.reason.to_string(),
-                Ok(_) => "no stable solution".into(),
-            };
-            return Err(PlanError::GoalUnreachable(reason));
-        }
+        let mut goals = goal_rods(&request.goal, &g, &options)?;
         let found = goals.len();
-        goals.retain(|g| {
-            margin_of(&g.a) >= MIN_MARGIN && collides(&g.a, &request.obstacles) == Some(false)
+        goals.retain(|a| {
+            margin_of(a, &g) >= MIN_MARGIN && collides(a, &g, &request.obstacles) == Some(false)
         });
         if crate::deadline::expired() {
             return Err(PlanError::Deadline { edges_checked: 0 });
@@ -227,10 +235,40 @@ impl Planner {
         if goals.is_empty() {
             return Err(PlanError::GoalBlocked { rods: found });
         }
-        let goal_rods: Vec<PlanarParams> = goals.iter().map(|g| g.a).collect();
-        let mut query = Query::new(self, start, goal_rods, request);
+        let mut query = Query::new(self, start, goals, request);
         query.run()
     }
+}
+
+/// Every stable rod found whose tip is `goal` (weightless: `ig::solve_all`; with weight, the
+/// model's search for all of them); refused with the search's reason when there is none.
+fn goal_rods(
+    goal: &PlanarPose,
+    g: &Gravity,
+    options: &SolveOptions,
+) -> Result<Vec<PlanarParams>, PlanError> {
+    let rods: Vec<PlanarParams> = if g.is_weightless() {
+        ig::solve_all(goal, options).iter().map(|s| s.a).collect()
+    } else {
+        let model = HeavyPlanar::new(*g);
+        crate::solver::solve_every(&model, goal, options)
+            .solutions
+            .iter()
+            .map(|s| s.a)
+            .collect()
+    };
+    if !rods.is_empty() {
+        return Ok(rods);
+    }
+    let failure = if g.is_weightless() {
+        ig::solve(goal, options).err()
+    } else {
+        crate::solver::solve(&HeavyPlanar::new(*g), goal, options).err()
+    };
+    Err(PlanError::GoalUnreachable(failure.map_or_else(
+        || "no stable solution".into(),
+        |f| f.reason.to_string(),
+    )))
 }
 
 fn check_request(request: &PlanRequest) -> Result<(), PlanError> {
@@ -298,11 +336,16 @@ fn check_obstacle(o: &Obstacle) -> Result<(), PlanError> {
     Ok(())
 }
 
-/// The normalised stability margin of `a` (−∞ when it cannot be evaluated or the verdict is
-/// not "stable").
-fn margin_of(a: &PlanarParams) -> f64 {
+/// The normalised stability margin of `a` under `g` (−∞ when it cannot be evaluated or the
+/// verdict is not "stable").
+fn margin_of(a: &PlanarParams, g: &Gravity) -> f64 {
     crate::deadline::charge(crate::deadline::units::STABILITY_REPORT);
-    match planar::stability(a) {
+    let report = if g.is_weightless() {
+        planar::stability(a)
+    } else {
+        heavy::stability(a, g)
+    };
+    match report {
         Ok(r) if r.stable => r.margin,
         _ => f64::NEG_INFINITY,
     }
@@ -310,14 +353,18 @@ fn margin_of(a: &PlanarParams) -> f64 {
 
 /// True when the rod's body touches an obstacle; `None` when the deadline passed first (the
 /// tests are charged to [`crate::deadline`], a few obstacles at a time).
-fn collides(a: &PlanarParams, obstacles: &[Obstacle]) -> Option<bool> {
+fn collides(a: &PlanarParams, g: &Gravity, obstacles: &[Obstacle]) -> Option<bool> {
     if obstacles.is_empty() {
         return Some(false);
     }
-    let Ok(rod) = PlanarRod::new(a) else {
+    let body = if g.is_weightless() {
+        PlanarRod::new(a).map(|rod| rod.shape(BODY_SAMPLES))
+    } else {
+        heavy::shape(a, g, BODY_SAMPLES)
+    };
+    let Ok(body) = body else {
         return Some(true);
     };
-    let body = rod.shape(BODY_SAMPLES);
     let mut tests = 0u64;
     for o in obstacles {
         if body.windows(2).any(|w| segment_touches(&w[0], &w[1], o)) {
@@ -587,7 +634,7 @@ impl<'p> Query<'p> {
             if self.expired() {
                 return None;
             }
-            let m = margin_of(&r);
+            let m = margin_of(&r, &self.planner.gravity);
             min_margin = min_margin.min(m);
             if m < MIN_MARGIN {
                 if roadmap_pair {
@@ -600,7 +647,7 @@ impl<'p> Query<'p> {
             self.planner.edge_stable.insert(key(u, v), true);
         }
         for r in edge_samples(&a, &b)? {
-            if collides(&r, self.obstacles) != Some(false) {
+            if collides(&r, &self.planner.gravity, self.obstacles) != Some(false) {
                 return None;
             }
         }
@@ -624,7 +671,7 @@ impl<'p> Query<'p> {
                     edges_checked: self.edges_checked,
                 });
             };
-            let mut min_margin = margin_of(&self.start);
+            let mut min_margin = margin_of(&self.start, &self.planner.gravity);
             let mut ok = true;
             for w in path.windows(2) {
                 match self.check_edge(w[0], w[1]) {
@@ -651,9 +698,17 @@ impl<'p> Query<'p> {
                 rods.extend(samples.skip(1).step_by(2));
             }
         }
+        let g = &self.planner.gravity;
+        let tip = |a: &PlanarParams| {
+            if g.is_weightless() {
+                planar::tip(a)
+            } else {
+                heavy::tip(a, g)
+            }
+        };
         let gripper = rods
             .iter()
-            .map(|a| planar::tip(a).unwrap_or(PlanarPose::new(f64::NAN, f64::NAN, f64::NAN)))
+            .map(|a| tip(a).unwrap_or(PlanarPose::new(f64::NAN, f64::NAN, f64::NAN)))
             .collect();
         Plan {
             rods,
@@ -677,7 +732,7 @@ mod tests {
     /// A rod drawn from the stable, moderately bent set (the shapes the planner sees).
     /// `collides` with no deadline in force (it always answers).
     fn touches(a: &PlanarParams, obstacles: &[Obstacle]) -> bool {
-        collides(a, obstacles).expect("no deadline in force")
+        collides(a, &Gravity::NONE, obstacles).expect("no deadline in force")
     }
 
     fn rod() -> impl Strategy<Value = PlanarParams> {

@@ -249,6 +249,7 @@ fn obstacle_coordinates_are_bounded_and_huge_ones_refused() {
         goal: PlanarPose::new(0.8, 0.3, 0.5),
         obstacles,
         deadline: Duration::from_secs(2),
+        gravity: rod_ig_core::planar::heavy::Gravity::NONE,
     };
     let mut planner = Planner::new();
     // The triangle: 1e200 overflowed the geometry and was ignored (success: true).

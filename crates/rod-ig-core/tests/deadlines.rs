@@ -122,6 +122,7 @@ fn the_planner_stops_inside_its_collision_scans_and_far_edges() {
             goal: PlanarPose::new(0.8, 0.3, 0.5),
             obstacles,
             deadline: MAX_DEADLINE,
+            gravity: rod_ig_core::planar::heavy::Gravity::NONE,
         };
         for budget in [50, 1_000] {
             let (r, charged) = counted(budget, || planner.plan(&request));
@@ -145,6 +146,7 @@ fn the_planner_stops_inside_its_collision_scans_and_far_edges() {
         goal: PlanarPose::new(0.8, 0.3, 0.5),
         obstacles: vec![discs[0].clone(); MAX_OBSTACLES + 1],
         deadline: MAX_DEADLINE,
+        gravity: rod_ig_core::planar::heavy::Gravity::NONE,
     };
     let e = planner.plan(&request).expect_err("too many obstacles");
     assert!(e.to_string().contains("at most"), "{e}");

@@ -75,6 +75,7 @@ fn first_calls_answer_within_their_budget() {
                 goal: PlanarPose::new(0.8, 0.3, 0.5),
                 obstacles: Vec::new(),
                 deadline: MAX_DEADLINE,
+                gravity: rod_ig_core::planar::heavy::Gravity::NONE,
             })
         });
         if let Err(e) = plan {

@@ -92,6 +92,7 @@ fn plans_between_random_stable_rods_are_stable_all_the_way() {
             // The longest a request may ask: a loaded machine must not change the count
             // (the planner's speed is measured by `rod-ig bench`).
             deadline: rod_ig_core::planar::ig::MAX_DEADLINE,
+            gravity: rod_ig_core::planar::heavy::Gravity::NONE,
         };
         match planner.plan(&request) {
             Ok(plan) => {
@@ -122,6 +123,7 @@ fn plans_avoid_obstacles_and_failures_say_why() {
         goal,
         obstacles: vec![disc.clone()],
         deadline: Duration::from_secs(2),
+        gravity: rod_ig_core::planar::heavy::Gravity::NONE,
     };
     let plan = planner.plan(&request).expect("a way around the disc");
     verify(&plan, &request, true);
@@ -161,4 +163,94 @@ fn plans_avoid_obstacles_and_failures_say_why() {
         ..request
     };
     assert!(matches!(planner.plan(&bad), Err(PlanError::Invalid(_))));
+}
+
+/// A stable heavy rod of gentle moment and force with margin ≥ 1e-2 (comfortably above the
+/// planner's [`MIN_MARGIN`]), and its tip.
+fn random_stable_heavy(
+    rng: &mut SplitMix64,
+    g: &rod_ig_core::planar::heavy::Gravity,
+) -> (PlanarParams, PlanarPose) {
+    use rod_ig_core::planar::heavy;
+    loop {
+        let a = PlanarParams::new(
+            rng.range(-3.0, 3.0),
+            rng.range(-15.0, 15.0),
+            rng.range(-15.0, 15.0),
+        );
+        if let Ok(e) = heavy::evaluate(&a, g) {
+            if e.stability.stable && e.stability.margin >= 1e-2 {
+                return (a, e.tip);
+            }
+        }
+    }
+}
+
+/// A cable with weight (issue 41): the plan's rods are the heavy rod's. Every rod and midpoint
+/// is a stable heavy rod with margin; the last rod's heavy tip is the goal by the independent
+/// DOP853 integration of the rod with weight, while its weightless tip is elsewhere; the
+/// sagging bodies stay clear of a disc just under the held cable.
+#[test]
+fn plans_for_a_cable_with_weight_use_the_heavy_rod() {
+    use rod_ig_core::ode::heavy_reference;
+    use rod_ig_core::planar::heavy::{self, Gravity};
+    rod_ig_core::planar::ig::warm_up();
+    let g = Gravity::new(15.0, [0.0, -1.0]).expect("gravity");
+    let mut rng = SplitMix64::new(41);
+    let (start, _) = random_stable_heavy(&mut rng, &g);
+    let (_, goal) = random_stable_heavy(&mut rng, &g);
+    // Just under the held cable's lowest point.
+    let body = heavy::shape(&start, &g, 49).expect("evaluates");
+    let low = body
+        .iter()
+        .min_by(|p, q| p.y.total_cmp(&q.y))
+        .expect("samples");
+    let centre = [low.x, low.y - 0.15];
+    let request = PlanRequest {
+        start,
+        goal,
+        obstacles: vec![Obstacle::Disc {
+            center: centre,
+            radius: 0.1,
+        }],
+        deadline: rod_ig_core::planar::ig::MAX_DEADLINE,
+        gravity: g,
+    };
+    let mut planner = Planner::new();
+    let plan = planner.plan(&request).expect("a plan for the cable");
+    assert_eq!(plan.rods[0], start);
+    assert!(plan.min_margin >= MIN_MARGIN);
+    for w in plan.rods.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        assert!((b - a).norm() <= 0.1 * (1.0 + a.norm().min(b.norm())) + 1e-12);
+        for r in [b, 0.5 * (a + b)] {
+            let report = heavy::stability(&r, &g).expect("evaluates");
+            assert!(report.stable && report.margin > 0.0, "{r:?}: {report:?}");
+        }
+    }
+    for (a, q) in plan.rods.iter().zip(&plan.gripper) {
+        assert_eq!(*q, heavy::tip(a, &g).expect("evaluates"));
+        for p in heavy::shape(a, &g, 200).expect("evaluates") {
+            let d = (p.x - centre[0]).hypot(p.y - centre[1]);
+            assert!(d > 0.1 - 2e-3, "rod {a:?} enters the disc ({d})");
+        }
+    }
+    let last = plan.rods.last().expect("non-empty");
+    let reference = heavy_reference::evaluate(last, &g).expect("evaluates");
+    let off = |t: &PlanarPose| {
+        (t.x - goal.x).hypot(t.y - goal.y) + wrap_angle(t.theta - goal.theta).abs()
+    };
+    assert!(off(&reference.tip) <= 1e-6, "{:?}", reference.tip);
+    assert!(reference.stability.stable);
+    let weightless_tip = planar::tip(last).expect("evaluates");
+    assert!(off(&weightless_tip) > 1e-2, "the weight changed nothing");
+    // The same planner, weightless again: its own rods (the heavy verdicts were dropped).
+    let weightless = PlanRequest {
+        start: random_stable(&mut SplitMix64::new(7), 1e-2).0,
+        gravity: Gravity::NONE,
+        obstacles: Vec::new(),
+        ..request
+    };
+    let plan = planner.plan(&weightless).expect("a weightless plan");
+    verify(&plan, &weightless, false);
 }
