@@ -42,6 +42,27 @@ def test_a_heavy_cable_held_level_sags(cable):
     assert math.isclose(sol.base_wrench.force.y, sol.a[2] * 3.5e-4 / 0.3**2, rel_tol=1e-12)
 
 
+def test_rod_plan_plans_for_the_cable_with_weight(cable):
+    """rod/plan with weight: a stable path of heavy rods, ending where the heavy rod's tip is
+    the goal; gravity out of the rod's plane is refused with the reason."""
+    _, c = cable
+    start = [1.7939773444075664, -11.347913785723009, 2.39993152353178]
+    gx, gy, gyaw = 0.2413 * 0.3, -0.7694 * 0.3, -1.5494
+    resp = c.plan(start=start, goal=c.make_target(gx, gy, gyaw, h.next_seq()))
+    assert resp is not None and resp.success, resp and resp.reason
+    assert resp.min_margin >= 1e-3
+    last = resp.gripper_path.poses[-1].pose
+    assert math.hypot(last.position.x - gx, last.position.y - gy) < 1e-6
+    assert list(resp.rods[:3]) == start
+    # Gravity out of the plane: the planner is planar.
+    assert all(r.successful for r in c.set_params(gravity=[0.0, -6.0, 7.0]))
+    try:
+        resp = c.plan(start=start, goal=c.make_target(gx, gy, gyaw, h.next_seq()))
+        assert resp is not None and not resp.success and "plane" in resp.reason
+    finally:
+        assert all(r.successful for r in c.set_params(gravity=[0.0, -9.81, 0.0]))
+
+
 def test_weight_changes_take_effect_and_bad_values_are_refused(cable):
     _, c = cable
     # Gravity along +x (the base gripper turned): another rod for the same target.
@@ -52,7 +73,7 @@ def test_weight_changes_take_effect_and_bad_values_are_refused(cable):
     # Gravity out of the rod's plane: refused with the reason.
     assert all(r.successful for r in c.set_params(gravity=[0.0, -6.0, 7.0]))
     sol, _ = solve_topic(c, 0.18, 0.0, 0.0)
-    assert not sol.success and "plane" in sol.message
+    assert not sol.success and "plane" in sol.message and "solve_3d" in sol.message
     # No gravity, or no stiffness: refused, naming what is missing.
     assert all(r.successful for r in c.set_params(gravity=[0.0, 0.0, 0.0]))
     sol, _ = solve_topic(c, 0.18, 0.0, 0.0)
@@ -69,3 +90,60 @@ def test_weight_changes_take_effect_and_bad_values_are_refused(cable):
     assert all(r.successful for r in c.set_params(linear_density=0.0))
     sol, _ = solve_topic(c, 0.18, 0.0, 0.0)
     assert sol.success and sol.weight == 0.0 and sol.total_energy == sol.elastic_energy
+
+
+@pytest.fixture(scope="module")
+def cable_3d():
+    node, client = h.start_node_and_client(["--ros-args", *CABLE, "-p", "solve_3d:=true"],
+                                           name="rod_ig_weight_3d_client")
+    yield node, client
+    h.stop_node_and_client(node, client)
+
+
+def tilted(yaw, tilt):
+    """yaw about z, then `tilt` rad about x: a target out of the rod's plane."""
+    cy, sy, ct, st = math.cos(yaw / 2), math.sin(yaw / 2), math.cos(tilt / 2), math.sin(tilt / 2)
+    return (cy * st, sy * st, sy * ct, cy * ct)
+
+
+def check_heavy_3d(c, s, x, y, z, w=W):
+    sol = c.solution_for(s)
+    assert sol is not None and sol.success, sol and sol.message
+    assert sol.spatial and sol.stable
+    assert math.isclose(sol.weight, w, rel_tol=1e-12)
+    assert sol.total_energy != sol.elastic_energy
+    last = c.path_for(s, timeout=2.0).poses[-1].pose.position
+    assert math.dist((last.x, last.y, last.z), (x, y, z)) < 1e-6
+    return sol
+
+
+def test_the_3d_rod_with_weight_serves_non_planar_targets(cable_3d):
+    """solve_3d with weight: the 3-D rod under gravity (spatial::HeavySpatial), not a refusal."""
+    _, c = cable_3d
+    s = h.next_seq()
+    c.pub.publish(c.make_target(0.18, 0.06, 0.0, s, z=0.05, q=tilted(0.4, 0.3)))
+    heavy = check_heavy_3d(c, s, 0.18, 0.06, 0.05)
+    # The same target without weight is another rod: the weight was modelled.
+    assert all(r.successful for r in c.set_params(linear_density=0.0))
+    s = h.next_seq()
+    c.pub.publish(c.make_target(0.18, 0.06, 0.0, s, z=0.05, q=tilted(0.4, 0.3)))
+    light = c.solution_for(s)
+    assert light.success and light.spatial and light.weight == 0.0, light.message
+    assert max(abs(p - q) for p, q in zip(heavy.a_spatial, light.a_spatial)) > 1.0
+    assert all(r.successful for r in c.set_params(linear_density=0.02))
+
+
+def test_gravity_out_of_the_plane_is_the_3d_rods(cable_3d):
+    """Gravity leaving the rod's plane (a tilted base gripper): with solve_3d even a planar
+    target is the 3-D rod's, sagging out of the plane."""
+    _, c = cable_3d
+    assert all(r.successful for r in c.set_params(gravity=[0.0, -6.0, 7.0]))
+    try:
+        s = h.next_seq()
+        c.pub.publish(c.make_target(0.18, 0.09, 0.5, s))
+        # |g| = sqrt(6^2 + 7^2) m/s^2 here.
+        check_heavy_3d(c, s, 0.18, 0.09, 0.0, w=W * math.hypot(6.0, 7.0) / 9.81)
+        shape = c.path_for(s, timeout=2.0).poses
+        assert max(abs(p.pose.position.z) for p in shape) > 1e-3  # out of the plane
+    finally:
+        assert all(r.successful for r in c.set_params(gravity=[0.0, -9.81, 0.0]))

@@ -4,6 +4,7 @@
 //! L ([`to_normalised`] / [`to_metres`]) and the bending stiffness EI, and quaternion ↔ yaw.
 
 use rod_ig_core::planar::heavy::Gravity;
+use rod_ig_core::spatial::heavy::Gravity3;
 use thiserror::Error;
 
 use crate::messages::{
@@ -50,6 +51,17 @@ pub enum TargetError {
     /// The weight parameters cannot be used (see [`gravity_of`]).
     #[error("{0}")]
     Weight(String),
+    /// Gravity leaves the rod's plane by more than `planar_tolerance`: the planar rod with
+    /// weight hangs in a vertical plane (the 3-D rod's with `solve_3d`).
+    #[error("gravity leaves the rod's plane by {tilt:.3e} rad (gravity z = {gz} m/s^2; accepted <= planar_tolerance = {tol} rad): the planar rod with weight hangs in a vertical plane; with solve_3d:=true the 3-D rod with weight serves every target")]
+    GravityOutOfPlane {
+        /// Angle between gravity and the rod's plane (rad).
+        tilt: f64,
+        /// Gravity's z component (m/s²).
+        gz: f64,
+        /// Accepted tilt (rad).
+        tol: f64,
+    },
     /// The target's frame could not be transformed into `base_frame` (`use_tf`).
     #[error(
         "cannot transform the target from frame {frame:?} to {base:?} within {timeout} s: {why}"
@@ -74,26 +86,32 @@ impl TargetError {
             Self::Frame { .. } => "tf_lookup",
             Self::OutOfReach { .. } => "unreachable",
             Self::OffPlane { .. } | Self::Tilted { .. } => "non_planar",
-            Self::NonFinite(_) | Self::ZeroQuaternion(_) | Self::Weight(_) => "invalid_input",
+            Self::NonFinite(_)
+            | Self::ZeroQuaternion(_)
+            | Self::Weight(_)
+            | Self::GravityOutOfPlane { .. } => "invalid_input",
         }
     }
 
     /// The target is valid except that it is not planar (z or tilt beyond
-    /// `planar_tolerance`): the 3-D solver can take it when `solve_3d` is set.
+    /// `planar_tolerance`), or gravity is not in the rod's plane: the 3-D solver can take it
+    /// when `solve_3d` is set.
     pub fn is_non_planar(&self) -> bool {
-        matches!(self, Self::OffPlane { .. } | Self::Tilted { .. })
+        matches!(
+            self,
+            Self::OffPlane { .. } | Self::Tilted { .. } | Self::GravityOutOfPlane { .. }
+        )
     }
 }
 
-/// The rod's weight from the parameters: the dimensionless w = ρA |g| L³ / EI
-/// (`linear_density`, `gravity`, `rod_length`, `bending_stiffness`) along the direction of
-/// `gravity` in the rod's plane (the base frame's x-y plane). No weight when `linear_density`
-/// is 0. Refused with a reason when EI or gravity is missing, when gravity leaves the rod's
-/// plane by more than `planar_tolerance` (rad), or when w exceeds the solver's domain.
-pub fn gravity_of(params: &Params) -> Result<Gravity, TargetError> {
+/// The rod's weight from the parameters, in the base frame: the dimensionless
+/// w = ρA |g| L³ / EI (`linear_density`, `gravity`, `rod_length`, `bending_stiffness`) and
+/// gravity's direction; None when `linear_density` is 0. Refused with a reason when EI or
+/// gravity is missing.
+fn weight_of(params: &Params) -> Result<Option<(f64, [f64; 3])>, TargetError> {
     let refuse = |why: String| Err(TargetError::Weight(why));
     if params.linear_density == 0.0 {
-        return Ok(Gravity::NONE);
+        return Ok(None);
     }
     if params.bending_stiffness <= 0.0 {
         return refuse("linear_density > 0 needs bending_stiffness (EI, N m^2) > 0 for the rod's dimensionless weight".into());
@@ -103,20 +121,45 @@ pub fn gravity_of(params: &Params) -> Result<Gravity, TargetError> {
     if g <= 0.0 || !g.is_finite() {
         return refuse("linear_density > 0 needs the gravity parameter (m/s^2 in the base frame, e.g. [0.0, -9.81, 0.0])".into());
     }
-    let tilt = (gz / g).abs().asin();
-    if tilt > params.planar_tolerance {
-        return refuse(format!(
-            "gravity leaves the rod's plane by {tilt:.3e} rad (gravity z = {gz} m/s^2; accepted <= planar_tolerance = {} rad): the planar rod with weight hangs in a vertical plane, and the 3-D rod with weight is not implemented yet",
-            params.planar_tolerance
-        ));
-    }
     let l = params.rod_length;
-    let w = params.linear_density * g * l * l * l / params.bending_stiffness;
-    Gravity::new(w, [gx, gy]).or_else(|e| {
-        refuse(format!(
-            "the rod's dimensionless weight w = rho*A*g*L^3/EI = {w:e}: {e}"
-        ))
-    })
+    Ok(Some((
+        params.linear_density * g * l * l * l / params.bending_stiffness,
+        params.gravity,
+    )))
+}
+
+fn out_of_domain(w: f64, e: impl std::fmt::Display) -> TargetError {
+    TargetError::Weight(format!(
+        "the rod's dimensionless weight w = rho*A*g*L^3/EI = {w:e}: {e}"
+    ))
+}
+
+/// The planar rod's weight (`weight_of`) along the direction of gravity in the rod's plane
+/// (the base frame's x-y plane). Also refused when gravity leaves the rod's plane by more than
+/// `planar_tolerance` (rad): such a rod is the 3-D rod's ([`gravity_3d_of`], `solve_3d`), or
+/// when w exceeds the solver's domain.
+pub fn gravity_of(params: &Params) -> Result<Gravity, TargetError> {
+    let Some((w, [gx, gy, gz])) = weight_of(params)? else {
+        return Ok(Gravity::NONE);
+    };
+    let tilt = (gz / (gx * gx + gy * gy + gz * gz).sqrt()).abs().asin();
+    if tilt > params.planar_tolerance {
+        return Err(TargetError::GravityOutOfPlane {
+            tilt,
+            gz,
+            tol: params.planar_tolerance,
+        });
+    }
+    Gravity::new(w, [gx, gy]).map_err(|e| out_of_domain(w, e))
+}
+
+/// The 3-D rod's weight (`weight_of`): w along gravity's direction in the base frame, which
+/// may leave the rod's plane. Refused when w exceeds the solver's domain.
+pub fn gravity_3d_of(params: &Params) -> Result<Gravity3, TargetError> {
+    match weight_of(params)? {
+        None => Ok(Gravity3::NONE),
+        Some((w, g)) => Gravity3::new(w, g).map_err(|e| out_of_domain(w, e)),
+    }
 }
 
 /// A position in metres as normalised coordinates (divided by the rod length).
@@ -500,13 +543,15 @@ fn nan_pose() -> Pose {
 }
 
 /// The RodSolution of a converged 3-D solve: `spatial` = true, `a_spatial` = (a1..a6),
-/// `a` = its planar components (a3, a4, a5), `tip` the reached 3-D pose.
+/// `a` = its planar components (a3, a4, a5), `tip` the reached 3-D pose, `weight` and the
+/// energies as the planar rod's.
 pub fn solution_message_3d(
     s: &Solved3d,
     header: &Header,
     params: &Params,
     solve_time: f64,
 ) -> RodSolution {
+    let (weight, elastic_energy) = (s.weight, s.elastic_energy);
     let s = &s.solution;
     let (l, ei) = (params.rod_length, params.bending_stiffness);
     let a_spatial: [f64; 6] = std::array::from_fn(|i| s.a[i]);
@@ -519,8 +564,8 @@ pub fn solution_message_3d(
         tip: spatial_to_pose(&s.tip, l),
         event: "",
         critical: None,
-        weight: 0.0,
-        elastic_energy: s.energy,
+        weight,
+        elastic_energy,
     };
     converged_message(s, parts, header, params, solve_time)
 }
@@ -593,7 +638,7 @@ pub fn failure_message(
         a_spatial,
         event: failed.map_or("", |f| f.event).to_string(),
         critical_pose: nan_pose(),
-        weight: gravity_of(params).map_or(f64::NAN, |g| g.weight()),
+        weight: gravity_3d_of(params).map_or(f64::NAN, |g| g.weight()),
         total_energy: nan,
     }
 }

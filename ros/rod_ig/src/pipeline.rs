@@ -4,6 +4,8 @@
 
 use std::time::Instant;
 
+use rod_ig_core::spatial::heavy::Gravity3;
+
 use crate::convert::{
     failure_message, output_header, shape_to_marker, shape_to_path, solution_message,
     solution_message_3d, target_to_planar, target_to_spatial, ShapeSample,
@@ -145,6 +147,7 @@ pub fn settings_of(params: &Params) -> SolverSettings {
         follow_branch: params.follow_branch,
         // Unusable weight parameters refuse every target (`process`); the settings keep none.
         gravity: crate::convert::gravity_of(params).unwrap_or_default(),
+        gravity_3d: crate::convert::gravity_3d_of(params).unwrap_or(Gravity3::NONE),
     }
 }
 
@@ -205,9 +208,8 @@ impl Processor {
             method: overrides.method.unwrap_or(settings.method),
             tolerance: overrides.tolerance.unwrap_or(settings.tolerance),
             max_iterations: overrides.max_iterations.unwrap_or(settings.max_iterations),
-            deadline: settings.deadline,
             follow_branch: false,
-            gravity: settings.gravity,
+            ..settings
         });
         let rejected = |e: crate::convert::TargetError| Outcome {
             failure: e.key(),
@@ -221,10 +223,11 @@ impl Processor {
             path: None,
             marker: None,
         };
-        if let Err(e) = crate::convert::gravity_of(params) {
-            return rejected(e);
-        }
-        match target_to_planar(&target.pose, params) {
+        // Gravity out of the rod's plane makes every target the 3-D rod's, as a non-planar one.
+        let planar = crate::convert::gravity_3d_of(params)
+            .and_then(|_| crate::convert::gravity_of(params))
+            .and_then(|_| target_to_planar(&target.pose, params));
+        match planar {
             Ok(planar) => {
                 let result = self
                     .solver
@@ -238,9 +241,10 @@ impl Processor {
                     )
                 })
             }
-            // Non-planar but otherwise valid: the 3-D solver when enabled (the planar
-            // initial guess of a service request is embedded as (0, 0, a3, a4, a5, 0)).
-            Err(e) if e.is_non_planar() && params.solve_3d && settings.gravity.is_weightless() => {
+            // Non-planar (or under gravity out of the rod's plane) but otherwise valid: the
+            // 3-D solver when enabled (the planar initial guess of a service request is
+            // embedded as (0, 0, a3, a4, a5, 0)).
+            Err(e) if e.is_non_planar() && params.solve_3d => {
                 let spatial = match target_to_spatial(&target.pose, params) {
                     Ok(t) => t,
                     Err(e) => return rejected(e),
@@ -255,11 +259,6 @@ impl Processor {
                         s.solution.stable,
                     )
                 })
-            }
-            Err(e) if e.is_non_planar() && params.solve_3d => {
-                rejected(crate::convert::TargetError::Weight(format!(
-                    "{e}; the 3-D solver does not model weight yet (linear_density > 0)"
-                )))
             }
             Err(e) => rejected(e),
         }
@@ -312,16 +311,16 @@ impl Processor {
         held: Option<PlanarParams>,
     ) -> Planned {
         let header = output_header(&request.goal.header, params);
-        let weightless = match crate::convert::gravity_of(params) {
-            Ok(g) if g.is_weightless() => Ok(()),
-            Ok(_) => Err("the planner does not model weight yet (linear_density > 0)".to_string()),
-            Err(e) => Err(e.to_string()),
-        };
-        let plan = weightless
-            .and_then(|()| Self::plan_query(request, params, held))
-            .and_then(|query| self.planner.plan(&query).map_err(|e| e.to_string()));
+        // The planar rod's weight (gravity out of its plane is refused with the reason: the
+        // planner is planar).
+        let gravity = crate::convert::gravity_of(params).map_err(|e| e.to_string());
+        let plan = gravity.and_then(|g| {
+            let query = Self::plan_query(request, params, held, g)?;
+            let plan = self.planner.plan(&query).map_err(|e| e.to_string())?;
+            Ok((plan, g))
+        });
         match plan {
-            Ok(plan) => planned(&plan, header, params),
+            Ok((plan, g)) => planned(&plan, &g, header, params),
             Err(reason) => Planned {
                 response: PlanRodResponse {
                     success: false,
@@ -344,6 +343,7 @@ impl Processor {
         request: &PlanRodRequest,
         params: &Params,
         held: Option<PlanarParams>,
+        gravity: rod_ig_core::planar::heavy::Gravity,
     ) -> Result<rod_ig_core::plan::PlanRequest, String> {
         use rod_ig_core::plan::{Obstacle, PlanRequest, DEFAULT_PLAN_DEADLINE};
         let l = params.rod_length;
@@ -393,6 +393,7 @@ impl Processor {
             goal,
             obstacles,
             deadline,
+            gravity,
         })
     }
 
@@ -404,7 +405,12 @@ impl Processor {
 
 /// The answer to a successful plan: the gripper path in metres, the rods, and a marker with
 /// at most [`PLAN_RODS_DRAWN`] of them.
-fn planned(plan: &rod_ig_core::plan::Plan, header: Header, params: &Params) -> Planned {
+fn planned(
+    plan: &rod_ig_core::plan::Plan,
+    gravity: &rod_ig_core::planar::heavy::Gravity,
+    header: Header,
+    params: &Params,
+) -> Planned {
     let l = params.rod_length;
     let poses = plan
         .gripper
@@ -421,8 +427,7 @@ fn planned(plan: &rod_ig_core::plan::Plan, header: Header, params: &Params) -> P
     }
     let shapes: Vec<Vec<rod_ig_core::PlanarPose>> = drawn
         .iter()
-        .filter_map(|a| rod_ig_core::planar::PlanarRod::new(a).ok())
-        .map(|r| r.shape(PLAN_ROD_SAMPLES))
+        .filter_map(|a| crate::solver::shape_of(a, gravity, PLAN_ROD_SAMPLES))
         .collect();
     Planned {
         marker: Some(crate::convert::rods_to_marker(&shapes, &header, params)),
@@ -767,5 +772,45 @@ mod tests {
         }
         // The mutations are not all rejected: the decoded ones exercised the pipeline.
         assert!(decoded > 100, "only {decoded} mutated messages decoded");
+    }
+
+    /// Gravity out of the rod's plane: refused without `solve_3d` (the reason names it), the
+    /// 3-D rod's with it, sagging out of the plane with the weight reported.
+    #[test]
+    fn gravity_out_of_the_plane_is_served_by_the_3d_rod() {
+        let cable = Params {
+            rod_length: 0.3,
+            bending_stiffness: 3.5e-4,
+            linear_density: 0.02,
+            gravity: [0.0, -6.0, 7.0],
+            path_samples: 20,
+            ..Params::default()
+        };
+        let w = 0.02 * (36.0f64 + 49.0).sqrt() * 0.027 / 3.5e-4;
+        let t = target(0.18, 0.09, 0.5, "base_gripper");
+        let refused = warm_processor(&cable).process(&t, &cable, &Overrides::default());
+        assert!(!refused.solution.success);
+        assert!(
+            refused.solution.message.contains("solve_3d"),
+            "{}",
+            refused.solution.message
+        );
+        let params = Params {
+            solve_3d: true,
+            ..cable
+        };
+        let o = warm_processor(&params).process(&t, &params, &Overrides::default());
+        let sol = &o.solution;
+        assert!(sol.success && sol.spatial && sol.stable, "{}", sol.message);
+        assert!((sol.weight - w).abs() <= 1e-12 * w);
+        assert_ne!(sol.total_energy, sol.elastic_energy);
+        check_path_reaches(&o, &t, 20, 1e-6);
+        let path = o.path.as_ref().expect("path");
+        let sag = path
+            .poses
+            .iter()
+            .map(|p| p.pose.position.z.abs())
+            .fold(0.0, f64::max);
+        assert!(sag > 1e-3, "the rod stays in its plane: {sag}");
     }
 }

@@ -3,8 +3,8 @@
 //! Everything the node needs from the solver goes through [`RodSolver`]: warm-started
 //! tracking of consecutive targets (`ig::Tracker`), one-off solves with per-request options
 //! (`ig::solve`), and the sampled shape of the solution (`planar::PlanarRod`); for non-planar
-//! targets (parameter `solve_3d`) the 3-D solver `spatial::ig::solve`, warm-started from the
-//! previous 3-D solution, and its shape `spatial::shape`. Units here are
+//! targets (parameter `solve_3d`) the 3-D solver `spatial::ig::solve` (with weight, on the
+//! model `spatial::HeavySpatial`), warm-started from the previous 3-D solution, and its shape. Units here are
 //! the solver's normalised units (unit rod length, unit bending stiffness); scaling to metres
 //! happens in [`crate::convert`].
 
@@ -13,9 +13,10 @@ use rod_ig_core::planar::ig::{self, Failure, Solution, SolveOptions, Tracker};
 use rod_ig_core::planar::PlanarClosedForm;
 use rod_ig_core::planar::PlanarRod;
 use rod_ig_core::solver::{self as rod_solver, BranchEvent, BranchFollower};
+use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
 use rod_ig_core::spatial::ig::{Failure3d, Solution3d, SolveOptions3d};
-use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, Stiffness};
+use rod_ig_core::spatial::{HeavySpatial, Spatial};
 pub use rod_ig_core::spatial::{SpatialParams, SpatialPose};
 pub use rod_ig_core::{PlanarParams, PlanarPose};
 
@@ -37,6 +38,9 @@ pub struct SolverSettings {
     pub follow_branch: bool,
     /// The rod's weight (parameters `linear_density`, `gravity`; none by default).
     pub gravity: Gravity,
+    /// The same weight for the 3-D rod: gravity's direction in the base frame, which may
+    /// leave the rod's plane.
+    pub gravity_3d: Gravity3,
 }
 
 /// A converged solve with its sampled shape, normalised units: the core crate's solution
@@ -277,11 +281,21 @@ impl RodSolver {
         } else {
             self.last_3d
         };
-        let solution = rod_solver::solve(&Spatial::default(), target, &options_3d(&s, guess))?;
+        let options = options_3d(&s, guess);
+        let g = s.gravity_3d;
+        let solution = if g.is_weightless() {
+            rod_solver::solve(&Spatial::default(), target, &options)?
+        } else {
+            let model = HeavySpatial {
+                stiffness: Stiffness::default(),
+                gravity: g,
+            };
+            rod_solver::solve(&model, target, &options)?
+        };
         if !one_off_solve {
             self.last_3d = Some(solution.a);
         }
-        with_shape_3d(&solution, samples)
+        with_shape_3d(&solution, &g, samples)
     }
 
     /// Solves for `target` (normalised) and samples `samples` shape poses.
@@ -349,6 +363,16 @@ impl RodSolver {
     }
 }
 
+/// `samples` poses of the planar rod `a` under `g` (weightless: the closed forms); None where
+/// it cannot be evaluated.
+pub fn shape_of(a: &PlanarParams, g: &Gravity, samples: usize) -> Option<Vec<PlanarPose>> {
+    if g.is_weightless() {
+        PlanarRod::new(a).ok().map(|r| r.shape(samples))
+    } else {
+        heavy::shape(a, g, samples).ok()
+    }
+}
+
 /// A followed move as the node answers it: the solution with its shape (`shape`), the branch
 /// event and, after a snap, the critical gripper pose; or the failure with its event.
 fn followed(
@@ -409,8 +433,9 @@ fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
     })
 }
 
-fn with_shape_3d(s: &Solution3d, samples: usize) -> Result<Solved3d, Failed> {
-    let shape = spatial::shape(&s.a, &Stiffness::default(), samples).map_err(|e| Failed {
+fn with_shape_3d(s: &Solution3d, g: &Gravity3, samples: usize) -> Result<Solved3d, Failed> {
+    let k = Stiffness::default();
+    let failure = |e: rod_ig_core::RodError| Failed {
         reason: format!("cannot evaluate the solution's shape: {e}"),
         termination: rod_ig_core::solver::Termination::EvaluationFailed.as_str(),
         iterations: s.iterations,
@@ -419,13 +444,25 @@ fn with_shape_3d(s: &Solution3d, samples: usize) -> Result<Solved3d, Failed> {
         last_a_spatial: Some(Box::new(s.a)),
         spatial: true,
         event: "",
-    })?;
+    };
+    let (shape, elastic_energy) = if g.is_weightless() {
+        (
+            spatial::shape(&s.a, &k, samples).map_err(failure)?,
+            s.energy,
+        )
+    } else {
+        let shape = heavy3::shape(&s.a, &k, g, samples).map_err(failure)?;
+        let elastic = heavy3::evaluate(&s.a, &k, g)
+            .map_err(failure)?
+            .elastic_energy;
+        (shape, elastic)
+    };
     Ok(WithShape {
         solution: *s,
         shape,
         event: "",
         critical: None,
-        weight: 0.0,
-        elastic_energy: s.energy,
+        weight: g.weight(),
+        elastic_energy,
     })
 }
