@@ -84,6 +84,7 @@ const TEMPLATES: [(&str, &[&str]); 6] = [
         &[
             "{\"start\": [#, #, #], \"goal\": {\"x\": #, \"y\": #, \"theta\": #}, \"obstacles\": [{\"type\": \"polygon\", \"points\": [[#, #], [#, #], [#, #]]}], \"deadline_ms\": 5}",
             "{\"start\": [0.5, 0.1, 0.1], \"goal\": {\"x\": #, \"y\": #, \"theta\": #}, \"obstacles\": [{\"type\": \"disc\", \"center\": [#, #], \"radius\": #}], \"deadline_ms\": #}",
+            "{\"start\": [#, #, #], \"goal\": {\"x\": #, \"y\": #, \"theta\": #}, \"weight\": #, \"gravity\": [#, #], \"deadline_ms\": 5}",
         ],
     ),
     (
