@@ -354,7 +354,7 @@ fn pose_and_jac_with(
         need => need,
     };
     if need != SeriesNeed::None {
-        if let Some(answer) = small_angle_pose_and_jac(a, t) {
+        if let Some(answer) = small_angle::checked_pose_and_jacobian(a, t) {
             return Ok(answer);
         }
     }
@@ -442,7 +442,7 @@ impl PlanarRod {
         };
         // As forward does, the small-angle expansion before a series that cannot run.
         let series_or_small_angle = || match series() {
-            Err(e) if small_angle_tip(a).is_none() => Err(e),
+            Err(e) if small_angle::checked_tip(a).is_none() => Err(e),
             Err(_) => Ok(Backend::SmallAngle),
             Ok(r) => Ok(Backend::Series(r)),
         };
@@ -461,13 +461,13 @@ impl PlanarRod {
             {
                 // As `tip` does: the small-angle expansion first (a nearly straight rod under
                 // tension), so that forward and shape answer the same rods.
-                match small_angle_tip(a) {
+                match small_angle::checked_tip(a) {
                     Some(tip) => tip,
                     None => ill_conditioned_tip(a).map(|(p, _, _)| [p.x, p.y, p.theta])?,
                 }
             }
             Backend::Series(r) => r.tip(),
-            Backend::SmallAngle => small_angle_tip(a).ok_or_else(overflow)?,
+            Backend::SmallAngle => small_angle::checked_tip(a).ok_or_else(overflow)?,
         };
         let tip = PlanarPose::new(tip[0], tip[1], tip[2]);
         if !tip.is_finite() {
@@ -502,7 +502,7 @@ impl PlanarRod {
             Backend::Series(r) => r.pose(t.clamp(0.0, 1.0)).unwrap_or([f64::NAN; 3]),
             // The base is the identity (the expansion's J is 0/0 there).
             Backend::SmallAngle if t <= 0.0 => [0.0; 3],
-            Backend::SmallAngle => small_angle_pose_and_jac(&self.a, t.min(1.0))
+            Backend::SmallAngle => small_angle::checked_pose_and_jacobian(&self.a, t.min(1.0))
                 .map_or([f64::NAN; 3], |(p, _)| [p.x, p.y, p.theta]),
         };
         PlanarPose::new(p[0], p[1], p[2])
@@ -518,7 +518,7 @@ impl PlanarRod {
         match &self.backend {
             Backend::Closed(c) => c.curvature(t),
             Backend::Series(r) => r.curvature(t.clamp(0.0, 1.0)).unwrap_or(f64::NAN),
-            Backend::SmallAngle => small_angle_curvature(&self.a, t.clamp(0.0, 1.0)),
+            Backend::SmallAngle => small_angle::curvature(&self.a, t.clamp(0.0, 1.0)),
         }
     }
 
@@ -552,26 +552,9 @@ impl PlanarRod {
             Backend::Closed(c) => closed_energy(c, &self.a, &self.tip).unwrap_or(f64::INFINITY),
             // ½∫κ² integrated along: the identity cancels for a nearly straight rod under force.
             Backend::Series(r) => r.energy(),
-            Backend::SmallAngle => small_angle_energy(&self.a).unwrap_or(f64::INFINITY),
+            Backend::SmallAngle => small_angle::checked_energy(&self.a).unwrap_or(f64::INFINITY),
         }
     }
-}
-
-/// κ(t) = θ′ of the linearised rod, θ = a3 S1 − a5 S2 (`small_angle`): a3 S0 − a5 S1, with
-/// S0 = cosh(wt), cos(wt) or 1 and S1 = sinh(wt)/w, sin(wt)/w or t (w = √|a4|) under tension,
-/// compression or no axial force.
-fn small_angle_curvature(a: &PlanarParams, t: f64) -> f64 {
-    let (a3, a4, a5) = (a[0], a[1], a[2]);
-    let w = a4.abs().sqrt();
-    let (s0, s1) = if a4 > 0.0 {
-        ((w * t).cosh(), (w * t).sinh() / w)
-    } else if a4 < 0.0 {
-        let (s, c) = (w * t).sin_cos();
-        (c, s / w)
-    } else {
-        (1.0, t)
-    };
-    a3 * s0 - a5 * s1
 }
 
 fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
@@ -632,7 +615,7 @@ fn closed_energy<T: crate::scalar::Real>(
             return Ok(e);
         }
     }
-    if let Some(e) = small_angle_energy(a) {
+    if let Some(e) = small_angle::checked_energy(a) {
         return Ok(e);
     }
     // Near the separatrix under a strong force the f64 series' rounding grows like e^{√‖F‖}
@@ -654,97 +637,6 @@ fn closed_energy<T: crate::scalar::Real>(
     } else {
         Err(overflow())
     }
-}
-
-/// Largest a-priori error of the small-angle tip ([`small_angle::tip_abs_error`]) for which it
-/// is taken: 100× inside the 1e-11 the references check.
-const SMALL_ANGLE_TIP_TOLERANCE: f64 = 1e-13;
-
-/// q(t) and J(t) of a nearly straight rod from the small-angle expansion, where its error
-/// bounds are within the closed form's tolerances (J to [`CLOSED_J_TOLERANCE`], the pose to
-/// [`SMALL_ANGLE_TIP_TOLERANCE`]); None elsewhere. It replaces the series where the closed
-/// form's x row (O(σ), O(σ²)) is swamped by rounding.
-fn small_angle_pose_and_jac(a: &PlanarParams, t: f64) -> Option<(PlanarPose, PlanarJacobian)> {
-    small_angle_pose_and_jac_at(a, t, small_angle::effective_angle(a[0], a[1], a[2]))
-}
-
-/// [`small_angle_pose_and_jac`] for the rod's effective angle `th`
-/// ([`small_angle::effective_angle`], computed once by callers that need several answers): the
-/// straight-rod linearisation, or under compression the pendulum of exact frequency
-/// ([`pendulum`]), whose error does not grow with the number of wavelengths.
-fn small_angle_pose_and_jac_at(
-    a: &PlanarParams,
-    t: f64,
-    th: f64,
-) -> Option<(PlanarPose, PlanarJacobian)> {
-    let ([x, y, theta], jacobian) =
-        linearised_pose_and_jac(a, t, th).or_else(|| pendulum_pose_and_jac(a, t))?;
-    let pose = PlanarPose::new(x, y, theta);
-    let j = PlanarJacobian::from_row_slice(&jacobian.concat());
-    (pose.is_finite() && j.iter().all(|v| v.is_finite())).then_some((pose, j))
-}
-
-/// (x, y, θ) and J (rows) of the straight-rod linearisation where its bounds are within the
-/// tolerances (see [`small_angle_pose_and_jac`]).
-fn linearised_pose_and_jac(a: &PlanarParams, t: f64, th: f64) -> Option<PoseAndRows> {
-    let (a3, a4, a5) = (a[0], a[1], a[2]);
-    let j_truncation = small_angle::jacobian_rel_error(th);
-    let tip_truncation = small_angle::tip_abs_error(th);
-    if j_truncation > CLOSED_J_TOLERANCE || tip_truncation > SMALL_ANGLE_TIP_TOLERANCE {
-        return None;
-    }
-    let lin = small_angle::pose_and_jacobian(a3, a4, a5, t);
-    (j_truncation + lin.jacobian_rounding <= CLOSED_J_TOLERANCE
-        && tip_truncation + lin.pose_rounding <= SMALL_ANGLE_TIP_TOLERANCE)
-        .then_some((lin.pose, lin.jacobian))
-}
-
-/// (x, y, θ) and J (rows x, y, θ) of an expansion.
-type PoseAndRows = ([f64; 3], [[f64; 3]; 3]);
-
-/// (x, y, θ) and J (rows) of the compressed rod's pendulum where its bounds are within the
-/// tolerances (see [`small_angle_pose_and_jac`]).
-fn pendulum_pose_and_jac(a: &PlanarParams, t: f64) -> Option<PoseAndRows> {
-    let form = pendulum::pose_and_jacobian(a[0], a[1], a[2], t)?;
-    (form.jacobian_error <= CLOSED_J_TOLERANCE && form.pose_error <= SMALL_ANGLE_TIP_TOLERANCE)
-        .then_some((form.pose, form.jacobian))
-}
-
-/// The tip of a nearly straight rod from the small-angle expansion (or, under compression,
-/// the pendulum of exact frequency), where its bound is within [`SMALL_ANGLE_TIP_TOLERANCE`].
-fn small_angle_tip(a: &PlanarParams) -> Option<[f64; 3]> {
-    let (a3, a4, a5) = (a[0], a[1], a[2]);
-    let truncation = small_angle::tip_abs_error(small_angle::effective_angle(a3, a4, a5));
-    if truncation <= SMALL_ANGLE_TIP_TOLERANCE {
-        let lin = small_angle::pose_and_jacobian(a3, a4, a5, 1.0);
-        if truncation + lin.pose_rounding <= SMALL_ANGLE_TIP_TOLERANCE
-            && lin.pose.iter().all(|v| v.is_finite())
-        {
-            return Some(lin.pose);
-        }
-    }
-    pendulum::tip(a3, a4, a5)
-        .and_then(|(tip, error)| (error <= SMALL_ANGLE_TIP_TOLERANCE).then_some(tip))
-}
-
-/// ½∫κ² of a nearly straight rod from the small-angle expansion, where its bound is within
-/// [`ENERGY_REL_TOLERANCE`].
-fn small_angle_energy(a: &PlanarParams) -> Option<f64> {
-    small_angle_energy_at(a, small_angle::effective_angle(a[0], a[1], a[2]))
-}
-
-/// [`small_angle_energy`] for the rod's effective angle `th` (under compression, the
-/// pendulum's ½∫ψ'² where the linearisation's bound fails).
-fn small_angle_energy_at(a: &PlanarParams, th: f64) -> Option<f64> {
-    let truncation = small_angle::energy_rel_error(th);
-    if truncation <= ENERGY_REL_TOLERANCE {
-        let (e, rounding) = small_angle::energy(a[0], a[1], a[2]);
-        if truncation + rounding <= ENERGY_REL_TOLERANCE && e.is_finite() {
-            return Some(e);
-        }
-    }
-    pendulum::energy(a[0], a[1], a[2])
-        .and_then(|(e, error)| (error <= ENERGY_REL_TOLERANCE).then_some(e))
 }
 
 fn finite_tip([x, y, th]: [f64; 3]) -> Result<PlanarPose, RodError> {
@@ -797,7 +689,7 @@ pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
         }
         match closed.needs_series() {
             SeriesNeed::None => closed.pose(1.0),
-            _ if let Some(tip) = small_angle_tip(a) => tip,
+            _ if let Some(tip) = small_angle::checked_tip(a) => tip,
             SeriesNeed::IllConditioned => {
                 ill_conditioned_tip(a).map(|(p, _, _)| [p.x, p.y, p.theta])?
             }
@@ -999,7 +891,7 @@ pub fn energy(a: &PlanarParams) -> Result<f64, RodError> {
     if beyond_ordinary_force(a) {
         return domain_evaluation(a).map(|e| e.energy);
     }
-    if let Some(e) = small_angle_energy(a) {
+    if let Some(e) = small_angle::checked_energy(a) {
         return Ok(e);
     }
     let e = PlanarRod::new(a)?.energy();
@@ -1049,10 +941,10 @@ fn evaluate_series(a: &PlanarParams) -> Result<Evaluation, RodError> {
 /// is within its tolerance; None elsewhere.
 fn evaluate_small_angle(a: &PlanarParams) -> Result<Option<Evaluation>, RodError> {
     let th = small_angle::effective_angle(a[0], a[1], a[2]);
-    let Some((tip, jacobian)) = small_angle_pose_and_jac_at(a, 1.0, th) else {
+    let Some((tip, jacobian)) = small_angle::checked_pose_and_jacobian_at(a, 1.0, th) else {
         return Ok(None);
     };
-    let Some(energy) = small_angle_energy_at(a, th) else {
+    let Some(energy) = small_angle::checked_energy_at(a, th) else {
         return Ok(None);
     };
     let Some(stability) = stability::small_angle_report(a)? else {

@@ -20,6 +20,13 @@
 //!
 //! The neglected terms are O(Θ²) relative, Θ the largest bending angle (measured bound in
 //! [`truncation`]).
+//!
+//! As a formulation of the rod (issue 44), its answers come with their a-priori bounds
+//! (`checked_*`): None where a bound exceeds the tolerance asked of an answer.
+
+use super::closed::CLOSED_J_TOLERANCE;
+use super::ENERGY_REL_TOLERANCE;
+use crate::{PlanarJacobian, PlanarParams, PlanarPose};
 
 /// A value and its derivative with respect to a4 (a one-variable dual number: the straight
 /// rod's functions need no other derivative, and Horner's rule in it costs a third of
@@ -525,6 +532,119 @@ pub(crate) fn max_angle_to(a3: f64, a4: f64, a5: f64, t: f64) -> f64 {
         let w = (-a4).sqrt();
         a3.abs() * w.recip().min(t) + a5.abs() * (2.0 / (w * w)).min(0.5 * t * t)
     }
+}
+
+// The formulation (issue 44): the expansion's answers where its a-priori bounds are within the
+// tolerances asked of an answer, None elsewhere (the dispatcher then takes another formulation).
+
+/// κ(t) = θ′ of the linearised rod, θ = a3 S1 − a5 S2 (`small_angle`): a3 S0 − a5 S1, with
+/// S0 = cosh(wt), cos(wt) or 1 and S1 = sinh(wt)/w, sin(wt)/w or t (w = √|a4|) under tension,
+/// compression or no axial force.
+pub(super) fn curvature(a: &PlanarParams, t: f64) -> f64 {
+    let (a3, a4, a5) = (a[0], a[1], a[2]);
+    let w = a4.abs().sqrt();
+    let (s0, s1) = if a4 > 0.0 {
+        ((w * t).cosh(), (w * t).sinh() / w)
+    } else if a4 < 0.0 {
+        let (s, c) = (w * t).sin_cos();
+        (c, s / w)
+    } else {
+        (1.0, t)
+    };
+    a3 * s0 - a5 * s1
+}
+
+/// Largest a-priori error of the small-angle tip ([`tip_abs_error`]) for which it
+/// is taken: 100× inside the 1e-11 the references check.
+pub(super) const TIP_TOLERANCE: f64 = 1e-13;
+
+/// q(t) and J(t) of a nearly straight rod from the small-angle expansion, where its error
+/// bounds are within the closed form's tolerances (J to [`CLOSED_J_TOLERANCE`], the pose to
+/// [`TIP_TOLERANCE`]); None elsewhere. It replaces the series where the closed
+/// form's x row (O(σ), O(σ²)) is swamped by rounding.
+pub(super) fn checked_pose_and_jacobian(
+    a: &PlanarParams,
+    t: f64,
+) -> Option<(PlanarPose, PlanarJacobian)> {
+    checked_pose_and_jacobian_at(a, t, effective_angle(a[0], a[1], a[2]))
+}
+
+/// [`checked_pose_and_jacobian`] for the rod's effective angle `th`
+/// ([`effective_angle`], computed once by callers that need several answers): the
+/// straight-rod linearisation, or under compression the pendulum of exact frequency
+/// ([`super::pendulum`]), whose error does not grow with the number of wavelengths.
+pub(super) fn checked_pose_and_jacobian_at(
+    a: &PlanarParams,
+    t: f64,
+    th: f64,
+) -> Option<(PlanarPose, PlanarJacobian)> {
+    let ([x, y, theta], jacobian) =
+        checked_linearised(a, t, th).or_else(|| checked_pendulum(a, t))?;
+    let pose = PlanarPose::new(x, y, theta);
+    let j = PlanarJacobian::from_row_slice(&jacobian.concat());
+    (pose.is_finite() && j.iter().all(|v| v.is_finite())).then_some((pose, j))
+}
+
+/// (x, y, θ) and J (rows) of the straight-rod linearisation where its bounds are within the
+/// tolerances (see [`checked_pose_and_jacobian`]).
+fn checked_linearised(a: &PlanarParams, t: f64, th: f64) -> Option<PoseAndRows> {
+    let (a3, a4, a5) = (a[0], a[1], a[2]);
+    let j_truncation = jacobian_rel_error(th);
+    let tip_truncation = tip_abs_error(th);
+    if j_truncation > CLOSED_J_TOLERANCE || tip_truncation > TIP_TOLERANCE {
+        return None;
+    }
+    let lin = pose_and_jacobian(a3, a4, a5, t);
+    (j_truncation + lin.jacobian_rounding <= CLOSED_J_TOLERANCE
+        && tip_truncation + lin.pose_rounding <= TIP_TOLERANCE)
+        .then_some((lin.pose, lin.jacobian))
+}
+
+/// (x, y, θ) and J (rows x, y, θ) of an expansion.
+type PoseAndRows = ([f64; 3], [[f64; 3]; 3]);
+
+/// (x, y, θ) and J (rows) of the compressed rod's pendulum where its bounds are within the
+/// tolerances (see [`checked_pose_and_jacobian`]).
+fn checked_pendulum(a: &PlanarParams, t: f64) -> Option<PoseAndRows> {
+    let form = super::pendulum::pose_and_jacobian(a[0], a[1], a[2], t)?;
+    (form.jacobian_error <= CLOSED_J_TOLERANCE && form.pose_error <= TIP_TOLERANCE)
+        .then_some((form.pose, form.jacobian))
+}
+
+/// The tip of a nearly straight rod from the small-angle expansion (or, under compression,
+/// the pendulum of exact frequency), where its bound is within [`TIP_TOLERANCE`].
+pub(super) fn checked_tip(a: &PlanarParams) -> Option<[f64; 3]> {
+    let (a3, a4, a5) = (a[0], a[1], a[2]);
+    let truncation = tip_abs_error(effective_angle(a3, a4, a5));
+    if truncation <= TIP_TOLERANCE {
+        let lin = pose_and_jacobian(a3, a4, a5, 1.0);
+        if truncation + lin.pose_rounding <= TIP_TOLERANCE && lin.pose.iter().all(|v| v.is_finite())
+        {
+            return Some(lin.pose);
+        }
+    }
+    super::pendulum::tip(a3, a4, a5)
+        .and_then(|(tip, error)| (error <= TIP_TOLERANCE).then_some(tip))
+}
+
+/// ½∫κ² of a nearly straight rod from the small-angle expansion, where its bound is within
+/// [`super::ENERGY_REL_TOLERANCE`].
+pub(super) fn checked_energy(a: &PlanarParams) -> Option<f64> {
+    checked_energy_at(a, effective_angle(a[0], a[1], a[2]))
+}
+
+/// [`checked_energy`] for the rod's effective angle `th` (under compression, the
+/// pendulum's ½∫ψ'² where the linearisation's bound fails).
+pub(super) fn checked_energy_at(a: &PlanarParams, th: f64) -> Option<f64> {
+    let truncation = energy_rel_error(th);
+    if truncation <= ENERGY_REL_TOLERANCE {
+        let (e, rounding) = energy(a[0], a[1], a[2]);
+        if truncation + rounding <= ENERGY_REL_TOLERANCE && e.is_finite() {
+            return Some(e);
+        }
+    }
+    super::pendulum::energy(a[0], a[1], a[2])
+        .and_then(|(e, error)| (error <= ENERGY_REL_TOLERANCE).then_some(e))
 }
 
 #[cfg(test)]

@@ -404,7 +404,7 @@ fn compressed_rods_answer_by_the_pendulum() {
             continue;
         };
         if form.jacobian_error > CLOSED_J_TOLERANCE
-            || form.pose_error > SMALL_ANGLE_TIP_TOLERANCE
+            || form.pose_error > small_angle::TIP_TOLERANCE
             || (a3 == 0.0 && a5 == 0.0)
         {
             continue;
