@@ -31,7 +31,10 @@ use crate::scalar::Dual3;
 use crate::{
     PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport, StabilityVerdict,
 };
-use taylor::{DualF64x2, Gradient, TaylorRod};
+pub(crate) use taylor::{
+    pose_jac_from, series_dd, series_dual, series_f64, series_pose_and_jac, SERIES_MAX_STEPS,
+};
+use taylor::{Gradient, TaylorRod};
 
 /// Rods with ρ = max(|a3|, √‖(a4, a5)‖) up to this value are evaluated by the Taylor series
 /// without trying the closed form: one step from 0 to 1 (a few µs), and the closed form's own
@@ -41,11 +44,6 @@ use taylor::{DualF64x2, Gradient, TaylorRod};
 /// m (near-circles under a tiny force, nearly straight rods under compression) and on gently
 /// bent rods whose entries of J are far smaller than the elliptic quantities they come from.
 const SERIES_RHO: f64 = 0.25;
-/// Step budget of the f64 Taylor series (bounded time: ≈ 3 µs per step in dual numbers, so
-/// ≲ 6 ms; a rod that needs more steps is beyond what the fallback resolves quickly).
-pub(crate) const SERIES_MAX_STEPS: usize = 2_000;
-/// Step budget of the double-double series (≈ 30–60 µs per step in dual numbers: ≲ 40 ms).
-const SERIES_DD_MAX_STEPS: usize = 800;
 /// Largest √‖F‖ for which the stability scan runs on the double-double series near the
 /// separatrix (the steps scale like √‖F‖: ≈ 20 ms at √‖F‖ = 100, the top of issue 9's
 /// strong-force family a4 ≤ 1e4). Beyond [`SERIES_DD_MAX_ROOT_F`] its g(t) is not certified
@@ -94,20 +92,6 @@ fn series_first(a: &PlanarParams) -> bool {
     curvature_scale(a) <= SERIES_RHO
 }
 
-fn series_f64(a: &PlanarParams, dense: bool) -> Result<TaylorRod<f64>, RodError> {
-    TaylorRod::new(a[0], a[1], a[2], SERIES_MAX_STEPS, dense)
-}
-
-pub(crate) fn series_dual(a: &PlanarParams, dense: bool) -> Result<TaylorRod<Dual3>, RodError> {
-    TaylorRod::new(
-        Dual3::variable(a[0], 0),
-        Dual3::variable(a[1], 1),
-        Dual3::variable(a[2], 2),
-        SERIES_MAX_STEPS,
-        dense,
-    )
-}
-
 /// Refuses, as the domain says, a rod under tension beyond √‖F‖ = ln(f64::MAX) whose closed
 /// form cannot be built (deep by the separatrix): its rounding grows like e^{√‖F‖ t} in any
 /// f64 integration, whose answer is then wrong without overflowing (a = (8.9e-220, 1.05e6,
@@ -125,37 +109,6 @@ fn overflow_force() -> RodError {
         "planar rod: under this force J(t, a) grows like e^(sqrt|F| t) and exceeds f64 \
          (sqrt|F| > {LN_F64_MAX})"
     ))
-}
-
-/// The dense series in double-double dual numbers, for rods where the closed form's error
-/// estimate fails. Those are the ill-conditioned ones (strong axial force: rounding made while
-/// the rod loops grows like e^{√F (1 − t)} while it then sits near the unstable straight
-/// equilibrium; an f64 integration, the oracle's included, is off by up to 1e-5 there, see
-/// tests/relaxed_oracle.rs), so they are integrated with a 106-bit significand.
-fn series_dd<const TIGHT: bool>(
-    a: &PlanarParams,
-    dense: bool,
-    max_root_f: f64,
-) -> Result<TaylorRod<DualF64x2<TIGHT>>, RodError> {
-    let root_f = a[1].hypot(a[2]).sqrt();
-    if root_f > LN_F64_MAX {
-        return Err(overflow_force());
-    }
-    if root_f > max_root_f {
-        return Err(RodError::OutOfDomain(format!(
-            "planar rod near its straight equilibrium under a force of {:.3e}: rounding grows \
-             like e^(sqrt|F|) and the answer cannot be certified to 1e-9 in bounded time \
-             (supported: sqrt|F| <= {max_root_f})",
-            root_f * root_f
-        )));
-    }
-    TaylorRod::new(
-        DualF64x2::variable(a[0], 0),
-        DualF64x2::variable(a[1], 1),
-        DualF64x2::variable(a[2], 2),
-        SERIES_DD_MAX_STEPS,
-        dense,
-    )
 }
 
 /// Largest √‖F‖ for which the f64 series answers the tip, J and energy of an ill-conditioned
@@ -251,27 +204,6 @@ fn cross_checked_tip(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian, f6
         }
     };
     Ok((tip, j, energy))
-}
-
-fn pose_jac_from<T: Gradient>(p: [T; 3]) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-    let [x, y, th] = p.map(|v| (v.value(), v.gradient()));
-    let pose = PlanarPose::new(x.0, y.0, th.0);
-    let j = PlanarJacobian::new(
-        x.1[0], x.1[1], x.1[2], y.1[0], y.1[1], y.1[2], th.1[0], th.1[1], th.1[2],
-    );
-    if !(pose.is_finite() && j.iter().all(|v| v.is_finite())) {
-        return Err(overflow());
-    }
-    Ok((pose, j))
-}
-
-/// q(t) and J(t) from the series (dense only when t < 1).
-fn series_pose_and_jac(a: &PlanarParams, t: f64) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-    if t >= 1.0 {
-        return pose_jac_from(series_dual(a, false)?.tip());
-    }
-    let rod = series_dual(a, true)?;
-    pose_jac_from(rod.pose(t.max(0.0)).ok_or_else(overflow)?)
 }
 
 /// Checks a at every public entry, and charges the evaluation to the deadline in force (one

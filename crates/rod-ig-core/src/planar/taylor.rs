@@ -26,6 +26,7 @@
 use crate::eft::{two_prod, two_sum};
 use crate::scalar::Dual3;
 use crate::RodError;
+use crate::{PlanarJacobian, PlanarParams, PlanarPose};
 
 /// Highest Taylor order per step. The terms decay like (h/R)ᵏ with R the radius of convergence
 /// (≳ 3 for gently bent rods: one step to t = 1 in ≲ 32 terms); where R is smaller, shorter
@@ -809,6 +810,89 @@ fn converged<T: Measured>(seg: &Segment<T>, h: f64) -> bool {
         }
     }
     true
+}
+
+// The formulation (issue 44): the series of a rod as the planar entry points ask it, with its
+// step budgets and the domain refusals of the double-double series.
+
+/// Step budget of the f64 Taylor series (bounded time: ≈ 3 µs per step in dual numbers, so
+/// ≲ 6 ms; a rod that needs more steps is beyond what the fallback resolves quickly).
+pub(crate) const SERIES_MAX_STEPS: usize = 2_000;
+/// Step budget of the double-double series (≈ 30–60 µs per step in dual numbers: ≲ 40 ms).
+const SERIES_DD_MAX_STEPS: usize = 800;
+
+/// The f64 series of a (dense: keeps every step's polynomials, for poses at t < 1).
+pub(crate) fn series_f64(a: &PlanarParams, dense: bool) -> Result<TaylorRod<f64>, RodError> {
+    TaylorRod::new(a[0], a[1], a[2], SERIES_MAX_STEPS, dense)
+}
+
+/// The series in dual numbers seeded with the identity on a: carries J.
+pub(crate) fn series_dual(a: &PlanarParams, dense: bool) -> Result<TaylorRod<Dual3>, RodError> {
+    TaylorRod::new(
+        Dual3::variable(a[0], 0),
+        Dual3::variable(a[1], 1),
+        Dual3::variable(a[2], 2),
+        SERIES_MAX_STEPS,
+        dense,
+    )
+}
+
+/// The dense series in double-double dual numbers, for rods where the closed form's error
+/// estimate fails. Those are the ill-conditioned ones (strong axial force: rounding made while
+/// the rod loops grows like e^{√F (1 − t)} while it then sits near the unstable straight
+/// equilibrium; an f64 integration, the oracle's included, is off by up to 1e-5 there, see
+/// tests/relaxed_oracle.rs), so they are integrated with a 106-bit significand.
+pub(crate) fn series_dd<const TIGHT: bool>(
+    a: &PlanarParams,
+    dense: bool,
+    max_root_f: f64,
+) -> Result<TaylorRod<DualF64x2<TIGHT>>, RodError> {
+    let root_f = a[1].hypot(a[2]).sqrt();
+    if root_f > super::LN_F64_MAX {
+        return Err(super::overflow_force());
+    }
+    if root_f > max_root_f {
+        return Err(RodError::OutOfDomain(format!(
+            "planar rod near its straight equilibrium under a force of {:.3e}: rounding grows \
+             like e^(sqrt|F|) and the answer cannot be certified to 1e-9 in bounded time \
+             (supported: sqrt|F| <= {max_root_f})",
+            root_f * root_f
+        )));
+    }
+    TaylorRod::new(
+        DualF64x2::variable(a[0], 0),
+        DualF64x2::variable(a[1], 1),
+        DualF64x2::variable(a[2], 2),
+        SERIES_DD_MAX_STEPS,
+        dense,
+    )
+}
+
+/// The pose and J from a dual-number pose; refused where either is not finite.
+pub(crate) fn pose_jac_from<T: Gradient>(
+    p: [T; 3],
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    let [x, y, th] = p.map(|v| (v.value(), v.gradient()));
+    let pose = PlanarPose::new(x.0, y.0, th.0);
+    let j = PlanarJacobian::new(
+        x.1[0], x.1[1], x.1[2], y.1[0], y.1[1], y.1[2], th.1[0], th.1[1], th.1[2],
+    );
+    if !(pose.is_finite() && j.iter().all(|v| v.is_finite())) {
+        return Err(super::overflow());
+    }
+    Ok((pose, j))
+}
+
+/// q(t) and J(t) from the series (dense only when t < 1).
+pub(crate) fn series_pose_and_jac(
+    a: &PlanarParams,
+    t: f64,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    if t >= 1.0 {
+        return pose_jac_from(series_dual(a, false)?.tip());
+    }
+    let rod = series_dual(a, true)?;
+    pose_jac_from(rod.pose(t.max(0.0)).ok_or_else(super::overflow)?)
 }
 
 #[cfg(test)]
