@@ -639,3 +639,159 @@ impl ShortSeries {
         Some((v, e, slope))
     }
 }
+
+// The closed form's det J(t) as the scans read it (normalised g(t), its bound, its slope),
+// and the verdict it decides alone.
+
+/// Absolute error floor of the closed form's J entries: they are differences of O(1) internal
+/// quantities, so an entry that is itself tiny (∂x/∂a4 = O(θ²t⁵) on a nearly straight rod)
+/// carries an absolute error of a few ulps of 1 (observed 2.3e-16 at t = 0.05 on a rod with
+/// a = (1.4e-5, 10.4, −8.2e-3); ×64 allowance).
+pub(super) const CLOSED_J_ABS: f64 = 64.0 * f64::EPSILON;
+
+pub(super) fn rows(p: &[Dual3; 3]) -> [[f64; 3]; 3] {
+    [p[0].g, p[1].g, p[2].g]
+}
+
+/// g(t) alone from the dual-number closed form (scans that bound it elsewhere).
+pub(super) fn normalised_det_value(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64) -> f64 {
+    det3(&rows(&c.pose_for_jacobian(t))) / normalisation(a3, a5, t)
+}
+
+/// Largest m of a case II rod (a near-circle below) whose closed-form g is bounded column-wise
+/// ([`normalised_det`]). Entry-wise, on 813 near-circles (m 1e-6..1e-2) the samples the scan
+/// accepted were off by up to 96 times their bound (1,076 of them); column-wise by at most 0.20
+/// of it. Above, entry-wise bounds are exceeded too, on fewer samples (up to 7.6×, 82 of
+/// 34,212 in `closed_g_within_its_bound`), but column-wise ones there hand the strong-force
+/// family's nearly straight first part to the series: +22 % instructions per forward call,
+/// where the closed form's values were within 1e-7 of the reference. Case II has no
+/// conjugate point, so only margins are at stake.
+pub(super) const COLUMN_WISE_MAX_M: f64 = 0.01;
+
+/// g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (FINDINGS §5) and its error bound, from the
+/// dual-number closed form. Each entry of J(t) is off by at most rel·|entry| + 64ε (rel =
+/// [`Closed::jacobian_rel_error_at`]), or on a near-circle (case II, m <
+/// [`COLUMN_WISE_MAX_M`]) by rel·‖its column‖ + 64ε: a column is the derivative along one
+/// parameter, and case II's O(1/m) terms cancel across it (`closed_g_within_its_bound`).
+/// With `norm_wise`, every entry's error is bounded by rel·‖J(t)‖ (the Frobenius estimate
+/// itself) instead: near the separatrix an entry far below ‖J‖ (the x row while the rod
+/// lingers by the straight equilibrium) can be off by that much.
+pub(super) fn normalised_det(
+    c: &Closed<Dual3>,
+    a3: f64,
+    a5: f64,
+    t: f64,
+    norm_wise: bool,
+) -> (f64, f64) {
+    let j = rows(&c.pose_for_jacobian(t));
+    let (g, e, _) = normalised_det_from(c, &j, (a3, a5, t), norm_wise);
+    (g, e)
+}
+
+/// [`normalised_det`] and the slope g′(t), from the same Jacobi values: d det J/dt =
+/// det[J_x; J_y; ∂κ/∂a] ([`Closed::pose_and_curvature_for_jacobian`]) and
+/// g′ = det′/N − g·N′/N (`planar_det_leading_term_log_slope`). The slope
+/// only guides where the scan samples next (it is never a verdict), so it carries no bound.
+pub(super) fn normalised_det_sloped(
+    c: &Closed<Dual3>,
+    a3: f64,
+    a5: f64,
+    t: f64,
+    norm_wise: bool,
+) -> (f64, f64, f64) {
+    let (pose, kappa) = c.pose_and_curvature_for_jacobian(t);
+    let j = rows(&pose);
+    let (g, e, n) = normalised_det_from(c, &j, (a3, a5, t), norm_wise);
+    let det_slope = det3(&[j[0], j[1], kappa.g]);
+    let log_slope = crate::types::planar_det_leading_term_log_slope(a3, a5, t);
+    (g, e, det_slope / n - g * log_slope)
+}
+
+/// g, its bound and the normalisation N from J(t) of the closed form ([`normalised_det`]).
+pub(super) fn normalised_det_from(
+    c: &Closed<Dual3>,
+    j: &[[f64; 3]; 3],
+    (a3, a5, t): (f64, f64, f64),
+    norm_wise: bool,
+) -> (f64, f64, f64) {
+    let rel = c.jacobian_rel_error_at(t);
+    let (det, err) = if norm_wise {
+        let abs = CLOSED_J_ABS.max(rel * j.iter().flatten().map(|v| v * v).sum::<f64>().sqrt());
+        det_and_error(j, rel, abs)
+    } else if c.case == Case::II && c.m.v < COLUMN_WISE_MAX_M {
+        let column = |k: usize| (j[0][k] * j[0][k] + j[1][k] * j[1][k] + j[2][k] * j[2][k]).sqrt();
+        det_and_error_by_column(j, [0, 1, 2].map(|k| rel * column(k) + CLOSED_J_ABS))
+    } else {
+        det_and_error(j, rel, CLOSED_J_ABS)
+    };
+    let n = normalisation(a3, a5, t);
+    (det / n, err / n, n)
+}
+
+/// g(t) and its bound from the closed form in double-double: every entry of J(t) off by its
+/// norm-wise estimate ([`Closed::jacobian_rel_error_own_at`], the f64 model at 2⁻¹⁰⁴) times
+/// ‖J‖, plus its rounding to f64 (ε of itself).
+pub(super) fn normalised_det_extended(c: &Closed<DualDd>, a3: f64, a5: f64, t: f64) -> (f64, f64) {
+    let p = c.pose_for_jacobian(t);
+    let j = [0, 1, 2].map(|r| p[r].g.map(|v| v.to_f64()));
+    let rel = c.jacobian_rel_error_own_at(t);
+    let abs = rel * j.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+    let (det, err) = det_and_error(&j, f64::EPSILON, abs);
+    let n = normalisation(a3, a5, t);
+    (det / n, err / n)
+}
+
+/// How many times its own error bound g(1) must lie below zero for [`verdict_of`] to call a
+/// rod unstable from that one sample (the scans call a sign beyond one bound certain; the
+/// factor is a margin for the bound's own approximations).
+pub(super) const END_UNSTABLE_BOUNDS: f64 = 4.0;
+
+/// True where [`stability_of_with`] scans the f64 closed form with its own bounds (its last
+/// branch): no series, no double-double, no small-angle expansion.
+pub(super) fn plain_closed_scan(c: &Closed<Dual3>, a: &PlanarParams) -> bool {
+    let theta = small_angle::max_angle(a[0], a[1], a[2]);
+    matches!(c.case, Case::I | Case::II)
+        && !c.needs_precise_series()
+        && !c.det_needs_series()
+        && c.needs_series() == SeriesNeed::None
+        && SMALL_ANGLE_TRUNCATION_C * theta * theta > SMALL_ANGLE_MAX_TRUNCATION
+}
+
+/// True where g(1) < 0 beyond [`END_UNSTABLE_BOUNDS`] times its error bound (on a rod of the
+/// plain scan, with the bound that scan uses): g → 1 as t → 0 (det J ~ t⁹(a3²/8640 +
+/// a5²t²/33600) > 0 off the straight rod, FINDINGS §5), so det J vanishes somewhere on
+/// (0, 1), a conjugate point.
+pub(super) fn unstable_at_the_end(c: &Closed<Dual3>, a: &PlanarParams) -> bool {
+    let (g, bound) = normalised_det(c, a[0], a[2], 1.0, false);
+    g < -END_UNSTABLE_BOUNDS * bound
+}
+
+/// The verdict alone on the closed form ([`crate::planar::stability_verdict`]), None where the
+/// caller must run the full test. In order:
+/// 1. a theorem ([`Closed::theorem_verdict`]: no conjugate point before the first inflection,
+///    one by the third; [`with_theorem`] gives every report that verdict);
+/// 2. on the rods of the plain closed-form scan only, g(1) ([`unstable_at_the_end`]);
+/// 3. that scan from the theorem's t_free on ([`Closed::conjugate_free_until`]: no conjugate
+///    point before it, so det J > 0 on (0, t_free) and the rod is stable iff det J > 0 on
+///    [t_free, 1]), where the scan is certain.
+///
+/// On 20,000 rods of the paper's box the first two decide 64 % (20 % stable and 31 %
+/// unstable by the theorems, 13 % unstable by g(1)); with the third, 7.1k instructions per
+/// call, against 8.7k with the full test after the first two and 20.0k for the full test
+/// (callgrind, 512 box rods).
+pub(crate) fn verdict_of(
+    c: &Closed<Dual3>,
+    a: &PlanarParams,
+) -> Result<Option<StabilityVerdict>, RodError> {
+    if let Some(verdict) = c.theorem_verdict() {
+        return Ok(Some(verdict));
+    }
+    if !plain_closed_scan(c, a) {
+        return Ok(None);
+    }
+    if unstable_at_the_end(c, a) {
+        return Ok(Some(StabilityVerdict::Unstable));
+    }
+    let report = closed_scan_from(c, a, false, None, c.conjugate_free_until())?;
+    Ok((!report.uncertain).then(|| report.verdict()))
+}

@@ -237,3 +237,122 @@ pub(super) fn certified_verdict(
         uncertain: !certified,
     }
 }
+
+// The series' det J(t) as the scans read it (normalised g(t), its bound, its slope).
+
+/// g(t) and its error bound from the Taylor series, with the x row and the a4 column divided
+/// by σ = max(|a3|, |a5|) (det scales by 1/σ², the normalisation is taken with a/σ): both are
+/// O(σ²) for a nearly straight rod, and the scaled quantities are O(1).
+pub(super) fn normalised_det_series<T: Gradient>(
+    rod: &TaylorRod<T>,
+    a3: f64,
+    a5: f64,
+    t: f64,
+) -> (f64, f64) {
+    normalised_det_series_amplified(rod, a3, a5, t, 0.0)
+}
+
+/// [`normalised_det_series`] with, besides the entries' own [`SERIES_ENTRY_REL`], an error of
+/// `amplified`·‖J‖ in every entry: rounding (or truncation) made near the hyperbolic straight
+/// equilibrium grows like e^{√‖F‖ t} and spreads over all entries.
+pub(super) fn normalised_det_series_amplified<T: Gradient>(
+    rod: &TaylorRod<T>,
+    a3: f64,
+    a5: f64,
+    t: f64,
+    amplified: f64,
+) -> (f64, f64) {
+    let Some(j) = scaled_series_jacobian(rod, a3, a5, t) else {
+        return (f64::NAN, f64::INFINITY);
+    };
+    normalised_det_of(&j, a3, a5, t, SERIES_ENTRY_REL, amplified)
+}
+
+/// g(t) and its bound from a scaled series J (see [`normalised_det_series_amplified`]).
+/// `entry_rel`: the entries' own relative error ([`SERIES_ENTRY_REL`] for a series truncated
+/// at one unit roundoff).
+pub(super) fn normalised_det_of(
+    j: &[[f64; 3]; 3],
+    a3: f64,
+    a5: f64,
+    t: f64,
+    entry_rel: f64,
+    amplified: f64,
+) -> (f64, f64) {
+    let size = amplified * j.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+    let (det, err) = det_and_error(j, entry_rel, size);
+    let n = normalisation_scaled(a3, a5, t);
+    (det / n, err / n)
+}
+
+/// g(t) alone (the scan's samples; the error bound is needed at the margin's t only).
+pub(super) fn normalised_det_series_value<T: Gradient>(
+    rod: &TaylorRod<T>,
+    a3: f64,
+    a5: f64,
+    t: f64,
+) -> f64 {
+    let Some(j) = scaled_series_jacobian(rod, a3, a5, t) else {
+        return f64::NAN;
+    };
+    det3(&j) / normalisation_scaled(a3, a5, t)
+}
+
+/// [`normalised_det_series_value`] and its slope g′(t) = det′/N − g·N′/N with d det J/dt =
+/// det[J_x; J_y; ∂κ/∂a] from the series' own κ (scaled as the θ row: a4 column over σ).
+pub(super) fn series_probe<T: Gradient>(rod: &TaylorRod<T>, a3: f64, a5: f64, t: f64) -> Probe {
+    let nan = Probe {
+        v: f64::NAN,
+        d: f64::NAN,
+    };
+    let (Some(pose), Some(kappa)) = (rod.pose(t), rod.curvature(t)) else {
+        return nan;
+    };
+    let Some(j) = scaled_jacobian(pose, a3, a5) else {
+        return nan;
+    };
+    let sigma = a3.abs().max(a5.abs());
+    let mut k = kappa.gradient();
+    k[1] /= sigma;
+    let n = normalisation_scaled(a3, a5, t);
+    let v = det3(&j) / n;
+    let log_slope = crate::types::planar_det_leading_term_log_slope(a3 / sigma, a5 / sigma, t);
+    Probe {
+        v,
+        d: det3(&[j[0], j[1], k]) / n - v * log_slope,
+    }
+}
+
+/// J(t) from the series with the x row and the a4 column divided by σ = max(|a3|, |a5|).
+pub(super) fn scaled_series_jacobian<T: Gradient>(
+    rod: &TaylorRod<T>,
+    a3: f64,
+    a5: f64,
+    t: f64,
+) -> Option<[[f64; 3]; 3]> {
+    scaled_jacobian(rod.pose(t)?, a3, a5)
+}
+
+/// J from a pose in dual numbers, with the x row and the a4 column divided by σ = max(|a3|,
+/// |a5|) (see [`normalised_det_series`]).
+pub(super) fn scaled_jacobian<T: Gradient>(
+    pose: [T; 3],
+    a3: f64,
+    a5: f64,
+) -> Option<[[f64; 3]; 3]> {
+    let sigma = a3.abs().max(a5.abs());
+    let mut j = pose.map(|v| v.gradient());
+    for v in j[0].iter_mut() {
+        *v /= sigma;
+    }
+    for r in j.iter_mut() {
+        r[1] /= sigma;
+    }
+    Some(j)
+}
+
+/// The normalisation taken with a/σ (see [`normalised_det_series`]).
+pub(super) fn normalisation_scaled(a3: f64, a5: f64, t: f64) -> f64 {
+    let sigma = a3.abs().max(a5.abs());
+    normalisation(a3 / sigma, a5 / sigma, t)
+}
