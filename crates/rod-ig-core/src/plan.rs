@@ -27,9 +27,9 @@
 //!
 //! [`solve_all`]: crate::planar::ig::solve_all
 
+use crate::planar;
 use crate::planar::heavy::{self, Gravity, HeavyPlanar};
 use crate::planar::ig::{self, SolveOptions};
-use crate::planar::{self, PlanarRod};
 use crate::{PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use std::collections::{BinaryHeap, HashMap, HashSet};
@@ -357,12 +357,8 @@ fn collides(a: &PlanarParams, g: &Gravity, obstacles: &[Obstacle]) -> Option<boo
     if obstacles.is_empty() {
         return Some(false);
     }
-    let body = if g.is_weightless() {
-        PlanarRod::new(a).map(|rod| rod.shape(BODY_SAMPLES))
-    } else {
-        heavy::shape(a, g, BODY_SAMPLES)
-    };
-    let Ok(body) = body else {
+    // Weightless, `heavy::shape` is the closed forms' `PlanarRod::shape`.
+    let Ok(body) = heavy::shape(a, g, BODY_SAMPLES) else {
         return Some(true);
     };
     let mut tests = 0u64;
@@ -699,16 +695,9 @@ impl<'p> Query<'p> {
             }
         }
         let g = &self.planner.gravity;
-        let tip = |a: &PlanarParams| {
-            if g.is_weightless() {
-                planar::tip(a)
-            } else {
-                heavy::tip(a, g)
-            }
-        };
         let gripper = rods
             .iter()
-            .map(|a| tip(a).unwrap_or(PlanarPose::new(f64::NAN, f64::NAN, f64::NAN)))
+            .map(|a| heavy::tip(a, g).unwrap_or(PlanarPose::new(f64::NAN, f64::NAN, f64::NAN)))
             .collect();
         Plan {
             rods,
@@ -727,6 +716,7 @@ mod tests {
     //! The obstacle geometry on polygons and discs from 1e-300 to the coordinate bound, and
     //! degenerate ones (issue 24: products of huge coordinates overflowed, tiny ones underflow).
     use super::*;
+    use crate::planar::PlanarRod;
     use proptest::prelude::*;
 
     /// A rod drawn from the stable, moderately bent set (the shapes the planner sees).

@@ -427,7 +427,7 @@ fn planned(
     }
     let shapes: Vec<Vec<rod_ig_core::PlanarPose>> = drawn
         .iter()
-        .filter_map(|a| crate::solver::shape_of(a, gravity, PLAN_ROD_SAMPLES))
+        .filter_map(|a| rod_ig_core::planar::heavy::shape(a, gravity, PLAN_ROD_SAMPLES).ok())
         .collect();
     Planned {
         marker: Some(crate::convert::rods_to_marker(&shapes, &header, params)),

@@ -363,16 +363,6 @@ impl RodSolver {
     }
 }
 
-/// `samples` poses of the planar rod `a` under `g` (weightless: the closed forms); None where
-/// it cannot be evaluated.
-pub fn shape_of(a: &PlanarParams, g: &Gravity, samples: usize) -> Option<Vec<PlanarPose>> {
-    if g.is_weightless() {
-        PlanarRod::new(a).ok().map(|r| r.shape(samples))
-    } else {
-        heavy::shape(a, g, samples).ok()
-    }
-}
-
 /// A followed move as the node answers it: the solution with its shape (`shape`), the branch
 /// event and, after a snap, the critical gripper pose; or the failure with its event.
 fn followed(
