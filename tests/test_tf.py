@@ -46,7 +46,15 @@ def tf_node():
         time.sleep(0.05)
     # world -> rod_base: the base gripper 0.3 m along world x, turned +90 deg about z.
     static_pub.publish(TFMessage(transforms=[transform("world", "rod_base", (0.3, 0.0, 0.0), math.pi / 2)]))
+    # Our count of matched readers is not the node's match of our writer: the transient-local
+    # sample reaches its buffer when *its* discovery completes, which under load can take longer
+    # than tf_timeout. Wait as a tf2 user waits (canTransform), through the side-effect-free
+    # service, before the tests that assume the frame is known.
+    probe = client.make_target(0.1, 0.6, 0.5 + math.pi / 2, h.next_seq(), frame="world")
+    deadline = time.monotonic() + 15
     try:
+        while not client.solve(probe).solution.success:
+            assert time.monotonic() < deadline, "the node never received world -> rod_base on /tf_static"
         yield node, client, dynamic_pub
     finally:
         h.stop_node_and_client(node, client)
