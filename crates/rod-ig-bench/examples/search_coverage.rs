@@ -19,6 +19,12 @@
 //!     for each `x,y,theta,a3,a4,a5` line: the rod polished onto the target (its branch
 //!     followed, else Newton from it) and checked by the DOP853 reference (tip 2e-6, stable):
 //!     JSON lines {"target", "a"}
+//! cargo run --release -p rod-ig-bench --example search_coverage -- heavy N SEED
+//!     issue 41's success rate: N targets reached by stable heavy rods (log-scale a as in
+//!     `box`, w = 10^U(-1, log 200) with 5 % at exactly 200, gravity along -y for half, in any
+//!     direction for the rest; tips within 0.98 of the base), solved by the robust search
+//!     with weight from no guess; each answer re-checked (on target to 1e-6, stable); prints
+//!     `miss w gx,gy x,y,theta a3,a4,a5 why` per failure, the count and the time quantiles
 //! ```
 use rod_ig_core::ode::planar_reference;
 use rod_ig_core::planar::{self, ig, PlanarClosedForm};
@@ -38,7 +44,8 @@ fn main() {
         Some("reference") => reference(&read(args.get(1))),
         Some("evidence") => evidence(&read(args.get(1))),
         Some("solves") => solves(num(1, 500) as usize),
-        _ => eprintln!("usage: search_coverage box|workspace N SEED | reference|evidence FILE"),
+        Some("heavy") => heavy_coverage(num(1, 3000) as usize, num(2, 41)),
+        _ => eprintln!("usage: search_coverage box|workspace|heavy N SEED | reference|evidence FILE"),
     }
 }
 
@@ -238,4 +245,77 @@ fn solves(n: usize) {
         solved += usize::from(ig::solve(&tip, &ig::SolveOptions::default()).is_ok());
     }
     println!("{solved} of {n} solved");
+}
+
+/// Issue 41's success rate of the robust search with weight (see the module's header).
+fn heavy_coverage(n: usize, seed: u64) {
+    use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
+    use rod_ig_core::solver;
+    let mut r = SplitMix64::new(seed);
+    let mut cases = Vec::new();
+    while cases.len() < n {
+        let a = log_scale_rod(&mut r);
+        let w = if r.next_u64() % 20 == 0 {
+            200.0
+        } else {
+            10f64.powf(r.range(-1.0, 200f64.log10()))
+        };
+        let dir = if r.next_u64() % 2 == 0 {
+            [0.0, -1.0]
+        } else {
+            let phi = r.range(-PI, PI);
+            [phi.cos(), phi.sin()]
+        };
+        let Ok(g) = Gravity::new(w, dir) else { continue };
+        let Ok(e) = heavy::evaluate(&a, &g) else { continue };
+        if e.stability.verdict() == StabilityVerdict::Stable && e.tip.x.hypot(e.tip.y) <= 0.98 {
+            cases.push((a, g, e.tip));
+        }
+    }
+    let options = ig::SolveOptions::default();
+    let (mut solved, mut wrong, mut times) = (0usize, 0usize, Vec::new());
+    for (a, g, target) in &cases {
+        let t0 = Instant::now();
+        let result = solver::solve(&HeavyPlanar::new(*g), target, &options);
+        times.push(t0.elapsed().as_secs_f64() * 1e6);
+        let why = match &result {
+            Ok(s) => match heavy::evaluate(&s.a, g) {
+                Ok(e) if e.stability.stable
+                    && (e.tip.x - target.x).hypot(e.tip.y - target.y) <= 1e-6
+                    && wrap_angle(e.tip.theta - target.theta).abs() <= 1e-6 =>
+                {
+                    solved += 1;
+                    continue;
+                }
+                other => {
+                    wrong += 1;
+                    format!("WRONG: re-check gives {other:?}")
+                }
+            },
+            Err(f) => f.reason.to_string(),
+        };
+        println!(
+            "miss {:.6e} {:.6},{:.6} {:.9},{:.9},{:.9} {:.9e},{:.9e},{:.9e} {why}",
+            g.weight(),
+            g.direction()[0],
+            g.direction()[1],
+            target.x,
+            target.y,
+            target.theta,
+            a[0],
+            a[1],
+            a[2]
+        );
+    }
+    times.sort_by(f64::total_cmp);
+    let q = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
+    println!(
+        "{solved} of {} solved ({:.2} %), {wrong} wrong; µs median {:.0}, p90 {:.0}, p99 {:.0}, max {:.0}",
+        cases.len(),
+        100.0 * solved as f64 / cases.len().max(1) as f64,
+        q(0.5),
+        q(0.9),
+        q(0.99),
+        q(1.0)
+    );
 }
