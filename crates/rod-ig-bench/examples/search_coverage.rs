@@ -25,6 +25,9 @@
 //!     direction for the rest; tips within 0.98 of the base), solved by the robust search
 //!     with weight from no guess; each answer re-checked (on target to 1e-6, stable); prints
 //!     `miss w gx,gy x,y,theta a3,a4,a5 why` per failure, the count and the time quantiles
+//! cargo run --release -p rod-ig-bench --example search_coverage -- heavy3d N SEED
+//!     the same for the 3-D rod with weight: moments and forces log-scale (1e-2..10 and
+//!     1e-2..100, signs, 10 % exact zeros), w = 10^U(-1, log 200), gravity along -z for half
 //! ```
 use rod_ig_core::ode::planar_reference;
 use rod_ig_core::planar::{self, ig, PlanarClosedForm};
@@ -45,7 +48,10 @@ fn main() {
         Some("evidence") => evidence(&read(args.get(1))),
         Some("solves") => solves(num(1, 500) as usize),
         Some("heavy") => heavy_coverage(num(1, 3000) as usize, num(2, 41)),
-        _ => eprintln!("usage: search_coverage box|workspace|heavy N SEED | reference|evidence FILE"),
+        Some("heavy3d") => heavy_coverage_3d(num(1, 500) as usize, num(2, 43)),
+        _ => {
+            eprintln!("usage: search_coverage box|workspace|heavy N SEED | reference|evidence FILE")
+        }
     }
 }
 
@@ -255,19 +261,23 @@ fn heavy_coverage(n: usize, seed: u64) {
     let mut cases = Vec::new();
     while cases.len() < n {
         let a = log_scale_rod(&mut r);
-        let w = if r.next_u64() % 20 == 0 {
+        let w = if r.next_u64().is_multiple_of(20) {
             200.0
         } else {
             10f64.powf(r.range(-1.0, 200f64.log10()))
         };
-        let dir = if r.next_u64() % 2 == 0 {
+        let dir = if r.next_u64().is_multiple_of(2) {
             [0.0, -1.0]
         } else {
             let phi = r.range(-PI, PI);
             [phi.cos(), phi.sin()]
         };
-        let Ok(g) = Gravity::new(w, dir) else { continue };
-        let Ok(e) = heavy::evaluate(&a, &g) else { continue };
+        let Ok(g) = Gravity::new(w, dir) else {
+            continue;
+        };
+        let Ok(e) = heavy::evaluate(&a, &g) else {
+            continue;
+        };
         if e.stability.verdict() == StabilityVerdict::Stable && e.tip.x.hypot(e.tip.y) <= 0.98 {
             cases.push((a, g, e.tip));
         }
@@ -280,9 +290,10 @@ fn heavy_coverage(n: usize, seed: u64) {
         times.push(t0.elapsed().as_secs_f64() * 1e6);
         let why = match &result {
             Ok(s) => match heavy::evaluate(&s.a, g) {
-                Ok(e) if e.stability.stable
-                    && (e.tip.x - target.x).hypot(e.tip.y - target.y) <= 1e-6
-                    && wrap_angle(e.tip.theta - target.theta).abs() <= 1e-6 =>
+                Ok(e)
+                    if e.stability.stable
+                        && (e.tip.x - target.x).hypot(e.tip.y - target.y) <= 1e-6
+                        && wrap_angle(e.tip.theta - target.theta).abs() <= 1e-6 =>
                 {
                     solved += 1;
                     continue;
@@ -313,6 +324,93 @@ fn heavy_coverage(n: usize, seed: u64) {
         "{solved} of {} solved ({:.2} %), {wrong} wrong; µs median {:.0}, p90 {:.0}, p99 {:.0}, max {:.0}",
         cases.len(),
         100.0 * solved as f64 / cases.len().max(1) as f64,
+        q(0.5),
+        q(0.9),
+        q(0.99),
+        q(1.0)
+    );
+}
+
+/// Issue 41's success rate of the 3-D robust search with weight (see the module's header).
+fn heavy_coverage_3d(n: usize, seed: u64) {
+    use rod_ig_core::solver;
+    use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
+    use rod_ig_core::spatial::{HeavySpatial, SpatialParams, Stiffness};
+    let mut r = SplitMix64::new(seed);
+    let k = Stiffness::default();
+    let mut cases = Vec::new();
+    while cases.len() < n {
+        let a = SpatialParams::from_fn(|i, _| match r.next_u64() % 10 {
+            0 => 0.0,
+            _ if i < 3 => r.signed_pow10(-2.0, 1.0),
+            _ => r.signed_pow10(-2.0, 2.0),
+        });
+        let w = 10f64.powf(r.range(-1.0, 200f64.log10()));
+        let dir = if r.next_u64().is_multiple_of(2) {
+            [0.0, 0.0, -1.0]
+        } else {
+            [r.range(-1.0, 1.0), r.range(-1.0, 1.0), r.range(-1.0, 1.0)]
+        };
+        let Ok(g) = Gravity3::new(w, dir) else {
+            continue;
+        };
+        let Ok(e) = heavy3::evaluate(&a, &k, &g) else {
+            continue;
+        };
+        if e.stability.verdict() == StabilityVerdict::Stable && e.tip.position.norm() <= 0.98 {
+            cases.push((a, g, e.tip));
+        }
+    }
+    let options = solver::SolveOptions::default();
+    let (mut solved, mut wrong, mut times) = (0usize, 0usize, Vec::new());
+    // ONLY=i,j,…: re-run those cases alone (the indices the misses print).
+    let only: Option<Vec<usize>> = std::env::var("ONLY")
+        .ok()
+        .map(|v| v.split(',').filter_map(|x| x.parse().ok()).collect());
+    let mut tried = 0usize;
+    for (index, (a, g, target)) in cases.iter().enumerate() {
+        if only.as_ref().is_some_and(|o| !o.contains(&index)) {
+            continue;
+        }
+        tried += 1;
+        let model = HeavySpatial {
+            stiffness: k,
+            gravity: *g,
+        };
+        let t0 = Instant::now();
+        let result = solver::solve(&model, target, &options);
+        times.push(t0.elapsed().as_secs_f64() * 1e6);
+        let why = match &result {
+            Ok(s) => match heavy3::evaluate(&s.a, &k, g) {
+                Ok(e)
+                    if e.stability.stable
+                        && (e.tip.position - target.position).norm() <= 1e-6
+                        && e.tip.rotation.angle_to(&target.rotation) <= 1e-6 =>
+                {
+                    solved += 1;
+                    continue;
+                }
+                other => {
+                    wrong += 1;
+                    format!("WRONG: re-check gives {other:?}")
+                }
+            },
+            Err(f) => f.reason.to_string(),
+        };
+        println!(
+            "miss #{index} {:.0} µs w={:.6e} g={:?} target={:?} a={:?} {why}",
+            times.last().copied().unwrap_or(0.0),
+            g.weight(),
+            g.direction(),
+            target,
+            a.as_slice()
+        );
+    }
+    times.sort_by(f64::total_cmp);
+    let q = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
+    println!(
+        "{solved} of {tried} solved ({:.2} %), {wrong} wrong; µs median {:.0}, p90 {:.0}, p99 {:.0}, max {:.0}",
+        100.0 * solved as f64 / tried.max(1) as f64,
         q(0.5),
         q(0.9),
         q(0.99),

@@ -94,6 +94,27 @@ pub fn scope(budget: Duration) -> Guard {
     g
 }
 
+/// Narrows the deadline in force to `fraction` of the time it leaves (of its work units too),
+/// until the guard is dropped: a search that tries several starts in turn gives one start a
+/// share, so that one start cannot spend the time of all the others. Without a deadline in
+/// force, none is started.
+pub(crate) fn share_of_remaining(fraction: f64) -> Guard {
+    let g = guard();
+    let now = Instant::now();
+    if let Some(end) = g.end {
+        let left = end
+            .saturating_duration_since(now)
+            .mul_f64(fraction.clamp(0.0, 1.0));
+        END.with(|e| e.set(now.checked_add(left).map(|n| n.min(end)).or(Some(end))));
+    }
+    if let Some(work_end) = g.work_end {
+        let left = work_end.saturating_sub(charged()) as f64 * fraction.clamp(0.0, 1.0);
+        WORK_END.with(|e| e.set(Some(charged().saturating_add(left as u64).min(work_end))));
+        UNPOLLED.with(|u| u.set(0));
+    }
+    g
+}
+
 /// Puts a deadline counted in work units in force until the guard is dropped: it passes once
 /// `units` more have been charged on this thread (an enclosing budget that ends earlier is
 /// kept). Deterministic: the same call stops at the same point on any machine.
@@ -175,4 +196,37 @@ pub fn charge(units: u64) -> bool {
         n
     });
     unpolled >= POLL_UNITS && expired()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A share narrows the budget in force to its fraction of what is left, and dropping it
+    /// gives back the rest: counted in work units, so the test does not depend on the clock.
+    #[test]
+    fn a_share_of_the_remaining_work_expires_first_and_gives_back_the_rest() {
+        let _budget = work_budget(1_000);
+        assert!(!charge(100));
+        {
+            let _share = share_of_remaining(0.5);
+            // 900 left: the share ends after 450 more.
+            assert!(!charge(440));
+            assert!(!expired());
+            assert!(charge(20) || expired());
+        }
+        // The share's end is gone; the budget's 1,000 still holds.
+        assert!(!expired());
+        assert!(!charge(400));
+        assert!(charge(100) || expired());
+    }
+
+    /// Without a deadline in force a share starts none.
+    #[test]
+    fn a_share_without_a_deadline_is_unbounded() {
+        let _unbounded = unbounded();
+        let _share = share_of_remaining(0.01);
+        assert!(!charge(1 << 40));
+        assert!(!expired());
+    }
 }

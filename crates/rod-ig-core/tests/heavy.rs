@@ -353,3 +353,62 @@ fn heavy_3d_inverse_geometry_reaches_targets_of_stable_heavy_rods() {
     eprintln!("3-D: solved {solved} of {tried}");
     assert!(solved >= 10, "solved {solved} of {tried}");
 }
+
+/// Targets of stable heavy 3-D rods for which the weightless search finds no rod at all
+/// (`search_coverage heavy3d 4000 44`, cases 2537 and 3143): continuation in the load has no
+/// start, and the search's last stage carries a heavy rod to the target along its branch.
+/// Each answer is re-checked on the heavy model (tip to 1e-6, stable).
+#[test]
+fn heavy_3d_targets_without_a_weightless_rod_are_reached_along_a_heavy_branch() {
+    use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
+    use rod_ig_core::spatial::{HeavySpatial, SpatialParams, Stiffness};
+    let k = Stiffness::default();
+    let cases = [
+        (
+            [
+                -0.010111506160112768,
+                0.6600221010772603,
+                3.9878483916187375,
+                15.694721361047701,
+                -2.06688289379348,
+                0.0,
+            ],
+            6.997702e-1,
+            [0.0, 0.0, -1.0],
+        ),
+        (
+            [
+                -0.018318446627580757,
+                -6.256250126734735,
+                0.34529941630525757,
+                0.0,
+                0.48230359907618126,
+                1.2783500984460663,
+            ],
+            1.987012e-1,
+            [
+                -0.8341725661439651,
+                -0.5512491588528202,
+                0.016747977694344014,
+            ],
+        ),
+    ];
+    for (a, w, d) in cases {
+        let a = SpatialParams::from_column_slice(&a);
+        let g = Gravity3::new(w, d).unwrap();
+        let e = heavy3::evaluate(&a, &k, &g).unwrap();
+        assert!(e.stability.stable, "the case's rod is a stable heavy rod");
+        let model = HeavySpatial {
+            stiffness: k,
+            gravity: g,
+        };
+        let s = solver::solve(&model, &e.tip, &SolveOptions::default())
+            .unwrap_or_else(|f| panic!("w {w}: {}", f.reason));
+        let check = heavy3::evaluate(&s.a, &k, &g).unwrap();
+        let (dp, dq) = check.tip.distance_to(&e.tip);
+        assert!(
+            dp < 1e-6 && dq < 1e-6 && check.stability.stable,
+            "wrong answer"
+        );
+    }
+}

@@ -10,9 +10,10 @@
 //! run from the weightless rod with the load shared by the two grippers, then by this
 //! continuation from zero load.
 
-use super::{relative_distance, DISTINCT};
+use super::{branch_to, relative_distance, DISTINCT};
 use super::{
-    Failure, FailureOf, IgError, RodModel, Solution, SolutionOf, SolveOptions, Verified, Work,
+    Failure, FailureOf, IgError, InverseGeometry, RodModel, Solution, SolutionOf, SolveOptions,
+    Verified, Work,
 };
 use crate::RodError;
 use nalgebra::SVector;
@@ -40,6 +41,14 @@ pub const MAX_LOAD_STEP: f64 = 10.0;
 const MAX_CORRECTION: f64 = 0.3;
 /// Halvings of a Newton step in the line search.
 const LINE_SEARCH: u32 = 10;
+/// Continuation steps of the last stage, a heavy rod carried to the target along its branch
+/// (each at most a few corrections; the deadline bounds them too).
+const BRANCH_STEPS: u32 = 1024;
+/// Heavy rods the last stage carries along their branches: the shared-load rods of the first
+/// starts tried, then the model's default start.
+const BRANCH_STARTS: usize = 3;
+/// Share of the time left that one start of the search may spend.
+const START_SHARE: f64 = 0.5;
 
 /// The search's running state: target, options, the work done and the last error.
 pub(crate) struct Search<'a, const N: usize, M: RodModel<N>> {
@@ -247,9 +256,27 @@ impl<'a, const N: usize, M: LoadedModel<N>> Search<'a, N, M> {
     }
 }
 
+impl<const N: usize, M: LoadedModel<N> + InverseGeometry<N> + Copy> Search<'_, N, M> {
+    /// The heavy rod `a` (anywhere: its tip need not be on target) carried to the target along
+    /// its branch as the gripper moves there from its tip ([`branch_to`]: continuation in the
+    /// target, where continuation in the load failed), then polished and tested.
+    fn along_branch(&mut self, heavy: &M, a: &SVector<f64, N>) -> Option<SolutionOf<N, M>> {
+        self.work.starts += 1;
+        let end = branch_to(
+            *heavy,
+            self.options,
+            BRANCH_STEPS,
+            a,
+            &self.target,
+            &mut self.work,
+        )?;
+        self.finish(heavy, &end)
+    }
+}
+
 /// The first stable heavy rod followed from `starts` (weightless rods on target under
 /// `weightless`), or why none was.
-pub(crate) fn first<const N: usize, M: LoadedModel<N>>(
+pub(crate) fn first<const N: usize, M: LoadedModel<N> + InverseGeometry<N> + Copy>(
     weightless: &M,
     heavy: &M,
     target: &M::Pose,
@@ -261,7 +288,7 @@ pub(crate) fn first<const N: usize, M: LoadedModel<N>>(
 }
 
 /// Every distinct stable heavy rod followed from `starts`, and the work it took.
-pub(crate) fn every<const N: usize, M: LoadedModel<N>>(
+pub(crate) fn every<const N: usize, M: LoadedModel<N> + InverseGeometry<N> + Copy>(
     weightless: &M,
     heavy: &M,
     target: &M::Pose,
@@ -278,8 +305,11 @@ pub(crate) fn every<const N: usize, M: LoadedModel<N>>(
 }
 
 /// The first stable heavy rod followed from `starts` (weightless rods on target), or every
-/// distinct one when `all`.
-fn search_from<'a, const N: usize, M: LoadedModel<N>>(
+/// distinct one when `all`. Where none is found, the last stage carries heavy rods to the
+/// target along their branches ([`Search::along_branch`]): the shared-load rods of the first
+/// [`BRANCH_STARTS`] starts, then the model's default start (which needs no weightless rod on
+/// target: the weightless search can miss a target that a heavy rod reaches).
+fn search_from<'a, const N: usize, M: LoadedModel<N> + InverseGeometry<N> + Copy>(
     weightless: &M,
     heavy: &M,
     target: &M::Pose,
@@ -304,7 +334,12 @@ fn search_from<'a, const N: usize, M: LoadedModel<N>>(
             continue;
         }
         tried.push(a0);
-        if let Some(s) = search.follow(weightless, heavy, &a0) {
+        // Half of the time left to each start: a start whose continuation crawls (a rod deep
+        // in tension, evaluations of ms) leaves time to the others and to the last stage.
+        let slice = crate::deadline::share_of_remaining(START_SHARE);
+        let followed = search.follow(weightless, heavy, &a0);
+        drop(slice);
+        if let Some(s) = followed {
             if solutions
                 .iter()
                 .all(|o| relative_distance(&o.a, &s.a, &scale) > DISTINCT)
@@ -312,6 +347,22 @@ fn search_from<'a, const N: usize, M: LoadedModel<N>>(
                 solutions.push(s);
             }
             if !all {
+                break;
+            }
+        }
+    }
+    if solutions.is_empty() {
+        let share = heavy.shared_load_step(weightless);
+        let carried = tried.iter().take(BRANCH_STARTS).map(|a0| a0 + share);
+        for a in carried.chain(heavy.default_start(target)) {
+            if search.out_of_time() {
+                break;
+            }
+            let slice = crate::deadline::share_of_remaining(START_SHARE);
+            let carried = search.along_branch(heavy, &a);
+            drop(slice);
+            if let Some(s) = carried {
+                solutions.push(s);
                 break;
             }
         }
