@@ -226,6 +226,7 @@ impl Closed<Dual3> {
     /// rods, [`Closed::jacobian_rel_error_at`] without its 1e-10 floor) and 64(1 + |Γ|) the
     /// rounding of the Jacobi functions at a phase carrying an error ~ε|Γ|. det P adds `rel`
     /// times its condition.
+    #[inline]
     pub(crate) fn det_sample(&self, f: &DetFrame, t: f64) -> DetSample {
         let u = f.r * t;
         let gamma = u + f.phi;

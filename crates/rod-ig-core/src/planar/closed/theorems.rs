@@ -18,6 +18,7 @@ impl<T: Real> Closed<T> {
     /// the rounding of φ and K. A rod starting exactly at an inflection point (a3 = 0) gets the
     /// next one: the conjugate time is continuous in the phase, and for a base just past an
     /// inflection the bound is that next one (checked on the 320-bit references).
+    #[inline]
     pub(crate) fn conjugate_free_until(&self) -> f64 {
         let (a3, sign_sure) = (self.a3.re(), self.case_is_sure());
         match self.case {

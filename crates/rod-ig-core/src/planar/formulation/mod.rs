@@ -1,0 +1,222 @@
+//! The formulations of the planar rod behind one trait (issue 44). Each is one way of
+//! evaluating the rod: it answers a quantity only inside its own domain for that quantity
+//! (the a-priori error bound that decides it) and says `None` elsewhere, so that the
+//! dispatcher ([`super::dispatch`]) takes the next row of its table. None calls the
+//! dispatcher back.
+//!
+//! | formulation | module | answers |
+//! | --- | --- | --- |
+//! | [`FullEvaluation`] | `full` (here) | beyond ‖(a4, a5)‖ = 625: every quantity from one full evaluation |
+//! | [`ClosedForm`] | `closed_form` | where the closed form's error estimate holds (J to 1e-8) |
+//! | [`SmallAngle`] | `small_angle` | nearly straight rods, where the expansion's (or the pendulum's) bounds hold |
+//! | [`IllConditioned`] | `ill_conditioned` | by the separatrix: double-double closed form, f64 / double-double series, cross-check |
+//! | [`Series`] | `series` | gently bent rods (ρ ≤ 0.25), closed forms that overflow, closed-form J that cancels |
+
+use super::closed::{Closed, SeriesNeed, CLOSED_J_TOLERANCE};
+use super::Evaluation;
+use crate::scalar::Dual3;
+use crate::StabilityVerdict;
+use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
+
+mod closed_form;
+mod ill_conditioned;
+mod series;
+mod small_angle;
+
+pub(crate) use closed_form::{closed_energy, ClosedForm, ENERGY_REL_TOLERANCE};
+#[cfg(test)]
+pub(crate) use closed_form::{SUBSTEP_J_TOLERANCE, ZETA_ENERGY_ULPS};
+pub(crate) use ill_conditioned::{
+    ill_conditioned_tip, IllConditioned, CROSS_CHECK_J, CROSS_CHECK_TIP,
+};
+pub(crate) use series::Series;
+pub(crate) use small_angle::SmallAngle;
+
+/// Largest √‖F‖ for which the f64 series answers the tip, J and energy of an ill-conditioned
+/// rod. Its rounding grows like e^{√‖F‖ t} at most, and far less where the rod only leaves the
+/// straight equilibrium: against the 320-bit references (the 82 rods of
+/// `tests/data/separatrix_truth*.jsonl` near the separatrix with √‖F‖ from 10.7 to 27) its J is
+/// within 0.04·ε·e^{√‖F‖} and its tip within a hundredth of that. With ×3, J stays within 1e-9
+/// up to √‖F‖ = 17.4, a hundred times inside the 1e-6 asked of J, at ~1/50 of the
+/// double-double series' cost.
+pub(crate) const SERIES_F64_TIP_MAX_ROOT_F: f64 = 17.0;
+
+/// An answer of a formulation: `None` outside its domain, else its value or its refusal.
+pub(crate) type Answer<T> = Option<Result<T, RodError>>;
+
+/// One way of evaluating the planar rod (module docs). Every method answers for the rod the
+/// formulation was made for; a formulation that has no such quantity keeps the default, `None`.
+pub(crate) trait Formulation {
+    /// Tip pose q(1).
+    fn tip(&self) -> Answer<PlanarPose> {
+        None
+    }
+    /// q(t) and J(t) = ∂q(t)/∂a, to the accuracy `precision` asks.
+    fn pose_and_jacobian(
+        &self,
+        _t: f64,
+        _precision: Precision,
+    ) -> Answer<(PlanarPose, PlanarJacobian)> {
+        None
+    }
+    /// Elastic energy ½∫₀¹κ² to 1e-9 relative.
+    fn energy(&self) -> Answer<f64> {
+        None
+    }
+    /// The stability report (FINDINGS §5): the scan over this formulation's det J(t), or the
+    /// theorem that decides.
+    fn stability(&self) -> Answer<StabilityReport> {
+        None
+    }
+    /// The verdict alone (what [`Self::stability`]'s report says, possibly without its scan).
+    fn stability_verdict(&self) -> Answer<StabilityVerdict> {
+        self.stability().map(|r| r.map(|r| r.verdict()))
+    }
+    /// Tip, J(1), energy and stability at full accuracy.
+    fn evaluate(&self) -> Answer<Evaluation> {
+        None
+    }
+}
+
+/// How accurate the J of [`Formulation::pose_and_jacobian`] must be.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Precision {
+    /// An answer: J to 1e-8 relative and the tip to 1e-11, wherever a formulation certifies them.
+    Answer,
+    /// A solver's iteration: by the separatrix the f64 series stands in for the double-double
+    /// ones (errors ε·e^{√‖F‖}, ≈ 100× cheaper; the solvers verify their answer at `Answer`).
+    Iteration,
+    /// A continuation's intermediate step: the closed form wherever its J estimate is within
+    /// 100× an answer's tolerance (strongly tensioned rods: 1 µs where the series takes ms).
+    Substep,
+}
+
+/// What the closed form of the rod said, for the rows after it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Need {
+    /// No closed form: a gently bent rod (ρ ≤ 0.25), or one whose closed form overflowed.
+    NoClosedForm,
+    /// The closed form's estimate holds.
+    Closed,
+    /// Cancellation in the closed form only: the f64 series is accurate.
+    Cancellation,
+    /// By the separatrix: rounding grows like e^{√‖F‖} in any f64 evaluation.
+    IllConditioned,
+}
+
+impl Need {
+    /// What the closed form says of J(t) ([`Closed::needs_series`]): at t < 1 the part [0, t]
+    /// is a rod of length t, whose J is as hard as J(1) of a gently bent rod
+    /// ([`Closed::jacobian_rel_error_at`]).
+    #[inline]
+    pub(crate) fn at<T: crate::scalar::Real>(c: &Closed<T>, t: f64) -> Self {
+        match c.needs_series() {
+            SeriesNeed::None if t < 1.0 && c.jacobian_rel_error_at(t) > CLOSED_J_TOLERANCE => {
+                if c.needs_precise_series() {
+                    Need::IllConditioned
+                } else {
+                    Need::Cancellation
+                }
+            }
+            SeriesNeed::None => Need::Closed,
+            SeriesNeed::Cancellation => Need::Cancellation,
+            SeriesNeed::IllConditioned => Need::IllConditioned,
+        }
+    }
+}
+
+/// The rod as the formulations after the closed form see it: a, the closed form in dual
+/// numbers where the question built one, and what it said.
+#[derive(Clone, Copy)]
+pub(crate) struct Rod<'c> {
+    /// The parameters a = (a3, a4, a5).
+    pub(crate) a: &'c PlanarParams,
+    /// The closed form in dual numbers (None without one, or where the question built it in f64).
+    pub(crate) closed: Option<&'c Closed<Dual3>>,
+    /// What the closed form said at t = 1.
+    pub(crate) need: Need,
+    /// Whether a series standing in for the closed form must be the double-double one
+    /// ([`Closed::needs_precise_series`]; false without a closed form).
+    pub(crate) precise_series: bool,
+}
+
+impl<'c> Rod<'c> {
+    /// The rod of a built closed form, for the rows after it (the closed form declined).
+    pub(crate) fn after<T: crate::scalar::Real>(
+        closed_form: &ClosedForm<'c, T>,
+        closed: Option<&'c Closed<Dual3>>,
+    ) -> Self {
+        Rod {
+            a: closed_form.a,
+            closed,
+            need: closed_form.need(),
+            precise_series: closed_form.c.needs_precise_series(),
+        }
+    }
+
+    /// What the closed form says of J(t) ([`Need::at`]; without one, [`Need::NoClosedForm`]).
+    pub(crate) fn need_at(&self, t: f64) -> Need {
+        match self.closed {
+            Some(c) if t < 1.0 => Need::at(c, t),
+            _ => self.need,
+        }
+    }
+}
+
+/// Beyond ‖(a4, a5)‖ = 625 the full evaluation decides the domain for every quantity (a
+/// formulation may refuse there what another answers), and its answer is theirs.
+pub(crate) struct FullEvaluation<'e>(pub(crate) &'e Evaluation);
+
+impl Formulation for FullEvaluation<'_> {
+    fn tip(&self) -> Answer<PlanarPose> {
+        Some(Ok(self.0.tip))
+    }
+    /// J(1) only: at t < 1 the rows after it answer (within the same domain).
+    fn pose_and_jacobian(&self, t: f64, _: Precision) -> Answer<(PlanarPose, PlanarJacobian)> {
+        (t == 1.0).then_some(Ok((self.0.tip, self.0.jacobian)))
+    }
+    fn energy(&self) -> Answer<f64> {
+        Some(Ok(self.0.energy))
+    }
+    fn stability(&self) -> Answer<StabilityReport> {
+        Some(Ok(self.0.stability))
+    }
+}
+
+/// The tip as a pose, refused where it is not finite.
+pub(crate) fn finite_tip([x, y, th]: [f64; 3]) -> Result<PlanarPose, RodError> {
+    let tip = PlanarPose::new(x, y, th);
+    if tip.is_finite() {
+        Ok(tip)
+    } else {
+        Err(super::overflow())
+    }
+}
+
+/// An evaluation whose every part is at full accuracy.
+pub(crate) fn full_accuracy(
+    tip: PlanarPose,
+    jacobian: PlanarJacobian,
+    energy: f64,
+    stability: StabilityReport,
+) -> Evaluation {
+    Evaluation {
+        tip,
+        jacobian,
+        energy,
+        stability,
+        full_accuracy: true,
+    }
+}
+
+/// The evaluation with the stability verdict a theorem gives where one applies
+/// (`stability::with_theorem`).
+pub(crate) fn with_theorem(
+    e: Evaluation,
+    theorem: impl FnOnce() -> Option<StabilityVerdict>,
+) -> Evaluation {
+    Evaluation {
+        stability: super::stability::with_theorem(e.stability, theorem),
+        ..e
+    }
+}

@@ -1,0 +1,72 @@
+//! The Taylor series (FINDINGS §4's fallback) as a formulation: gently bent rods, closed forms
+//! that overflow, and rods whose closed-form J cancels.
+
+use super::super::closed::Closed;
+use super::super::{pose_jac_from, series_dual, series_f64, series_pose_and_jac, stability};
+use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Formulation};
+use super::{Precision, Rod};
+use crate::StabilityVerdict;
+use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
+
+/// The Taylor series of the rod in f64 (dual numbers for J): the last row of the table, it
+/// answers whatever reaches it (gently bent rods, closed forms that overflow, closed-form J
+/// that cancels; by the separatrix, a solver's iterations). Its own refusals are its step
+/// budget and its overflow.
+pub(crate) struct Series<'c>(pub(crate) Rod<'c>);
+
+impl Formulation for Series<'_> {
+    fn tip(&self) -> Answer<PlanarPose> {
+        Some(series_f64(self.0.a, false).and_then(|r| finite_tip(r.tip())))
+    }
+    fn pose_and_jacobian(&self, t: f64, _: Precision) -> Answer<(PlanarPose, PlanarJacobian)> {
+        Some(series_pose_and_jac(self.0.a, t))
+    }
+    /// ½∫κ² integrated along (the identity cancels on a nearly straight rod under force).
+    fn energy(&self) -> Answer<f64> {
+        let e = series_f64(self.0.a, false).map(|r| r.energy());
+        Some(e.and_then(|e| {
+            if e.is_finite() {
+                Ok(e)
+            } else {
+                Err(super::super::overflow())
+            }
+        }))
+    }
+    fn stability(&self) -> Answer<StabilityReport> {
+        Some(stability_by_series(self.0.a))
+    }
+    /// With the theorem of the rod's closed form where one was built, else of its f64 one.
+    fn evaluate(&self) -> Answer<Evaluation> {
+        let e = evaluate_series(self.0.a);
+        Some(e.map(|e| match self.0.closed {
+            Some(c) => with_theorem(e, || c.theorem_verdict()),
+            None => with_theorem(e, || theorem_verdict(self.0.a)),
+        }))
+    }
+}
+
+/// The evaluation on the Taylor series (one dense integration serves all four quantities).
+fn evaluate_series(a: &PlanarParams) -> Result<Evaluation, RodError> {
+    // Where the small-angle limit decides stability, the scan needs no dense output.
+    let small_angle = stability::small_angle_report(a)?;
+    let rod = series_dual(a, small_angle.is_none())?;
+    let (tip, jacobian) = pose_jac_from(rod.tip())?;
+    let energy = rod.energy().v;
+    let stability = match small_angle {
+        Some(report) => report,
+        None => stability::stability_of_dense_series(a, &rod)?,
+    };
+    Ok(full_accuracy(tip, jacobian, energy, stability))
+}
+
+/// The stability report on the Taylor series (near-relaxed rods, or where the closed form overflows).
+fn stability_by_series(a: &PlanarParams) -> Result<StabilityReport, RodError> {
+    let report = stability::stability_of_series(a, None, None, None)?;
+    Ok(stability::with_theorem(report, || theorem_verdict(a)))
+}
+
+/// [`Closed::theorem_verdict`] of a rod whose closed form was not built (None where it
+/// cannot be).
+pub(crate) fn theorem_verdict(a: &PlanarParams) -> Option<StabilityVerdict> {
+    Closed::<f64>::new(a[0], a[1], a[2]).and_then(|c| c.theorem_verdict())
+}
