@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Follows one parameter through the code, from its function's imports and calls (issue 44).
 
-    python3 scripts/dataflow_walk.py crates/rod-ig-core/src planar/mod.rs evaluate a [--trace]
+    python3 scripts/dataflow_walk.py crates/rod-ig-core/src planar/mod.rs evaluate a [--trace] [--typed]
 
 The walk starts in the named function with the named parameter tracked. In a function's body a
 tracked value is any tracked parameter, `self` when the function was reached as a method of a
@@ -10,7 +10,11 @@ mentions one. Every call whose arguments or receiver mention a tracked value is 
 per function: the walk is a depth-first traversal of first visits), and the callee's parameter
 at that position becomes tracked. A call resolves by name: a path's module names the file
 (`closed::f` → `closed.rs` or `closed/mod.rs`), else the caller's own file, else the files the
-caller's file imports from, else any file of the crate (all definitions of that name).
+caller's file imports from, else any file of the crate (all definitions of that name). With `--typed`, a method call on a value whose type the code
+names (an argument `&ClosedForm { … }` or `dispatch::Evaluate`, a local `let x = Foo::new(…)`,
+`self` in an impl) resolves to that type's method or its trait's default only, and a generic
+function is walked once per binding of its parameters' types (a reader following one
+instantiation).
 
 Printed: the walk's sequence of files (runs of the same file collapsed), the number of *stays*
 (runs) and of *returns* (runs in a file the walk had already left). Test modules
@@ -95,8 +99,27 @@ def test_spans(text):
 
 
 class Fn:
-    def __init__(self, file, name, params, body, is_method):
+    def __init__(self, file, name, params, body, is_method, owner=(None, None)):
         self.file, self.name, self.params, self.body, self.is_method = file, name, params, body, is_method
+        # (self type, trait) of the enclosing `impl Trait for Type` / `impl Type` / `trait Trait`.
+        self.owner = owner
+
+
+IMPL_RE = re.compile(r"\b(?:impl(?:<[^{]*?>)?\s+(?:([\w:]+)(?:<[^{]*?>)?\s+for\s+)?&?([\w:]+)[^{;]*?"
+                     r"|(?:pub(?:\([\w]+\))?\s+)?trait\s+(\w+)[^{;]*?)\{")
+
+
+def owners(text):
+    """Spans of impl and trait blocks with their (type, trait)."""
+    spans = []
+    for m in IMPL_RE.finditer(text):
+        trait, ty, own_trait = m.group(1), m.group(2), m.group(3)
+        end = matching(text, m.end() - 1, "{", "}")
+        if own_trait:
+            spans.append((m.end(), end, (None, own_trait)))
+        else:
+            spans.append((m.end(), end, (ty.split("::")[-1], trait.split("::")[-1] if trait else None)))
+    return spans
 
 
 def parse(root):
@@ -108,6 +131,7 @@ def parse(root):
             path = os.path.relpath(os.path.join(dirpath, f), root)
             text = strip_comments(open(os.path.join(root, path), encoding="utf-8").read())
             spans = test_spans(text)
+            blocks = owners(text)
             imports[path] = set(re.findall(r"\buse\s+(?:crate::|super::|self::)?([\w:]+)", text))
             for t in re.findall(r"\bimpl(?:<[^>]*>)?\s+(?:[\w:<>, ]+\s+for\s+)?(\w+)", text):
                 types.setdefault(t, set()).add(path)
@@ -127,8 +151,9 @@ def parse(root):
                     name = p.split(":")[0].strip()
                     name = re.sub(r"^(mut|ref)\s+", "", name)
                     params.append(name if re.fullmatch(r"\w+", name) else None)
+                owner = next((o for a, b, o in reversed(blocks) if a <= m.start() <= b), (None, None))
                 fns.setdefault(m.group(1), []).append(
-                    Fn(path, m.group(1), params, text[brace:end + 1], is_method))
+                    Fn(path, m.group(1), params, text[brace:end + 1], is_method, owner))
     return fns, imports, types
 
 
@@ -210,18 +235,52 @@ def mentions(expr, names):
     return any(re.search(r"(?<![\w.])" + re.escape(n) + r"\b", expr) for n in names)
 
 
-def walk(fns, imports, types, start, seeds, trace):
-    seq, seen = [], set()
+TYPE_ARG_RE = re.compile(r"^\s*&?\s*(?:\w+::)*([A-Z]\w*)\s*(?:[({]|::\s*new\b|$)")
 
-    def visit(fn, tracked, depth):
-        key = (fn.file, fn.name, fn.body[:40])
+
+def type_of(expr, known, types):
+    """The type (one with impls) an argument or a local's initialiser names (`&ClosedForm { … }`,
+    `dispatch::Evaluate`, `Foo::new(…)`), or the type bound to the plain name it is."""
+    m = TYPE_ARG_RE.match(expr)
+    if m:
+        return m.group(1) if m.group(1) in types else None
+    name = re.fullmatch(r"\s*&?\s*(\w+)\s*", expr)
+    return known.get(name.group(1)) if name else None
+
+
+def typed_candidates(fns, name, ty, traits_of):
+    """The method `name` of type `ty`: its impls' own, else its traits' default."""
+    own = [f for f in fns.get(name, []) if f.owner[0] == ty]
+    if own:
+        return own
+    return [f for f in fns.get(name, []) if f.owner[0] is None and f.owner[1] in traits_of.get(ty, ())]
+
+
+def walk(fns, imports, types, start, seeds, trace, typed=False):
+    seq, seen = [], set()
+    traits_of = {}
+    for defs in fns.values():
+        for f in defs:
+            if f.owner[0] and f.owner[1]:
+                traits_of.setdefault(f.owner[0], set()).add(f.owner[1])
+
+    def visit(fn, tracked, depth, bound=None):
+        bound = bound or {}
+        key = (fn.file, fn.name, fn.body[:40], tuple(sorted(bound.items())) if typed else ())
         if key in seen:
             return
         seen.add(key)
         seq.append(fn.file)
         if trace:
-            print("  " * depth + f"{fn.file}::{fn.name} {sorted(tracked)}")
+            print("  " * depth + f"{fn.file}::{fn.name} {sorted(tracked)}" + (f" {bound}" if bound else ""))
         names = tainted(fn.body, tracked)
+        # Locals whose type their initialiser names (typed walk only).
+        known = dict(bound)
+        if typed:
+            for m in re.finditer(r"let\s+(?:mut\s+)?(\w+)\s*(?::[^=]+)?=\s*([^;]+);", fn.body):
+                t = type_of(m.group(2), known, types)
+                if t:
+                    known[m.group(1)] = t
         for m in CALL_RE.finditer(fn.body):
             qual, dot, name = m.group(1), m.group(2), m.group(3)
             if name in KEYWORDS:
@@ -237,7 +296,17 @@ def walk(fns, imports, types, start, seeds, trace):
             via_receiver = bool(dot) and mentions(receiver, names)
             if not hits and not via_receiver:
                 continue
-            for callee in resolve(fns, imports, types, fn, qual, name, bool(dot)):
+            callees = None
+            if typed and dot:
+                recv = re.fullmatch(r"&?(\w+)", receiver or "")
+                ty = known.get(recv.group(1)) if recv else None
+                if recv and recv.group(1) == "self" and fn.owner[0]:
+                    ty = fn.owner[0]
+                if ty:
+                    callees = typed_candidates(fns, name, ty, traits_of)
+            if callees is None:
+                callees = resolve(fns, imports, types, fn, qual, name, bool(dot))
+            for callee in callees:
                 if callee is fn:
                     continue
                 seeds2 = {callee.params[i] for i in hits
@@ -246,7 +315,15 @@ def walk(fns, imports, types, start, seeds, trace):
                     seeds2.add("self")
                 if not seeds2:
                     continue
-                visit(callee, seeds2, depth + 1)
+                bound2 = {}
+                if typed:
+                    for i, x in enumerate(args):
+                        t = type_of(x, known, types)
+                        if t and i < len(callee.params) and callee.params[i]:
+                            bound2[callee.params[i]] = t
+                    if via_receiver and callee.is_method and callee.owner[0]:
+                        bound2["self"] = callee.owner[0]
+                visit(callee, seeds2, depth + 1, bound2)
                 seq.append(fn.file)
 
     visit(start, set(seeds), 0)
@@ -272,7 +349,8 @@ def main():
     start = [f for f in fns.get(name, []) if f.file == file]
     if not start:
         sys.exit(f"no fn {name} in {file}")
-    runs, returns = walk(fns, imports, types, start[0], [param], "--trace" in sys.argv)
+    runs, returns = walk(fns, imports, types, start[0], [param], "--trace" in sys.argv,
+                         "--typed" in sys.argv)
     print(" -> ".join(runs))
     print(f"{len(runs)} stays in {len(set(runs))} files, {returns} returns to a file it had left")
 

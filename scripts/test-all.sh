@@ -58,7 +58,9 @@ done
 python3 scripts/long_functions.py crates/*/src ros/rod_ig/src python/src >>"$LOGS/layering.log" \
     || { echo "functions over 80 lines (see $LOGS/layering.log)"; status=1; }
 # Issue 44's measure of the planar evaluation's path (recorded, not yet a gate: docs/design.md).
-{ echo "data-flow walk of planar::evaluate's a:"; python3 scripts/dataflow_walk.py crates/rod-ig-core/src planar/mod.rs evaluate a | tail -1; } >>"$LOGS/layering.log" || true
+{ echo "data-flow walk of planar::evaluate's a (by name; by type):"
+  python3 scripts/dataflow_walk.py crates/rod-ig-core/src planar/mod.rs evaluate a | tail -1
+  python3 scripts/dataflow_walk.py crates/rod-ig-core/src planar/mod.rs evaluate a --typed | tail -1; } >>"$LOGS/layering.log" || true
 
 echo "== cargo test: the crates, then the node (release profile: shares the build with the node under test)"
 { cargo test --release --workspace --no-fail-fast 2>&1; cargo test --release "${NODE[@]}" --no-fail-fast 2>&1; } \
