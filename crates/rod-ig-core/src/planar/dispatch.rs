@@ -12,18 +12,19 @@
 //! | 2 | [`SmallAngle`] | the energy only | its bound is the cheapest certificate, and the identity cancels on nearly straight rods |
 //! | 3 | [`Series`] (no closed form) | ρ ≤ [`SERIES_RHO`] | one series step; the closed form's own estimate would reject nearly all of them |
 //! | 4 | (refusal), [`Series`] | the closed form overflows | beyond √‖F‖ = ln(f64::MAX) under tension every f64 evaluation is wrong; below, the series has its own overflow detection |
-//! | 5 | [`ClosedForm`] | its error estimate holds | ≈ 0.3–2 µs, exact to ≈ 1e-10 |
-//! | 6 | [`SmallAngle`] | the closed form declined | nearly straight rods: the closed form's x row is rounding there |
-//! | 7 | [`IllConditioned`] | by the separatrix | rounding grows like e^{√‖F‖}: double-double, or the cross-check |
-//! | 8 | [`Series`] | whatever is left | the f64 series is exact to ~1e-14 where only the closed form cancels |
+//! | 5 | [`ClosedForm`] | its error estimate holds; for the verdict, a theorem or det J(1) | ≈ 0.3–2 µs, exact to ≈ 1e-10 |
+//! | 6 | [`SmallAngle`] | the closed form declined, or the stability | nearly straight rods: the closed form's x row is rounding there |
+//! | 7 | [`ClosedScan`] | the stability | the closed form's scans (its own bounds; the small-m scan) |
+//! | 8 | [`IllConditioned`] | by the separatrix | rounding grows like e^{√‖F‖}: double-double, or the cross-check |
+//! | 9 | [`Series`] | whatever is left | the f64 series is exact to ~1e-14 where only the closed form cancels |
 //!
 //! A formulation answers a quantity inside its own domain for it and says `None` outside (e.g.
 //! [`FullEvaluation`] has J at t = 1 only): the next row is asked.
 
 use super::closed::Closed;
 use super::formulation::{
-    Answer, ClosedForm, Formulation, FullEvaluation, IllConditioned, Need, Precision, Rod, Series,
-    SmallAngle,
+    Answer, ClosedForm, ClosedScan, Formulation, FullEvaluation, IllConditioned, Need, Precision,
+    Rod, Series, SmallAngle,
 };
 use super::{curvature_scale, evaluate, Evaluation};
 use crate::scalar::Dual3;
@@ -193,9 +194,12 @@ pub(crate) fn answer<Q: Question>(a: &PlanarParams, q: Q) -> Result<Q::Answer, R
     }
 }
 
-/// Rows 6–8 of the table.
+/// Rows 6–9 of the table.
 fn after_closed_form<Q: Question>(q: Q, rod: Rod) -> Result<Q::Answer, RodError> {
     if let Some(answer) = q.ask(&SmallAngle(rod)) {
+        return answer;
+    }
+    if let Some(answer) = q.ask(&ClosedScan(rod)) {
         return answer;
     }
     if let Some(answer) = q.ask(&IllConditioned(rod)) {

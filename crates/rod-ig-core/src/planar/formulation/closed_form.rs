@@ -1,13 +1,13 @@
 //! The closed form (FINDINGS §1–§3) as a formulation: its answers where its a-priori error
 //! estimate holds, and the energy by the identity of FINDINGS §1 or by ζ where their bounds do.
 
-use super::super::closed::{Case, Closed, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F};
+use super::super::closed::{Case, Closed, SeriesNeed, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F};
 use super::super::taylor::Gradient;
 use super::super::{
     extended, overflow, series_dd, series_dual, series_f64, small_angle, stability,
 };
 use super::{
-    full_accuracy, with_theorem, Answer, Evaluation, Formulation, Need, Precision,
+    full_accuracy, with_theorem, Answer, Evaluation, Formulation, Need, Precision, Rod,
     SERIES_F64_TIP_MAX_ROOT_F,
 };
 use crate::scalar::{Dual3, Real};
@@ -96,19 +96,10 @@ impl Formulation for ClosedForm<'_, Dual3> {
             || (precision == Precision::Substep && self.c.accurate_within(SUBSTEP_J_TOLERANCE));
         within.then(|| super::super::pose_jac_from(self.c.pose(t)))
     }
-    /// The scans on the closed form (with the series where its estimates fail: the scan's own
-    /// choices, `stability::stability_of`) and the theorems that decide.
-    fn stability(&self) -> Answer<StabilityReport> {
-        let report = stability::stability_of(self.c, self.a);
-        Some(report.map(|r| stability::with_theorem(r, || self.c.theorem_verdict())))
-    }
+    /// The verdict where a theorem, the sign of det J(1) or the scan from the theorem's
+    /// conjugate-free time decides ([`stability::verdict_of`]); the stability rows elsewhere.
     fn stability_verdict(&self) -> Answer<StabilityVerdict> {
-        Some(match stability::verdict_of(self.c, self.a) {
-            Ok(Some(verdict)) => Ok(verdict),
-            Ok(None) => stability::stability_of(self.c, self.a)
-                .map(|r| stability::with_theorem(r, || self.c.theorem_verdict()).verdict()),
-            Err(e) => Err(e),
-        })
+        stability::verdict_of(self.c, self.a).transpose()
     }
     fn evaluate(&self) -> Answer<Evaluation> {
         (self.need() == Need::Closed).then(|| {
@@ -150,6 +141,24 @@ pub(crate) fn energy_by_identity<T: Real>(
         return Err(overflow());
     }
     Ok((bound <= ENERGY_REL_TOLERANCE * e.abs()).then_some(e))
+}
+
+/// The closed form's own stability scans (a row after the small-angle expansion's: on a
+/// nearly straight rod the expansion decides, `stability::closed_report`).
+pub(crate) struct ClosedScan<'c>(pub(crate) Rod<'c>);
+
+impl Formulation for ClosedScan<'_> {
+    fn stability(&self) -> Answer<StabilityReport> {
+        let c = self.0.closed?;
+        let need = match self.0.need {
+            Need::Closed => SeriesNeed::None,
+            Need::IllConditioned => SeriesNeed::IllConditioned,
+            Need::Cancellation | Need::NoClosedForm => SeriesNeed::Cancellation,
+        };
+        let report = stability::closed_report(c, self.0.a, need, self.0.precise_series);
+        let report = report.transpose()?;
+        Some(report.map(|r| stability::with_theorem(r, || c.theorem_verdict())))
+    }
 }
 
 /// The energy by the identity ([`energy_by_identity`], free) where its error bound allows,

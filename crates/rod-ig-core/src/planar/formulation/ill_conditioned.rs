@@ -8,7 +8,7 @@ use super::super::{stability, STABILITY_DD_MAX_ROOT_F};
 use super::closed_form::{energy_by_identity, energy_from_tip, ENERGY_REL_TOLERANCE};
 use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Formulation, Need};
 use super::{Precision, Rod, SERIES_F64_TIP_MAX_ROOT_F};
-use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError};
+use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 
 /// The rod by the separatrix ([`Need::IllConditioned`]), where every f64 evaluation loses
 /// e^{√‖F‖} to rounding. Its energy row also takes the rods whose closed form is accurate but
@@ -57,6 +57,16 @@ impl Formulation for IllConditioned<'_> {
                 Err(overflow())
             }
         }))
+    }
+    /// By the separatrix: the closed scan with norm-wise bounds, then in double-double, then
+    /// the double-double series (`stability::precise_scan`).
+    fn stability(&self) -> Answer<StabilityReport> {
+        let c = self.0.closed?;
+        if !self.0.precise_series {
+            return None;
+        }
+        let report = stability::precise_scan(c, self.0.a, None);
+        Some(report.map(|r| stability::with_theorem(r, || c.theorem_verdict())))
     }
     /// One double-double closed form for the forward map and the stability scan.
     fn evaluate(&self) -> Answer<Evaluation> {

@@ -7,7 +7,8 @@
 //! | formulation | module | answers |
 //! | --- | --- | --- |
 //! | [`FullEvaluation`] | `full` (here) | beyond ‖(a4, a5)‖ = 625: every quantity from one full evaluation |
-//! | [`ClosedForm`] | `closed_form` | where the closed form's error estimate holds (J to 1e-8) |
+//! | [`ClosedForm`] | `closed_form` | where the closed form's error estimate holds (J to 1e-8); the verdict where a theorem or det J(1) decides |
+//! | [`ClosedScan`] | `closed_form` | the stability scans on the closed form, after the small-angle expansion's |
 //! | [`SmallAngle`] | `small_angle` | nearly straight rods, where the expansion's (or the pendulum's) bounds hold |
 //! | [`IllConditioned`] | `ill_conditioned` | by the separatrix: double-double closed form, f64 / double-double series, cross-check |
 //! | [`Series`] | `series` | gently bent rods (ρ ≤ 0.25), closed forms that overflow, closed-form J that cancels |
@@ -23,7 +24,7 @@ mod ill_conditioned;
 mod series;
 mod small_angle;
 
-pub(crate) use closed_form::{closed_energy, ClosedForm, ENERGY_REL_TOLERANCE};
+pub(crate) use closed_form::{closed_energy, ClosedForm, ClosedScan, ENERGY_REL_TOLERANCE};
 #[cfg(test)]
 pub(crate) use closed_form::{SUBSTEP_J_TOLERANCE, ZETA_ENERGY_ULPS};
 pub(crate) use ill_conditioned::{

@@ -32,8 +32,16 @@ impl Formulation for Series<'_> {
             }
         }))
     }
+    /// The series scan (the small-angle row before it declined), with the theorem that
+    /// decides where the series runs out of steps.
     fn stability(&self) -> Answer<StabilityReport> {
-        Some(stability_by_series(self.0.a))
+        let a = self.0.a;
+        Some(match self.0.closed {
+            Some(c) => stability::series_report_after_closed(c, a)
+                .map(|r| stability::with_theorem(r, || c.theorem_verdict())),
+            None => stability::series_after_small_angle(a, None, None, None)
+                .map(|r| stability::with_theorem(r, || theorem_verdict(a))),
+        })
     }
     /// With the theorem of the rod's closed form where one was built, else of its f64 one.
     fn evaluate(&self) -> Answer<Evaluation> {
@@ -57,12 +65,6 @@ fn evaluate_series(a: &PlanarParams) -> Result<Evaluation, RodError> {
         None => stability::stability_of_dense_series(a, &rod)?,
     };
     Ok(full_accuracy(tip, jacobian, energy, stability))
-}
-
-/// The stability report on the Taylor series (near-relaxed rods, or where the closed form overflows).
-fn stability_by_series(a: &PlanarParams) -> Result<StabilityReport, RodError> {
-    let report = stability::stability_of_series(a, None, None, None)?;
-    Ok(stability::with_theorem(report, || theorem_verdict(a)))
 }
 
 /// [`Closed::theorem_verdict`] of a rod whose closed form was not built (None where it

@@ -4,7 +4,7 @@
 use super::super::{small_angle, stability};
 use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Formulation, Need};
 use super::{Precision, Rod};
-use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError};
+use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 
 /// A nearly straight rod by the small-angle expansion (or, under compression, the pendulum of
 /// exact frequency). Its tip, J and evaluation answer where the closed form declined (on a
@@ -34,6 +34,15 @@ impl Formulation for SmallAngle<'_> {
     }
     fn energy(&self) -> Answer<f64> {
         small_angle::checked_energy(self.0.a).map(Ok)
+    }
+    /// The stability of a nearly straight rod from the expansion's det J, where its bounds
+    /// decide the verdict with certainty (`stability::small_angle_report`), before any scan.
+    fn stability(&self) -> Answer<StabilityReport> {
+        let report = stability::small_angle_report(self.0.a).transpose()?;
+        Some(report.map(|r| match self.0.closed {
+            Some(c) => stability::with_theorem(r, || c.theorem_verdict()),
+            None => stability::with_theorem(r, || super::series::theorem_verdict(self.0.a)),
+        }))
     }
     fn evaluate(&self) -> Answer<Evaluation> {
         if !self.declined_at(1.0) {

@@ -13,62 +13,75 @@ pub(crate) fn stability_of(
 }
 
 /// [`stability_of`] with the rod's closed form in double-double when the caller has built it
-/// already (`planar::extended::seeded_within_reach`; built here when needed otherwise).
+/// already (`planar::extended::seeded_within_reach`; built here when needed otherwise). For
+/// the evaluation, which holds one closed form (and one double-double form) for all its parts:
+/// the stability rows of the dispatcher's table (`planar/dispatch.rs`) in its order, each
+/// piece the one its row asks: [`small_angle_report`], [`closed_report`], [`precise_scan`],
+/// [`series_report_after_closed`].
 pub(crate) fn stability_of_with(
     c: &Closed<Dual3>,
     a: &PlanarParams,
     extended: Option<&Closed<DualDd>>,
 ) -> Result<StabilityReport, RodError> {
-    if c.case == Case::Straight {
-        return Ok(straight_report());
-    }
     if let Some(report) = small_angle_report(a)? {
         return Ok(report);
     }
-    if c.needs_precise_series() {
+    let precise = c.needs_precise_series();
+    if let Some(report) = closed_report(c, a, c.needs_series(), precise)? {
+        return Ok(report);
+    }
+    if precise {
         return precise_scan(c, a, extended);
+    }
+    series_report_after_closed(c, a)
+}
+
+/// The closed form's own stability report (the closed-scan row of the dispatcher's table,
+/// asked after the small-angle expansion declined): the straight rod's; the closed scan where
+/// a theorem decides and no series can reach the tip; the small-m scan where det J needs the
+/// series but its certification holds; the closed scan where the closed form's estimate holds
+/// and the scan is certain. None elsewhere: by the separatrix (`precise`: the double-double
+/// scans), where the closed form's J needs the series, where the small-m certification or the
+/// closed scan cannot decide (the series scan).
+pub(crate) fn closed_report(
+    c: &Closed<Dual3>,
+    a: &PlanarParams,
+    need: SeriesNeed,
+    precise: bool,
+) -> Result<Option<StabilityReport>, RodError> {
+    if c.case == Case::Straight {
+        return Ok(Some(straight_report()));
+    }
+    if precise {
+        return Ok(None);
     }
     // A theorem decides the verdict (circles, case II) and no series can reach the tip: the
     // closed scan's margin stands, uncertain or not (a near-circle of ~10⁴ turns under a small
     // force ran out of series steps here).
     if series_out_of_reach(a) && c.theorem_verdict().is_some() {
-        return closed_scan(c, a, false, None);
+        return closed_scan(c, a, false, None).map(Some);
     }
-    let wavelength = Some(c.wavelength());
     if c.det_needs_series() {
-        if let Some(report) = small_m_scan(c, a)? {
-            return Ok(report);
-        }
-        return or_theorem(
-            c,
-            a,
-            None,
-            series_after_small_angle(a, None, wavelength, None),
-        );
+        return small_m_scan(c, a);
     }
-    match c.needs_series() {
-        SeriesNeed::IllConditioned => {
-            let series = series_after_small_angle(a, None, wavelength, Some(c));
-            return or_theorem(c, a, None, series);
-        }
-        SeriesNeed::Cancellation => {
-            return or_theorem(
-                c,
-                a,
-                None,
-                series_after_small_angle(a, None, wavelength, None),
-            )
-        }
-        SeriesNeed::None => {}
+    if need != SeriesNeed::None {
+        return Ok(None);
     }
+    // Uncertain: the closed form's error bound covers the margin; the series' entries are
+    // accurate relative to themselves (the series row).
     let report = closed_scan(c, a, false, None)?;
-    if report.uncertain {
-        // The closed form cannot decide: its error bound covers the margin. The series'
-        // entries are accurate relative to themselves; ask it.
-        let series = series_after_small_angle(a, None, wavelength, None);
-        return or_theorem(c, a, Some(report), series);
-    }
-    Ok(report)
+    Ok((!report.uncertain).then_some(report))
+}
+
+/// The series scan of a rod whose closed form was built and declined (the series row of the
+/// table), unless the series runs out of steps on a rod whose verdict a theorem decides: then
+/// the closed scan's report, its margin possibly uncertain ([`or_theorem`]).
+pub(crate) fn series_report_after_closed(
+    c: &Closed<Dual3>,
+    a: &PlanarParams,
+) -> Result<StabilityReport, RodError> {
+    let series = series_after_small_angle(a, None, Some(c.wavelength()), None);
+    or_theorem(c, a, series)
 }
 
 /// The stability of a rod by the separatrix under a strong force. There the closed form's
@@ -77,7 +90,7 @@ pub(crate) fn stability_of_with(
 /// were wrong on the rigorous reference (scripts/gen_separatrix_truth.py). The scan bounds
 /// every entry norm-wise and hands what it cannot decide to a second pass in double-double,
 /// then to the double-double series.
-fn precise_scan(
+pub(crate) fn precise_scan(
     c: &Closed<Dual3>,
     a: &PlanarParams,
     extended: Option<&Closed<DualDd>>,
@@ -116,18 +129,16 @@ fn precise_scan(
 }
 
 /// The series' report, unless it ran out of steps on a rod whose verdict a theorem decides:
-/// then the closed scan's (`closed`, or scanned now), its margin possibly uncertain.
+/// then the closed scan's (scanned now), its margin possibly uncertain.
 fn or_theorem(
     c: &Closed<Dual3>,
     a: &PlanarParams,
-    closed: Option<StabilityReport>,
     series: Result<StabilityReport, RodError>,
 ) -> Result<StabilityReport, RodError> {
     match series {
-        Err(RodError::Integration(_)) if c.theorem_verdict().is_some() => match closed {
-            Some(report) => Ok(report),
-            None => closed_scan(c, a, false, None),
-        },
+        Err(RodError::Integration(_)) if c.theorem_verdict().is_some() => {
+            closed_scan(c, a, false, None)
+        }
         answer => answer,
     }
 }
@@ -570,7 +581,7 @@ impl ShortSeries {
 
     /// g(t) and its error bound from the series; None where the series cannot be built (the
     /// caller keeps the closed form's value) or the bending is too small to scale (σ < 1e-60,
-    /// where `stability_of_series` works on a ray).
+    /// where `whole_series_scan` works on a ray).
     fn normalised_det(&self, t: f64) -> Option<(f64, f64, f64)> {
         let (a3, a5) = (self.a[0], self.a[2]);
         if a3.abs().max(a5.abs()) < SIGMA_RAY {

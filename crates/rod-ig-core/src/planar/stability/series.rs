@@ -3,28 +3,8 @@
 
 use super::*;
 
-/// Stability on the Taylor series of near-relaxed rods (`rod`, when given, is their dense
-/// dual-number series), or, with `precise` (the rod's closed form), on the double-double
-/// series of the rods where the closed form's error estimate fails. `wavelength` bounds the
-/// scan spacing.
-pub(crate) fn stability_of_series(
-    a: &PlanarParams,
-    rod: Option<&TaylorRod<Dual3>>,
-    wavelength: Option<f64>,
-    precise: Option<&Closed<Dual3>>,
-) -> Result<StabilityReport, RodError> {
-    let sigma = a[0].abs().max(a[2].abs());
-    if sigma == 0.0 {
-        return Ok(straight_report());
-    }
-    if let Some(report) = small_angle_report(a)? {
-        return Ok(report);
-    }
-    whole_series_scan(a, rod, wavelength, precise)
-}
-
-/// [`stability_of_series`] on the rod's dense dual-number series, for a caller that has
-/// already asked [`small_angle_report`].
+/// The series scan on the rod's dense dual-number series, for a caller that has already
+/// asked [`small_angle_report`].
 pub(crate) fn stability_of_dense_series(
     a: &PlanarParams,
     rod: &TaylorRod<Dual3>,
@@ -32,9 +12,11 @@ pub(crate) fn stability_of_dense_series(
     series_after_small_angle(a, Some(rod), None, None)
 }
 
-/// [`stability_of_series`] for a caller that has already asked [`small_angle_report`] (it
-/// would ask again).
-pub(super) fn series_after_small_angle(
+/// Stability on the Taylor series (`rod`, when given, is the rod's dense dual-number series;
+/// with `precise`, the rod's closed form, the double-double series cross-checked against it)
+/// for a caller that has already asked [`small_angle_report`] (the dispatcher's small-angle
+/// row). `wavelength` bounds the scan spacing.
+pub(crate) fn series_after_small_angle(
     a: &PlanarParams,
     rod: Option<&TaylorRod<Dual3>>,
     wavelength: Option<f64>,
@@ -46,7 +28,7 @@ pub(super) fn series_after_small_angle(
     whole_series_scan(a, rod, wavelength, precise)
 }
 
-/// [`stability_of_series`] without the small-angle shortcut: the scan on the whole rod's series.
+/// The scan on the whole rod's series (no small-angle shortcut).
 pub(super) fn whole_series_scan(
     a: &PlanarParams,
     rod: Option<&TaylorRod<Dual3>>,
