@@ -1,6 +1,6 @@
 //! The one dispatcher of the planar evaluation (issue 44). Every entry point (`tip`,
-//! `pose_and_jacobian`, `energy`, `stability`, `stability_verdict`, `evaluate`, and the
-//! solvers' `tip_and_jacobian_for_iteration` / `_for_substep`) asks its [`Question`] through
+//! `pose_and_jacobian`, `energy`, `stability`, `stability_verdict`, `evaluate`, the shape
+//! `PlanarRod::new`, and the solvers' `tip_and_jacobian_for_iteration` / `_for_substep`) asks its [`Question`] through
 //! [`answer`], which walks one ordered table of formulations ([`super::formulation`]) and
 //! takes the first answer. It is the only place where a rod's regime is decided, so the entry
 //! points share one domain and one refusal.
@@ -26,7 +26,7 @@ use super::formulation::{
     Answer, ClosedForm, ClosedScan, Formulation, FullEvaluation, IllConditioned, Need, Precision,
     Rod, Series, SmallAngle,
 };
-use super::{curvature_scale, evaluate, Evaluation};
+use super::{curvature_scale, evaluate, Evaluation, PlanarRod};
 use crate::scalar::Dual3;
 use crate::StabilityVerdict;
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
@@ -147,6 +147,7 @@ pub(crate) fn answer<Q: Question>(a: &PlanarParams, q: Q) -> Result<Q::Answer, R
         a,
         closed: None,
         need: Need::NoClosedForm,
+        case: None,
         precise_series: false,
     };
     if Q::SMALL_ANGLE_FIRST {
@@ -289,5 +290,18 @@ impl Question for Evaluate {
     const FULL_EVALUATION: bool = false;
     fn ask<F: Formulation>(self, f: &F) -> Answer<Evaluation> {
         f.evaluate()
+    }
+}
+
+/// The shape ([`PlanarRod`]): its refusals and tip beyond row 1 are the full evaluation's,
+/// which `PlanarRod::new` asks first.
+#[derive(Clone, Copy)]
+pub(crate) struct Shape;
+impl Question for Shape {
+    type Answer = PlanarRod;
+    const BUILD: Build = Build::F64WithPhase;
+    const FULL_EVALUATION: bool = false;
+    fn ask<F: Formulation>(self, f: &F) -> Answer<PlanarRod> {
+        f.shape()
     }
 }

@@ -38,7 +38,7 @@ use dispatch::{
     beyond_ordinary_force, check_params, domain_evaluation, overflow_force, series_first,
     LN_F64_MAX,
 };
-use formulation::{closed_energy, ill_conditioned_tip, Precision};
+use formulation::{closed_energy, Precision};
 pub(crate) use formulation::{CROSS_CHECK_J, CROSS_CHECK_TIP, ENERGY_REL_TOLERANCE};
 pub use model::{check_target, PlanarClosedForm, PlanarReference};
 pub use shape::PlanarRod;

@@ -15,10 +15,13 @@ pub struct PlanarRod {
     tip: PlanarPose,
 }
 
+/// How a [`PlanarRod`] places its poses.
 #[derive(Clone, Debug)]
 #[allow(clippy::large_enum_variant)] // one per rod, never in bulk; boxing costs an allocation
-enum Backend {
+pub(crate) enum Backend {
+    /// The closed form (its estimate holds).
     Closed(Closed<f64>),
+    /// The dense f64 Taylor series.
     Series(TaylorRod<f64>),
     /// The small-angle expansion (or the pendulum), where forward answers by it and the series
     /// cannot stand in (beyond √‖F‖ = ln(f64::MAX), a nearly straight rod under compression).
@@ -27,7 +30,7 @@ enum Backend {
 
 /// The closed-form case of a when the series is used without building the closed form (the
 /// classification of FINDINGS §2, which `case()` reports for information).
-fn case_without_closed(a: &PlanarParams) -> Case {
+pub(crate) fn case_without_closed(a: &PlanarParams) -> Case {
     let (a3, a4, a5) = (a[0], a[1], a[2]);
     if a3 == 0.0 && a5 == 0.0 {
         Case::Straight
@@ -39,6 +42,23 @@ fn case_without_closed(a: &PlanarParams) -> Case {
     }
 }
 
+/// The series backend of a shape, or the small-angle expansion where the series cannot run and
+/// the expansion's tip is within its bound (as forward does). Beyond √‖F‖ = ln(f64::MAX) the
+/// series' poses between base and tip overflow (NaN at phases of ~1e8 loops where the tip did
+/// not, a = (−8e−65, 5e16, 0), which forward refuses too).
+pub(crate) fn series_backend(a: &PlanarParams) -> Result<Backend, RodError> {
+    let series = if crate::scalar::fast_hypot(a[1], a[2]).sqrt() > LN_F64_MAX {
+        Err(overflow_force())
+    } else {
+        series_f64(a, true)
+    };
+    match series {
+        Err(e) if small_angle::checked_tip(a).is_none() => Err(e),
+        Err(_) => Ok(Backend::SmallAngle),
+        Ok(r) => Ok(Backend::Series(r)),
+    }
+}
+
 impl PlanarRod {
     /// Precomputes the rod for a. Errors: [`RodError::NonFinite`] if a component of a is NaN
     /// or ±∞; every refusal of [`evaluate`] (one domain: beyond ‖(a4, a5)‖ = 625 the full
@@ -46,57 +66,29 @@ impl PlanarRod {
     /// shape cannot be represented in f64 (its series beyond √‖(a4, a5)‖ = ln(f64::MAX), the
     /// one kind of rod forward answers and the shape does not: `tests/domain.rs`).
     pub fn new(a: &PlanarParams) -> Result<Self, RodError> {
-        check_params(a)?;
-        // Forward's refusals are the shape's too (one domain); its tip is the shape's.
+        // Forward's refusals are the shape's too (one domain; NaN and ±∞ count as beyond, and
+        // the evaluation refuses them); its tip is the shape's.
         let known = if beyond_ordinary_force(a) {
             Some(domain_evaluation(a)?)
         } else {
             None
         };
-        let closed = if series_first(a) {
-            None
-        } else {
-            Closed::new(a[0], a[1], a[2])
-        };
-        // Where the series stands in for the closed form, beyond √‖F‖ = ln(f64::MAX) its poses
-        // between base and tip overflow (NaN at phases of ~1e8 loops where the tip did not, a =
-        // (−8e−65, 5e16, 0), which forward refuses too).
-        let series = || {
-            if crate::scalar::fast_hypot(a[1], a[2]).sqrt() > LN_F64_MAX {
-                return Err(overflow_force());
-            }
-            series_f64(a, true)
-        };
-        // As forward does, the small-angle expansion before a series that cannot run.
-        let series_or_small_angle = || match series() {
-            Err(e) if small_angle::checked_tip(a).is_none() => Err(e),
-            Err(_) => Ok(Backend::SmallAngle),
-            Ok(r) => Ok(Backend::Series(r)),
-        };
-        let (case, backend) = match closed {
-            Some(c) if !c.needs_reference() => (c.case, Backend::Closed(c)),
-            Some(c) => (c.case, series_or_small_angle()?),
-            None => (case_without_closed(a), series_or_small_angle()?),
-        };
-        let tip = match &backend {
-            _ if let Some(e) = &known => [e.tip.x, e.tip.y, e.tip.theta],
-            Backend::Closed(c) => c.pose(1.0),
-            // Near the separatrix the f64 series' tip drifts: the double-double one (at small
-            // m the f64 series is exact to ~1e-14 and serves as is).
-            Backend::Series(_)
-                if closed.is_some_and(|c| c.needs_series() == SeriesNeed::IllConditioned) =>
-            {
-                // As `tip` does: the small-angle expansion first (a nearly straight rod under
-                // tension), so that forward and shape answer the same rods.
-                match small_angle::checked_tip(a) {
-                    Some(tip) => tip,
-                    None => ill_conditioned_tip(a).map(|(p, _, _)| [p.x, p.y, p.theta])?,
-                }
-            }
-            Backend::Series(r) => r.tip(),
-            Backend::SmallAngle => small_angle::checked_tip(a).ok_or_else(overflow)?,
-        };
-        let tip = PlanarPose::new(tip[0], tip[1], tip[2]);
+        let mut rod = dispatch::answer(a, dispatch::Shape)?;
+        if let Some(e) = known {
+            rod.tip = e.tip;
+        }
+        Ok(rod)
+    }
+
+    /// The rod from the parts a formulation built (`planar/formulation/`); refused where its
+    /// tip is not finite.
+    pub(crate) fn from_parts(
+        a: &PlanarParams,
+        case: Case,
+        backend: Backend,
+        [x, y, theta]: [f64; 3],
+    ) -> Result<Self, RodError> {
+        let tip = PlanarPose::new(x, y, theta);
         if !tip.is_finite() {
             return Err(overflow());
         }

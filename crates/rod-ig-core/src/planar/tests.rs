@@ -2,7 +2,7 @@
 
 use super::closed::{CLOSED_J_TOLERANCE, SERIES_DD_MAX_ROOT_F};
 use super::dispatch::SERIES_RHO;
-use super::formulation::{SUBSTEP_J_TOLERANCE, ZETA_ENERGY_ULPS};
+use super::formulation::{ill_conditioned_tip, SUBSTEP_J_TOLERANCE, ZETA_ENERGY_ULPS};
 use super::taylor::Gradient;
 use super::*;
 use crate::rng::SplitMix64;

@@ -271,17 +271,14 @@ impl<T: Real> Closed<T> {
         CLOSED_POSE_ULPS * T::EPSILON * (1.0 + loss) * rho.recip().max(1.0)
     }
 
-    /// True when J (and det J) from this closed form may be off by more than
-    /// [`CLOSED_J_TOLERANCE`]: where its cancellation estimate (`jacobian_rel_error_at`)
+    /// Not [`SeriesNeed::None`] when J (and det J) from this closed form may be off by more
+    /// than [`CLOSED_J_TOLERANCE`]: where its cancellation estimate (`jacobian_rel_error_at`)
     /// exceeds it (near the separatrix by 2/√m1, at small m by 1/m, on gently bent rods by
     /// 1/ρ³), at small m (1e-6 > m: near-straight rods under compression, near-circles above
-    /// the small-force switch) and in case III with |Γ| > 8 somewhere on [0, 1]. Callers then
-    /// take the pose, J and the stability test from the Taylor series (FINDINGS §4: "fall back
-    /// to an ODE"), unless max(a3², |a4|, |a5|) > 1e6; see `needs_series` for which one.
-    pub fn needs_reference(&self) -> bool {
-        self.needs_series() != SeriesNeed::None
-    }
-
+    /// the small-force switch) and in case III with |Γ| > 8 somewhere on [0, 1]; the
+    /// dispatcher then asks the other formulations (FINDINGS §4: "fall back to an ODE"),
+    /// unless max(a3², |a4|, |a5|) > 1e6.
+    ///
     /// Why (and how) the closed form must be replaced by the series: near the separatrix the
     /// rod lingers by the hyperbolic straight equilibrium, where rounding grows exponentially
     /// (ill-conditioned: double-double series); at small m the loss is plain cancellation in the

@@ -2,7 +2,9 @@
 //! estimate holds, and the energy by the identity of FINDINGS §1 or by ζ where their bounds do.
 
 use super::super::closed::{Case, Closed, SeriesNeed, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F};
+use super::super::shape::Backend;
 use super::super::taylor::Gradient;
+use super::super::PlanarRod;
 use super::super::{
     extended, overflow, series_dd, series_dual, series_f64, small_angle, stability,
 };
@@ -60,6 +62,14 @@ impl<'c, T: Real> ClosedForm<'c, T> {
 }
 
 impl Formulation for ClosedForm<'_, f64> {
+    /// The closed form with everything that depends on a only precomputed, where its estimate
+    /// holds.
+    fn shape(&self) -> Answer<PlanarRod> {
+        (self.need() == Need::Closed).then(|| {
+            let backend = Backend::Closed(*self.c);
+            PlanarRod::from_parts(self.a, self.c.case, backend, self.c.pose(1.0))
+        })
+    }
     /// q(1) (FINDINGS §1–§3), where the estimate holds. Built without the phase, the tip is
     /// placed by the addition theorems (~18 % of q(1)); it may differ from the evaluation's in
     /// the last bits, both within the closed form's pose bound.

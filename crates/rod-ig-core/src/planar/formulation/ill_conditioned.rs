@@ -3,6 +3,7 @@
 
 use super::super::closed::{Closed, SERIES_DD_MAX_ROOT_F};
 use super::super::taylor::Gradient;
+use super::super::PlanarRod;
 use super::super::{extended, overflow, pose_jac_from, seeded_closed, series_dd, series_dual};
 use super::super::{stability, STABILITY_DD_MAX_ROOT_F};
 use super::closed_form::{energy_by_identity, energy_from_tip, ENERGY_REL_TOLERANCE};
@@ -67,6 +68,22 @@ impl Formulation for IllConditioned<'_> {
         }
         let report = stability::precise_scan(c, self.0.a, None);
         Some(report.map(|r| stability::with_theorem(r, || c.theorem_verdict())))
+    }
+    /// The f64 series' poses with the tip of the ill-conditioned routes (near the separatrix
+    /// the f64 series' tip drifts): the small-angle tip first, as `tip` does, so that forward
+    /// and shape answer the same rods.
+    fn shape(&self) -> Answer<PlanarRod> {
+        if self.0.need != Need::IllConditioned {
+            return None;
+        }
+        let a = self.0.a;
+        Some(
+            self.0
+                .series_shape(|_| match super::super::small_angle::checked_tip(a) {
+                    Some(tip) => Ok(tip),
+                    None => ill_conditioned_tip(a).map(|(p, _, _)| [p.x, p.y, p.theta]),
+                }),
+        )
     }
     /// One double-double closed form for the forward map and the stability scan.
     fn evaluate(&self) -> Answer<Evaluation> {

@@ -13,8 +13,10 @@
 //! | [`IllConditioned`] | `ill_conditioned` | by the separatrix: double-double closed form, f64 / double-double series, cross-check |
 //! | [`Series`] | `series` | gently bent rods (ρ ≤ 0.25), closed forms that overflow, closed-form J that cancels |
 
+use super::closed::Case;
 use super::closed::{Closed, SeriesNeed, CLOSED_J_TOLERANCE};
-use super::Evaluation;
+use super::shape::{case_without_closed, series_backend, Backend};
+use super::{Evaluation, PlanarRod};
 use crate::scalar::Dual3;
 use crate::StabilityVerdict;
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
@@ -27,9 +29,9 @@ mod small_angle;
 pub(crate) use closed_form::{closed_energy, ClosedForm, ClosedScan, ENERGY_REL_TOLERANCE};
 #[cfg(test)]
 pub(crate) use closed_form::{SUBSTEP_J_TOLERANCE, ZETA_ENERGY_ULPS};
-pub(crate) use ill_conditioned::{
-    ill_conditioned_tip, IllConditioned, CROSS_CHECK_J, CROSS_CHECK_TIP,
-};
+#[cfg(test)]
+pub(crate) use ill_conditioned::ill_conditioned_tip;
+pub(crate) use ill_conditioned::{IllConditioned, CROSS_CHECK_J, CROSS_CHECK_TIP};
 pub(crate) use series::Series;
 pub(crate) use small_angle::SmallAngle;
 
@@ -75,6 +77,10 @@ pub(crate) trait Formulation {
     }
     /// Tip, J(1), energy and stability at full accuracy.
     fn evaluate(&self) -> Answer<Evaluation> {
+        None
+    }
+    /// The rod ready to be sampled along its length (its tip this formulation's).
+    fn shape(&self) -> Answer<PlanarRod> {
         None
     }
 }
@@ -136,6 +142,8 @@ pub(crate) struct Rod<'c> {
     pub(crate) closed: Option<&'c Closed<Dual3>>,
     /// What the closed form said at t = 1.
     pub(crate) need: Need,
+    /// The closed form's case (FINDINGS §2), where one was built.
+    pub(crate) case: Option<Case>,
     /// Whether a series standing in for the closed form must be the double-double one
     /// ([`Closed::needs_precise_series`]; false without a closed form).
     pub(crate) precise_series: bool,
@@ -151,8 +159,24 @@ impl<'c> Rod<'c> {
             a: closed_form.a,
             closed,
             need: closed_form.need(),
+            case: Some(closed_form.c.case),
             precise_series: closed_form.c.needs_precise_series(),
         }
+    }
+
+    /// The case the shape reports (the closed form's, else classified from a).
+    pub(crate) fn case(&self) -> Case {
+        self.case.unwrap_or_else(|| case_without_closed(self.a))
+    }
+
+    /// A shape on the series (or the expansion where the series cannot run), with `tip`.
+    pub(crate) fn series_shape(
+        &self,
+        tip: impl FnOnce(&Backend) -> Result<[f64; 3], RodError>,
+    ) -> Result<PlanarRod, RodError> {
+        let backend = series_backend(self.a)?;
+        let tip = tip(&backend)?;
+        PlanarRod::from_parts(self.a, self.case(), backend, tip)
     }
 
     /// What the closed form says of J(t) ([`Need::at`]; without one, [`Need::NoClosedForm`]).

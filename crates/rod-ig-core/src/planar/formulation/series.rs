@@ -2,6 +2,8 @@
 //! that overflow, and rods whose closed-form J cancels.
 
 use super::super::closed::Closed;
+use super::super::shape::Backend;
+use super::super::PlanarRod;
 use super::super::{pose_jac_from, series_dual, series_f64, series_pose_and_jac, stability};
 use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Formulation};
 use super::{Precision, Rod};
@@ -42,6 +44,14 @@ impl Formulation for Series<'_> {
             None => stability::series_after_small_angle(a, None, None, None)
                 .map(|r| stability::with_theorem(r, || theorem_verdict(a))),
         })
+    }
+    /// The dense f64 series (or the expansion where the series cannot run).
+    fn shape(&self) -> Answer<PlanarRod> {
+        let a = self.0.a;
+        Some(self.0.series_shape(|backend| match backend {
+            Backend::Series(r) => Ok(r.tip()),
+            _ => super::super::small_angle::checked_tip(a).ok_or_else(super::super::overflow),
+        }))
     }
     /// With the theorem of the rod's closed form where one was built, else of its f64 one.
     fn evaluate(&self) -> Answer<Evaluation> {

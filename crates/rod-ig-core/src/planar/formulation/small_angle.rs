@@ -1,7 +1,8 @@
 //! The small-angle expansion and the pendulum (`planar::small_angle`, `planar::pendulum`) as a
 //! formulation: nearly straight rods, where their a-priori bounds hold.
 
-use super::super::{small_angle, stability};
+use super::super::shape::Backend;
+use super::super::{small_angle, stability, PlanarRod};
 use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Formulation, Need};
 use super::{Precision, Rod};
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
@@ -34,6 +35,22 @@ impl Formulation for SmallAngle<'_> {
     }
     fn energy(&self) -> Answer<f64> {
         small_angle::checked_energy(self.0.a).map(Ok)
+    }
+    /// Where the closed form declined and no series can run (beyond √‖F‖ = ln(f64::MAX), a
+    /// nearly straight rod under compression).
+    fn shape(&self) -> Answer<PlanarRod> {
+        let a = self.0.a;
+        let beyond_series = crate::scalar::fast_hypot(a[1], a[2]).sqrt() > super::super::LN_F64_MAX;
+        if self.0.need == Need::Closed || !beyond_series {
+            return None;
+        }
+        let tip = small_angle::checked_tip(a)?;
+        Some(PlanarRod::from_parts(
+            a,
+            self.0.case(),
+            Backend::SmallAngle,
+            tip,
+        ))
     }
     /// The stability of a nearly straight rod from the expansion's det J, where its bounds
     /// decide the verdict with certainty (`stability::small_angle_report`), before any scan.
