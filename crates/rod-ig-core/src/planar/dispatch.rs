@@ -197,8 +197,11 @@ pub(crate) fn answer<Q: Question>(a: &PlanarParams, q: Q) -> Result<Q::Answer, R
 
 /// Rows 6–9 of the table.
 fn after_closed_form<Q: Question>(q: Q, rod: Rod) -> Result<Q::Answer, RodError> {
-    if let Some(answer) = q.ask(&SmallAngle(rod)) {
-        return answer;
+    // A question that asked the expansion first (row 2) has its answer already: not twice.
+    if !Q::SMALL_ANGLE_FIRST {
+        if let Some(answer) = q.ask(&SmallAngle(rod)) {
+            return answer;
+        }
     }
     if let Some(answer) = q.ask(&ClosedScan(rod)) {
         return answer;
