@@ -97,6 +97,28 @@ pub trait InverseGeometry<const N: usize>: RodModel<N> {
 
     /// The start of the paper's Newton when the caller gives none.
     fn default_start(&self, target: &Self::Pose) -> Option<SVector<f64, N>>;
+
+    /// The paper's Newton from `a0` ([`Method::Newton`]): the generic Newton on this model,
+    /// unless the model iterates on another formulation (the long cables' node states).
+    fn newton(
+        &self,
+        target: &Self::Pose,
+        a0: &SVector<f64, N>,
+        options: &SolveOptions<SVector<f64, N>>,
+    ) -> Result<SolutionOf<N, Self>, FailureOf<N>> {
+        newton::solve(self, target, a0, options)
+    }
+}
+
+/// The paper's Newton on `model` ([`InverseGeometry::newton`]'s default), for a model that
+/// overrides it and falls back to it.
+pub fn newton_solve<const N: usize, M: RodModel<N> + ?Sized>(
+    model: &M,
+    target: &M::Pose,
+    a0: &SVector<f64, N>,
+    options: &SolveOptions<SVector<f64, N>>,
+) -> Result<SolutionOf<N, M>, FailureOf<N>> {
+    newton::solve(model, target, a0, options)
 }
 
 fn check<const N: usize, M: InverseGeometry<N> + ?Sized>(
@@ -176,7 +198,7 @@ fn dispatch<const N: usize, M: InverseGeometry<N> + ?Sized>(
                 };
                 return Err(Failure::early(reason));
             };
-            newton::solve(model, target, &a0, options)
+            model.newton(target, &a0, options)
         }
         (Method::Robust, Objective::FirstFound) => model.robust(target, options),
         (Method::Robust, Objective::LeastEnergy) => {
@@ -200,7 +222,8 @@ fn dispatch<const N: usize, M: InverseGeometry<N> + ?Sized>(
                     s.iterations = all.iterations + fi;
                     s.evaluations = all.evaluations + fe;
                     s.starts = all.starts + fs;
-                    s.complete = complete;
+                    // A search that cannot prove it found every rod says so itself.
+                    s.complete = complete && s.complete;
                     Ok(s)
                 }
                 None => first,

@@ -53,6 +53,10 @@ pub struct SolveOptions<P> {
     /// Starts the robust search tries at most (≥ 1); `None`: the model's search's default
     /// (planar 48, 3-D 12). A setting of the search, not of the model.
     pub max_starts: Option<u32>,
+    /// Most full turns of the tangent an answer may make (0, the default: loop-free, and the
+    /// centreline must not cross itself). Applied by the long-cable search (planar, w > 200:
+    /// [`crate::planar::heavy::cable_search`]); the other searches do not filter by it yet.
+    pub max_turns: u32,
 }
 
 /// Default wall-time budget of one planar solve: 250 ms. The robust solver's p99.9 on the
@@ -92,6 +96,7 @@ impl<P> SolveOptions<P> {
             objective: Objective::FirstFound,
             deadline,
             max_starts: None,
+            max_turns: 0,
         }
     }
 }

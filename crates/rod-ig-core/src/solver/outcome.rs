@@ -225,6 +225,24 @@ pub enum IgError {
     /// reaching a stable rod: what it searched (a stable rod outside that search may exist).
     #[error("{0}")]
     SearchExhausted(Box<Searched>),
+    /// The long-cable search (multiple shooting, w > 200) admitted no rod: none of its starts
+    /// reached a stable rod within the admitted turns. Not a proof that none exists.
+    #[error(
+        "no stable rod with at most {max_turns} turns found by {starts} starts of the \
+         long-cable search{}{}",
+        if *cut_short { " before its deadline passed" } else { "" },
+        last.as_ref().map(|l| format!("; last start: {l}")).unwrap_or_default()
+    )]
+    NoAdmittedRod {
+        /// Starts tried (weightless rods carried in load, seeds moved to the target).
+        starts: u32,
+        /// The `max_turns` the search admitted.
+        max_turns: u32,
+        /// The deadline cut the search.
+        cut_short: bool,
+        /// Why the last start failed, when known.
+        last: Option<String>,
+    },
 }
 
 /// What an exhausted search searched ([`IgError::SearchExhausted`]).
@@ -279,6 +297,10 @@ impl IgError {
             Self::NoStableSolution { .. } | Self::SearchExhausted(_) => {
                 Termination::NoStableSolution
             }
+            Self::NoAdmittedRod {
+                cut_short: true, ..
+            } => Termination::Deadline,
+            Self::NoAdmittedRod { .. } => Termination::NoStableSolution,
             Self::Evaluation { .. } => Termination::EvaluationFailed,
         }
     }

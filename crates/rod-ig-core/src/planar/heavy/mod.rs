@@ -20,6 +20,8 @@
 // `!(x > y)` comparisons deliberately reject NaN; index loops mirror the formulas.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
+pub mod cable;
+pub mod cable_search;
 mod model;
 pub(crate) mod scan;
 pub(crate) mod series;
@@ -150,8 +152,49 @@ pub struct HeavyEvaluation {
     pub energy: f64,
     /// Elastic energy ½∫κ².
     pub elastic_energy: f64,
-    /// Stability verdict and margin (`scan`).
+    /// Stability verdict and margin (`scan`; for a long cable a solver returned, the second
+    /// variation: [`cable::SecondVariation`]).
     pub stability: StabilityReport,
+    /// ‖J(1, a)‖∞ · max(1, ‖a‖∞): how much a relative rounding of a moves the tip. The tip of
+    /// an f64 `a` is uncertain by about `condition` × 1.1e-16; above w = 200 a condition
+    /// beyond [`MAX_TRUSTED_CONDITION`] makes the verdict `uncertain`, unless the rod is one a
+    /// solver returned, evaluated from its node states ([`cable_search::recall`]).
+    pub condition: f64,
+}
+
+/// Largest `condition` at which a single-shooting evaluation is trusted (tip to ~1e-7).
+pub const MAX_TRUSTED_CONDITION: f64 = 1e9;
+
+fn condition_of(a: &PlanarParams, j: &PlanarJacobian) -> f64 {
+    j.abs().row_sum().max() * a.amax().max(1.0)
+}
+
+/// The evaluation of a long cable a solver returned, from its node states.
+fn evaluate_cable(c: &cable::Cable) -> Result<HeavyEvaluation, RodError> {
+    let (energy, elastic_energy) = c.energies()?;
+    let sv = c.second_variation()?;
+    let jacobian = c.jacobian()?;
+    Ok(HeavyEvaluation {
+        tip: c.tip()?,
+        jacobian,
+        energy,
+        elastic_energy,
+        stability: StabilityReport {
+            stable: sv.stable(),
+            margin: sv.normalised(),
+            first_conjugate_t: None,
+            uncertain: sv.uncertain(),
+        },
+        condition: condition_of(&c.params(), &jacobian),
+    })
+}
+
+fn recalled(a: &PlanarParams, g: &Gravity) -> Option<cable::Cable> {
+    if g.weight() > cable_search::LONG_CABLE_WEIGHT {
+        cable_search::recall(a, g)
+    } else {
+        None
+    }
 }
 
 fn check_params(a: &PlanarParams) -> Result<(), RodError> {
@@ -191,6 +234,9 @@ pub fn tip(a: &PlanarParams, g: &Gravity) -> Result<PlanarPose, RodError> {
         return crate::planar::tip(a);
     }
     check_params(a)?;
+    if let Some(c) = recalled(a, g) {
+        return c.tip();
+    }
     let end = series::integrate(&g.problem(a), false, |_| true).map_err(stop_error)?;
     Ok(PlanarPose::new(end.x, end.y, end.theta))
 }
@@ -204,6 +250,9 @@ pub fn tip_and_jacobian(
         return crate::planar::tip_and_jacobian(a);
     }
     check_params(a)?;
+    if let Some(c) = recalled(a, g) {
+        return Ok((c.tip()?, c.jacobian()?));
+    }
     let end = series::integrate(&g.problem(a), true, |_| true).map_err(stop_error)?;
     Ok((PlanarPose::new(end.x, end.y, end.theta), jacobian_of(&end)))
 }
@@ -243,6 +292,9 @@ pub fn shape(a: &PlanarParams, g: &Gravity, samples: usize) -> Result<Vec<Planar
         return Ok(crate::planar::PlanarRod::new(a)?.shape(samples));
     }
     check_params(a)?;
+    if let Some(c) = recalled(a, g) {
+        return c.shape(samples);
+    }
     let mut out = Vec::new();
     out.try_reserve_exact(samples)
         .map_err(|_| RodError::OutOfDomain(format!("{samples} samples do not fit in memory")))?;
@@ -280,6 +332,9 @@ pub fn energy(a: &PlanarParams, g: &Gravity) -> Result<(f64, f64), RodError> {
         return Ok((e, e));
     }
     check_params(a)?;
+    if let Some(c) = recalled(a, g) {
+        return c.energies();
+    }
     let end = series::integrate(&g.problem(a), false, |_| true).map_err(stop_error)?;
     Ok((end.elastic + g.weight * end.potential, end.elastic))
 }
@@ -305,9 +360,13 @@ pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyEvaluation, RodErr
             energy: e.energy,
             elastic_energy: e.energy,
             stability: e.stability,
+            condition: condition_of(a, &e.jacobian),
         });
     }
     check_params(a)?;
+    if let Some(c) = recalled(a, g) {
+        return evaluate_cable(&c);
+    }
     let p = g.problem(a);
     let mut scan = scan::Scan::new(a[0], a[2], p.load[1]);
     let end = series::integrate(&p, true, |s| {
@@ -317,11 +376,20 @@ pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyEvaluation, RodErr
         true
     })
     .map_err(stop_error)?;
+    let jacobian = jacobian_of(&end);
+    let condition = condition_of(a, &jacobian);
+    let mut stability = scan.report();
+    if g.weight() > cable_search::LONG_CABLE_WEIGHT && !(condition <= MAX_TRUSTED_CONDITION) {
+        // The tip of this f64 `a` is not determined to the accuracy of the verdict.
+        stability.stable = false;
+        stability.uncertain = true;
+    }
     Ok(HeavyEvaluation {
         tip: PlanarPose::new(end.x, end.y, end.theta),
-        jacobian: jacobian_of(&end),
+        jacobian,
         energy: end.elastic + g.weight * end.potential,
         elastic_energy: end.elastic,
-        stability: scan.report(),
+        stability,
+        condition,
     })
 }

@@ -5,12 +5,13 @@
 //! continuation in load of [`crate::solver::load`] (the shared load a + (0, w ĝ/2) first, exact
 //! for a level rod). Every returned rod passed the heavy rod's stability test.
 
+use super::cable_search::{self, Admission, LONG_CABLE_WEIGHT};
 use super::{Gravity, HeavyEvaluation};
 use crate::planar::ig::SolveOptions;
 use crate::planar::PlanarClosedForm;
 use crate::solver::load::{self, LoadedModel};
 use crate::solver::{
-    Failure, Found, IgError, InverseGeometry, ModelEvaluation, RodModel, Solution,
+    Failure, Found, IgError, InverseGeometry, ModelEvaluation, Objective, RodModel, Solution,
 };
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError};
 use nalgebra::{SMatrix, Vector3};
@@ -27,6 +28,11 @@ impl HeavyPlanar {
     /// The model for `gravity`.
     pub fn new(gravity: Gravity) -> Self {
         Self { gravity }
+    }
+
+    /// True when the rod is solved by multiple shooting (w > [`LONG_CABLE_WEIGHT`]).
+    pub fn is_long_cable(&self) -> bool {
+        self.gravity.weight() > LONG_CABLE_WEIGHT
     }
 
     /// Tip, J, energies and stability ([`super::evaluate`]).
@@ -231,6 +237,14 @@ impl InverseGeometry<3> for HeavyPlanar {
         if self.gravity.is_weightless() {
             return PlanarClosedForm.robust(target, options);
         }
+        if self.is_long_cable() {
+            let admission = Admission::of(options);
+            let found = cable_search::search(target, &self.gravity, options, admission);
+            return match found.solutions.first() {
+                Some(s) => Ok(cable_search::solution_of(s, target, &found)),
+                None => Err(cable_search::failure_of(&found, admission)),
+            };
+        }
         let starts = weightless_starts(target, options);
         load::first(
             &HeavyPlanar::new(Gravity::NONE),
@@ -249,6 +263,24 @@ impl InverseGeometry<3> for HeavyPlanar {
         if self.gravity.is_weightless() {
             return PlanarClosedForm.robust_all(target, options);
         }
+        if self.is_long_cable() {
+            let all = SolveOptions {
+                objective: Objective::LeastEnergy,
+                ..*options
+            };
+            let found = cable_search::search(target, &self.gravity, &all, Admission::of(options));
+            let work: u32 = found.solutions.iter().map(|s| s.iterations).sum();
+            return Found {
+                solutions: found
+                    .solutions
+                    .iter()
+                    .map(|s| cable_search::solution_of(s, target, &found))
+                    .collect(),
+                iterations: work,
+                evaluations: work,
+                starts: found.starts,
+            };
+        }
         let starts = weightless_starts(target, options);
         load::every(
             &HeavyPlanar::new(Gravity::NONE),
@@ -257,6 +289,21 @@ impl InverseGeometry<3> for HeavyPlanar {
             options,
             starts,
         )
+    }
+
+    /// Above w = 200 the Newton iterates on the node states of the multiple-shooting
+    /// formulation from the cable `a0` integrates to (single shooting from an f64 `a0` loses
+    /// its digits there), and the answer must pass the same admission as the search's.
+    fn newton(
+        &self,
+        target: &PlanarPose,
+        a0: &PlanarParams,
+        options: &SolveOptions,
+    ) -> Result<Solution<PlanarParams, PlanarPose>, Failure<PlanarParams>> {
+        if !self.is_long_cable() {
+            return crate::solver::newton_solve(self, target, a0, options);
+        }
+        cable_search::newton(target, &self.gravity, a0, options)
     }
 
     fn default_start(&self, target: &PlanarPose) -> Option<PlanarParams> {

@@ -1,0 +1,399 @@
+//! Inverse geometry of long cables (w > [`LONG_CABLE_WEIGHT`]) on the multiple-shooting
+//! formulation ([`super::cable`]): which rods the search starts from, how each is carried to
+//! the target, and which answers it admits.
+//!
+//! Starts, in order: the caller's guess (corrected where it is, then moved to the target);
+//! every stable weightless rod through the target (the closed forms' search, loop-free ones
+//! first, least energy first), each carried from w = 0 to the rod's weight with the gripper
+//! fixed; the same rods with the load shared by both grippers, a + (0, w ĝ/2), moved from
+//! where they end to the target at the full weight; last, the stable rods the single-shooting
+//! search finds at w = 150, carried to the rod's weight. Each start may spend half of the time
+//! left, and a branch whose tangent turns far beyond what is admitted is abandoned.
+//! An answer is admitted when its second variation is positive (stable), it makes at most
+//! `max_turns` turns and, when `max_turns` is 0, its centreline does not cross itself.
+
+use super::cable::{lift_near, Cable, CableError, FollowLimits, SecondVariation};
+use super::Gravity;
+use crate::planar::ig::SolveOptions;
+use crate::planar::PlanarClosedForm;
+use crate::solver::{
+    Failure, IgError, InverseGeometry, Objective, RodModel, Solution, Verified, Work,
+};
+use crate::{PlanarParams, PlanarPose, RodError};
+use std::sync::Mutex;
+
+/// Above this weight the heavy planar rod is solved by multiple shooting (below it single
+/// shooting keeps ≥ 6 digits of the tip from an f64 `a`: cond J(1) ≲ 1e8).
+pub const LONG_CABLE_WEIGHT: f64 = 200.0;
+/// The weight at which the search's last stage asks the single-shooting search.
+const MODERATE_WEIGHT: f64 = 150.0;
+/// Share of the time left that one start may spend.
+const START_SHARE: f64 = 0.5;
+/// Weightless rods the search starts from, at most.
+const MAX_WEIGHTLESS_STARTS: usize = 12;
+
+/// A solved long cable and what the search checked of it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CableSolution {
+    /// The equilibrium (node states).
+    pub cable: Cable,
+    /// Its tip, θ unwrapped.
+    pub tip: PlanarPose,
+    /// Total energy (elastic + gravitational).
+    pub energy: f64,
+    /// Elastic energy.
+    pub elastic_energy: f64,
+    /// The stability test.
+    pub stability: SecondVariation,
+    /// Full turns of the tangent along the rod.
+    pub turns: u32,
+    /// The centreline crosses itself.
+    pub self_intersects: bool,
+    /// Newton iterations and continuation steps spent on it.
+    pub iterations: u32,
+}
+
+/// What a long-cable search found.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CableSearch {
+    /// The admitted solutions, least energy first.
+    pub solutions: Vec<CableSolution>,
+    /// Starts tried.
+    pub starts: u32,
+    /// Why the last start failed, when one did.
+    pub last_failure: Option<String>,
+    /// The deadline passed before every start was tried.
+    pub cut_short: bool,
+}
+
+/// Which answers the search admits (the default: loop-free).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Admission {
+    /// Most turns of the tangent (0: loop-free, the default).
+    pub max_turns: u32,
+}
+
+impl Admission {
+    /// What `options` admit (`max_turns`).
+    pub fn of(options: &SolveOptions) -> Self {
+        Self {
+            max_turns: options.max_turns,
+        }
+    }
+
+    fn admits(&self, s: &CableSolution) -> bool {
+        s.stability.stable()
+            && s.turns <= self.max_turns
+            && (self.max_turns > 0 || !s.self_intersects)
+    }
+}
+
+fn finish(cable: Cable, iterations: u32) -> Result<CableSolution, RodError> {
+    let tip = cable.tip()?;
+    let (energy, elastic_energy) = cable.energies()?;
+    let stability = cable.second_variation()?;
+    let shape = cable.shape(super::cable::SHAPE_CHECK_SAMPLES)?;
+    Ok(CableSolution {
+        turns: super::cable::turns_of(&shape),
+        self_intersects: super::cable::self_intersects(&shape),
+        cable,
+        tip,
+        energy,
+        elastic_energy,
+        stability,
+        iterations,
+    })
+}
+
+/// Searches the stable equilibria of the cable under `gravity` whose tip is at `target`
+/// (module docs). With [`Objective::FirstFound`] it stops at the first admitted one.
+pub fn search(
+    target: &PlanarPose,
+    gravity: &Gravity,
+    options: &SolveOptions,
+    admission: Admission,
+) -> CableSearch {
+    let mut out = CableSearch::default();
+    let first_only = options.objective == Objective::FirstFound && options.initial_guess.is_none();
+    let admit = |out: &mut CableSearch, r: Result<(Cable, u32), CableError>| match r
+        .and_then(|(c, it)| finish(c, it).map_err(CableError::from))
+    {
+        Ok(s) if admission.admits(&s) => {
+            let duplicate = out.solutions.iter().any(|o| {
+                (o.cable.params() - s.cable.params()).amax()
+                    <= 1e-6 * (1.0 + s.cable.params().amax())
+            });
+            if !duplicate {
+                remember(&s.cable);
+                out.solutions.push(s);
+            }
+        }
+        Ok(s) => {
+            out.last_failure = Some(format!(
+                "a rod was found but not admitted (stable: {}, turns: {}, crosses itself: {})",
+                s.stability.stable(),
+                s.turns,
+                s.self_intersects
+            ))
+        }
+        Err(e) => out.last_failure = Some(e.to_string()),
+    };
+    let weightless = Gravity::new(0.0, gravity.direction()).unwrap_or(Gravity::NONE);
+    // A branch whose tangent turns far beyond what is admitted is abandoned early.
+    let limits = FollowLimits {
+        max_theta_spread: std::f64::consts::TAU * (admission.max_turns as f64 + 1.5),
+        ..FollowLimits::default()
+    };
+    // 1. The caller's guess.
+    if let Some(a0) = options.initial_guess {
+        out.starts += 1;
+        let _share = crate::deadline::share_of_remaining(START_SHARE);
+        admit(&mut out, from_guess(&a0, gravity, target, &limits));
+        if !out.solutions.is_empty() && options.objective == Objective::FirstFound {
+            return out;
+        }
+    }
+    // 2. and 3. The weightless rods through the target: carried in load, then shared-load
+    // seeds moved to the target.
+    let rods = weightless_rods(target, options);
+    for seeded in [false, true] {
+        for a in &rods {
+            if crate::deadline::expired() {
+                out.cut_short = true;
+                break;
+            }
+            out.starts += 1;
+            let _share = crate::deadline::share_of_remaining(START_SHARE);
+            let r = if seeded {
+                seed_moved(a, gravity, target, &limits)
+            } else {
+                carried(a, &weightless, gravity, target, &limits)
+            };
+            admit(&mut out, r);
+            if first_only && !out.solutions.is_empty() {
+                return sorted(out);
+            }
+        }
+        if !out.solutions.is_empty() && options.objective == Objective::FirstFound {
+            break;
+        }
+    }
+    // 4. The moderate-weight rods through the target (single shooting is exact there),
+    // carried to the rod's weight.
+    if out.solutions.is_empty() || options.objective != Objective::FirstFound {
+        let moderate = gravity.with_weight(MODERATE_WEIGHT.min(gravity.weight()));
+        if let Ok(moderate) = moderate {
+            let found = super::HeavyPlanar::new(moderate).robust_all(target, options);
+            for s in found.solutions {
+                if crate::deadline::expired() || (first_only && !out.solutions.is_empty()) {
+                    break;
+                }
+                out.starts += 1;
+                let _share = crate::deadline::share_of_remaining(START_SHARE);
+                admit(&mut out, carried(&s.a, &moderate, gravity, target, &limits));
+            }
+        }
+    }
+    if crate::deadline::expired() {
+        out.cut_short = true;
+    }
+    sorted(out)
+}
+
+fn sorted(mut out: CableSearch) -> CableSearch {
+    out.solutions.sort_by(|a, b| a.energy.total_cmp(&b.energy));
+    out
+}
+
+/// The stable weightless rods through `target`, loop-free first, least energy first.
+fn weightless_rods(target: &PlanarPose, options: &SolveOptions) -> Vec<PlanarParams> {
+    let mut sols = PlanarClosedForm.robust_all(target, options).solutions;
+    if let Ok(s) = PlanarClosedForm.robust(target, options) {
+        sols.push(s);
+    }
+    let mut keyed: Vec<(bool, f64, PlanarParams)> = sols
+        .into_iter()
+        .map(|s| {
+            let coiled = crate::planar::PlanarRod::new(&s.a)
+                .map(|r| {
+                    let shape = r.shape(super::cable::SHAPE_CHECK_SAMPLES);
+                    super::cable::turns_of(&shape) > 0 || super::cable::self_intersects(&shape)
+                })
+                .unwrap_or(true);
+            (coiled, s.energy, s.a)
+        })
+        .collect();
+    keyed.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    keyed.dedup_by(|a, b| (a.2 - b.2).amax() <= 1e-6 * (1.0 + b.2.amax()));
+    keyed
+        .into_iter()
+        .take(MAX_WEIGHTLESS_STARTS)
+        .map(|k| k.2)
+        .collect()
+}
+
+/// The weightless rod `a` carried from zero load to `gravity` with the gripper at `target`.
+fn carried(
+    a: &PlanarParams,
+    from: &Gravity,
+    gravity: &Gravity,
+    target: &PlanarPose,
+    limits: &FollowLimits,
+) -> Result<(Cable, u32), CableError> {
+    let mut c = Cable::from_params(a, from)?;
+    let lifted = lift_near(target, c.tip()?.theta);
+    let it = c.solve(&lifted)? as u32;
+    let steps = c.carry_within(gravity, &lifted, limits)?;
+    Ok((c, it + steps))
+}
+
+/// The rod a + (0, w ĝ / 2) at the full weight (each gripper holding half of it), moved from
+/// where it ends to `target`.
+fn seed_moved(
+    a: &PlanarParams,
+    gravity: &Gravity,
+    target: &PlanarPose,
+    limits: &FollowLimits,
+) -> Result<(Cable, u32), CableError> {
+    let l = gravity.load();
+    let seed = PlanarParams::new(a[0], a[1] + 0.5 * l[0], a[2] + 0.5 * l[1]);
+    moved(&seed, gravity, target, limits)
+}
+
+/// Newton from the caller's `a0` alone ([`crate::solver::Method::Newton`] above w = 200): the
+/// cable `a0` integrates to, corrected on the target where it is (else moved there); the
+/// answer must be admitted.
+pub fn newton(
+    target: &PlanarPose,
+    gravity: &Gravity,
+    a0: &PlanarParams,
+    options: &SolveOptions,
+) -> Result<Solution<PlanarParams, PlanarPose>, Failure<PlanarParams>> {
+    let admission = Admission::of(options);
+    let limits = FollowLimits {
+        max_theta_spread: std::f64::consts::TAU * (admission.max_turns as f64 + 1.5),
+        ..FollowLimits::default()
+    };
+    let mut out = CableSearch {
+        starts: 1,
+        ..CableSearch::default()
+    };
+    match from_guess(a0, gravity, target, &limits)
+        .and_then(|(c, it)| finish(c, it).map_err(CableError::from))
+    {
+        Ok(s) if admission.admits(&s) => {
+            remember(&s.cable);
+            out.solutions.push(s);
+        }
+        Ok(_) => {
+            out.last_failure = Some("the rod reached is not admitted (unstable or coiled)".into())
+        }
+        Err(e) => out.last_failure = Some(e.to_string()),
+    }
+    out.cut_short = crate::deadline::expired();
+    match out.solutions.first() {
+        Some(s) => Ok(solution_of(s, target, &out)),
+        None => Err(failure_of(&out, admission)),
+    }
+}
+
+/// The rod `a` under `gravity`, moved from where it ends to `target`.
+fn moved(
+    a: &PlanarParams,
+    gravity: &Gravity,
+    target: &PlanarPose,
+    limits: &FollowLimits,
+) -> Result<(Cable, u32), CableError> {
+    let mut c = Cable::from_params(a, gravity)?;
+    let steps = c.move_within(target, limits)?;
+    Ok((c, steps))
+}
+
+/// The caller's guess: corrected on target where it is, else moved there.
+fn from_guess(
+    a0: &PlanarParams,
+    gravity: &Gravity,
+    target: &PlanarPose,
+    limits: &FollowLimits,
+) -> Result<(Cable, u32), CableError> {
+    let c = Cable::from_params(a0, gravity)?;
+    let lifted = lift_near(target, c.tip()?.theta);
+    let mut direct = c.clone();
+    if let Ok(it) = direct.solve(&lifted) {
+        return Ok((direct, it as u32));
+    }
+    let mut moved = c;
+    let steps = moved.move_within(target, limits)?;
+    Ok((moved, steps))
+}
+
+/// Cables the solvers returned, remembered so that the shape, energy and stability of an
+/// answer's `a` come from its node states (an f64 `a` alone does not reproduce the rod at
+/// large w): the last [`REMEMBERED`] of the process.
+static SOLVED: Mutex<Vec<Cable>> = Mutex::new(Vec::new());
+/// Cables remembered.
+pub const REMEMBERED: usize = 256;
+
+fn remember(c: &Cable) {
+    if let Ok(mut v) = SOLVED.lock() {
+        if v.iter().any(|o| o.same_rod(c)) {
+            return;
+        }
+        if v.len() >= REMEMBERED {
+            v.remove(0);
+        }
+        v.push(c.clone());
+    }
+}
+
+/// The cable a solve returned with base wrench exactly `a` under `gravity`, if remembered.
+pub fn recall(a: &PlanarParams, gravity: &Gravity) -> Option<Cable> {
+    let v = SOLVED.lock().ok()?;
+    v.iter()
+        .rev()
+        .find(|c| c.params() == *a && c.gravity() == gravity)
+        .cloned()
+}
+
+/// The solver's [`Solution`] of a cable on `target` after `search`'s work.
+pub fn solution_of(
+    s: &CableSolution,
+    target: &PlanarPose,
+    search: &CableSearch,
+) -> Solution<PlanarParams, PlanarPose> {
+    let (position_error, orientation_error) = PlanarClosedForm.pose_error(&s.tip, target);
+    let mut out = Solution::new(
+        s.cable.params(),
+        Verified {
+            tip: s.tip,
+            errors: (position_error, orientation_error),
+            energy: s.energy,
+            margin: s.stability.normalised(),
+        },
+        Work {
+            iterations: s.iterations,
+            evaluations: s.iterations,
+            starts: search.starts,
+        },
+    );
+    out.complete = false;
+    out
+}
+
+/// The solver's [`Failure`] of a search that admitted nothing.
+pub fn failure_of(search: &CableSearch, admission: Admission) -> Failure<PlanarParams> {
+    let reason = if search.cut_short && search.starts == 0 {
+        IgError::Deadline { iteration: 0 }
+    } else {
+        IgError::NoAdmittedRod {
+            starts: search.starts,
+            max_turns: admission.max_turns,
+            cut_short: search.cut_short,
+            last: search.last_failure.clone(),
+        }
+    };
+    Failure {
+        starts: search.starts,
+        ..Failure::early(reason)
+    }
+}

@@ -1,0 +1,205 @@
+//! Long cables (issue 51): the multiple-shooting formulation and its search against the
+//! public long-cable references (`data/oracle/long_cables_public.jsonl`: equilibria to 46
+//! digits from a 256-bit multiple shooting, eigenvalues from the discretised energy's Hessian)
+//! and against our own discretised-energy reference (`common/discrete_energy.rs`).
+
+mod common;
+#[path = "common/discrete_energy.rs"]
+mod discrete_energy;
+
+use discrete_energy::{angles, richardson, Problem};
+use rod_ig_core::planar::heavy::cable::{self_intersects, turns_of, STRAIGHT_ROD_EIGENVALUE};
+use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
+use rod_ig_core::planar::ig::SolveOptions;
+use rod_ig_core::solver::{self, Method, Objective};
+use rod_ig_core::{PlanarParams, PlanarPose};
+use std::time::Duration;
+
+fn lines() -> Vec<serde_json::Value> {
+    let text = std::fs::read_to_string(common::oracle_file("long_cables_public.jsonl")).unwrap();
+    common::json_lines(&text).collect()
+}
+
+fn least_energy() -> SolveOptions {
+    SolveOptions {
+        objective: Objective::LeastEnergy,
+        deadline: Duration::from_secs(10),
+        ..SolveOptions::default()
+    }
+}
+
+/// The relative distance max_i |a_i − b_i| / (1 + |b_i|).
+fn rel(a: &PlanarParams, b: &[f64]) -> f64 {
+    (0..3)
+        .map(|i| (a[i] - b[i]).abs() / (1.0 + b[i].abs()))
+        .fold(0.0, f64::max)
+}
+
+/// Every public long cable (w = 300 … 8,700, level and random targets, gravity along −y and
+/// anywhere): the least-energy answer is the reference's least-energy loop-free rod. Tolerances:
+/// a within 1e-10 relative (the issue's 1e-8; the segments are integrated at rtol 1e-13 and
+/// amplify by ≤ e² each), energy 1e-9 relative, the second variation's least eigenvalue
+/// within 1e-4 relative of the reference's (ours is extrapolated from two grids, the
+/// reference's from N = 200, 400), the tip of the answer's `a` on target to 1e-9.
+#[test]
+fn public_long_cables_are_solved_to_the_reference() {
+    for l in lines() {
+        let w = l["weight"].as_f64().unwrap();
+        let g = common::numbers(&l["gravity"]);
+        let t = &l["target"];
+        let f = |k: &str| t[k].as_f64().unwrap();
+        let target = PlanarPose::new(f("x"), f("y"), f("theta"));
+        let a_star: Vec<f64> = l["a_star"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap().parse().unwrap())
+            .collect();
+        let gravity = Gravity::new(w, [g[0], g[1]]).unwrap();
+        let model = HeavyPlanar::new(gravity);
+        let s = solver::solve(&model, &target, &least_energy())
+            .unwrap_or_else(|e| panic!("w = {w}, {target:?}: {e}"));
+        assert!(
+            rel(&s.a, &a_star) < 1e-10,
+            "w = {w}: a {:?} vs {a_star:?}",
+            s.a
+        );
+        let energy = l["energy"].as_f64().unwrap();
+        assert!(
+            (s.energy - energy).abs() < 1e-9 * (1.0 + energy.abs()),
+            "w = {w}: energy"
+        );
+        let e = heavy::evaluate(&s.a, &gravity).unwrap();
+        assert!(e.stability.stable && !e.stability.uncertain);
+        let eig = l["eig"].as_f64().unwrap();
+        let ours = e.stability.margin * STRAIGHT_ROD_EIGENVALUE;
+        assert!(
+            (ours - eig).abs() < 1e-4 * eig,
+            "w = {w}: eig {ours} vs {eig}"
+        );
+        let tip = heavy::tip(&s.a, &gravity).unwrap();
+        assert!(
+            (tip.x - target.x).hypot(tip.y - target.y) < 1e-9,
+            "w = {w}: tip {tip:?}"
+        );
+        let shape = heavy::shape(&s.a, &gravity, 401).unwrap();
+        assert_eq!(turns_of(&shape), 0);
+        assert!(!self_intersects(&shape));
+    }
+}
+
+/// The cable held level (tip (d, 0, 0), gravity −y) at every weight to 10⁴ and d to 0.95: the
+/// hanging rod, stable, loop-free, mirror-symmetric (each gripper holds half the weight:
+/// a5 = −w/2), sagging, and at d = 0.8, w = 2,000 with the issue's reference sag 0.2676.
+#[test]
+fn level_cables_hang_at_every_weight() {
+    for w in [300.0, 1_000.0, 2_000.0, 5_000.0, 10_000.0] {
+        for d in [0.5, 0.8, 0.95] {
+            let gravity = Gravity::new(w, [0.0, -1.0]).unwrap();
+            let target = PlanarPose::new(d, 0.0, 0.0);
+            let s = solver::solve(&HeavyPlanar::new(gravity), &target, &least_energy())
+                .unwrap_or_else(|e| panic!("w = {w}, d = {d}: {e}"));
+            assert!(
+                (s.a[2] + 0.5 * w).abs() < 1e-9 * w,
+                "w = {w}, d = {d}: a5 = {}",
+                s.a[2]
+            );
+            let shape = heavy::shape(&s.a, &gravity, 2001).unwrap();
+            let sag = -shape.iter().map(|p| p.y).fold(f64::INFINITY, f64::min);
+            assert!(sag > 0.0 && shape.iter().all(|p| p.y <= 1e-12));
+            assert_eq!(turns_of(&shape), 0);
+            assert!(!self_intersects(&shape));
+            for i in 0..=1000 {
+                let (p, q) = (&shape[i], &shape[2000 - i]);
+                assert!(
+                    (p.y - q.y).abs() < 1e-7 && (p.x + q.x - d).abs() < 1e-7,
+                    "mirror"
+                );
+            }
+            if w == 2_000.0 && d == 0.8 {
+                assert!((sag - 0.2676).abs() < 1e-4, "sag {sag}");
+            }
+        }
+    }
+}
+
+/// Our own independent reference at w = 1,000: the discretised energy (N = 160, 320, Newton on
+/// the KKT system, Richardson) gives the same base wrench within its extrapolation error (the
+/// boundary layers are 1/√w ≈ 0.03 wide: 10 segments at N = 320, a residual error of ~1e-4
+/// relative after extrapolation) and the same verdict.
+#[test]
+fn the_discretised_energy_agrees_at_w_1000() {
+    let w = 1_000.0;
+    let gravity = Gravity::new(w, [0.6, -0.8]).unwrap();
+    let target = PlanarPose::new(0.55, -0.25, -0.6);
+    let s = solver::solve(&HeavyPlanar::new(gravity), &target, &least_energy()).unwrap();
+    let cable_shape = heavy::shape(&s.a, &gravity, 4001).unwrap();
+    let theta = |t: f64| cable_shape[(t * 4000.0).round() as usize].theta;
+    let p = Problem {
+        weight: w,
+        direction: gravity.direction(),
+        target: [target.x, target.y, cable_shape[4000].theta],
+    };
+    let tip_force = gravity.tip_force(&s.a);
+    let solve = |n: usize| {
+        p.solve(&angles(n, theta), tip_force)
+            .expect("the KKT Newton converges")
+    };
+    let (coarse, fine) = (solve(160), solve(320));
+    for i in 0..3 {
+        let extrapolated = richardson(coarse.a[i], fine.a[i]);
+        let err = (extrapolated - s.a[i]).abs() / (1.0 + s.a[i].abs());
+        assert!(err < 3e-4, "a[{i}]: {} vs {extrapolated} ({err:e})", s.a[i]);
+    }
+    assert!(fine.min_eig > 0.0);
+    let energy = richardson(coarse.energy, fine.energy);
+    assert!(
+        (energy - s.energy).abs() < 1e-3 * (1.0 + s.energy.abs()),
+        "energy {energy} vs {}",
+        s.energy
+    );
+}
+
+/// A warm start 1e-3 (relative) from the answer converges back to it with the robust search.
+/// (The paper's Newton from that guess alone does not yet: the cable an f64 `a0` integrates to
+/// coils beyond t ≈ 0.2 at this weight; it fails with a reason, checked below.)
+#[test]
+fn a_warm_start_converges_at_w_2000() {
+    let gravity = Gravity::new(2_000.0, [0.0, -1.0]).unwrap();
+    let target = PlanarPose::new(0.8, 0.0, 0.0);
+    let model = HeavyPlanar::new(gravity);
+    let exact = solver::solve(&model, &target, &least_energy()).unwrap();
+    let a0 = exact.a * (1.0 + 1e-3);
+    let o = |method| SolveOptions {
+        method,
+        initial_guess: Some(a0),
+        deadline: Duration::from_secs(10),
+        ..SolveOptions::default()
+    };
+    let s = solver::solve(&model, &target, &o(Method::Robust)).unwrap();
+    assert!(rel(&s.a, exact.a.as_slice()) < 1e-10, "{:?}", s.a);
+    // Newton: an answer is the same rod, a failure says why (never a coiled or unstable rod).
+    match solver::solve(&model, &target, &o(Method::Newton)) {
+        Ok(s) => assert!(rel(&s.a, exact.a.as_slice()) < 1e-10),
+        Err(f) => assert!(f.reason.to_string().contains("long-cable search"), "{f}"),
+    }
+}
+
+/// `forward` of an f64 `a` that does not determine its tip (w = 8,000, cond ≈ 1e13): the
+/// condition figure says so and the verdict is `uncertain`, never a confident answer.
+#[test]
+fn forward_reports_an_undetermined_tip() {
+    let l = &lines()[2];
+    assert_eq!(l["weight"].as_f64(), Some(8_000.0));
+    let a: Vec<f64> = common::numbers(&l["a"]);
+    // Not an answer of this process's solvers: one ulp away from the reference's `a`.
+    let a = PlanarParams::new(a[0], a[1].next_up(), a[2]);
+    let gravity = Gravity::new(8_000.0, [0.0, -1.0]).unwrap();
+    let e = heavy::evaluate(&a, &gravity).unwrap();
+    assert!(
+        e.condition > heavy::MAX_TRUSTED_CONDITION,
+        "{}",
+        e.condition
+    );
+    assert!(e.stability.uncertain && !e.stability.stable);
+}
