@@ -45,6 +45,11 @@ struct ForwardAnswer {
     /// With weight: the internal force at the tip, n(1) = (a4, a5) − w ĝ.
     #[serde(skip_serializing_if = "Option::is_none")]
     tip_force: Option<[f64; 2]>,
+    /// With weight: ‖J(1)‖∞ · max(1, ‖a‖∞), the tip's sensitivity to a relative rounding of
+    /// a (the tip is uncertain by about condition × 1.1e-16; above weight 200 and 1e9 the
+    /// verdict is `stability_uncertain`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    condition: Option<f64>,
 }
 
 fn rows(j: &rod_ig_core::PlanarJacobian) -> [[f64; 3]; 3] {
@@ -68,6 +73,7 @@ pub fn forward_line(line: &str) -> Result<Value, String> {
         stability_uncertain: e.stability.uncertain,
         elastic_energy: heavy.then_some(e.elastic_energy),
         tip_force: heavy.then(|| g.tip_force(&a)),
+        condition: heavy.then_some(e.condition),
     })
 }
 
@@ -93,6 +99,9 @@ struct SolveRequest {
     weight: Option<f64>,
     /// Direction of gravity in the base frame (default [0, -1]).
     gravity: Option<[f64; 2]>,
+    /// Most full turns of the tangent an answer may make (default 0: loop-free). Applied by
+    /// the long-cable search (weight > 200).
+    max_turns: Option<u32>,
 }
 
 /// Answers one `solve` line (`verbose`: the solver's events on stderr).
@@ -107,7 +116,15 @@ pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
         deadline_ms: request.deadline_ms,
         a0: request.a0.map(PlanarParams::from),
     };
-    let options = jsonl::solve_options(knobs, SolveOptions::default())?;
+    let mut options = jsonl::solve_options(knobs, SolveOptions::default())?;
+    if let Some(turns) = request.max_turns {
+        if turns > MAX_TURNS {
+            return Err(format!(
+                "max_turns must be in [0, {MAX_TURNS}] (got {turns})"
+            ));
+        }
+        options.max_turns = turns;
+    }
     let g = gravity_of(request.weight, request.gravity)?;
     if !g.is_weightless() {
         return jsonl::to_value(&answer(
@@ -130,6 +147,9 @@ pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
         |tip| *tip,
     ))
 }
+
+/// Largest accepted `max_turns` (a coil of 100 turns is no cable a gripper holds).
+pub const MAX_TURNS: u32 = 100;
 
 /// Most samples `shape` draws per rod: 1e6 poses are ≈ 24 MB of f64 and far beyond any screen
 /// or path message; larger requests are a mistake (issue 9: 1e12 aborted, 2⁶⁴ − 1 panicked).

@@ -628,3 +628,31 @@ fn track_starts_from_the_straight_rod_at_rest() {
     assert_eq!(out[1]["success"], true, "{}", out[1]);
     assert_ne!(out[1]["event"], "buckle");
 }
+
+/// A 1 m cable (w = 2,000) held level 0.8 apart (issue 51): `solve` answers the hanging,
+/// loop-free rod on target (a5 = −w/2), `forward` of an `a` one rounding away reports its
+/// `condition` and an uncertain verdict, and a bad `max_turns` is refused by name.
+#[test]
+fn a_one_metre_cable_is_solved() {
+    let out = run(
+        &["solve"],
+        "{\"target\": {\"x\": 0.8, \"y\": 0, \"theta\": 0}, \"weight\": 2000, \"max_turns\": 0}\n\
+         {\"target\": {\"x\": 0.8, \"y\": 0, \"theta\": 0}, \"weight\": 2000, \"max_turns\": 1000}\n",
+    );
+    assert_eq!(out[0]["success"], true, "{}", out[0]);
+    let a5 = out[0]["a"][2].as_f64().unwrap();
+    assert!((a5 + 1000.0).abs() < 1e-6, "{}", out[0]);
+    assert!(out[0]["position_error"].as_f64().unwrap() < 1e-9);
+    assert!(out[1]["error"].as_str().unwrap().contains("max_turns"));
+    // The answer's a with a4 rounded differently: a new process has no node states for it.
+    let a: Vec<f64> = (0..3).map(|i| out[0]["a"][i].as_f64().unwrap()).collect();
+    let line = format!(
+        "{{\"a\": [{}, {}, {}], \"weight\": 2000}}\n",
+        a[0],
+        a[1] * (1.0 + 4e-16),
+        a[2]
+    );
+    let f = run(&["forward"], &line);
+    assert!(f[0]["condition"].as_f64().unwrap() > 1e9, "{}", f[0]);
+    assert_eq!(f[0]["stability_uncertain"], true);
+}
