@@ -92,6 +92,38 @@ def test_weight_changes_take_effect_and_bad_values_are_refused(cable):
     assert sol.success and sol.weight == 0.0 and sol.total_energy == sol.elastic_energy
 
 
+# A 1 m harness of 100 g/m with EI = 4.905e-4 N m^2: w = 0.1 * 9.81 * 1^3 / 4.905e-4 = 2,000
+# (issue 51: solved by multiple shooting on node states above w = 200).
+HARNESS = ["-p", "rod_length:=1.0", "-p", "bending_stiffness:=4.905e-4", "-p", "linear_density:=0.1",
+           "-p", "gravity:=[0.0, -9.81, 0.0]", "-p", "deadline_ms:=5000.0"]
+
+
+@pytest.fixture(scope="module")
+def harness():
+    node, client = h.start_node_and_client(["--ros-args", *HARNESS], name="rod_ig_harness_client")
+    yield node, client
+    h.stop_node_and_client(node, client)
+
+
+def test_a_one_metre_harness_hangs_and_follows_the_gripper(harness):
+    """w = 2,000 held level 0.8 m apart: the hanging, loop-free cable (each gripper holds half of
+    the weight: a5 = -w/2), its path below the grippers with the reference sag 0.2676 m; the
+    next target starts from the rod just returned (its node states) and is solved too."""
+    _, c = harness
+    sol, path = solve_topic(c, 0.8, 0.0, 0.0)
+    assert sol.success, sol.message
+    assert sol.stable and math.isclose(sol.weight, 2000.0, rel_tol=1e-9)
+    assert abs(sol.a[2] + 1000.0) < 1e-6
+    ys = [p.pose.position.y for p in path.poses]
+    assert max(ys) <= 1e-9 and abs(-min(ys) - 0.2676) < 5e-3  # 100 path samples: the sag to 5 mm
+    last = path.poses[-1].pose.position
+    assert math.hypot(last.x - 0.8, last.y) < 1e-6
+    sol, path = solve_topic(c, 0.75, 0.05, 0.1)
+    assert sol.success, sol.message
+    last = path.poses[-1].pose.position
+    assert math.hypot(last.x - 0.75, last.y - 0.05) < 1e-6
+
+
 @pytest.fixture(scope="module")
 def cable_3d():
     node, client = h.start_node_and_client(["--ros-args", *CABLE, "-p", "solve_3d:=true"],

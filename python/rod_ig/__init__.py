@@ -295,6 +295,7 @@ def solve(
     threads: int | None = None,
     weight: npt.ArrayLike | None = None,
     gravity: npt.ArrayLike | None = None,
+    max_turns: int = 0,
 ) -> SolveResult:
     """Planar inverse geometry: for each target (x, y, theta) of shape (..., 3), a stable rod
     whose tip is there. ``a0`` (broadcast against the targets) starts the search and selects
@@ -302,7 +303,9 @@ def solve(
     paper's alpha-Newton from ``a0``); ``deadline_ms`` per target; ``tolerance`` on the
     position (rod lengths) and angle (rad) errors, in [1e-14, 1e-2]; ``max_iterations`` per
     start; ``all=True`` also lists every distinct stable solution found. ``weight``,
-    ``gravity``: as for ``forward`` (the heavy rod's search: docs/weight.md)."""
+    ``gravity``: as for ``forward`` (the heavy rod's search: docs/weight.md); above weight 200
+    (long cables, solved by multiple shooting) ``max_turns`` full turns of the tangent are
+    admitted (default 0: loop-free rods that do not cross themselves)."""
     t, _ = _batch("targets", targets, 3)
     arrays = [t]
     if a0 is not None:
@@ -322,6 +325,7 @@ def solve(
         alpha=alpha,
         all=all,
         threads=_threads(threads),
+        max_turns=_integer("max_turns", max_turns, 0, 100),
         **_weight_kwargs(flat, len(arrays)),
     )
     return _solve_result(d, batch, 3, all)

@@ -453,6 +453,9 @@ impl SolveOut {
     }
 }
 
+/// Largest accepted `max_turns` (as the CLI's).
+const MAX_TURNS: u32 = 100;
+
 /// Targets per block of a batch solve between two checks for Ctrl-C (a solve takes µs to ms).
 const SOLVE_BLOCK: usize = 256;
 
@@ -460,7 +463,7 @@ const SOLVE_BLOCK: usize = 256;
 #[pyfunction]
 #[pyo3(signature = (targets, a0=None, objective="first", method="robust", deadline_ms=None,
                     tolerance=None, max_iterations=None, alpha=None, all=false, threads=None,
-                    weight=None, gravity=None))]
+                    weight=None, gravity=None, max_turns=0))]
 #[allow(clippy::too_many_arguments)]
 fn solve<'py>(
     py: Python<'py>,
@@ -476,11 +479,17 @@ fn solve<'py>(
     threads: Option<i64>,
     weight: Option<PyReadonlyArray1<'py, f64>>,
     gravity: Option<PyReadonlyArray1<'py, f64>>,
+    max_turns: u32,
 ) -> PyResult<Bound<'py, PyDict>> {
     let t = targets.as_slice()?;
     let g = gravities2(t.len() / 3, weight.as_ref(), gravity.as_ref())?;
     let a0 = a0.as_ref().map(|a| a.as_slice()).transpose()?;
-    let base = options(
+    if max_turns > MAX_TURNS {
+        return Err(PyValueError::new_err(format!(
+            "max_turns must be in [0, {MAX_TURNS}], got {max_turns}"
+        )));
+    }
+    let mut base = options(
         SolveOptions::default(),
         method,
         objective,
@@ -490,6 +499,7 @@ fn solve<'py>(
         alpha,
         a0.is_some(),
     )?;
+    base.max_turns = max_turns;
     rod_ig_core::planar::ig::warm_up();
     let target_of = |i: usize| Ok(PlanarPose::new(t[3 * i], t[3 * i + 1], t[3 * i + 2]));
     if let Some(g) = g {

@@ -412,6 +412,26 @@ def test_weight_solve_reaches_heavy_targets_and_errors_name_the_argument() -> No
         rod_ig.forward([1.0, 2.0, 3.0], weight="heavy")
 
 
+def test_a_one_metre_cable_hangs_and_matches_the_long_cable_reference() -> None:
+    """w = 2,000 held level 0.8 apart (issue 51): the hanging loop-free rod, on target, whose
+    shape sags 0.2676 (the issue's reference); a public long cable to its 46-digit a*."""
+    rod_ig.warm_up()
+    s = rod_ig.solve([0.8, 0.0, 0.0], weight=2000.0, max_turns=0)
+    assert bool(s.success)
+    assert abs(float(s.a[2]) + 1000.0) < 1e-6
+    poses = rod_ig.shape(s.a, samples=2001, weight=2000.0)
+    assert abs(-poses[:, 1].min() - 0.2676) < 1e-4
+    assert np.abs(poses[-1, :2] - [0.8, 0.0]).max() < 1e-9
+    line = json.loads((REPO / "data" / "oracle" / "long_cables_public.jsonl").read_text().splitlines()[0])
+    t = line["target"]
+    r = rod_ig.solve([t["x"], t["y"], t["theta"]], weight=line["weight"], gravity=line["gravity"],
+                     objective="least_energy", deadline_ms=10_000.0)
+    a_star = np.array([float(v) for v in line["a_star"]])
+    assert np.abs((r.a - a_star) / (1.0 + np.abs(a_star))).max() < 1e-10
+    with pytest.raises(ValueError, match="max_turns"):
+        rod_ig.solve([0.8, 0.0, 0.0], weight=2000.0, max_turns=1000)
+
+
 def test_weight_in_3d_matches_the_public_cases_and_solves() -> None:
     lines = (REPO / "data" / "oracle" / "gravity_public.jsonl").read_text().splitlines()
     cases = [c for c in map(json.loads, lines) if c["kind"] == "3d" and c["stiffness"] == [1.0, 1.0, 1.0]]

@@ -45,16 +45,20 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Forward map. Reads JSON lines {"a": [a3, a4, a5]} on stdin; writes one line each:
-    /// {"tip": {"x", "y", "theta"}, "jacobian": [[dx/da3, dx/da4, dx/da5], [dy/..], [dθ/..]],
-    /// "stable", "energy", "stability_margin" (normalised g_min, ≈ 1 for a gently bent rod),
-    /// "stability_uncertain"}. theta is unwrapped (∫κ). A line that cannot be parsed or
-    /// evaluated gets {"error": "why"}; the stream goes on.
+    /// Forward map. Reads JSON lines {"a": [a3, a4, a5], "weight"? (w = ρgAL³/EI, default 0),
+    /// "gravity"? ([gx, gy] in the base frame, default [0, -1])} on stdin; writes one line
+    /// each: {"tip": {"x", "y", "theta"}, "jacobian": [[dx/da3, dx/da4, dx/da5], [dy/..],
+    /// [dθ/..]], "stable", "energy", "stability_margin" (normalised g_min, ≈ 1 for a gently
+    /// bent rod), "stability_uncertain"; with weight also "elastic_energy", "tip_force" and
+    /// "condition" (the tip's sensitivity to rounding a: above weight 200 and 1e9 the verdict
+    /// is uncertain)}. theta is unwrapped (∫κ). A line that cannot be parsed or evaluated gets
+    /// {"error": "why"}; the stream goes on.
     Forward,
     /// Inverse geometry. Reads JSON lines {"target": {"x", "y", "theta"}, "a0"?: [..],
     /// "method"?: "robust"|"newton", "alpha"?, "max_iterations"?, "tolerance"?,
     /// "objective"?: "first"|"least_energy", "all"?: bool, "deadline_ms"? (default 250, at
-    /// most 10000)}; writes one line each:
+    /// most 10000), "weight"?, "gravity"? (as `forward`), "max_turns"? (weight > 200: full
+    /// turns an answer may make, default 0 = loop-free)}; writes one line each:
     /// {"success", "a", "tip", "stable", "iterations", "residual", "energy", "position_error",
     /// "orientation_error", "stability_margin", "reason" (on failure), "termination"
     /// ("converged", "deadline", "no_stable_solution", ...), "starts", "complete" (false when
@@ -84,7 +88,8 @@ enum Command {
     /// Quasi-static motion: the rod follows its equilibrium branch as the tip gripper moves.
     /// Reads JSON lines {"target": {"x", "y", "theta"}, "a0"?: [a3, a4, a5] (first line: the
     /// rod held at the start; without it the first target is a fresh solve), "tolerance"?,
-    /// "deadline_ms"?}; writes the fields of `solve` plus "event": "none" | "snap" | "lost" | "buckle" (a0 = 0,
+    /// "deadline_ms"?, "weight"?, "gravity"? (a line may change them: the held rod is carried)};
+    /// writes the fields of `solve` plus "event": "none" | "snap" | "lost" | "buckle" (a0 = 0,
     /// the rod at rest, buckles on the first move: the least-energy rod found there),
     /// "progress" (the fraction of the move done: 1 when the target was reached), "held_a"
     /// (the rod held after the line: on a deadline the last equilibrium reached, kept for the

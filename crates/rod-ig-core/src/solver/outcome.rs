@@ -211,8 +211,8 @@ pub enum IgError {
     },
     /// A multi-start strategy found no stable solution from any of its starts.
     #[error(
-        "no stable solution found from {starts} starts (target may be outside the stable \
-         workspace){}",
+        "no stable solution found from {starts} starts (the search's starts reached none; this \
+         does not prove that none exists){}",
         last.as_ref().map(|l| format!("; last start: {l}")).unwrap_or_default()
     )]
     NoStableSolution {

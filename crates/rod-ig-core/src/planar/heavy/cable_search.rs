@@ -114,7 +114,7 @@ pub fn search(
     admission: Admission,
 ) -> CableSearch {
     let mut out = CableSearch::default();
-    let first_only = options.objective == Objective::FirstFound && options.initial_guess.is_none();
+    let first_only = options.objective == Objective::FirstFound;
     let admit = |out: &mut CableSearch, r: Result<(Cable, u32), CableError>| match r
         .and_then(|(c, it)| finish(c, it).map_err(CableError::from))
     {
@@ -149,7 +149,7 @@ pub fn search(
         out.starts += 1;
         let _share = crate::deadline::share_of_remaining(START_SHARE);
         admit(&mut out, from_guess(&a0, gravity, target, &limits));
-        if !out.solutions.is_empty() && options.objective == Objective::FirstFound {
+        if !out.solutions.is_empty() && first_only {
             return out;
         }
     }
@@ -174,13 +174,13 @@ pub fn search(
                 return sorted(out);
             }
         }
-        if !out.solutions.is_empty() && options.objective == Objective::FirstFound {
+        if !out.solutions.is_empty() && first_only {
             break;
         }
     }
     // 4. The moderate-weight rods through the target (single shooting is exact there),
     // carried to the rod's weight.
-    if out.solutions.is_empty() || options.objective != Objective::FirstFound {
+    if out.solutions.is_empty() || !first_only {
         let moderate = gravity.with_weight(MODERATE_WEIGHT.min(gravity.weight()));
         if let Ok(moderate) = moderate {
             let found = super::HeavyPlanar::new(moderate).robust_all(target, options);
@@ -309,13 +309,20 @@ fn moved(
     Ok((c, steps))
 }
 
-/// The caller's guess: corrected on target where it is, else moved there.
+/// The caller's guess: a rod a solver returned is moved from where it is to the target along
+/// its branch; another `a0` is integrated to its cable, corrected on target where it is, else
+/// moved there.
 fn from_guess(
     a0: &PlanarParams,
     gravity: &Gravity,
     target: &PlanarPose,
     limits: &FollowLimits,
 ) -> Result<(Cable, u32), CableError> {
+    // A rod a solver returned: its node states, moved to the target (tracking).
+    if let Some(mut c) = recall(a0, gravity) {
+        let steps = c.move_within(target, limits)?;
+        return Ok((c, steps));
+    }
     let c = Cable::from_params(a0, gravity)?;
     let lifted = lift_near(target, c.tip()?.theta);
     let mut direct = c.clone();
