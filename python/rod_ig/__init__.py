@@ -285,7 +285,7 @@ def shape(
 def solve(
     targets: npt.ArrayLike,
     a0: npt.ArrayLike | None = None,
-    objective: Objective = "first",
+    objective: Objective | None = None,
     method: Method = "robust",
     deadline_ms: float = 250.0,
     tolerance: float | None = None,
@@ -299,8 +299,9 @@ def solve(
 ) -> SolveResult:
     """Planar inverse geometry: for each target (x, y, theta) of shape (..., 3), a stable rod
     whose tip is there. ``a0`` (broadcast against the targets) starts the search and selects
-    the branch; ``objective`` "first" | "least_energy"; ``method`` "robust" | "newton" (the
-    paper's alpha-Newton from ``a0``); ``deadline_ms`` per target; ``tolerance`` on the
+    the branch; ``objective`` "first" | "least_energy" (default: "least_energy" with
+    ``weight``, the hanging cable a user sees, else "first"); ``method`` "robust" | "newton"
+    (the paper's alpha-Newton from ``a0``); ``deadline_ms`` per target; ``tolerance`` on the
     position (rod lengths) and angle (rad) errors, in [1e-14, 1e-2]; ``max_iterations`` per
     start; ``all=True`` also lists every distinct stable solution found. ``weight``,
     ``gravity``: as for ``forward`` (the heavy rod's search: docs/weight.md); above weight 200
@@ -315,7 +316,9 @@ def solve(
     d = _rod_ig.solve(
         flat[0],
         a0=flat[1] if a0 is not None else None,
-        objective=objective,
+        objective=objective
+        if objective is not None
+        else ("least_energy" if weight is not None else "first"),
         method=method,
         deadline_ms=deadline_ms,
         tolerance=tolerance,

@@ -56,7 +56,7 @@ enum Command {
     Forward,
     /// Inverse geometry. Reads JSON lines {"target": {"x", "y", "theta"}, "a0"?: [..],
     /// "method"?: "robust"|"newton", "alpha"?, "max_iterations"?, "tolerance"?,
-    /// "objective"?: "first"|"least_energy", "all"?: bool, "deadline_ms"? (default 250, at
+    /// "objective"?: "first"|"least_energy" (default: least_energy with weight, else first), "all"?: bool, "deadline_ms"? (default 250, at
     /// most 10000), "weight"?, "gravity"? (as `forward`), "max_turns"? (weight > 200: full
     /// turns an answer may make, default 0 = loop-free)}; writes one line each:
     /// {"success", "a", "tip", "stable", "iterations", "residual", "energy", "position_error",

@@ -95,6 +95,9 @@ struct GravityChange {
     gripper: Option<PlanarPose>,
     /// Total energy released by the snap.
     energy_released: f64,
+    /// No stable rod was found under the new gravity where the gripper stands: the rod was
+    /// lost (the event "lost"; the line's target is then solved afresh).
+    lost: bool,
 }
 
 /// A `track` answer: the `solve` fields plus the branch event.
@@ -211,6 +214,7 @@ fn change_gravity(
                 snapped_from: None,
                 gripper: None,
                 energy_released: 0.0,
+                lost: false,
             },
         ));
     };
@@ -219,6 +223,7 @@ fn change_gravity(
             snapped_from: None,
             gripper: None,
             energy_released: 0.0,
+            lost: false,
         };
         return Ok((Follower::holding(*to, options, s.a)?, change));
     }
@@ -226,13 +231,22 @@ fn change_gravity(
         objective: Objective::LeastEnergy,
         ..options
     };
-    let s = solver::solve(&HeavyPlanar::new(*to), &gripper, &least)
-        .map_err(|f| format!("the rod was lost when gravity changed: {}", f.reason))?;
+    let Ok(s) = solver::solve(&HeavyPlanar::new(*to), &gripper, &least) else {
+        // Lost: an event, not an error; the follower starts afresh.
+        let change = GravityChange {
+            snapped_from: None,
+            gripper: Some(gripper),
+            energy_released: 0.0,
+            lost: true,
+        };
+        return Ok((Follower::new(*to, options), change));
+    };
     let before = heavy::energy(&a, to).map(|e| e.0).unwrap_or(f64::NAN);
     let change = GravityChange {
         snapped_from: Some(a),
         gripper: Some(gripper),
         energy_released: before - s.energy,
+        lost: false,
     };
     Ok((Follower::holding(*to, options, s.a)?, change))
 }
@@ -254,6 +268,10 @@ impl Tracking {
             options.deadline = jsonl::deadline_from_ms(ms)?;
         }
         let gravity = self.requested_gravity(&request)?;
+        if !gravity.is_weightless() {
+            // A fresh solve with weight answers the hanging cable (least energy), as `solve`.
+            options.objective = Objective::LeastEnergy;
+        }
         let change = self.hold(&request, gravity, options)?;
         let follower = self
             .follower
@@ -352,10 +370,13 @@ impl Tracking {
             answer.critical_a = Some(params3(&critical_a));
             answer.energy_released = Some(energy_released);
             self.draw(&critical_a, &gravity, SequenceKind::Critical);
+        } else if let Some(GravityChange { lost: true, .. }) = change {
+            answer.event = "lost";
         } else if let Some(GravityChange {
             snapped_from: Some(from),
             gripper,
             energy_released,
+            ..
         }) = change
         {
             // The gravity change snapped the rod where the gripper stood.

@@ -88,8 +88,8 @@ struct SolveRequest {
     alpha: Option<f64>,
     max_iterations: Option<u32>,
     tolerance: Option<f64>,
-    #[serde(default)]
-    objective: ObjectiveName,
+    /// Default: "least_energy" with weight (the hanging cable a user sees), else "first".
+    objective: Option<ObjectiveName>,
     /// When true, also list every distinct stable solution found (`solutions`).
     #[serde(default)]
     all: bool,
@@ -109,7 +109,13 @@ pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
     let request: SolveRequest = jsonl::parse(line)?;
     let knobs = Knobs {
         method: request.method,
-        objective: request.objective,
+        objective: request
+            .objective
+            .unwrap_or(if request.weight.is_some_and(|w| w > 0.0) {
+                ObjectiveName::LeastEnergy
+            } else {
+                ObjectiveName::First
+            }),
         alpha: request.alpha,
         max_iterations: request.max_iterations,
         tolerance: request.tolerance,

@@ -636,7 +636,7 @@ fn track_starts_from_the_straight_rod_at_rest() {
 fn a_one_metre_cable_is_solved() {
     let out = run(
         &["solve"],
-        "{\"target\": {\"x\": 0.8, \"y\": 0, \"theta\": 0}, \"weight\": 2000, \"max_turns\": 0}\n\
+        "{\"target\": {\"x\": 0.8, \"y\": 0, \"theta\": 0}, \"weight\": 2000, \"max_turns\": 0, \"deadline_ms\": 5000}\n\
          {\"target\": {\"x\": 0.8, \"y\": 0, \"theta\": 0}, \"weight\": 2000, \"max_turns\": 1000}\n",
     );
     assert_eq!(out[0]["success"], true, "{}", out[0]);
@@ -655,4 +655,40 @@ fn a_one_metre_cable_is_solved() {
     let f = run(&["forward"], &line);
     assert!(f[0]["condition"].as_f64().unwrap() > 1e9, "{}", f[0]);
     assert_eq!(f[0]["stability_uncertain"], true);
+}
+
+/// `track` with a 1 m cable (issue 51): the weight ramped line by line at fixed grippers from
+/// 50 to 10⁴ (coarse steps: ×2 to ×2.5), then the gripper moved in 20 lines at w = 10⁴; every
+/// line succeeds with event "none" (the hanging rod carried and followed on its branch).
+#[test]
+fn track_carries_and_follows_a_long_cable() {
+    let mut lines = String::new();
+    for w in [
+        50.0, 100.0, 250.0, 500.0, 1_000.0, 2_000.0, 5_000.0, 10_000.0,
+    ] {
+        lines += &format!(
+            "{{\"target\": {{\"x\": 0.8, \"y\": 0, \"theta\": 0}}, \"weight\": {w}, \"deadline_ms\": 10000}}\n"
+        );
+    }
+    for i in 1..=20 {
+        let s = i as f64 / 20.0;
+        lines += &format!(
+            "{{\"target\": {{\"x\": {}, \"y\": {}, \"theta\": {}}}, \"deadline_ms\": 10000}}\n",
+            0.8 - 0.2 * s,
+            0.1 * s,
+            0.3 * s
+        );
+    }
+    let out = run(&["track"], &lines);
+    assert_eq!(out.len(), 28);
+    for (i, o) in out.iter().enumerate() {
+        assert_eq!(o["success"], true, "line {i}: {o}");
+        assert_eq!(o["event"], "none", "line {i}: {o}");
+    }
+    // The hanging rod at w = 10⁴: each gripper holds half of the weight.
+    assert!(
+        (out[7]["a"][2].as_f64().unwrap() + 5_000.0).abs() < 1e-6,
+        "{}",
+        out[7]
+    );
 }

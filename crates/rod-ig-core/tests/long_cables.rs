@@ -203,3 +203,61 @@ fn forward_reports_an_undetermined_tip() {
     );
     assert!(e.stability.uncertain && !e.stability.stable);
 }
+
+/// Motion of a 1 m cable (w = 2,000): the branch follower holds the hanging rod and follows it
+/// over a 100-step move of the gripper, on its node states; every step stays on the branch
+/// (no event), on target, stable and loop-free.
+#[test]
+fn a_one_metre_cable_is_tracked_over_a_hundred_steps() {
+    use rod_ig_core::solver::{BranchEvent, BranchFollower};
+    let gravity = Gravity::new(2_000.0, [0.0, -1.0]).unwrap();
+    let model = HeavyPlanar::new(gravity);
+    let start = PlanarPose::new(0.8, 0.0, 0.0);
+    let held = solver::solve(&model, &start, &least_energy()).unwrap();
+    let options = SolveOptions {
+        deadline: Duration::from_secs(10),
+        ..SolveOptions::default()
+    };
+    let mut follower = BranchFollower::holding(model, options, held.a).unwrap();
+    let end = PlanarPose::new(0.6, 0.15, 0.4);
+    for i in 1..=100 {
+        let s = i as f64 / 100.0;
+        let goal = PlanarPose::new(
+            start.x + s * (end.x - start.x),
+            start.y + s * (end.y - start.y),
+            start.theta + s * (end.theta - start.theta),
+        );
+        let m = follower.follow(&goal);
+        assert_eq!(m.event, BranchEvent::None, "step {i}");
+        let r = m.result.unwrap_or_else(|f| panic!("step {i}: {f}"));
+        assert!(r.stable && r.position_error < 1e-6, "step {i}");
+    }
+    let shape = heavy::shape(&follower.rod().unwrap(), &gravity, 401).unwrap();
+    assert_eq!(turns_of(&shape), 0);
+    assert!(!self_intersects(&shape));
+    let last = shape[400];
+    assert!((last.x - end.x).hypot(last.y - end.y) < 1e-6);
+}
+
+/// The weight of a cable held level 0.8 apart ramped at fixed grippers from 50 (single
+/// shooting) to 10⁴ in one call of `carry`: the hanging rod all the way (a5 = −w/2), stable.
+#[test]
+fn the_weight_is_carried_to_ten_thousand() {
+    let gripper = PlanarPose::new(0.8, 0.0, 0.0);
+    let light = Gravity::new(50.0, [0.0, -1.0]).unwrap();
+    let heavy_g = Gravity::new(10_000.0, [0.0, -1.0]).unwrap();
+    let start = solver::solve(&HeavyPlanar::new(light), &gripper, &least_energy()).unwrap();
+    assert!(
+        (start.a[2] + 25.0).abs() < 1e-6,
+        "the hanging rod at w = 50: {:?}",
+        start.a
+    );
+    let options = SolveOptions {
+        deadline: Duration::from_secs(10),
+        ..SolveOptions::default()
+    };
+    let s = heavy::carry(&start.a, &light, &heavy_g, &gripper, &options).unwrap();
+    assert!(s.stable && (s.a[2] + 5_000.0).abs() < 1e-6, "{:?}", s.a);
+    let shape = heavy::shape(&s.a, &heavy_g, 401).unwrap();
+    assert!(shape.iter().all(|p| p.y <= 1e-12) && !self_intersects(&shape));
+}

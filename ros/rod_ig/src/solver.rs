@@ -347,16 +347,21 @@ impl RodSolver {
     ) -> Result<Solved, Failed> {
         let g = self.settings.gravity;
         let model = HeavyPlanar::new(g);
+        // With weight the answer is the least-energy rod: the hanging cable a user sees.
+        let heavy_options = |s: &SolverSettings, guess| SolveOptions {
+            objective: ig::Objective::LeastEnergy,
+            ..options(s, guess)
+        };
         if initial_guess.is_some() || one_off.is_some() {
             let s = one_off.unwrap_or(self.settings);
-            let solution = rod_solver::solve(&model, target, &options(&s, initial_guess))?;
+            let solution = rod_solver::solve(&model, target, &heavy_options(&s, initial_guess))?;
             return with_heavy_shape(&solution, &g, samples);
         }
         if self.settings.method == Method::Robust && self.settings.follow_branch {
             let m = self.heavy_follower.follow(target);
             return followed(m, |s| with_heavy_shape(s, &g, samples));
         }
-        let o = options(&self.settings, self.last_heavy);
+        let o = heavy_options(&self.settings, self.last_heavy);
         let solution = rod_solver::solve(&model, target, &o)?;
         self.last_heavy = Some(solution.a);
         with_heavy_shape(&solution, &g, samples)

@@ -661,6 +661,11 @@ impl<const N: usize, M: InverseGeometry<N>> BranchFollower<N, M> {
         substep: bool,
         work: &mut Work,
     ) -> Option<Held<N, M::Pose>> {
+        if let Some(step) = self.model.branch_step(&from.a, goal, tolerance) {
+            work.iterations += 1;
+            work.evaluations += 1;
+            return step.map(|(a, tip, jacobian)| Held { a, tip, jacobian });
+        }
         let side = self.model.jacobian_det(&from.jacobian);
         let mut x = *from;
         let mut previous_step = f64::INFINITY;

@@ -123,6 +123,23 @@ pub trait RodModel<const N: usize> {
         false
     }
 
+    /// One corrector step of the branch follower ([`crate::solver::BranchFollower`]) taken by
+    /// the model itself: the rod of `from`'s branch whose tip is at `goal` (within
+    /// `tolerance`), with its tip and J(1, a), `Some(None)` when the step fails (too long, or
+    /// across a fold), `None` when the model leaves the step to the generic Newton in a (the
+    /// default). A model whose `a` does not fix its rod to the accuracy asked (the long
+    /// cables' node states) follows its branch in its own unknowns.
+    #[allow(clippy::type_complexity)]
+    fn branch_step(
+        &self,
+        from: &SVector<f64, N>,
+        goal: &Self::Pose,
+        tolerance: f64,
+    ) -> Option<Option<(SVector<f64, N>, Self::Pose, nalgebra::SMatrix<f64, N, N>)>> {
+        let _ = (from, goal, tolerance);
+        None
+    }
+
     /// Checks the model's own settings (stiffness, integration tolerance).
     fn check_settings(&self) -> Result<(), IgError> {
         Ok(())

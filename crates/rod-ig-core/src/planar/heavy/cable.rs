@@ -115,18 +115,28 @@ fn rhs<const D: usize>(load: [f64; 2], n0: [f64; 2], t: f64, y: &[f64; D], dy: &
     }
 }
 
-fn ode_options() -> OdeOptions {
+fn ode_options_at(rtol: f64) -> OdeOptions {
     OdeOptions {
-        rtol: SEGMENT_RTOL,
-        atol: SEGMENT_RTOL,
+        rtol,
+        atol: rtol,
         max_steps: 20_000,
         error_components: 4,
         ..OdeOptions::default()
     }
 }
 
+fn ode_options() -> OdeOptions {
+    ode_options_at(SEGMENT_RTOL)
+}
+
+/// Relative tolerance of the segments while a continuation moves between its intermediate
+/// rods (their accuracy only needs to keep the next predictor in Newton's basin); the rod a
+/// continuation ends with is corrected at [`SEGMENT_RTOL`].
+const SUBSTEP_RTOL: f64 = 1e-9;
+
 /// One segment from `start` = (x, y, θ, κ) at t0 to t1, without variations.
 fn segment_end(
+    rtol: f64,
     load: [f64; 2],
     n0: [f64; 2],
     t0: f64,
@@ -140,13 +150,14 @@ fn segment_end(
         t0,
         y,
         t1,
-        &ode_options(),
+        &ode_options_at(rtol),
     )?;
     Ok(end)
 }
 
 /// One segment from `start` = (x, y, θ, κ) at t0 to t1, with its variational columns.
 fn segment(
+    rtol: f64,
     load: [f64; 2],
     n0: [f64; 2],
     t0: f64,
@@ -162,7 +173,7 @@ fn segment(
         t0,
         y,
         t1,
-        &ode_options(),
+        &ode_options_at(rtol),
     )?;
     Ok(end)
 }
@@ -192,6 +203,9 @@ pub struct Cable {
     force: [f64; 2],
     /// (x, y, θ, κ) at t₀ … t_{M−1}; the first is (0, 0, 0, a3).
     nodes: Vec<[f64; 4]>,
+    /// Relative tolerance of the segments' integration in the Newton equations: the full
+    /// [`SEGMENT_RTOL`], or [`SUBSTEP_RTOL`] on a continuation's intermediate rods.
+    rtol: f64,
 }
 
 impl Cable {
@@ -205,7 +219,7 @@ impl Cable {
         let mesh = uniform_mesh(segments_for(force_max(force, load)));
         let mut nodes = vec![[0.0, 0.0, 0.0, a[0]]];
         for k in 0..mesh.len() - 2 {
-            let e = segment(load, force, mesh[k], mesh[k + 1], nodes[k])?;
+            let e = segment(SEGMENT_RTOL, load, force, mesh[k], mesh[k + 1], nodes[k])?;
             nodes.push([e[0], e[1], e[2], e[3]]);
         }
         Ok(Self {
@@ -213,6 +227,7 @@ impl Cable {
             mesh,
             force,
             nodes,
+            rtol: SEGMENT_RTOL,
         })
     }
 
@@ -245,6 +260,7 @@ impl Cable {
     fn last_segment(&self) -> Result<[f64; FULL], RodError> {
         let m = self.segments();
         segment(
+            SEGMENT_RTOL,
             self.gravity.load(),
             self.force,
             self.mesh[m - 1],
@@ -294,9 +310,10 @@ impl Cable {
             let (t0, t1, start) = (self.mesh[k], self.mesh[k + 1], self.nodes[k]);
             let mut e = [0.0; FULL];
             if jacobian {
-                e = segment(load, self.force, t0, t1, start)?;
+                e = segment(self.rtol, load, self.force, t0, t1, start)?;
             } else {
-                e[..STATE].copy_from_slice(&segment_end(load, self.force, t0, t1, start)?);
+                e[..STATE]
+                    .copy_from_slice(&segment_end(self.rtol, load, self.force, t0, t1, start)?);
             }
             let row = 4 * k;
             let rows = if k + 1 < m { 4 } else { 3 };
@@ -348,7 +365,10 @@ impl Cable {
 
     /// [`Cable::solve`], and the sign of the determinant of the last Newton matrix factored
     /// (it changes where the equilibria through the target fold).
-    fn solve_with_sign(&mut self, target: &PlanarPose) -> Result<(usize, f64), CableError> {
+    pub(crate) fn solve_with_sign(
+        &mut self,
+        target: &PlanarPose,
+    ) -> Result<(usize, f64), CableError> {
         let (mut r, _) = self.residual(target, false)?;
         let mut norm = r.amax();
         let mut sign = 0.0;
@@ -376,7 +396,7 @@ impl Cable {
                     Err(RodError::Deadline { t }) => return Err(RodError::Deadline { t }.into()),
                     _ if alpha > 1.0 / 64.0 => alpha *= 0.5,
                     // At the rounding floor no step decreases the residual further.
-                    _ if norm <= RESIDUAL_TOLERANCE => return Ok((it, sign)),
+                    _ if norm <= self.residual_tolerance() => return Ok((it, sign)),
                     _ => {
                         return Err(CableError::NoConvergence {
                             iterations: it,
@@ -386,11 +406,11 @@ impl Cable {
                 }
             }
             let small = alpha * step.amax() <= 1e-9 * scale;
-            if norm <= 1e-14 || (norm <= RESIDUAL_TOLERANCE && small) {
+            if norm <= 1e-14 || (norm <= self.residual_tolerance() && small) {
                 return Ok((it + 1, sign));
             }
         }
-        if norm <= RESIDUAL_TOLERANCE {
+        if norm <= self.residual_tolerance() {
             return Ok((NEWTON_ITERATIONS, sign));
         }
         Err(CableError::NoConvergence {
@@ -408,6 +428,7 @@ impl Cable {
         d[3][0] = 1.0;
         for k in 0..self.segments() {
             let e = segment(
+                SEGMENT_RTOL,
                 load,
                 self.force,
                 self.mesh[k],
@@ -434,6 +455,12 @@ impl Cable {
             j[(2, c)] = d[2][c];
         }
         Ok(j)
+    }
+
+    /// The scaled residual at which Newton stops: [`RESIDUAL_TOLERANCE`], or 100 × the
+    /// integration's tolerance when that is looser (a continuation's intermediate rods).
+    fn residual_tolerance(&self) -> f64 {
+        RESIDUAL_TOLERANCE.max(100.0 * self.rtol)
     }
 
     /// The same rod on a mesh fit for its current forces (more segments when the forces
@@ -648,6 +675,11 @@ impl Cable {
             let next = (s + ds).min(1.0);
             let (g, target) = path(next)?;
             let mut trial = self.with_gravity(g);
+            trial.rtol = if next < 1.0 {
+                SUBSTEP_RTOL
+            } else {
+                SEGMENT_RTOL
+            };
             if let Some((sp, zp)) = &prev {
                 let z = self.unknowns();
                 let f = (next - s) / (s - sp);
@@ -669,7 +701,7 @@ impl Cable {
                 sign = sg;
                 *self = trial;
                 s = next;
-                ds = (ds * 1.5).min(0.25);
+                ds = (ds * 2.0).min(0.5);
             } else {
                 ds /= 3.0;
                 if ds < 1e-5 {
@@ -697,14 +729,14 @@ impl Cable {
 
     /// True when `other`'s base wrench is within 30 % (relative, scale 1 + w) of this one's:
     /// a corrector that lands farther has likely jumped to another branch.
-    fn close_to(&self, other: &Cable) -> bool {
+    pub(crate) fn close_to(&self, other: &Cable) -> bool {
         let (a, b) = (self.params(), other.params());
         let scale = 1.0 + self.gravity.weight().max(other.gravity.weight());
         (a - b).amax() <= 0.3 * (scale + b.amax())
     }
 
     /// Sign of the determinant of the Newton matrix (changes at a fold).
-    fn matrix_sign(&self, target: &PlanarPose) -> Result<f64, RodError> {
+    pub(crate) fn matrix_sign(&self, target: &PlanarPose) -> Result<f64, RodError> {
         let (_, j) = self.residual(target, true)?;
         let Some(j) = j else { unreachable!() };
         Ok(lu_sign(&j.lu()))

@@ -4,7 +4,7 @@
 //!
 //! Starts, in order: the caller's guess (corrected where it is, then moved to the target);
 //! every stable weightless rod through the target (the closed forms' search, loop-free ones
-//! first, least energy first), each carried from w = 0 to the rod's weight with the gripper
+//! first, least energy under the weight to first order first), each carried from w = 0 to the rod's weight with the gripper
 //! fixed; the same rods with the load shared by both grippers, a + (0, w ĝ/2), moved from
 //! where they end to the target at the full weight; last, the stable rods the single-shooting
 //! search finds at w = 150, carried to the rod's weight. Each start may spend half of the time
@@ -105,6 +105,59 @@ fn finish(cable: Cable, iterations: u32) -> Result<CableSolution, RodError> {
     })
 }
 
+/// The running state of one search: what it found and admits.
+struct Searcher<'a> {
+    target: &'a PlanarPose,
+    gravity: &'a Gravity,
+    admission: Admission,
+    /// A branch whose tangent turns far beyond what is admitted is abandoned early.
+    limits: FollowLimits,
+    first_only: bool,
+    out: CableSearch,
+}
+
+impl Searcher<'_> {
+    /// True when the search should stop: the deadline passed (noted), or the first admitted
+    /// rod is all that was asked.
+    fn done(&mut self) -> bool {
+        if crate::deadline::expired() {
+            self.out.cut_short = true;
+            return true;
+        }
+        self.first_only && !self.out.solutions.is_empty()
+    }
+
+    /// Runs one start (with half of the time left) and admits its rod, if any.
+    fn start(&mut self, run: impl FnOnce(&Self) -> Result<(Cable, u32), CableError>) {
+        self.out.starts += 1;
+        let _share = crate::deadline::share_of_remaining(START_SHARE);
+        let r = run(self).and_then(|(c, it)| finish(c, it).map_err(CableError::from));
+        let out = &mut self.out;
+        match r {
+            Ok(s) if self.admission.admits(&s) => {
+                let scale = 1e-6 * (1.0 + s.cable.params().amax());
+                if !out
+                    .solutions
+                    .iter()
+                    .any(|o| (o.cable.params() - s.cable.params()).amax() <= scale)
+                {
+                    remember(&s.cable);
+                    out.solutions.push(s);
+                }
+            }
+            Ok(s) => {
+                out.last_failure = Some(format!(
+                    "a rod was found but not admitted (stable: {}, turns: {}, crosses itself: {})",
+                    s.stability.stable(),
+                    s.turns,
+                    s.self_intersects
+                ))
+            }
+            Err(e) => out.last_failure = Some(e.to_string()),
+        }
+    }
+}
+
 /// Searches the stable equilibria of the cable under `gravity` whose tip is at `target`
 /// (module docs). With [`Objective::FirstFound`] it stops at the first admitted one.
 pub fn search(
@@ -113,91 +166,62 @@ pub fn search(
     options: &SolveOptions,
     admission: Admission,
 ) -> CableSearch {
-    let mut out = CableSearch::default();
-    let first_only = options.objective == Objective::FirstFound;
-    let admit = |out: &mut CableSearch, r: Result<(Cable, u32), CableError>| match r
-        .and_then(|(c, it)| finish(c, it).map_err(CableError::from))
-    {
-        Ok(s) if admission.admits(&s) => {
-            let duplicate = out.solutions.iter().any(|o| {
-                (o.cable.params() - s.cable.params()).amax()
-                    <= 1e-6 * (1.0 + s.cable.params().amax())
-            });
-            if !duplicate {
-                remember(&s.cable);
-                out.solutions.push(s);
-            }
-        }
-        Ok(s) => {
-            out.last_failure = Some(format!(
-                "a rod was found but not admitted (stable: {}, turns: {}, crosses itself: {})",
-                s.stability.stable(),
-                s.turns,
-                s.self_intersects
-            ))
-        }
-        Err(e) => out.last_failure = Some(e.to_string()),
-    };
-    let weightless = Gravity::new(0.0, gravity.direction()).unwrap_or(Gravity::NONE);
-    // A branch whose tangent turns far beyond what is admitted is abandoned early.
-    let limits = FollowLimits {
-        max_theta_spread: std::f64::consts::TAU * (admission.max_turns as f64 + 1.5),
-        ..FollowLimits::default()
+    let mut s = Searcher {
+        target,
+        gravity,
+        admission,
+        limits: limits_of(admission),
+        first_only: options.objective == Objective::FirstFound,
+        out: CableSearch::default(),
     };
     // 1. The caller's guess.
     if let Some(a0) = options.initial_guess {
-        out.starts += 1;
-        let _share = crate::deadline::share_of_remaining(START_SHARE);
-        admit(&mut out, from_guess(&a0, gravity, target, &limits));
-        if !out.solutions.is_empty() && first_only {
-            return out;
-        }
+        s.start(|s| from_guess(&a0, s.gravity, s.target, &s.limits));
     }
     // 2. and 3. The weightless rods through the target: carried in load, then shared-load
     // seeds moved to the target.
-    let rods = weightless_rods(target, options);
-    for seeded in [false, true] {
-        for a in &rods {
-            if crate::deadline::expired() {
-                out.cut_short = true;
-                break;
-            }
-            out.starts += 1;
-            let _share = crate::deadline::share_of_remaining(START_SHARE);
-            let r = if seeded {
-                seed_moved(a, gravity, target, &limits)
-            } else {
-                carried(a, &weightless, gravity, target, &limits)
-            };
-            admit(&mut out, r);
-            if first_only && !out.solutions.is_empty() {
-                return sorted(out);
-            }
-        }
-        if !out.solutions.is_empty() && first_only {
+    let weightless = Gravity::new(0.0, gravity.direction()).unwrap_or(Gravity::NONE);
+    let rods = if s.done() {
+        Vec::new()
+    } else {
+        weightless_rods(target, options, gravity)
+    };
+    for a in &rods {
+        if s.done() {
             break;
         }
+        s.start(|s| carried(a, &weightless, s.gravity, s.target, &s.limits));
+    }
+    for a in &rods {
+        if s.done() {
+            break;
+        }
+        s.start(|s| seed_moved(a, s.gravity, s.target, &s.limits));
     }
     // 4. The moderate-weight rods through the target (single shooting is exact there),
     // carried to the rod's weight.
-    if out.solutions.is_empty() || !first_only {
-        let moderate = gravity.with_weight(MODERATE_WEIGHT.min(gravity.weight()));
-        if let Ok(moderate) = moderate {
+    if !s.done() {
+        if let Ok(moderate) = gravity.with_weight(MODERATE_WEIGHT.min(gravity.weight())) {
             let found = super::HeavyPlanar::new(moderate).robust_all(target, options);
-            for s in found.solutions {
-                if crate::deadline::expired() || (first_only && !out.solutions.is_empty()) {
+            for rod in found.solutions {
+                if s.done() {
                     break;
                 }
-                out.starts += 1;
-                let _share = crate::deadline::share_of_remaining(START_SHARE);
-                admit(&mut out, carried(&s.a, &moderate, gravity, target, &limits));
+                s.start(|s| carried(&rod.a, &moderate, s.gravity, s.target, &s.limits));
             }
         }
     }
-    if crate::deadline::expired() {
-        out.cut_short = true;
+    s.done();
+    sorted(s.out)
+}
+
+/// The continuation limits of `admission`: a branch whose tangent turns more than 1.5 turns
+/// beyond the admitted ones is dropped.
+fn limits_of(admission: Admission) -> FollowLimits {
+    FollowLimits {
+        max_theta_spread: std::f64::consts::TAU * (admission.max_turns as f64 + 1.5),
+        ..FollowLimits::default()
     }
-    sorted(out)
 }
 
 fn sorted(mut out: CableSearch) -> CableSearch {
@@ -205,22 +229,34 @@ fn sorted(mut out: CableSearch) -> CableSearch {
     out
 }
 
-/// The stable weightless rods through `target`, loop-free first, least energy first.
-fn weightless_rods(target: &PlanarPose, options: &SolveOptions) -> Vec<PlanarParams> {
+/// The stable weightless rods through `target`, loop-free first, then by their energy under
+/// `gravity` to first order in w (the elastic energy plus w ∫(−ĝ · r) dt of the weightless
+/// shape: of two mirror images, the one that sags with gravity first).
+fn weightless_rods(
+    target: &PlanarPose,
+    options: &SolveOptions,
+    gravity: &Gravity,
+) -> Vec<PlanarParams> {
     let mut sols = PlanarClosedForm.robust_all(target, options).solutions;
     if let Ok(s) = PlanarClosedForm.robust(target, options) {
         sols.push(s);
     }
+    let g = gravity.direction();
     let mut keyed: Vec<(bool, f64, PlanarParams)> = sols
         .into_iter()
-        .map(|s| {
-            let coiled = crate::planar::PlanarRod::new(&s.a)
-                .map(|r| {
-                    let shape = r.shape(super::cable::SHAPE_CHECK_SAMPLES);
-                    super::cable::turns_of(&shape) > 0 || super::cable::self_intersects(&shape)
-                })
-                .unwrap_or(true);
-            (coiled, s.energy, s.a)
+        .filter_map(|s| {
+            let shape = crate::planar::PlanarRod::new(&s.a)
+                .ok()?
+                .shape(super::cable::SHAPE_CHECK_SAMPLES);
+            let coiled =
+                super::cable::turns_of(&shape) > 0 || super::cable::self_intersects(&shape);
+            let h = 1.0 / (shape.len() - 1) as f64;
+            let height = |p: &PlanarPose| -(g[0] * p.x + g[1] * p.y);
+            let potential: f64 = shape
+                .windows(2)
+                .map(|w| 0.5 * h * (height(&w[0]) + height(&w[1])))
+                .sum();
+            Some((coiled, s.energy + gravity.weight() * potential, s.a))
         })
         .collect();
     keyed.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
@@ -270,10 +306,7 @@ pub fn newton(
     options: &SolveOptions,
 ) -> Result<Solution<PlanarParams, PlanarPose>, Failure<PlanarParams>> {
     let admission = Admission::of(options);
-    let limits = FollowLimits {
-        max_theta_spread: std::f64::consts::TAU * (admission.max_turns as f64 + 1.5),
-        ..FollowLimits::default()
-    };
+    let limits = limits_of(admission);
     let mut out = CableSearch {
         starts: 1,
         ..CableSearch::default()
@@ -402,5 +435,90 @@ pub fn failure_of(search: &CableSearch, admission: Admission) -> Failure<PlanarP
     Failure {
         starts: search.starts,
         ..Failure::early(reason)
+    }
+}
+
+/// The cable of the rod `a` under `gravity`: the one a solver returned (its node states), or,
+/// at a weight single shooting keeps its digits (≤ [`LONG_CABLE_WEIGHT`]), the one `a`
+/// integrates to, corrected on `target`.
+fn cable_of(a: &PlanarParams, gravity: &Gravity, target: &PlanarPose) -> Option<Cable> {
+    if let Some(c) = recall(a, gravity) {
+        return Some(c);
+    }
+    if gravity.weight() > LONG_CABLE_WEIGHT {
+        return None;
+    }
+    let mut c = Cable::from_params(a, gravity).ok()?;
+    let lifted = lift_near(target, c.tip().ok()?.theta);
+    c.solve(&lifted).ok()?;
+    Some(c)
+}
+
+/// One corrector step of the branch follower on a long cable's node states
+/// ([`crate::solver::RodModel::branch_step`]): the rod of `from`'s branch with its tip at
+/// `goal`, when Newton reaches it in a few iterations, near `from`, on the same side of the
+/// fold (the sign of the Newton matrix's determinant); `None` otherwise. The rod reached is
+/// remembered, so that the follower's later evaluations of its `a` use its node states.
+pub fn branch_step(
+    from: &PlanarParams,
+    gravity: &Gravity,
+    goal: &PlanarPose,
+    tolerance: f64,
+) -> Option<(PlanarParams, PlanarPose, crate::PlanarJacobian)> {
+    let c = recall(from, gravity)?;
+    let here = c.tip().ok()?;
+    let side = c.matrix_sign(&here).ok()?;
+    let mut next = c.clone();
+    let goal = lift_near(goal, here.theta);
+    let (iterations, sign) = next.solve_with_sign(&goal).ok()?;
+    let tip = next.tip().ok()?;
+    let (pe, oe) = PlanarClosedForm.pose_error(&tip, &goal);
+    if iterations > 8 || sign != side || !next.close_to(&c) || pe > tolerance || oe > tolerance {
+        return None;
+    }
+    remember(&next);
+    Some((next.params(), tip, next.jacobian().ok()?))
+}
+
+/// [`super::carry`] above w = 200: the held rod's cable carried in load on its node states.
+pub fn carry(
+    a: &PlanarParams,
+    from: &Gravity,
+    to: &Gravity,
+    gripper: &PlanarPose,
+    options: &SolveOptions,
+) -> Result<Solution<PlanarParams, PlanarPose>, Failure<PlanarParams>> {
+    let _deadline = crate::deadline::scope(options.deadline);
+    let admission = Admission::of(options);
+    let mut out = CableSearch {
+        starts: 1,
+        ..CableSearch::default()
+    };
+    let carried = match cable_of(a, from, gripper) {
+        None => Err(CableError::Lost {
+            weight: from.weight(),
+            target_weight: to.weight(),
+            why: "the held rod's node states are not known (an `a` a solver returned at this \
+                  weight, or one at weight <= 200, is needed)"
+                .into(),
+        }),
+        Some(mut c) => {
+            let lifted = lift_near(gripper, c.tip().map(|t| t.theta).unwrap_or(gripper.theta));
+            c.carry_within(to, &lifted, &limits_of(admission))
+                .map(|steps| (c, steps))
+        }
+    };
+    match carried.and_then(|(c, it)| finish(c, it).map_err(CableError::from)) {
+        Ok(s) if s.stability.stable() => {
+            remember(&s.cable);
+            out.solutions.push(s);
+        }
+        Ok(_) => out.last_failure = Some("the carried rod is unstable".into()),
+        Err(e) => out.last_failure = Some(e.to_string()),
+    }
+    out.cut_short = crate::deadline::expired();
+    match out.solutions.first() {
+        Some(s) => Ok(solution_of(s, gripper, &out)),
+        None => Err(failure_of(&out, admission)),
     }
 }

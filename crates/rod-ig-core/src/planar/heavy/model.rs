@@ -125,6 +125,24 @@ impl RodModel<3> for HeavyPlanar {
         PlanarClosedForm.newton_increment(tip, jacobian, target)
     }
 
+    /// A long cable's branch is followed on its node states ([`cable_search::branch_step`]).
+    fn branch_step(
+        &self,
+        from: &PlanarParams,
+        goal: &PlanarPose,
+        tolerance: f64,
+    ) -> Option<Option<(PlanarParams, PlanarPose, PlanarJacobian)>> {
+        if !self.is_long_cable() {
+            return None;
+        }
+        Some(cable_search::branch_step(
+            from,
+            &self.gravity,
+            goal,
+            tolerance,
+        ))
+    }
+
     fn check_target(&self, target: &PlanarPose) -> Result<(), IgError> {
         PlanarClosedForm.check_target(target)
     }
@@ -175,6 +193,9 @@ pub fn carry(
     gripper: &PlanarPose,
     options: &SolveOptions,
 ) -> Result<Solution<PlanarParams, PlanarPose>, Failure<PlanarParams>> {
+    if from.weight().max(to.weight()) > LONG_CABLE_WEIGHT {
+        return cable_search::carry(a, from, to, gripper, options);
+    }
     load::carry(
         &HeavyPlanar::new(*from),
         &HeavyPlanar::new(*to),
