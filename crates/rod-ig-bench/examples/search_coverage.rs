@@ -28,6 +28,13 @@
 //! cargo run --release -p rod-ig-bench --example search_coverage -- heavy3d N SEED
 //!     the same for the 3-D rod with weight: moments and forces log-scale (1e-2..10 and
 //!     1e-2..100, signs, 10 % exact zeros), w = 10^U(-1, log 200), gravity along -z for half
+//! cargo run --release -p rod-ig-bench --example search_coverage -- long N SEED [objective]
+//!     issue 51's success rate: N targets of stable loop-free long cables (w = 10^U(log 200, 4),
+//!     gravity along -y for half, anywhere for the rest; a3 = ±10^U(0, 2) with 5 % zeros,
+//!     n(0) = s w ĝ + 10^U(0, log w) in a random direction, s = U(0, 1); the rod's node
+//!     states integrated from the base, kept when stable by the second variation, loop-free,
+//!     not crossing itself and |tip| <= 0.98), solved from no guess (deadline 2 s; objective
+//!     `first` or `least_energy`); each answer re-checked on target (1e-6) and stable
 //! ```
 use rod_ig_core::ode::planar_reference;
 use rod_ig_core::planar::{self, ig, PlanarClosedForm};
@@ -49,6 +56,11 @@ fn main() {
         Some("solves") => solves(num(1, 500) as usize),
         Some("heavy") => heavy_coverage(num(1, 3000) as usize, num(2, 41)),
         Some("heavy3d") => heavy_coverage_3d(num(1, 500) as usize, num(2, 43)),
+        Some("long") => long_coverage(
+            num(1, 200) as usize,
+            num(2, 51),
+            args.get(3).map(String::as_str) == Some("least_energy"),
+        ),
         _ => {
             eprintln!("usage: search_coverage box|workspace|heavy N SEED | reference|evidence FILE")
         }
@@ -411,6 +423,67 @@ fn heavy_coverage_3d(n: usize, seed: u64) {
     println!(
         "{solved} of {tried} solved ({:.2} %), {wrong} wrong; µs median {:.0}, p90 {:.0}, p99 {:.0}, max {:.0}",
         100.0 * solved as f64 / tried.max(1) as f64,
+        q(0.5),
+        q(0.9),
+        q(0.99),
+        q(1.0)
+    );
+}
+
+fn long_coverage(n: usize, seed: u64, least_energy: bool) {
+    use rod_ig_core::planar::heavy::{self, HeavyPlanar};
+    use rod_ig_core::solver::{self, Objective};
+    let cases = rod_ig_bench::families::long_cables(n, seed);
+    let options = ig::SolveOptions {
+        deadline: Duration::from_secs(2),
+        objective: if least_energy {
+            Objective::LeastEnergy
+        } else {
+            Objective::FirstFound
+        },
+        ..ig::SolveOptions::default()
+    };
+    let (mut solved, mut wrong, mut times) = (0usize, 0usize, Vec::new());
+    for (g, a, target) in &cases {
+        let t0 = Instant::now();
+        let result = solver::solve(&HeavyPlanar::new(*g), target, &options);
+        times.push(t0.elapsed().as_secs_f64() * 1e3);
+        let why = match &result {
+            Ok(s) => match heavy::evaluate(&s.a, g) {
+                Ok(e)
+                    if e.stability.stable
+                        && (e.tip.x - target.x).hypot(e.tip.y - target.y) <= 1e-6
+                        && wrap_angle(e.tip.theta - target.theta).abs() <= 1e-6 =>
+                {
+                    solved += 1;
+                    continue;
+                }
+                other => {
+                    wrong += 1;
+                    format!("WRONG: re-check gives {other:?}")
+                }
+            },
+            Err(f) => f.reason.to_string(),
+        };
+        println!(
+            "miss {:.6e} {:.6},{:.6} {:.9},{:.9},{:.9} {:.9e},{:.9e},{:.9e} {why}",
+            g.weight(),
+            g.direction()[0],
+            g.direction()[1],
+            target.x,
+            target.y,
+            target.theta,
+            a[0],
+            a[1],
+            a[2]
+        );
+    }
+    times.sort_by(f64::total_cmp);
+    let q = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
+    println!(
+        "{solved} of {} solved ({:.2} %), {wrong} wrong; ms median {:.1}, p90 {:.1}, p99 {:.1}, max {:.1}",
+        cases.len(),
+        100.0 * solved as f64 / cases.len().max(1) as f64,
         q(0.5),
         q(0.9),
         q(0.99),

@@ -3,7 +3,7 @@
 //! drawn with log-scale magnitudes and random signs (`rod-ig bench --only tails`, profiling).
 
 use crate::SplitMix64;
-use rod_ig_core::PlanarParams;
+use rod_ig_core::{PlanarParams, PlanarPose};
 
 /// ±10^u with u uniform in [lo, hi] and a random sign ([`SplitMix64::signed_pow10`]).
 pub fn signed_pow10(rng: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
@@ -80,4 +80,81 @@ pub fn samples(n: usize) -> Vec<(&'static str, Vec<PlanarParams>)> {
             }),
         ),
     ]
+}
+
+/// A stable, loop-free long cable (issue 51) and its tip: w = 10^U(log 200, 4), gravity along
+/// −y for half and anywhere for the rest; a3 = ±10^U(0, 2) with 5 % zeros, n(0) = s w ĝ +
+/// 10^U(0, log w) in a random direction, s = U(0, 1); the rod's node states integrated from the
+/// base, kept when stable by the second variation, loop-free, not crossing itself and
+/// |tip| ≤ 0.98 (θ wrapped). `None` for a draw that is not kept.
+pub fn long_cable(
+    r: &mut SplitMix64,
+) -> Option<(
+    rod_ig_core::planar::heavy::Gravity,
+    PlanarParams,
+    PlanarPose,
+)> {
+    use rod_ig_core::planar::heavy::cable::Cable;
+    use rod_ig_core::planar::heavy::Gravity;
+    let w = 10f64.powf(r.range(200f64.log10(), 4.0));
+    let dir = if r.next_u64().is_multiple_of(2) {
+        [0.0, -1.0]
+    } else {
+        let phi = r.range(-std::f64::consts::PI, std::f64::consts::PI);
+        [phi.cos(), phi.sin()]
+    };
+    let g = Gravity::new(w, dir).ok()?;
+    let sign = |r: &mut SplitMix64| {
+        if r.next_u64().is_multiple_of(2) {
+            1.0
+        } else {
+            -1.0
+        }
+    };
+    let a3 = if r.next_u64().is_multiple_of(20) {
+        0.0
+    } else {
+        sign(r) * 10f64.powf(r.range(0.0, 2.0))
+    };
+    let share = r.range(0.0, 1.0);
+    let (psi, mag) = (
+        r.range(-std::f64::consts::PI, std::f64::consts::PI),
+        10f64.powf(r.range(0.0, w.log10())),
+    );
+    let l = g.load();
+    let a = PlanarParams::new(
+        a3,
+        share * l[0] + mag * psi.cos(),
+        share * l[1] + mag * psi.sin(),
+    );
+    let c = Cable::from_params(&a, &g).ok()?;
+    let tip = c.tip().ok()?;
+    let ok = tip.x.hypot(tip.y) <= 0.98
+        && c.second_variation().ok()?.stable()
+        && c.turns().ok()? == 0
+        && !c.self_intersects().ok()?;
+    ok.then(|| {
+        (
+            g,
+            a,
+            PlanarPose::new(tip.x, tip.y, rod_ig_core::wrap_angle(tip.theta)),
+        )
+    })
+}
+
+/// `n` long cables drawn by [`long_cable`] from `seed` (the same every run).
+pub fn long_cables(
+    n: usize,
+    seed: u64,
+) -> Vec<(
+    rod_ig_core::planar::heavy::Gravity,
+    PlanarParams,
+    rod_ig_core::PlanarPose,
+)> {
+    let mut r = SplitMix64::new(seed);
+    let mut out = Vec::with_capacity(n);
+    while out.len() < n {
+        out.extend(long_cable(&mut r));
+    }
+    out
 }

@@ -7,7 +7,7 @@ use rod_ig_core::ode::planar_reference as reference;
 use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
 use rod_ig_core::planar::ig::SolveOptions;
 use rod_ig_core::solver;
-use rod_ig_core::{planar, PlanarParams};
+use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use std::path::Path;
 
 /// The paper's fixed RK4 step (the baseline of its speed claim).
@@ -444,8 +444,109 @@ pub fn weight(quick: bool) {
     });
     pair("tip + J + energy + stability", ev, ev0);
     heavy_solves(targets);
+    long_cables(quick);
     heavy_3d(quick);
     outln!();
+}
+
+/// Long cables (issue 51, item 7): the level cable at w = 2,000 (0.8 apart) against scipy's
+/// `solve_bvp` continuation (`scripts/level_cable_bvp.py`, run by the Python of `ROD_IG_PYTHON`,
+/// else `.venv/bin/python`, else `python3`), both timed in this run; then the robust solve's
+/// median over targets of stable loop-free long cables (w ∈ [200, 10⁴]).
+fn long_cables(quick: bool) {
+    use rod_ig_core::solver::Objective;
+    let gravity = Gravity::new(2_000.0, [0.0, -1.0]).expect("a valid gravity");
+    let target = PlanarPose::new(0.8, 0.0, 0.0);
+    let model = HeavyPlanar::new(gravity);
+    let options = |objective| SolveOptions {
+        objective,
+        deadline: std::time::Duration::from_secs(10),
+        ..SolveOptions::default()
+    };
+    let rounds = if quick { 3 } else { 7 };
+    let time_of = |objective| {
+        let mut t = Vec::new();
+        let mut a = PlanarParams::zeros();
+        for _ in 0..rounds {
+            let t0 = std::time::Instant::now();
+            if let Ok(s) = solver::solve(&model, &target, &options(objective)) {
+                a = s.a;
+            }
+            t.push(t0.elapsed().as_secs_f64());
+        }
+        (median(&mut t), a)
+    };
+    let (first, a) = time_of(Objective::FirstFound);
+    let (least, _) = time_of(Objective::LeastEnergy);
+    outln!(
+        "long cable held level 0.8 apart, w = 2,000: first found {:.1} ms, least energy {:.1} ms (median of {rounds}); a = [{:.12}, {:.12}, {:.12}]",
+        first * 1e3,
+        least * 1e3,
+        a[0],
+        a[1],
+        a[2]
+    );
+    for tol in ["1e-4", "1e-6"] {
+        match scipy_level_cable(tol) {
+            Ok(v) => {
+                let secs = v["seconds"].as_f64().unwrap_or(f64::NAN);
+                let err = (0..3)
+                    .map(|i| {
+                        let b = v["a"][i].as_f64().unwrap_or(f64::NAN);
+                        (b - a[i]).abs() / (1.0 + a[i].abs())
+                    })
+                    .fold(0.0, f64::max);
+                outln!(
+                    "    scipy solve_bvp (tol {tol}, continuation in w): {:.0} ms, a within {err:.1e} (relative) of ours: ours {:.0}× faster (first found; goal ≥ 100× at the same accuracy)",
+                    secs * 1e3,
+                    secs / first
+                );
+            }
+            Err(why) => outln!("    scipy solve_bvp: not measured ({why})"),
+        }
+    }
+    let cases = rod_ig_bench::families::long_cables(if quick { 10 } else { 60 }, 51);
+    let (mut times, mut solved) = (Vec::new(), 0);
+    for (g, _, target) in &cases {
+        let t0 = std::time::Instant::now();
+        solved += solver::solve(
+            &HeavyPlanar::new(*g),
+            target,
+            &options(Objective::FirstFound),
+        )
+        .is_ok() as usize;
+        times.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    let m = median(&mut times.clone());
+    times.sort_by(f64::total_cmp);
+    outln!(
+        "    robust solve of {} targets of stable loop-free long cables (w ∈ [200, 10⁴]): {solved} solved, median {m:.1} ms, max {:.1} ms",
+        cases.len(),
+        times.last().copied().unwrap_or(f64::NAN)
+    );
+}
+
+/// Runs `scripts/level_cable_bvp.py 2000 0.8 TOL` and returns its JSON line.
+fn scipy_level_cable(tol: &str) -> Result<serde_json::Value, String> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let python = std::env::var("ROD_IG_PYTHON").unwrap_or_else(|_| {
+        let venv = root.join(".venv/bin/python");
+        if venv.exists() {
+            venv.to_string_lossy().into_owned()
+        } else {
+            "python3".into()
+        }
+    });
+    let out = std::process::Command::new(&python)
+        .arg(root.join("scripts/level_cable_bvp.py"))
+        .args(["2000", "0.8", tol])
+        .output()
+        .map_err(|e| format!("{python}: {e}"))?;
+    if !out.status.success() {
+        let err = String::from_utf8_lossy(&out.stderr);
+        return Err(err.lines().last().unwrap_or("failed").to_string());
+    }
+    serde_json::from_slice(&out.stdout).map_err(|e| e.to_string())
 }
 
 /// The 3-D rod with weight against today's weightless 3-D integration (issue 41: forward + J

@@ -6,8 +6,10 @@
 //! every stable weightless rod through the target (the closed forms' search, loop-free ones
 //! first, least energy under the weight to first order first), each carried from w = 0 to the rod's weight with the gripper
 //! fixed; the same rods with the load shared by both grippers, a + (0, w ĝ/2), moved from
-//! where they end to the target at the full weight; last, the stable rods the single-shooting
-//! search finds at w = 150, carried to the rod's weight. Each start may spend half of the time
+//! where they end to the target at the full weight; then the stable rods the single-shooting
+//! search finds at w = 150, carried to the rod's weight, and the same with the extra load
+//! shared, moved; last, cables hanging from the base (the tension boundary layer's moment),
+//! moved to the target. Each start may spend half of the time
 //! left, and a branch whose tangent turns far beyond what is admitted is abandoned.
 //! An answer is admitted when its second variation is positive (stable), it makes at most
 //! `max_turns` turns and, when `max_turns` is 0, its centreline does not cross itself.
@@ -199,20 +201,58 @@ pub fn search(
         s.start(|s| seed_moved(a, s.gravity, s.target, &s.limits));
     }
     // 4. The moderate-weight rods through the target (single shooting is exact there),
-    // carried to the rod's weight.
+    // carried to the rod's weight, then the same with the extra load shared by the grippers,
+    // moved to the target at the full weight.
+    let mut moderate_rods = Vec::new();
     if !s.done() {
         if let Ok(moderate) = gravity.with_weight(MODERATE_WEIGHT.min(gravity.weight())) {
             let found = super::HeavyPlanar::new(moderate).robust_all(target, options);
-            for rod in found.solutions {
+            moderate_rods = found.solutions.iter().map(|r| r.a).collect();
+            for a in &moderate_rods {
                 if s.done() {
                     break;
                 }
-                s.start(|s| carried(&rod.a, &moderate, s.gravity, s.target, &s.limits));
+                s.start(|s| carried(a, &moderate, s.gravity, s.target, &s.limits));
             }
         }
     }
+    let extra = gravity.weight() - MODERATE_WEIGHT.min(gravity.weight());
+    for a in &moderate_rods {
+        if s.done() {
+            break;
+        }
+        let l = gravity.direction();
+        let seed = PlanarParams::new(a[0], a[1] + 0.5 * extra * l[0], a[2] + 0.5 * extra * l[1]);
+        s.start(|s| moved(&seed, s.gravity, s.target, &s.limits));
+    }
+    // 5. Cables hanging from the base (module docs), moved to the target.
+    for seed in hanging_seeds(gravity) {
+        if s.done() {
+            break;
+        }
+        s.start(|s| moved(&seed, s.gravity, s.target, &s.limits));
+    }
     s.done();
     sorted(s.out)
+}
+
+/// Rods hanging from the clamped base under their weight: n(0) = s w ĝ (s = 1: the tip
+/// gripper holds nothing; ½: half of the weight; 0: all of it) and the base moment of the
+/// tension boundary layer that turns the tangent from the clamp's direction toward gravity's
+/// by Δ, κ(0) = 2 √(T) sin(Δ/2) with T = max(s, ½) w (the elastica's first integral
+/// ½κ² = T (1 − cos Δ)).
+fn hanging_seeds(gravity: &Gravity) -> Vec<PlanarParams> {
+    let l = gravity.load();
+    let g = gravity.direction();
+    let turn = g[1].atan2(g[0]);
+    [1.0, 0.5, 0.0]
+        .iter()
+        .map(|&share: &f64| {
+            let tension = share.max(0.5) * gravity.weight();
+            let kappa = 2.0 * tension.sqrt() * (0.5 * turn).sin();
+            PlanarParams::new(kappa, share * l[0], share * l[1])
+        })
+        .collect()
 }
 
 /// The continuation limits of `admission`: a branch whose tangent turns more than 1.5 turns
