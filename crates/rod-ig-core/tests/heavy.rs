@@ -412,3 +412,53 @@ fn heavy_3d_targets_without_a_weightless_rod_are_reached_along_a_heavy_branch() 
         );
     }
 }
+
+/// 3-D weight 0 is no weight, bit for bit (issue 51, item 5: the CLI and Python answered some
+/// targets differently for `weight=None` and `weight=0.0`): the forward map and the robust
+/// search of `HeavySpatial` with w = 0 are `Spatial`'s, on rods and targets with signs, exact
+/// zeros and log-scale magnitudes.
+#[test]
+fn heavy_3d_without_weight_is_the_weightless_rod_bit_for_bit() {
+    use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
+    use rod_ig_core::spatial::{
+        self, HeavySpatial, Spatial, SpatialParams, StabilityOptions, Stiffness,
+    };
+    let mut rng = SplitMix64::new(51);
+    let k = Stiffness::default();
+    let none = Gravity3::new(0.0, [0.0, 0.0, -1.0]).unwrap();
+    let model = HeavySpatial {
+        stiffness: k,
+        gravity: none,
+    };
+    let mut solved = 0;
+    for i in 0..12 {
+        let a = SpatialParams::from_fn(|j, _| {
+            if i % 4 == 0 && j % 2 == 0 {
+                0.0
+            } else {
+                rng.signed_pow10(-2.0, if j < 3 { 0.5 } else { 1.2 })
+            }
+        });
+        let heavy_e = heavy3::evaluate(&a, &k, &none).unwrap();
+        let plain = spatial::evaluate(&a, &k, &StabilityOptions::production()).unwrap();
+        assert_eq!(heavy_e.tip, plain.tip);
+        assert_eq!(heavy_e.jacobian, plain.jacobian);
+        assert_eq!(heavy_e.stability, plain.stability);
+        if !plain.stability.stable || plain.tip.position.norm() > 0.95 {
+            continue;
+        }
+        let o = SolveOptions::default();
+        let (h, w) = (
+            solver::solve(&model, &plain.tip, &o),
+            solver::solve(&Spatial::with_stiffness(k), &plain.tip, &o),
+        );
+        match (h, w) {
+            (Ok(h), Ok(w)) => {
+                assert_eq!(h.a, w.a);
+                solved += 1;
+            }
+            (h, w) => assert_eq!(h.is_ok(), w.is_ok()),
+        }
+    }
+    assert!(solved >= 3, "{solved}");
+}

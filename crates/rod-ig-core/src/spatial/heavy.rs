@@ -234,12 +234,17 @@ pub struct HeavyEvaluation3d {
     pub stability: StabilityReport,
 }
 
-/// Tip and J(1, a) of the heavy 3-D rod (w = 0: the weightless integration's equations).
+/// Tip and J(1, a) of the heavy 3-D rod (w = 0: the weightless rod's, [`super::tip_and_jacobian`]
+/// at the production tolerance).
 pub fn tip_and_jacobian(
     a: &SpatialParams,
     k: &Stiffness,
     g: &Gravity3,
 ) -> Result<(SpatialPose, SpatialJacobian), RodError> {
+    if g.is_weightless() {
+        // No weight: the weightless rod's answer, bit for bit (issue 51, item 5).
+        return super::tip_and_jacobian(a, k, super::PRODUCTION_RTOL);
+    }
     check(a, k)?;
     let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
     let (s, _) = solve(
@@ -259,6 +264,17 @@ pub fn evaluate(
     k: &Stiffness,
     g: &Gravity3,
 ) -> Result<HeavyEvaluation3d, RodError> {
+    if g.is_weightless() {
+        // No weight: the weightless rod's answer, bit for bit (issue 51, item 5).
+        let e = super::evaluate(a, k, &super::StabilityOptions::production())?;
+        return Ok(HeavyEvaluation3d {
+            tip: e.tip,
+            jacobian: e.jacobian,
+            energy: e.energy,
+            elastic_energy: e.energy,
+            stability: e.stability,
+        });
+    }
     check(a, k)?;
     let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
     let grid: Vec<f64> = (40..=2000).map(|i| f64::from(i) / 2000.0).collect();

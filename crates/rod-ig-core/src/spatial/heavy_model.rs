@@ -43,11 +43,20 @@ impl RodModel<6> for HeavySpatial {
         "3-D rod with weight"
     }
 
+    // Without weight every evaluation and search is the weightless model's, so that weight 0
+    // and no weight answer bit for bit alike (issue 51, item 5).
+
     fn tip(&self, a: &SpatialParams) -> Result<SpatialPose, RodError> {
+        if self.gravity.is_weightless() {
+            return self.spatial().tip(a);
+        }
         Ok(heavy::tip_and_jacobian(a, &self.stiffness, &self.gravity)?.0)
     }
 
     fn evaluate(&self, a: &SpatialParams) -> Result<ModelEvaluation<6, SpatialPose>, RodError> {
+        if self.gravity.is_weightless() {
+            return self.spatial().evaluate(a);
+        }
         let e = heavy::evaluate(a, &self.stiffness, &self.gravity)?;
         Ok(ModelEvaluation {
             tip: e.tip,
@@ -62,7 +71,49 @@ impl RodModel<6> for HeavySpatial {
         &self,
         a: &SpatialParams,
     ) -> Result<(SpatialPose, SMatrix<f64, 6, 6>), RodError> {
+        if self.gravity.is_weightless() {
+            return self.spatial().tip_and_jacobian(a);
+        }
         heavy::tip_and_jacobian(a, &self.stiffness, &self.gravity)
+    }
+
+    fn tip_and_jacobian_for_substep(
+        &self,
+        a: &SpatialParams,
+    ) -> Result<(SpatialPose, SMatrix<f64, 6, 6>), RodError> {
+        if self.gravity.is_weightless() {
+            return self.spatial().tip_and_jacobian_for_substep(a);
+        }
+        self.tip_and_jacobian(a)
+    }
+
+    fn evaluate_iterate(
+        &self,
+        a: &SpatialParams,
+        start: &SpatialParams,
+    ) -> Result<ModelEvaluation<6, SpatialPose>, RodError> {
+        if self.gravity.is_weightless() {
+            return self.spatial().evaluate_iterate(a, start);
+        }
+        self.evaluate(a)
+    }
+
+    fn stability(&self, a: &SpatialParams) -> Result<crate::StabilityReport, RodError> {
+        if self.gravity.is_weightless() {
+            return self.spatial().stability(a);
+        }
+        Ok(self.evaluate(a)?.stability)
+    }
+
+    fn energy(&self, a: &SpatialParams) -> Result<f64, RodError> {
+        if self.gravity.is_weightless() {
+            return self.spatial().energy(a);
+        }
+        Ok(self.evaluate(a)?.energy)
+    }
+
+    fn is_straight(&self, a: &SpatialParams) -> bool {
+        self.gravity.is_weightless() && self.spatial().is_straight(a)
     }
 
     fn param_scale(&self) -> SVector<f64, 6> {
@@ -146,6 +197,9 @@ impl InverseGeometry<6> for HeavySpatial {
         target: &SpatialPose,
         options: &Options6,
     ) -> Result<Solution<SpatialParams, SpatialPose>, Failure<SpatialParams>> {
+        if self.gravity.is_weightless() {
+            return self.spatial().robust(target, options);
+        }
         let starts = weightless_starts(self.spatial(), target, options);
         load::first(&self.weightless(), self, target, options, starts)
     }
@@ -155,11 +209,17 @@ impl InverseGeometry<6> for HeavySpatial {
         target: &SpatialPose,
         options: &Options6,
     ) -> Found<SpatialParams, SpatialPose> {
+        if self.gravity.is_weightless() {
+            return self.spatial().robust_all(target, options);
+        }
         let starts = weightless_starts(self.spatial(), target, options);
         load::every(&self.weightless(), self, target, options, starts)
     }
 
     fn default_start(&self, target: &SpatialPose) -> Option<SpatialParams> {
+        if self.gravity.is_weightless() {
+            return self.spatial().default_start(target);
+        }
         let a = self.spatial().default_start(target)?;
         Some(a + self.shared_load_step(&self.weightless()))
     }

@@ -8,8 +8,9 @@
 //! fixed; the same rods with the load shared by both grippers, a + (0, w ĝ/2), moved from
 //! where they end to the target at the full weight; then the stable rods the single-shooting
 //! search finds at w = 150, carried to the rod's weight, and the same with the extra load
-//! shared, moved; last, cables hanging from the base (the tension boundary layer's moment),
-//! moved to the target. Each start may spend half of the time
+//! shared, moved; up to w = 600 the single-shooting search's rods at the weight itself,
+//! corrected; last, cables hanging from the base (the tension boundary layer's moment), moved
+//! to the target. Each start may spend half of the time
 //! left, and a branch whose tangent turns far beyond what is admitted is abandoned.
 //! An answer is admitted when its second variation is positive (stable), it makes at most
 //! `max_turns` turns and, when `max_turns` is 0, its centreline does not cross itself.
@@ -29,6 +30,9 @@ use std::sync::Mutex;
 pub const LONG_CABLE_WEIGHT: f64 = 200.0;
 /// The weight at which the search's last stage asks the single-shooting search.
 const MODERATE_WEIGHT: f64 = 150.0;
+/// Up to this weight the search also starts from the single-shooting search's rods (cond J(1)
+/// ≲ 1e7 for the level cable: their node states are a start within Newton's basin).
+const SINGLE_SHOOTING_STARTS_UP_TO: f64 = 600.0;
 /// Share of the time left that one start may spend.
 const START_SHARE: f64 = 0.5;
 /// Weightless rods the search starts from, at most.
@@ -158,6 +162,61 @@ impl Searcher<'_> {
             Err(e) => out.last_failure = Some(e.to_string()),
         }
     }
+
+    /// Stage 4 (module docs): the moderate-weight rods, carried, then moved with the extra
+    /// load shared.
+    fn moderate_starts(&mut self, options: &SolveOptions) {
+        let mut moderate_rods = Vec::new();
+        if !self.done() {
+            if let Ok(moderate) = self
+                .gravity
+                .with_weight(MODERATE_WEIGHT.min(self.gravity.weight()))
+            {
+                let found = super::HeavyPlanar::new(moderate).robust_all(self.target, options);
+                moderate_rods = found.solutions.iter().map(|r| r.a).collect();
+                for a in &moderate_rods {
+                    if self.done() {
+                        break;
+                    }
+                    self.start(|s| carried(a, &moderate, s.gravity, s.target, &s.limits));
+                }
+            }
+        }
+        let extra = self.gravity.weight() - MODERATE_WEIGHT.min(self.gravity.weight());
+        for a in &moderate_rods {
+            if self.done() {
+                break;
+            }
+            let l = self.gravity.direction();
+            let seed =
+                PlanarParams::new(a[0], a[1] + 0.5 * extra * l[0], a[2] + 0.5 * extra * l[1]);
+            self.start(|s| moved(&seed, s.gravity, s.target, &s.limits));
+        }
+    }
+
+    /// Stage 5: a little above w = 200, the single-shooting search's rods, corrected.
+    fn single_shooting_starts(&mut self, options: &SolveOptions) {
+        if self.gravity.weight() <= SINGLE_SHOOTING_STARTS_UP_TO && !self.done() {
+            let found =
+                super::HeavyPlanar::new(*self.gravity).single_shooting_all(self.target, options);
+            for rod in found.solutions {
+                if self.done() {
+                    break;
+                }
+                self.start(|s| corrected(&rod.a, s.gravity, s.target));
+            }
+        }
+    }
+
+    /// Stage 6: cables hanging from the base, moved to the target.
+    fn hanging_starts(&mut self) {
+        for seed in hanging_seeds(self.gravity) {
+            if self.done() {
+                break;
+            }
+            self.start(|s| moved(&seed, s.gravity, s.target, &s.limits));
+        }
+    }
 }
 
 /// Searches the stable equilibria of the cable under `gravity` whose tip is at `target`
@@ -200,38 +259,9 @@ pub fn search(
         }
         s.start(|s| seed_moved(a, s.gravity, s.target, &s.limits));
     }
-    // 4. The moderate-weight rods through the target (single shooting is exact there),
-    // carried to the rod's weight, then the same with the extra load shared by the grippers,
-    // moved to the target at the full weight.
-    let mut moderate_rods = Vec::new();
-    if !s.done() {
-        if let Ok(moderate) = gravity.with_weight(MODERATE_WEIGHT.min(gravity.weight())) {
-            let found = super::HeavyPlanar::new(moderate).robust_all(target, options);
-            moderate_rods = found.solutions.iter().map(|r| r.a).collect();
-            for a in &moderate_rods {
-                if s.done() {
-                    break;
-                }
-                s.start(|s| carried(a, &moderate, s.gravity, s.target, &s.limits));
-            }
-        }
-    }
-    let extra = gravity.weight() - MODERATE_WEIGHT.min(gravity.weight());
-    for a in &moderate_rods {
-        if s.done() {
-            break;
-        }
-        let l = gravity.direction();
-        let seed = PlanarParams::new(a[0], a[1] + 0.5 * extra * l[0], a[2] + 0.5 * extra * l[1]);
-        s.start(|s| moved(&seed, s.gravity, s.target, &s.limits));
-    }
-    // 5. Cables hanging from the base (module docs), moved to the target.
-    for seed in hanging_seeds(gravity) {
-        if s.done() {
-            break;
-        }
-        s.start(|s| moved(&seed, s.gravity, s.target, &s.limits));
-    }
+    s.moderate_starts(options);
+    s.single_shooting_starts(options);
+    s.hanging_starts();
     s.done();
     sorted(s.out)
 }
@@ -368,6 +398,18 @@ pub fn newton(
         Some(s) => Ok(solution_of(s, target, &out)),
         None => Err(failure_of(&out, admission)),
     }
+}
+
+/// The rod `a` under `gravity` corrected on `target` where it ends (θ lifted to its turn).
+fn corrected(
+    a: &PlanarParams,
+    gravity: &Gravity,
+    target: &PlanarPose,
+) -> Result<(Cable, u32), CableError> {
+    let mut c = Cable::from_params(a, gravity)?;
+    let lifted = lift_near(target, c.tip()?.theta);
+    let it = c.solve(&lifted)?;
+    Ok((c, it as u32))
 }
 
 /// The rod `a` under `gravity`, moved from where it ends to `target`.

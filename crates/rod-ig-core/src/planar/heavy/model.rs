@@ -30,6 +30,24 @@ impl HeavyPlanar {
         Self { gravity }
     }
 
+    /// Every stable rod the single-shooting search finds (the search below
+    /// [`LONG_CABLE_WEIGHT`], at any weight): a start of the long-cable search a little above
+    /// that weight, where single shooting still keeps a few digits.
+    pub(crate) fn single_shooting_all(
+        &self,
+        target: &PlanarPose,
+        options: &SolveOptions,
+    ) -> Found<PlanarParams, PlanarPose> {
+        let starts = weightless_starts(target, options);
+        load::every(
+            &HeavyPlanar::new(Gravity::NONE),
+            self,
+            target,
+            options,
+            starts,
+        )
+    }
+
     /// True when the rod is solved by multiple shooting (w > [`LONG_CABLE_WEIGHT`]).
     pub fn is_long_cable(&self) -> bool {
         self.gravity.weight() > LONG_CABLE_WEIGHT
