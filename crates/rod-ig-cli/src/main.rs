@@ -62,8 +62,9 @@ enum Command {
     /// {"success", "a", "tip", "stable", "iterations", "residual", "energy", "position_error",
     /// "orientation_error", "stability_margin", "reason" (on failure), "termination"
     /// ("converged", "deadline", "no_stable_solution", ...), "starts", "complete" (false when
-    /// the deadline cut a least-energy search or the list of all), "solutions" (with all)}.
-    /// One deadline holds for the whole line, `all` included.
+    /// the deadline cut a least-energy search or the list of all), "solutions" (with all),
+    /// with weight "turns" (full turns of the tangent: 0 for a loop-free cable)}. One deadline
+    /// holds for the whole line, `all` included.
     Solve {
         /// Print the solver's events (starts, iterations with residual and step, end) on
         /// stderr as JSON lines.

@@ -133,7 +133,7 @@ pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
     }
     let g = gravity_of(request.weight, request.gravity)?;
     if !g.is_weightless() {
-        return jsonl::to_value(&answer(
+        let mut value = jsonl::to_value(&answer(
             &HeavyPlanar::new(g),
             &request.target,
             &options,
@@ -141,7 +141,9 @@ pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
             verbose,
             |a| [a[0], a[1], a[2]],
             |tip| *tip,
-        ));
+        ))?;
+        with_turns(&mut value, &g);
+        return Ok(value);
     }
     jsonl::to_value(&answer(
         &PlanarClosedForm,
@@ -152,6 +154,32 @@ pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
         |a| [a[0], a[1], a[2]],
         |tip| *tip,
     ))
+}
+
+/// Adds `turns` (full turns of the tangent along the rod, on 401 samples; 0 for a loop-free
+/// cable) to a heavy answer and to each of its `solutions`.
+fn with_turns(value: &mut Value, g: &Gravity) {
+    let turns = |v: &Value| -> Option<u32> {
+        let a: Vec<f64> = v
+            .get("a")?
+            .as_array()?
+            .iter()
+            .filter_map(Value::as_f64)
+            .collect();
+        let a = PlanarParams::new(*a.first()?, *a.get(1)?, *a.get(2)?);
+        let shape = heavy::shape(&a, g, heavy::cable::SHAPE_CHECK_SAMPLES).ok()?;
+        Some(heavy::cable::turns_of(&shape))
+    };
+    if let Some(t) = turns(value) {
+        value["turns"] = t.into();
+    }
+    if let Some(list) = value.get_mut("solutions").and_then(Value::as_array_mut) {
+        for v in list {
+            if let Some(t) = turns(v) {
+                v["turns"] = t.into();
+            }
+        }
+    }
 }
 
 /// Largest accepted `max_turns` (a coil of 100 turns is no cable a gripper holds).

@@ -630,7 +630,7 @@ fn track_starts_from_the_straight_rod_at_rest() {
 }
 
 /// A 1 m cable (w = 2,000) held level 0.8 apart (issue 51): `solve` answers the hanging,
-/// loop-free rod on target (a5 = −w/2), `forward` of an `a` one rounding away reports its
+/// loop-free rod on target (a5 = −w/2, `turns` 0), `forward` of an `a` one rounding away reports its
 /// `condition` and an uncertain verdict, and a bad `max_turns` is refused by name.
 #[test]
 fn a_one_metre_cable_is_solved() {
@@ -642,6 +642,7 @@ fn a_one_metre_cable_is_solved() {
     assert_eq!(out[0]["success"], true, "{}", out[0]);
     let a5 = out[0]["a"][2].as_f64().unwrap();
     assert!((a5 + 1000.0).abs() < 1e-6, "{}", out[0]);
+    assert_eq!(out[0]["turns"], 0, "{}", out[0]);
     assert!(out[0]["position_error"].as_f64().unwrap() < 1e-9);
     assert!(out[1]["error"].as_str().unwrap().contains("max_turns"));
     // The answer's a with a4 rounded differently: a new process has no node states for it.
