@@ -9,8 +9,8 @@
 //! where they end to the target at the full weight; then the stable rods the single-shooting
 //! search finds at w = 150, carried to the rod's weight, and the same with the extra load
 //! shared, moved; up to w = 600 the single-shooting search's rods at the weight itself,
-//! corrected; last, cables hanging from the base (the tension boundary layer's moment), moved
-//! to the target. Each start may spend half of the time
+//! corrected; cables hanging from the base (the tension boundary layer's moment), moved to the
+//! target; last, an atlas of cables drawn at the weight itself, the nearest tips moved. Each start may spend half of the time
 //! left, and a branch whose tangent turns far beyond what is admitted is abandoned.
 //! An answer is admitted when its second variation is positive (stable), it makes at most
 //! `max_turns` turns and, when `max_turns` is 0, its centreline does not cross itself.
@@ -23,6 +23,7 @@ use crate::solver::{
     Failure, IgError, InverseGeometry, Objective, RodModel, Solution, Verified, Work,
 };
 use crate::{PlanarParams, PlanarPose, RodError};
+use std::f64::consts::PI;
 use std::sync::Mutex;
 
 /// Above this weight the heavy planar rod is solved by multiple shooting (below it single
@@ -33,6 +34,13 @@ const MODERATE_WEIGHT: f64 = 150.0;
 /// Up to this weight the search also starts from the single-shooting search's rods (cond J(1)
 /// ≲ 1e7 for the level cable: their node states are a start within Newton's basin).
 const SINGLE_SHOOTING_STARTS_UP_TO: f64 = 600.0;
+/// Draws of the atlas at the rod's weight (stage 7): a3 = ±10^U(0, 2), n(0) = s w ĝ plus
+/// 10^U(0, log w) in a random direction (the family of `search_coverage long`).
+const ATLAS_DRAWS: usize = 400;
+/// Atlas rods moved to the target, nearest tips first.
+const ATLAS_STARTS: usize = 12;
+/// Seed of the atlas's draws.
+const ATLAS_SEED: u64 = 0x5eed_ca61e;
 /// Share of the time left that one start may spend.
 const START_SHARE: f64 = 0.5;
 /// Weightless rods the search starts from, at most.
@@ -208,6 +216,52 @@ impl Searcher<'_> {
         }
     }
 
+    /// Stage 7: an atlas of cables at the rod's weight (module docs): the loop-free rods of
+    /// [`ATLAS_DRAWS`] seeded draws, the [`ATLAS_STARTS`] whose tips are nearest the target
+    /// moved there. The draws are the same on every call (a fixed seed): answers repeat.
+    fn atlas_starts(&mut self) {
+        if self.done() {
+            return;
+        }
+        let mut rng = crate::rng::SplitMix64::new(ATLAS_SEED);
+        let l = self.gravity.load();
+        let w = self.gravity.weight();
+        let mut near: Vec<(f64, Cable)> = Vec::new();
+        for _ in 0..ATLAS_DRAWS {
+            if crate::deadline::expired() {
+                break;
+            }
+            let share = rng.range(0.0, 1.0);
+            let (psi, mag) = (rng.range(-PI, PI), 10f64.powf(rng.range(0.0, w.log10())));
+            let a = PlanarParams::new(
+                rng.signed_pow10(0.0, 2.0),
+                share * l[0] + mag * psi.cos(),
+                share * l[1] + mag * psi.sin(),
+            );
+            let Ok(c) = Cable::from_params(&a, self.gravity) else {
+                continue;
+            };
+            let Ok(tip) = c.tip() else { continue };
+            if c.node_theta_spread() > self.limits.max_theta_spread || tip.x.hypot(tip.y) >= 1.0 {
+                continue;
+            }
+            let d = (tip.x - self.target.x).hypot(tip.y - self.target.y)
+                + 0.2 * crate::wrap_angle(tip.theta - self.target.theta).abs();
+            near.push((d, c));
+        }
+        near.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (_, c) in near.into_iter().take(ATLAS_STARTS) {
+            if self.done() {
+                break;
+            }
+            self.start(|s| {
+                let mut c = c;
+                let steps = c.move_within(s.target, &s.limits)?;
+                Ok((c, steps))
+            });
+        }
+    }
+
     /// Stage 6: cables hanging from the base, moved to the target.
     fn hanging_starts(&mut self) {
         for seed in hanging_seeds(self.gravity) {
@@ -262,6 +316,7 @@ pub fn search(
     s.moderate_starts(options);
     s.single_shooting_starts(options);
     s.hanging_starts();
+    s.atlas_starts();
     s.done();
     sorted(s.out)
 }
