@@ -40,6 +40,7 @@ def solve(
     threads: int | None = None,
     weight: npt.NDArray[np.float64] | None = None,
     gravity: npt.NDArray[np.float64] | None = None,
+    max_turns: int = 0,
 ) -> dict[str, Any]: ...
 def forward3d(
     a: npt.NDArray[np.float64],
