@@ -267,8 +267,7 @@ fn solves(n: usize) {
 
 /// Issue 41's success rate of the robust search with weight (see the module's header).
 fn heavy_coverage(n: usize, seed: u64) {
-    use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
-    use rod_ig_core::solver;
+    use rod_ig_core::planar::heavy::{self, Gravity};
     let mut r = SplitMix64::new(seed);
     let mut cases = Vec::new();
     while cases.len() < n {
@@ -294,53 +293,8 @@ fn heavy_coverage(n: usize, seed: u64) {
             cases.push((a, g, e.tip));
         }
     }
-    let options = ig::SolveOptions::default();
-    let (mut solved, mut wrong, mut times) = (0usize, 0usize, Vec::new());
-    for (a, g, target) in &cases {
-        let t0 = Instant::now();
-        let result = solver::solve(&HeavyPlanar::new(*g), target, &options);
-        times.push(t0.elapsed().as_secs_f64() * 1e6);
-        let why = match &result {
-            Ok(s) => match heavy::evaluate(&s.a, g) {
-                Ok(e)
-                    if e.stability.stable
-                        && (e.tip.x - target.x).hypot(e.tip.y - target.y) <= 1e-6
-                        && wrap_angle(e.tip.theta - target.theta).abs() <= 1e-6 =>
-                {
-                    solved += 1;
-                    continue;
-                }
-                other => {
-                    wrong += 1;
-                    format!("WRONG: re-check gives {other:?}")
-                }
-            },
-            Err(f) => f.reason.to_string(),
-        };
-        println!(
-            "miss {:.6e} {:.6},{:.6} {:.9},{:.9},{:.9} {:.9e},{:.9e},{:.9e} {why}",
-            g.weight(),
-            g.direction()[0],
-            g.direction()[1],
-            target.x,
-            target.y,
-            target.theta,
-            a[0],
-            a[1],
-            a[2]
-        );
-    }
-    times.sort_by(f64::total_cmp);
-    let q = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
-    println!(
-        "{solved} of {} solved ({:.2} %), {wrong} wrong; µs median {:.0}, p90 {:.0}, p99 {:.0}, max {:.0}",
-        cases.len(),
-        100.0 * solved as f64 / cases.len().max(1) as f64,
-        q(0.5),
-        q(0.9),
-        q(0.99),
-        q(1.0)
-    );
+    let cases: Vec<_> = cases.into_iter().map(|(a, g, tip)| (g, a, tip)).collect();
+    solve_and_report(&cases, &ig::SolveOptions::default());
 }
 
 /// Issue 41's success rate of the 3-D robust search with weight (see the module's header).
@@ -431,8 +385,7 @@ fn heavy_coverage_3d(n: usize, seed: u64) {
 }
 
 fn long_coverage(n: usize, seed: u64, least_energy: bool) {
-    use rod_ig_core::planar::heavy::{self, HeavyPlanar};
-    use rod_ig_core::solver::{self, Objective};
+    use rod_ig_core::solver::Objective;
     let cases = rod_ig_bench::families::long_cables(n, seed);
     let options = ig::SolveOptions {
         deadline: Duration::from_secs(2),
@@ -443,10 +396,26 @@ fn long_coverage(n: usize, seed: u64, least_energy: bool) {
         },
         ..ig::SolveOptions::default()
     };
+    solve_and_report(&cases, &options);
+}
+
+/// Solves every (gravity, a, target) case from no guess with `options`, re-checks each answer
+/// (on target to 1e-6, stable), prints `miss w gx,gy x,y,theta a3,a4,a5 why` per failure, then
+/// the count and the time quantiles (ms).
+fn solve_and_report(
+    cases: &[(
+        rod_ig_core::planar::heavy::Gravity,
+        PlanarParams,
+        PlanarPose,
+    )],
+    options: &ig::SolveOptions,
+) {
+    use rod_ig_core::planar::heavy::{self, HeavyPlanar};
+    use rod_ig_core::solver;
     let (mut solved, mut wrong, mut times) = (0usize, 0usize, Vec::new());
-    for (g, a, target) in &cases {
+    for (g, a, target) in cases {
         let t0 = Instant::now();
-        let result = solver::solve(&HeavyPlanar::new(*g), target, &options);
+        let result = solver::solve(&HeavyPlanar::new(*g), target, options);
         times.push(t0.elapsed().as_secs_f64() * 1e3);
         let why = match &result {
             Ok(s) => match heavy::evaluate(&s.a, g) {
@@ -481,7 +450,7 @@ fn long_coverage(n: usize, seed: u64, least_energy: bool) {
     times.sort_by(f64::total_cmp);
     let q = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
     println!(
-        "{solved} of {} solved ({:.2} %), {wrong} wrong; ms median {:.1}, p90 {:.1}, p99 {:.1}, max {:.1}",
+        "{solved} of {} solved ({:.2} %), {wrong} wrong; ms median {:.2}, p90 {:.2}, p99 {:.2}, max {:.2}",
         cases.len(),
         100.0 * solved as f64 / cases.len().max(1) as f64,
         q(0.5),

@@ -134,19 +134,23 @@ fn ode_options() -> OdeOptions {
 /// continuation ends with is corrected at [`SEGMENT_RTOL`].
 const SUBSTEP_RTOL: f64 = 1e-9;
 
-/// One segment from `start` = (x, y, θ, κ) at t0 to t1, without variations.
-fn segment_end(
+/// One segment from `start` = (x, y, θ, κ) at t0 to t1: with `D` = [`FULL`] its variational
+/// columns too (starting as ∂/∂θ_k = e_θ, ∂/∂κ_k = e_κ, ∂/∂n(0) = 0), with [`STATE`] without.
+fn integrate_segment<const D: usize>(
     rtol: f64,
     load: [f64; 2],
     n0: [f64; 2],
-    t0: f64,
-    t1: f64,
+    (t0, t1): (f64, f64),
     start: [f64; 4],
-) -> Result<[f64; STATE], RodError> {
-    let mut y = [0.0; STATE];
+) -> Result<[f64; D], RodError> {
+    let mut y = [0.0; D];
     y[..4].copy_from_slice(&start);
+    if D == FULL {
+        y[STATE + 2] = 1.0; // ∂θ/∂θ_k
+        y[STATE + 4 + 3] = 1.0; // ∂κ/∂κ_k
+    }
     let (end, _) = dop853::solve(
-        |t, y: &[f64; STATE], dy: &mut [f64; STATE]| rhs(load, n0, t, y, dy),
+        |t, y: &[f64; D], dy: &mut [f64; D]| rhs(load, n0, t, y, dy),
         t0,
         y,
         t1,
@@ -155,7 +159,19 @@ fn segment_end(
     Ok(end)
 }
 
-/// One segment from `start` = (x, y, θ, κ) at t0 to t1, with its variational columns.
+/// One segment without variations ([`integrate_segment`]).
+fn segment_end(
+    rtol: f64,
+    load: [f64; 2],
+    n0: [f64; 2],
+    t0: f64,
+    t1: f64,
+    start: [f64; 4],
+) -> Result<[f64; STATE], RodError> {
+    integrate_segment(rtol, load, n0, (t0, t1), start)
+}
+
+/// One segment with its variational columns ([`integrate_segment`]).
 fn segment(
     rtol: f64,
     load: [f64; 2],
@@ -164,18 +180,7 @@ fn segment(
     t1: f64,
     start: [f64; 4],
 ) -> Result<[f64; FULL], RodError> {
-    let mut y = [0.0; FULL];
-    y[..4].copy_from_slice(&start);
-    y[STATE + 2] = 1.0; // ∂θ/∂θ_k
-    y[STATE + 4 + 3] = 1.0; // ∂κ/∂κ_k
-    let (end, _) = dop853::solve(
-        |t, y: &[f64; FULL], dy: &mut [f64; FULL]| rhs(load, n0, t, y, dy),
-        t0,
-        y,
-        t1,
-        &ode_options_at(rtol),
-    )?;
-    Ok(end)
+    integrate_segment(rtol, load, n0, (t0, t1), start)
 }
 
 /// The mesh of `segments` equal segments.
