@@ -159,30 +159,6 @@ fn integrate_segment<const D: usize>(
     Ok(end)
 }
 
-/// One segment without variations ([`integrate_segment`]).
-fn segment_end(
-    rtol: f64,
-    load: [f64; 2],
-    n0: [f64; 2],
-    t0: f64,
-    t1: f64,
-    start: [f64; 4],
-) -> Result<[f64; STATE], RodError> {
-    integrate_segment(rtol, load, n0, (t0, t1), start)
-}
-
-/// One segment with its variational columns ([`integrate_segment`]).
-fn segment(
-    rtol: f64,
-    load: [f64; 2],
-    n0: [f64; 2],
-    t0: f64,
-    t1: f64,
-    start: [f64; 4],
-) -> Result<[f64; FULL], RodError> {
-    integrate_segment(rtol, load, n0, (t0, t1), start)
-}
-
 /// The mesh of `segments` equal segments.
 fn uniform_mesh(segments: usize) -> Vec<f64> {
     (0..=segments).map(|i| i as f64 / segments as f64).collect()
@@ -224,7 +200,13 @@ impl Cable {
         let mesh = uniform_mesh(segments_for(force_max(force, load)));
         let mut nodes = vec![[0.0, 0.0, 0.0, a[0]]];
         for k in 0..mesh.len() - 2 {
-            let e = segment(SEGMENT_RTOL, load, force, mesh[k], mesh[k + 1], nodes[k])?;
+            let e = integrate_segment::<FULL>(
+                SEGMENT_RTOL,
+                load,
+                force,
+                (mesh[k], mesh[k + 1]),
+                nodes[k],
+            )?;
             nodes.push([e[0], e[1], e[2], e[3]]);
         }
         Ok(Self {
@@ -262,14 +244,14 @@ impl Cable {
         Ok(PlanarPose::new(e[0], e[1], e[2]))
     }
 
-    fn last_segment(&self) -> Result<[f64; FULL], RodError> {
+    /// The last segment's end state, without variations (the tip needs none).
+    fn last_segment(&self) -> Result<[f64; STATE], RodError> {
         let m = self.segments();
-        segment(
+        integrate_segment::<STATE>(
             SEGMENT_RTOL,
             self.gravity.load(),
             self.force,
-            self.mesh[m - 1],
-            self.mesh[m],
+            (self.mesh[m - 1], self.mesh[m]),
             self.nodes[m - 1],
         )
     }
@@ -315,10 +297,15 @@ impl Cable {
             let (t0, t1, start) = (self.mesh[k], self.mesh[k + 1], self.nodes[k]);
             let mut e = [0.0; FULL];
             if jacobian {
-                e = segment(self.rtol, load, self.force, t0, t1, start)?;
+                e = integrate_segment::<FULL>(self.rtol, load, self.force, (t0, t1), start)?;
             } else {
-                e[..STATE]
-                    .copy_from_slice(&segment_end(self.rtol, load, self.force, t0, t1, start)?);
+                e[..STATE].copy_from_slice(&integrate_segment::<STATE>(
+                    self.rtol,
+                    load,
+                    self.force,
+                    (t0, t1),
+                    start,
+                )?);
             }
             let row = 4 * k;
             let rows = if k + 1 < m { 4 } else { 3 };
@@ -432,12 +419,11 @@ impl Cable {
         let mut d = [[0.0; 3]; 4];
         d[3][0] = 1.0;
         for k in 0..self.segments() {
-            let e = segment(
+            let e = integrate_segment::<FULL>(
                 SEGMENT_RTOL,
                 load,
                 self.force,
-                self.mesh[k],
-                self.mesh[k + 1],
+                (self.mesh[k], self.mesh[k + 1]),
                 self.nodes[k],
             )?;
             let col = |v: usize, r: usize| e[STATE + 4 * v + r];

@@ -431,21 +431,36 @@ pub fn newton(
     options: &SolveOptions,
 ) -> Result<Solution<PlanarParams, PlanarPose>, Failure<PlanarParams>> {
     let admission = Admission::of(options);
-    let limits = limits_of(admission);
+    let reached = from_guess(a0, gravity, target, &limits_of(admission));
+    one_start_outcome(
+        reached,
+        target,
+        admission,
+        |s| admission.admits(s),
+        "the rod reached is not admitted (unstable or coiled)",
+    )
+}
+
+/// The answer of a single-start run (`newton`, `carry`): the rod `reached`, finished and
+/// remembered when `accepted`, else the failure with `rejected` (or the error) as its last
+/// start's reason.
+fn one_start_outcome(
+    reached: Result<(Cable, u32), CableError>,
+    target: &PlanarPose,
+    admission: Admission,
+    accepted: impl Fn(&CableSolution) -> bool,
+    rejected: &str,
+) -> Result<Solution<PlanarParams, PlanarPose>, Failure<PlanarParams>> {
     let mut out = CableSearch {
         starts: 1,
         ..CableSearch::default()
     };
-    match from_guess(a0, gravity, target, &limits)
-        .and_then(|(c, it)| finish(c, it).map_err(CableError::from))
-    {
-        Ok(s) if admission.admits(&s) => {
+    match reached.and_then(|(c, it)| finish(c, it).map_err(CableError::from)) {
+        Ok(s) if accepted(&s) => {
             remember(&s.cable);
             out.solutions.push(s);
         }
-        Ok(_) => {
-            out.last_failure = Some("the rod reached is not admitted (unstable or coiled)".into())
-        }
+        Ok(_) => out.last_failure = Some(rejected.into()),
         Err(e) => out.last_failure = Some(e.to_string()),
     }
     out.cut_short = crate::deadline::expired();
@@ -627,10 +642,6 @@ pub fn carry(
 ) -> Result<Solution<PlanarParams, PlanarPose>, Failure<PlanarParams>> {
     let _deadline = crate::deadline::scope(options.deadline);
     let admission = Admission::of(options);
-    let mut out = CableSearch {
-        starts: 1,
-        ..CableSearch::default()
-    };
     let carried = match cable_of(a, from, gripper) {
         None => Err(CableError::Lost {
             weight: from.weight(),
@@ -645,17 +656,11 @@ pub fn carry(
                 .map(|steps| (c, steps))
         }
     };
-    match carried.and_then(|(c, it)| finish(c, it).map_err(CableError::from)) {
-        Ok(s) if s.stability.stable() => {
-            remember(&s.cable);
-            out.solutions.push(s);
-        }
-        Ok(_) => out.last_failure = Some("the carried rod is unstable".into()),
-        Err(e) => out.last_failure = Some(e.to_string()),
-    }
-    out.cut_short = crate::deadline::expired();
-    match out.solutions.first() {
-        Some(s) => Ok(solution_of(s, gripper, &out)),
-        None => Err(failure_of(&out, admission)),
-    }
+    one_start_outcome(
+        carried,
+        gripper,
+        admission,
+        |s| s.stability.stable(),
+        "the carried rod is unstable",
+    )
 }

@@ -320,14 +320,7 @@ impl InverseGeometry<3> for HeavyPlanar {
                 starts: found.starts,
             };
         }
-        let starts = weightless_starts(target, options);
-        load::every(
-            &HeavyPlanar::new(Gravity::NONE),
-            self,
-            target,
-            options,
-            starts,
-        )
+        self.single_shooting_all(target, options)
     }
 
     /// Above w = 200 the Newton iterates on the node states of the multiple-shooting
