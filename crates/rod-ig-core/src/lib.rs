@@ -2,7 +2,7 @@
 //!
 //! Equilibrium shapes of a Kirchhoff elastic rod held by two grippers, and their inverse
 //! geometry, after Roussel, Renaud & Taïx (2015), "Closed-forms of planar Kirchhoff elastic
-//! rods: application to inverse geometry" (corrections in `shared/paper/FINDINGS.md`).
+//! rods: application to inverse geometry" (corrections in `docs/math.md`).
 //!
 //! The rod has unit length and unit stiffness, its base is held at the identity. An
 //! equilibrium is parametrised by the base wrench a = μ(0): a ∈ R³ for the planar rod
@@ -27,6 +27,7 @@
 //!   in a-space.
 //! - [`rng`]: a small deterministic generator for reproducible samples.
 //! - [`spatial`]: the 3-D rod by numerical integration, and its inverse geometry.
+//! - [`wrench`]: the wrenches the rod exerts on its two grippers, as wrist sensors read them.
 #![warn(missing_docs)]
 
 mod angle;
@@ -44,6 +45,7 @@ mod simd;
 pub mod solver;
 pub mod spatial;
 mod types;
+pub mod wrench;
 
 pub use error::RodError;
 pub use types::{

@@ -9,7 +9,7 @@
 //! variations gain one term, δm ∋ −Rᵀ (δP × w ĝ), with δP' = δp = R η_v (world frame, 3
 //! values per column). The potential energy w ∫(−ĝ · p) = −w ĝ · P(1) comes for free.
 //!
-//! Stability: det J(t) > 0 on the rule's grid t = i/2000 ∈ [0.02, 1] (FINDINGS3D, the grid of
+//! Stability: det J(t) > 0 on the rule's grid t = i/2000 ∈ [0.02, 1] (docs/math.md §10, the grid of
 //! `shared/oracle/gravity_public.jsonl`'s 3-D lines), by dense output at rtol 1e-10.
 
 use super::reduced::{cross, rotmat, rt_mul as rt};
@@ -323,6 +323,38 @@ pub fn evaluate(
             scan.report()
         },
     })
+}
+
+/// The wrenches the rod exerts on its two grippers ([`crate::wrench`]; each in its gripper's
+/// frame). The world wrench at the tip is n(1) = a_f − w ĝ and, about the base,
+/// M(1) = a_m − P(1) × w ĝ (module docs); without weight, a_f and a_m.
+pub fn wrenches(
+    a: &SpatialParams,
+    k: &Stiffness,
+    g: &Gravity3,
+) -> Result<crate::wrench::GripperWrenches<crate::wrench::SpatialWrench>, RodError> {
+    use nalgebra::Vector3;
+    let (am, af) = (
+        Vector3::new(a[0], a[1], a[2]),
+        Vector3::new(a[3], a[4], a[5]),
+    );
+    if g.is_weightless() {
+        let tip = super::tip(a, k, super::PRODUCTION_RTOL)?;
+        return Ok(crate::wrench::spatial(a, &tip, af, am));
+    }
+    check(a, k)?;
+    let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
+    let (s, _) = solve(
+        |t, s, ds| rhs(&ci, &av, load, t, s, ds, false),
+        0.0,
+        initial(),
+        1.0,
+        &options(a),
+    )?;
+    super::finite(&s)?;
+    let load = Vector3::from(load);
+    let moment = am - Vector3::new(s[8], s[9], s[10]).cross(&load);
+    Ok(crate::wrench::spatial(a, &pose(&s), af - load, moment))
 }
 
 /// `samples` poses of the heavy 3-D rod from the base to the tip.

@@ -83,7 +83,7 @@ pub enum CableError {
     },
 }
 
-/// The right-hand side on a segment: the rod (FINDINGS §1 with n(t) = n(0) − w t ĝ) and, with
+/// The right-hand side on a segment: the rod (docs/math.md §1 with n(t) = n(0) − w t ĝ) and, with
 /// `VARS`, its four variational columns.
 #[inline(always)]
 fn rhs<const D: usize>(load: [f64; 2], n0: [f64; 2], t: f64, y: &[f64; D], dy: &mut [f64; D]) {
@@ -242,6 +242,11 @@ impl Cable {
     pub fn tip(&self) -> Result<PlanarPose, RodError> {
         let e = self.last_segment()?;
         Ok(PlanarPose::new(e[0], e[1], e[2]))
+    }
+
+    /// The tip's curvature κ(1) (the moment the tip gripper holds, with its sign reversed).
+    pub fn tip_curvature(&self) -> Result<f64, RodError> {
+        Ok(self.last_segment()?[3])
     }
 
     /// The last segment's end state, without variations (the tip needs none).

@@ -8,7 +8,7 @@
 //!
 //! κ' = n_x(t) sin θ − n_y(t) cos θ, θ' = κ, x' = cos θ, y' = sin θ, κ(0) = a3,
 //!
-//! the weightless equation (FINDINGS §1) with (a4, a5) replaced by n(t). The tip gripper
+//! the weightless equation (docs/math.md §1) with (a4, a5) replaced by n(t). The tip gripper
 //! carries n(1) = n(0) − w ĝ. Energy: the elastic ½∫κ² plus the potential w ∫(−ĝ · r) dt
 //! (zero at the base); [`HeavyEvaluation::energy`] is their sum.
 //!
@@ -318,6 +318,28 @@ pub fn shape(a: &PlanarParams, g: &Gravity, samples: usize) -> Result<Vec<Planar
     })
     .map_err(stop_error)?;
     Ok(out)
+}
+
+/// The wrenches the rod exerts on its two grippers ([`crate::wrench`]: each in its gripper's
+/// frame, as a wrist sensor reads it). Without weight κ(1) comes from the tip by the moment
+/// balance; with weight from the integration (or a long cable's node states).
+pub fn wrenches(
+    a: &PlanarParams,
+    g: &Gravity,
+) -> Result<crate::wrench::GripperWrenches<crate::wrench::PlanarWrench>, RodError> {
+    let (tip, kappa) = if g.is_weightless() {
+        let tip = crate::planar::tip(a)?;
+        (tip, crate::wrench::weightless_tip_curvature(a, &tip))
+    } else {
+        check_params(a)?;
+        if let Some(c) = recalled(a, g) {
+            (c.tip()?, c.tip_curvature()?)
+        } else {
+            let end = series::integrate(&g.problem(a), false, |_| true).map_err(stop_error)?;
+            (PlanarPose::new(end.x, end.y, end.theta), end.kappa)
+        }
+    };
+    Ok(crate::wrench::planar(a, &tip, g.tip_force(a), kappa))
 }
 
 /// Stability of the heavy rod (`scan`; w = 0: [`crate::planar::stability`]).
