@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Reference answers for barely bent planar rods under strong tension (issue 42, item 2).
 
-The planar rod obeys θ'' = a4 sin θ − a5 cos θ (FINDINGS §1). Under tension (a4 > 0) write
+The planar rod obeys θ'' = a4 sin θ − a5 cos θ (docs/math.md §1). Under tension (a4 > 0) write
 R = √(a4² + a5²), φ = atan2(a5, a4) and ψ = θ − φ: ψ'' = R sin ψ, a pendulum about its
 *unstable* equilibrium ψ = 0, with ψ(0) = −φ, ψ'(0) = a3. Its first integral
 ψ'² = h + 4R sin²(ψ/2), h = a3² − 4R sin²(φ/2), gives it exactly in Jacobi functions:
@@ -95,7 +95,9 @@ def digits_needed(a):
     terms = [v for v in (a3, a5 / r ** 0.5) if v > 0] or [1e-320]
     tiny = max(min(terms), 1e-320)
     lost = max(0.0, -2 * mp.log10(tiny) + mp.log10(4 * r))
-    return int(80 + lost + max(0.0, -mp.log10(tiny)))
+    # The energy and 1 − x are O(tiny²) differences of O(1) elliptic terms: as many digits
+    # again (without them an energy of 1e-179 came out 1e-6 off, issue 53).
+    return int(80 + 2 * lost + max(0.0, -mp.log10(tiny)))
 
 
 def reference(a):
@@ -109,6 +111,12 @@ def _reference(a):
     jac = [[None] * 3 for _ in range(3)]
     for j in range(3):
         step = mp.mpf(10) ** -40 * max(abs(mp.mpf(a[j])), mp.mpf(10) ** -320)
+        if j == 0:
+            # The a3 column at a3 = 0: a step on the bending's own scale |a5|/√a4 (a step of
+            # 1e-360 is below the digits that resolve the base's curvature).
+            root = mp.sqrt(abs(mp.mpf(a[1])))
+            step = mp.mpf(10) ** -40 * max(abs(mp.mpf(a[0])), abs(mp.mpf(a[2])) / root,
+                                           mp.mpf(10) ** -320)
         if j == 2:
             # The a5 column: a step that keeps h's sign where a5 is small (|δ| ≪ |a3|√a4).
             scale = max(abs(mp.mpf(a[2])), abs(mp.mpf(a[0])) * mp.sqrt(a[1]))
@@ -165,6 +173,39 @@ def samples_near_straight(n, seed):
     return out
 
 
+def samples_separatrix_limit(n, seed):
+    """Issue 53, item 4: a = (c, F, a5) with c log-uniform down to 1e-300 (either sign, or
+    exactly 0), √F log-uniform from 1 to 700, a5 = 0 or |a5|/F log-uniform in [1e-300, 1e-8];
+    and the two rods the issue found wrong."""
+    rng = random.Random(seed)
+    out = [[8.850559451519699e-186, 246788.58890306484, 0.0],
+           [1.5586680756769043e-199, 490000.0, 0.0]]
+    for i in range(n - len(out)):
+        root_f = 10 ** rng.uniform(0, float(mp.log10(700)))
+        a4 = float(root_f) ** 2
+        c = 10 ** rng.uniform(-300, -1) * rng.choice([-1, 1])
+        kind = i % 4
+        a5 = 0.0
+        if kind >= 2:
+            a5 = a4 * 10 ** rng.uniform(-300, -8) * rng.choice([-1, 1])
+        if kind == 3:
+            c = 0.0
+        out.append([c, a4, a5])
+    return out
+
+
+def samples_separatrix_limit_edge(n, seed):
+    """The separatrix limit's edge: |a3|/√F (and |a5|/F) log-uniform in [1e-9, 1e-7]."""
+    rng = random.Random(seed)
+    out = []
+    for i in range(n):
+        rf = 10 ** rng.uniform(0, 2.845)
+        c = 10 ** rng.uniform(-9, -7) * rf * rng.choice([-1, 1])
+        a5 = 0.0 if i % 2 == 0 else rf * rf * 10 ** rng.uniform(-9, -7) * rng.choice([-1, 1])
+        out.append([c, rf * rf, a5])
+    return out
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--n", type=int, default=120)
@@ -173,6 +214,10 @@ def main():
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--near-straight", action="store_true",
                    help="rods at the small-angle expansion's edge instead")
+    p.add_argument("--separatrix-limit", action="store_true",
+                   help="the separatrix limit's rods (issue 53) instead")
+    p.add_argument("--separatrix-limit-edge", action="store_true",
+                   help="the separatrix limit's edge, rho in [1e-9, 1e-7] (seed 531)")
     p.add_argument("--check", action="store_true", help="cross-check against the ODE and exit")
     p.add_argument("-o", "--output", default="-")
     args = p.parse_args()
@@ -186,7 +231,14 @@ def main():
         return
     out = open(args.output, "w") if args.output != "-" else None
     with multiprocessing.Pool(args.jobs) as pool:
-        rods = (samples_near_straight if args.near_straight else samples)(args.n, args.seed)
+        family = samples
+        if args.near_straight:
+            family = samples_near_straight
+        elif args.separatrix_limit:
+            family = samples_separatrix_limit
+        elif args.separatrix_limit_edge:
+            family = samples_separatrix_limit_edge
+        rods = family(args.n, args.seed)
         for line in pool.imap(_line, rods):
             print(line, file=out, flush=True) if out else print(line, flush=True)
 

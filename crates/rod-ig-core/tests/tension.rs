@@ -1,4 +1,6 @@
-//! Barely bent rods under strong tension (issue 42, item 2): a = (a3, a4, a5) with a4 > 0,
+//! Barely bent rods under strong tension (issue 42, item 2; issue 53, item 4: the separatrix
+//! limit in log form, `data/separatrix_limit_truth.jsonl`, answers every rod with
+//! ρ = max(|β|, |a3|/√R) ≤ 1e-7 and never a wrong tip): a = (a3, a4, a5) with a4 > 0,
 //! |a3| and |a5| log-uniform down to 1e-300, √a4 up to 700. The rod sits by its unstable
 //! straight equilibrium, then loops where ln(8√a4/|a3|)/√a4 < 1: the regime where a wrong tip
 //! slipped between a refusal and the series (θ = −6π for 2π at a = (1e-100, 240000, 0)).
@@ -26,7 +28,9 @@ struct Truth {
 fn truths() -> Vec<Truth> {
     let text = concat!(
         include_str!("data/tension_truth.jsonl"),
-        include_str!("data/tension_near_straight.jsonl")
+        include_str!("data/tension_near_straight.jsonl"),
+        include_str!("data/separatrix_limit_truth.jsonl"),
+        include_str!("data/separatrix_limit_edge.jsonl")
     );
     text.lines()
         .map(|line| {
@@ -113,4 +117,42 @@ fn barely_bent_rods_under_tension_are_answered_right_or_refused() {
     );
     assert!(wrong.is_empty(), "wrong answers:\n{}", wrong.join("\n"));
     assert_eq!(shape_only, 0, "shape draws rods forward refuses");
+}
+
+/// The separatrix limit in log form (issue 53, item 4) answers every rod of its domain, where
+/// 1 − k² ≈ ρ² underflows f64 (ρ = max(|β|, |a3|/√R) ≤ 1e-7, R ≥ 1, √R ≤ 709): none refused,
+/// θ(1) within 1e-9 of the exact pendulum (checked with the rest by the test above), and the
+/// worst tip and J errors stay at rounding level (1e-12 and 1e-9: the neglected terms are
+/// O(ρ²) ≤ 1e-14 relative).
+#[test]
+fn the_separatrix_limit_answers_its_whole_domain() {
+    let mut in_domain = 0;
+    let (mut worst_tip, mut worst_j) = (0.0f64, 0.0f64);
+    for t in truths() {
+        let (a3, a4, a5) = (t.a[0], t.a[1], t.a[2]);
+        let r = a4.hypot(a5);
+        let rho = (a5.atan2(a4)).abs().max(a3.abs() / r.sqrt());
+        if !(a4 > 0.0 && r >= 1.0 && r.sqrt() <= 709.0 && rho <= 1e-7) {
+            continue;
+        }
+        in_domain += 1;
+        let e = planar::evaluate(&t.a).unwrap_or_else(|err| panic!("{:?} refused: {err}", t.a));
+        let scale = t.jacobian.amax();
+        let j_err = ((e.jacobian - t.jacobian) / scale).norm() / (t.jacobian / scale).norm();
+        worst_tip = worst_tip.max(tip_error(&e.tip, &t));
+        worst_j = worst_j.max(j_err);
+        let tip = planar::tip(&t.a).expect("tip");
+        // The tip alone is the lattice in f64, evaluate's in dual numbers: rounding apart.
+        let d = (tip.x - e.tip.x).abs().max((tip.y - e.tip.y).abs());
+        let d = d.max((tip.theta - e.tip.theta).abs());
+        assert!(d <= 1e-13, "{:?}: tip and evaluate differ by {d:.1e}", t.a);
+    }
+    eprintln!(
+        "{in_domain} rods in the separatrix limit: worst tip {worst_tip:.1e}, J {worst_j:.1e}"
+    );
+    assert!(in_domain >= 60, "{in_domain} rods in the domain");
+    assert!(
+        worst_tip <= 1e-12 && worst_j <= 1e-9,
+        "tip {worst_tip:.1e}, J {worst_j:.1e}"
+    );
 }

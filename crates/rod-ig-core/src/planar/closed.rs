@@ -1,4 +1,4 @@
-//! The closed-form planar rod, generic over [`Real`] (FINDINGS §1–§3).
+//! The closed-form planar rod, generic over [`Real`] (docs/math.md §1–§3).
 //!
 //! [`Closed::new`] does everything that depends on a only (case selection, m, m1, r, phase,
 //! Landen sequence, values at Γ0 = φ); [`Closed::pose`] then costs one descending-Landen
@@ -147,7 +147,7 @@ pub(crate) struct Closed<T: Real> {
 
 /// First-order expansion of the Jacobi functions about m = 1 in δ = 1 − m (A&S 16.15.1–4),
 /// with E(am u|m) = tanh u + (δ/2)(u − tanh u/2 − u sech² u/2). At δ = 0 these are the
-/// separatrix forms of FINDINGS §3 case III; with a dual δ (value 0) they also carry the exact
+/// separatrix forms of docs/math.md §3 case III; with a dual δ (value 0) they also carry the exact
 /// first derivative across λ4 = 0. Returns (sn, cn, dn, E(am u)).
 #[inline]
 fn near_one<T: Real>(u: T, delta: T) -> (T, T, T, T) {
@@ -162,7 +162,7 @@ fn near_one<T: Real>(u: T, delta: T) -> (T, T, T, T) {
     (sn, cn, dn, e)
 }
 
-/// λ4 = a5² − a3²(a3²/4 + a4) (FINDINGS §2) to about ε relative to itself: the two terms cancel
+/// λ4 = a5² − a3²(a3²/4 + a4) (docs/math.md §2) to about ε relative to itself: the two terms cancel
 /// near the separatrix (λ4 = 0), and m1 ∝ λ4 sets every log-singular piece of the closed form
 /// there (a = (2, 3, 4 + 1e-8): λ4 = 8e-8 from terms of 16, so f64 leaves it 4e-8 off and J(t)
 /// 1.5e-6 off). Products by Dekker's exact two_prod, the sums in double-double; falls back to
@@ -316,7 +316,7 @@ fn circle_force_terms<T: Real>(c: T, t: f64) -> [T; 6] {
     }
 }
 
-/// The invariants of a rod's base wrench that select and parametrise its case (FINDINGS §2):
+/// The invariants of a rod's base wrench that select and parametrise its case (docs/math.md §2):
 /// F = ‖(a4, a5)‖, F ± a4 (each without cancellation), α3 = a3² + 2(F + a4) and
 /// λ4 = a5² − a3²(a3²/4 + a4).
 #[derive(Clone, Copy)]
@@ -389,7 +389,7 @@ impl<T: Real> Closed<T> {
         }
     }
 
-    /// Precomputes the closed form for a = (a3, a4, a5) (FINDINGS §2 table and phase).
+    /// Precomputes the closed form for a = (a3, a4, a5) (docs/math.md §2 table and phase).
     /// Returns None when an intermediate quantity is not finite (overflow).
     pub fn new(a3: T, a4: T, a5: T) -> Option<Self> {
         Self::build(a3, a4, a5, true)
@@ -462,7 +462,7 @@ impl<T: Real> Closed<T> {
             let (u4, u5) = (a4 / scale, a5 / scale);
             (u4 * u4 + u5 * u5).sqrt() * scale
         };
-        // F ± a4 without cancellation (FINDINGS §2).
+        // F ± a4 without cancellation (docs/math.md §2).
         let (fp, fm) = if a4r >= 0.0 {
             let fp = f + a4;
             (fp, a5 * a5 / fp)
@@ -537,7 +537,7 @@ impl<T: Real> Closed<T> {
         (sn, c)
     }
 
-    /// Case I (λ4 > 0, FINDINGS §2): parameter m = α3/(4F), r = √F.
+    /// Case I (λ4 > 0, docs/math.md §2): parameter m = α3/(4F), r = √F.
     fn init_case_i(&mut self, inv: &Invariants<T>, with_phase: bool) -> Option<()> {
         let Invariants {
             f,
@@ -586,7 +586,7 @@ impl<T: Real> Closed<T> {
         Some(())
     }
 
-    /// Case II (λ4 < 0, FINDINGS §2): parameter m = 4F/α3, r = √α3 / 2; tiny m is the
+    /// Case II (λ4 < 0, docs/math.md §2): parameter m = 4F/α3, r = √α3 / 2; tiny m is the
     /// small-force series ([`Case::SmallForce`]).
     fn init_case_ii(&mut self, inv: &Invariants<T>, with_phase: bool) -> Option<()> {
         let Invariants {
@@ -652,7 +652,7 @@ impl<T: Real> Closed<T> {
     }
 
     /// Case III (λ4 = 0, the separatrix): the m → 1 limit with its first-order term in
-    /// δ = 1 − m carried for the derivatives (FINDINGS §2 table).
+    /// δ = 1 − m carried for the derivatives (docs/math.md §2 table).
     fn init_case_iii(&mut self, inv: &Invariants<T>) {
         let Invariants {
             f,
@@ -664,7 +664,7 @@ impl<T: Real> Closed<T> {
         let one = T::from_f64(1.0);
         let zero = T::from_f64(0.0);
         self.case = Case::III;
-        // δ = 1 − m_I = λ4/(F α3): value 0, derivative carried (FINDINGS §2 table).
+        // δ = 1 − m_I = λ4/(F α3): value 0, derivative carried (docs/math.md §2 table).
         let delta = lambda4 / (f * alpha3);
         let (sn, cn) = self.phase_i(fp, fm, alpha3);
         let ratio = sn / cn;
@@ -706,7 +706,7 @@ impl<T: Real> Closed<T> {
         true
     }
 
-    /// Curvature κ(t) = μ3(t) (FINDINGS §2 table).
+    /// Curvature κ(t) = μ3(t) (docs/math.md §2 table).
     pub fn curvature(&self, t: f64) -> T {
         match self.case {
             Case::Straight => self.a3 * 0.0,
@@ -775,7 +775,7 @@ impl<T: Real> Closed<T> {
         (y1 * x0 - x1 * y0, x1 * x0 + y1 * y0)
     }
 
-    /// Case II: ∫β2 = −(dn − dn0)/(m r) (FINDINGS §3) from sn Γ, dn Γ, in the form that does
+    /// Case II: ∫β2 = −(dn − dn0)/(m r) (docs/math.md §3) from sn Γ, dn Γ, in the form that does
     /// not cancel: through sn² − sn0² = (dn0² − dn²)/m for small m, directly for m ≥ ½ (dn,
     /// computed with relative accuracy, is tiny near the separatrix while sn ≈ 1).
     #[inline(always)]
@@ -832,7 +832,7 @@ impl<T: Real> Closed<T> {
         (ib1, ib2, ju.am + turn)
     }
 
-    /// Pose (x, y, θ)(t) with θ unwrapped (FINDINGS §1 position formulas, §3 integrals):
+    /// Pose (x, y, θ)(t) with θ unwrapped (docs/math.md §1 position formulas, §3 integrals):
     /// x = −(a4/F)∫β1 + 2ε(a5/F)∫β2, y = −(a5/F)∫β1 − 2ε(a4/F)∫β2.
     ///
     /// A form built without its phase ([`Self::complete`]) places Γ by the addition

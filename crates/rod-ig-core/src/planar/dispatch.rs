@@ -10,6 +10,7 @@
 //! | 0 | (refusal) | a non-finite | nothing can answer |
 //! | 1 | [`FullEvaluation`] | ‖(a4, a5)‖ > [`ORDINARY_FORCE`] | beyond, one formulation may refuse what another answers: the full evaluation decides for all |
 //! | 2 | [`SmallAngle`] | the energy only | its bound is the cheapest certificate, and the identity cancels on nearly straight rods |
+//! | 2½ | [`SeparatrixLimit`] | a barely bent rod under a strong force (ρ = max(\|β\|, \|a3\|/√R) ≤ 1e-7) | exact in log form where 1 − k² underflows and every closed form loses its phase |
 //! | 3 | [`Series`] (no closed form) | ρ ≤ [`SERIES_RHO`] | one series step; the closed form's own estimate would reject nearly all of them |
 //! | 4 | (refusal), [`Series`] | the closed form overflows | beyond √‖F‖ = ln(f64::MAX) under tension every f64 evaluation is wrong; below, the series has its own overflow detection |
 //! | 5 | [`ClosedForm`] | its error estimate holds; for the verdict, a theorem or det J(1) | ≈ 0.3–2 µs, exact to ≈ 1e-10 |
@@ -24,7 +25,7 @@
 use super::closed::Closed;
 use super::formulation::{
     Answer, ClosedForm, ClosedScan, Formulation, FullEvaluation, IllConditioned, Need, Precision,
-    Rod, Series, SmallAngle,
+    Rod, SeparatrixLimit, Series, SmallAngle,
 };
 use super::{curvature_scale, evaluate, Evaluation, PlanarRod};
 use crate::scalar::Dual3;
@@ -155,6 +156,34 @@ pub(crate) fn answer<Q: Question>(a: &PlanarParams, q: Q) -> Result<Q::Answer, R
             return answer;
         }
     }
+    if let Some(limit) = SeparatrixLimit::of(a) {
+        if let Some(answer) = q.ask(&limit) {
+            return answer;
+        }
+    }
+    from_closed_form(a, q, without_closed)
+}
+
+/// Rows 3–9 of the table: what the separatrix limit asks where its own theorems do not decide
+/// the stability (an inflectional rod with one or two inflection points on the rod).
+pub(crate) fn stability_from_closed_form(a: &PlanarParams) -> Result<StabilityReport, RodError> {
+    let without_closed = Rod {
+        a,
+        closed: None,
+        need: Need::NoClosedForm,
+        case: None,
+        precise_series: false,
+    };
+    from_closed_form(a, Stability, without_closed)
+}
+
+/// Rows 3–9 of the table.
+#[inline]
+fn from_closed_form<Q: Question>(
+    a: &PlanarParams,
+    q: Q,
+    without_closed: Rod,
+) -> Result<Q::Answer, RodError> {
     if series_first(a) {
         return after_closed_form(q, without_closed);
     }

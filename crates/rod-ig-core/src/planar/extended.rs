@@ -1,5 +1,5 @@
 //! The closed form in double-double arithmetic ([`DualDd`]): the same generic code as the f64
-//! closed form (FINDINGS §1–§3), for the rods whose f64 closed form loses too much to
+//! closed form (docs/math.md §1–§3), for the rods whose f64 closed form loses too much to
 //! cancellation near the separatrix (J off by ≈ ε/√m1, m1 down to 1e-30) and whose Taylor
 //! series, in double-double too, takes milliseconds (√‖F‖ up to 27) or cannot be certified
 //! at all (beyond).
@@ -56,7 +56,7 @@ pub(crate) fn tip_jacobian_energy(a: &PlanarParams) -> Option<(PlanarPose, Plana
 /// q(1), J(1) and the energy from the double-double closed form `c` of the rod a, where its
 /// error estimates hold: J's relative error estimate ([`Closed::end_jacobian_rel_error_own`],
 /// the f64 model at 2⁻¹⁰⁴) within [`CLOSED_J_TOLERANCE`], the tip's within
-/// [`EXTENDED_TIP_TOLERANCE`], and the energy λ2/2 − a4 x − a5 y (FINDINGS §1, in
+/// [`EXTENDED_TIP_TOLERANCE`], and the energy λ2/2 − a4 x − a5 y (docs/math.md §1, in
 /// double-double) within 1e-9 of itself. None elsewhere.
 pub(crate) fn answer(
     c: &Closed<DualDd>,
@@ -88,7 +88,7 @@ pub(crate) fn energy(a: &PlanarParams) -> Option<f64> {
     identity_energy(a, x.v, y.v, pose_error)
 }
 
-/// E = a3²/2 + a4 − a4 x − a5 y (FINDINGS §1) in double-double, where its bound — the pose
+/// E = a3²/2 + a4 − a4 x − a5 y (docs/math.md §1) in double-double, where its bound — the pose
 /// error times (|a4| + |a5|) plus the rounding of the sum — is within
 /// [`ENERGY_REL_TOLERANCE`] of E.
 fn identity_energy(a: &PlanarParams, x: Dd, y: Dd, pose_error: f64) -> Option<f64> {

@@ -1,5 +1,5 @@
 //! Closed-form planar Kirchhoff rod (Roussel, Renaud & Taïx 2015, §2.2, with the corrections of
-//! `shared/paper/FINDINGS.md`): shape q(t) = (x, y, θ)(t), sensitivity J(t, a) = ∂q(t)/∂a,
+//! `docs/math.md`): shape q(t) = (x, y, θ)(t), sensitivity J(t, a) = ∂q(t)/∂a,
 //! stability (Bretl & McCarthy: det J(t, a) > 0 on (0, 1]) and elastic energy.
 //!
 //! Conventions: a = (a3, a4, a5) = μ(0) (base moment and force), unit length and stiffness,
@@ -8,7 +8,7 @@
 //!
 //! The closed form is written once, generic over [`crate::scalar::Real`]: in `f64` it gives the
 //! pose, in [`crate::scalar::Dual3`] seeded with the identity on a it gives the exact J in the
-//! same pass. All cases of FINDINGS §2 are covered: I (λ4 > 0), II (λ4 < 0, via the m > 1
+//! same pass. All cases of docs/math.md §2 are covered: I (λ4 > 0), II (λ4 < 0, via the m > 1
 //! transform), III (λ4 = 0 exactly), the circle (a4 = a5 = 0) and the straight rod
 //! (a3 = a5 = 0), with a3 = 0 (ε = +1), a5 = 0, small force (m → 0, D form) and the
 //! near-separatrix regime (m1 = 1 − m from λ4) handled without cancellation.
@@ -19,7 +19,7 @@
 //! evaluation) answers a rod: so they share one domain and one refusal.
 
 mod closed;
-mod dispatch;
+pub(crate) mod dispatch;
 mod extended;
 mod formulation;
 pub mod heavy;
@@ -28,6 +28,7 @@ pub mod model;
 mod pendulum;
 mod shape;
 mod small_angle;
+mod soliton;
 mod stability;
 mod taylor;
 
@@ -96,7 +97,7 @@ pub(crate) fn tip_by_closed_form(a: &PlanarParams) -> Option<PlanarPose> {
     tip.is_finite().then_some(tip)
 }
 
-/// Tip pose q(1, a): the closed form (FINDINGS §1–§3), or the Taylor series for nearly
+/// Tip pose q(1, a): the closed form (docs/math.md §1–§3), or the Taylor series for nearly
 /// straight, gently bent and tiny rods and wherever the closed form's error estimate fails.
 /// In cases I and II with m1, m ≥ 1e-3, 1e-2 the closed form places the tip by the addition
 /// theorems without computing its phase (~18 % fewer instructions on the paper's box), so it
@@ -111,7 +112,7 @@ pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
 /// gently bent and tiny rods (ρ ≤ 0.25) and wherever the closed form's error estimate fails
 /// (near the separatrix, at small m, gently bent rods: see `Closed::needs_series`),
 /// the Taylor series in dual numbers (double-double where rounding grows like e^{√‖F‖}).
-/// FINDINGS §4 asks for such a fallback.
+/// docs/math.md §4 asks for such a fallback.
 pub fn pose_and_jacobian(
     a: &PlanarParams,
     t: f64,
@@ -164,12 +165,12 @@ pub fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian)
     pose_and_jacobian(a, 1.0)
 }
 
-/// Stability of the equilibrium a (Bretl & McCarthy; FINDINGS §5): stable iff det J(t, a) > 0
+/// Stability of the equilibrium a (Bretl & McCarthy; docs/math.md §5): stable iff det J(t, a) > 0
 /// on (0, 1]. g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) is scanned on a grid whose spacing
 /// follows the rod's wavelength (from t = 0.02 on the closed form, 0.01 on the series; below,
 /// det J > 0 by its leading term), sign changes are located to 1e-7 and local minima refined;
 /// on the closed form every sample also gives g′(t) (d det J/dt = det[J_x; J_y; ∂κ/∂a]), which
-/// finds minima between samples and steers those refinements (half-wavelength grid). The margin is FINDINGS §5 `det_min`, min over t ∈ [0.05, 1] of g; the report is
+/// finds minima between samples and steers those refinements (half-wavelength grid). The margin is docs/math.md §5 `det_min`, min over t ∈ [0.05, 1] of g; the report is
 /// `uncertain` when it lies within its error bound (the closed form first hands such rods to
 /// the series). The straight rod (a3 = a5 = 0) has det J ≡ 0: uncertain, margin 0.
 ///
@@ -202,7 +203,7 @@ pub fn stability_verdict(a: &PlanarParams) -> Result<StabilityVerdict, RodError>
     dispatch::answer(a, dispatch::Verdict)
 }
 
-/// Elastic energy ½∫₀¹κ² (FINDINGS §1 identity λ2/2 − a4 x(1) − a5 y(1) where its bound holds;
+/// Elastic energy ½∫₀¹κ² (docs/math.md §1 identity λ2/2 − a4 x(1) − a5 y(1) where its bound holds;
 /// the small-angle expansion, ζ or the series elsewhere).
 pub fn energy(a: &PlanarParams) -> Result<f64, RodError> {
     dispatch::answer(a, dispatch::Energy)

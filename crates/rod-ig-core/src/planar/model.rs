@@ -9,7 +9,7 @@ use crate::{wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, RodError, Stab
 use nalgebra::{SMatrix, Vector3};
 
 /// Checks the target: finite, and ‖(x, y)‖ < 1 (the unit rod is inextensible; the straight rod
-/// at distance 1 is unstable, FINDINGS §5).
+/// at distance 1 is unstable, docs/math.md §5).
 pub fn check_target(target: &PlanarPose) -> Result<(), IgError> {
     for (component, value) in [("x", target.x), ("y", target.y), ("theta", target.theta)] {
         if !value.is_finite() {
@@ -83,7 +83,7 @@ pub(crate) fn evaluate_precise(a: &PlanarParams) -> Result<crate::planar::Evalua
     super::evaluate(a)
 }
 
-/// Elastic energy ½∫κ² from the tip, by the identity of FINDINGS §1:
+/// Elastic energy ½∫κ² from the tip, by the identity of docs/math.md §1:
 /// E = λ2/2 − a4·x(1) − a5·y(1), λ2 = a3² + 2a4.
 #[inline]
 pub(crate) fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
@@ -101,7 +101,7 @@ pub(crate) fn residual(tip: &PlanarPose, target: &PlanarPose) -> Vector3<f64> {
 }
 
 /// An iterate of a run from `start` by the closed forms at the precision that start needs
-/// ([`Precision`]); stability by the full FINDINGS §5 test.
+/// ([`Precision`]); stability by the full docs/math.md §5 test.
 fn evaluate_iterate(
     a: &PlanarParams,
     start: &PlanarParams,

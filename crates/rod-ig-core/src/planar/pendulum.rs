@@ -1,6 +1,6 @@
 //! A nearly straight rod under compression as a pendulum of exact frequency (issue 23).
 //!
-//! Under compression a4 = −w² the rod's angle obeys (FINDINGS §1)
+//! Under compression a4 = −w² the rod's angle obeys (docs/math.md §1)
 //!
 //! ```text
 //! θ'' = a4 sin θ − a5 cos θ = −R sin(θ + φ),   R = √(a4² + a5²),  (R cos φ, R sin φ) = (w², a5),

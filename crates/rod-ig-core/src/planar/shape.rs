@@ -4,7 +4,7 @@ use super::*;
 
 /// A planar rod ready to be sampled: the closed form with everything that depends on a only
 /// precomputed (case, m, m1 = 1 − m, r, phase φ, the Landen sequence and the values at Γ0 = φ;
-/// FINDINGS §2), so that each [`PlanarRod::pose`] costs one Jacobi-function evaluation — or,
+/// docs/math.md §2), so that each [`PlanarRod::pose`] costs one Jacobi-function evaluation — or,
 /// for nearly straight, gently bent and tiny rods (and wherever the closed form's error
 /// estimate fails), the Taylor-series polynomials of the rod, each pose one Horner evaluation.
 #[derive(Clone, Debug)]
@@ -26,10 +26,12 @@ pub(crate) enum Backend {
     /// The small-angle expansion (or the pendulum), where forward answers by it and the series
     /// cannot stand in (beyond √‖F‖ = ln(f64::MAX), a nearly straight rod under compression).
     SmallAngle,
+    /// The separatrix limit's soliton lattice (a barely bent rod under a strong force).
+    Separatrix(super::soliton::Lattice<f64>),
 }
 
 /// The closed-form case of a when the series is used without building the closed form (the
-/// classification of FINDINGS §2, which `case()` reports for information).
+/// classification of docs/math.md §2, which `case()` reports for information).
 pub(crate) fn case_without_closed(a: &PlanarParams) -> Case {
     let (a3, a4, a5) = (a[0], a[1], a[2]);
     if a3 == 0.0 && a5 == 0.0 {
@@ -105,13 +107,13 @@ impl PlanarRod {
         self.a
     }
 
-    /// Which closed form applies to a (FINDINGS §2 table and degenerate inputs), whichever
+    /// Which closed form applies to a (docs/math.md §2 table and degenerate inputs), whichever
     /// formulation evaluates it.
     pub fn case(&self) -> Case {
         self.case
     }
 
-    /// Pose q(t) = (x, y, θ)(t), θ unwrapped (FINDINGS §1: x = (a4 I4 + a5 I5)/F²,
+    /// Pose q(t) = (x, y, θ)(t), θ unwrapped (docs/math.md §1: x = (a4 I4 + a5 I5)/F²,
     /// y = (a5 I4 − a4 I5)/F², with the integrals of §3; or the Taylor series). Intended for
     /// t ∈ [0, 1] (the series clamps t to it); NaN t gives a NaN pose.
     pub fn pose(&self, t: f64) -> PlanarPose {
@@ -120,6 +122,8 @@ impl PlanarRod {
             Backend::Series(r) if t.is_nan() => [t; 3],
             Backend::Series(r) => r.pose(t.clamp(0.0, 1.0)).unwrap_or([f64::NAN; 3]),
             // The base is the identity (the expansion's J is 0/0 there).
+            Backend::Separatrix(l) if t.is_nan() => [t; 3],
+            Backend::Separatrix(l) => l.pose(t.clamp(0.0, 1.0)),
             Backend::SmallAngle if t <= 0.0 => [0.0; 3],
             Backend::SmallAngle => small_angle::checked_pose_and_jacobian(&self.a, t.min(1.0))
                 .map_or([f64::NAN; 3], |(p, _)| [p.x, p.y, p.theta]),
@@ -132,12 +136,13 @@ impl PlanarRod {
         self.tip
     }
 
-    /// Curvature κ(t) = μ3(t) (FINDINGS §2 table: ε√α3 cn Γ, ε√α3 dn Γ or ε√α3 sech Γ).
+    /// Curvature κ(t) = μ3(t) (docs/math.md §2 table: ε√α3 cn Γ, ε√α3 dn Γ or ε√α3 sech Γ).
     pub fn curvature(&self, t: f64) -> f64 {
         match &self.backend {
             Backend::Closed(c) => c.curvature(t),
             Backend::Series(r) => r.curvature(t.clamp(0.0, 1.0)).unwrap_or(f64::NAN),
             Backend::SmallAngle => small_angle::curvature(&self.a, t.clamp(0.0, 1.0)),
+            Backend::Separatrix(l) => l.curvature(t.clamp(0.0, 1.0)),
         }
     }
 
@@ -163,7 +168,7 @@ impl PlanarRod {
         }
     }
 
-    /// Elastic energy ½∫₀¹κ² = λ2/2 − a4 x(1) − a5 y(1), λ2 = a3² + 2a4 (FINDINGS §1), or
+    /// Elastic energy ½∫₀¹κ² = λ2/2 − a4 x(1) − a5 y(1), λ2 = a3² + 2a4 (docs/math.md §1), or
     /// integrated along the series where that identity cancels (see `closed_energy`).
     /// May be +∞ when a3² overflows (the free function [`energy`] reports that as an error).
     pub fn energy(&self) -> f64 {
@@ -172,6 +177,7 @@ impl PlanarRod {
             // ½∫κ² integrated along: the identity cancels for a nearly straight rod under force.
             Backend::Series(r) => r.energy(),
             Backend::SmallAngle => small_angle::checked_energy(&self.a).unwrap_or(f64::INFINITY),
+            Backend::Separatrix(l) => l.energy(),
         }
     }
 }

@@ -1,7 +1,7 @@
 //! The small-angle limit of the stability function g(t) for nearly straight rods (issue 23).
 //!
 //! A rod with little bending, σ = max(|a3|, |a5|) → 0 under a force a4 of any size, is a
-//! perturbation of the straight rod. Linearised (FINDINGS §1 with θ, a3 and a5 small):
+//! perturbation of the straight rod. Linearised (docs/math.md §1 with θ, a3 and a5 small):
 //!
 //! ```text
 //! θ'' = a4 θ − a5,  θ(0) = 0,  θ'(0) = a3   ⇒   θ = a3 S1 − a5 S2,   y = ∫θ = a3 S2 − a5 S3,
@@ -12,7 +12,7 @@
 //! straight rod. The entries of J(t) = ∂(x, y, θ)/∂(a3, a4, a5) follow: the θ and y rows to
 //! O(σ²) relative, the x row from ½∫θ² = ½(a3² I11 − 2 a3 a5 I12 + a5² I22), Iij = ∫Si Sj, to
 //! O(σ²) relative as well. det J(t) is a quadratic form in (a3, a5) at leading order, and
-//! g(t) = det J(t)/(t⁹(a3²/8640 + a5² t²/33600)) (FINDINGS §5) depends on (a3, a5) only
+//! g(t) = det J(t)/(t⁹(a3²/8640 + a5² t²/33600)) (docs/math.md §5) depends on (a3, a5) only
 //! through their ratio: this module gives that limit g₀(t), accurate relative to itself (every
 //! quantity is a positive series or a hyperbolic/trigonometric closed form, no difference of
 //! O(1) elliptic quantities), where the closed form's x row, a difference of O(1) terms, is
@@ -722,7 +722,7 @@ pub(crate) mod tests {
         }
     }
 
-    /// At t → 0 g → 1 by the normalisation (FINDINGS §5), for any ratio and force.
+    /// At t → 0 g → 1 by the normalisation (docs/math.md §5), for any ratio and force.
     #[test]
     fn leading_term_normalises_to_one() {
         for (a3, a4, a5) in [(1e-6, 20.0, 3e-7), (0.0, -20.0, 1e-5), (1e-5, 0.3, 0.0)] {

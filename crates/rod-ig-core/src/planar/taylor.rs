@@ -1,7 +1,7 @@
 //! Taylor-series integration of the planar rod: the better-conditioned formulation where the
 //! closed form loses accuracy (nearly straight, gently bent, tiny and strong-axial-force rods).
 //!
-//! The planar Kirchhoff equations (paper eq. 2.9 with the planar kinematics; FINDINGS §1) are
+//! The planar Kirchhoff equations (paper eq. 2.9 with the planar kinematics; docs/math.md §1) are
 //! polynomial once the base force is written in the world frame, μ4 = a4 cos θ + a5 sin θ,
 //! μ5 = a5 cos θ − a4 sin θ:
 //!

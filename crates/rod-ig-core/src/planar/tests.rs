@@ -462,7 +462,8 @@ fn compressed_rods_answer_by_the_pendulum() {
 /// estimate sent them to the double-double series and whose phase-aware one lets the closed
 /// form answer (328 of 600). Their J is within that estimate of the tight double-double series
 /// (its own error, 1e-32·e^{√‖F‖}, is far below), and within 1e-8: measured ≤ 0.07 of the
-/// estimate. `evaluate` answers them with that J, the tip within 1e-12 and the energy within
+/// estimate. `evaluate` answers them with that J (or, for the barely bent ones, ρ ≤ 1e-7, the
+/// separatrix limit's, within the same estimate), the tip within 1e-12 and the energy within
 /// its tolerance.
 #[test]
 fn separatrix_phase_estimate_holds() {
@@ -497,7 +498,17 @@ fn separatrix_phase_estimate_holds() {
         worst = worst.max(err / end);
         // The public answer: the closed form's J, its tip and an energy within tolerance.
         let e = evaluate(&a).expect("answered");
-        assert_eq!(e.jacobian, j, "{a:?}");
+        if super::soliton::Lattice::new(a3, a4, a5).is_some() {
+            // Barely bent (ρ ≤ 1e-7): the separatrix limit answers (`tests/tension.rs`),
+            // closer to the reference than this estimate.
+            let err = (e.jacobian - j_ref).norm() / j_ref.norm();
+            assert!(
+                err <= end,
+                "{a:?}: the separatrix limit's J {err:e} > {end:e}"
+            );
+        } else {
+            assert_eq!(e.jacobian, j, "{a:?}");
+        }
         let dtip = (e.tip.x - tip_ref.x)
             .abs()
             .max((e.tip.y - tip_ref.y).abs())

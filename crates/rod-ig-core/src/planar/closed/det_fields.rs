@@ -3,7 +3,7 @@
 //! The rod of parameters (φ, r, p) (base phase, scale, modulus: p = k = √m in case I, p = m in
 //! case II) is a piece of one canonical elastica P(s) = (X, Y, Θ)(s) of unit scale, taken from
 //! s = φ to s = Γ = φ + r t, moved so that its base is the identity and shrunk by 1/r:
-//! q(t) = (R(−Θ(φ))(p(Γ) − p(φ))/r, Θ(Γ) − Θ(φ)) (FINDINGS §1–3; the sign ε is a mirror image
+//! q(t) = (R(−Θ(φ))(p(Γ) − p(φ))/r, Θ(Γ) − Θ(φ)) (docs/math.md §1–3; the sign ε is a mirror image
 //! (x, y, θ) ↦ (x, −y, −θ) with a ↦ (−a3, a4, −a5), which leaves det J unchanged). Its
 //! derivatives along φ and r are written with P′ = (cos Θ, sin Θ, κ̂) alone, and along p with
 //! ∂/∂m of the Jacobi functions at fixed argument (A = ∂am/∂m, the formulas of

@@ -1,4 +1,4 @@
-//! The closed form's a-priori error estimates (FINDINGS §4): where its pose and J are within
+//! The closed form's a-priori error estimates (docs/math.md §4): where its pose and J are within
 //! their bounds, and which series takes over where they are not.
 
 use super::*;
@@ -276,7 +276,7 @@ impl<T: Real> Closed<T> {
     /// exceeds it (near the separatrix by 2/√m1, at small m by 1/m, on gently bent rods by
     /// 1/ρ³), at small m (1e-6 > m: near-straight rods under compression, near-circles above
     /// the small-force switch) and in case III with |Γ| > 8 somewhere on [0, 1]; the
-    /// dispatcher then asks the other formulations (FINDINGS §4: "fall back to an ODE"),
+    /// dispatcher then asks the other formulations (docs/math.md §4: "fall back to an ODE"),
     /// unless max(a3², |a4|, |a5|) > 1e6.
     ///
     /// Why (and how) the closed form must be replaced by the series: near the separatrix the

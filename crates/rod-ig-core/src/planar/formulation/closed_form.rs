@@ -1,5 +1,5 @@
-//! The closed form (FINDINGS §1–§3) as a formulation: its answers where its a-priori error
-//! estimate holds, and the energy by the identity of FINDINGS §1 or by ζ where their bounds do.
+//! The closed form (docs/math.md §1–§3) as a formulation: its answers where its a-priori error
+//! estimate holds, and the energy by the identity of docs/math.md §1 or by ζ where their bounds do.
 
 use super::super::closed::{Case, Closed, SeriesNeed, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F};
 use super::super::shape::Backend;
@@ -70,7 +70,7 @@ impl Formulation for ClosedForm<'_, f64> {
             PlanarRod::from_parts(self.a, self.c.case, backend, self.c.pose(1.0))
         })
     }
-    /// q(1) (FINDINGS §1–§3), where the estimate holds. Built without the phase, the tip is
+    /// q(1) (docs/math.md §1–§3), where the estimate holds. Built without the phase, the tip is
     /// placed by the addition theorems (~18 % of q(1)); it may differ from the evaluation's in
     /// the last bits, both within the closed form's pose bound.
     fn tip(&self) -> Answer<PlanarPose> {
@@ -118,7 +118,7 @@ impl Formulation for ClosedForm<'_, Dual3> {
     }
 }
 
-/// λ2/2 − a4 x(1) − a5 y(1) with λ2 = a3² + 2a4 (FINDINGS §1).
+/// λ2/2 − a4 x(1) − a5 y(1) with λ2 = a3² + 2a4 (docs/math.md §1).
 pub(crate) fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
     let (a3, a4, a5) = (a[0], a[1], a[2]);
     0.5 * a3 * a3 + a4 - a4 * tip.x - a5 * tip.y
@@ -133,7 +133,7 @@ pub(crate) const ENERGY_REL_TOLERANCE: f64 = 1e-9;
 /// .jsonl) and the double-double series (`zeta_energy_meets_its_bound`), ×3.
 pub(crate) const ZETA_ENERGY_ULPS: f64 = 32.0;
 
-/// The energy by the identity λ2/2 − a4 x − a5 y of FINDINGS §1 where its error bound allows,
+/// The energy by the identity λ2/2 − a4 x − a5 y of docs/math.md §1 where its error bound allows,
 /// else None. The identity subtracts a4·x + a5·y from λ2/2, both ≈ ‖F‖ on a nearly straight
 /// rod under force, whose energy is orders of magnitude smaller: its error is (|a4| + |a5|)
 /// times the pose error ([`Closed::pose_abs_error`]) plus the rounding of the sum.

@@ -1,4 +1,4 @@
-//! The ill-conditioned rods by the separatrix (FINDINGS §4): the closed form in double-double,
+//! The ill-conditioned rods by the separatrix (docs/math.md §4): the closed form in double-double,
 //! the f64 and double-double series, and their cross-check beyond what either certifies alone.
 
 use super::super::closed::{Closed, SERIES_DD_MAX_ROOT_F};

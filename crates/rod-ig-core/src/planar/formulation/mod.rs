@@ -6,6 +6,7 @@
 //!
 //! | formulation | module | answers |
 //! | --- | --- | --- |
+//! | [`SeparatrixLimit`] | `separatrix_limit` | a barely bent rod under a strong force (ρ ≤ 1e-7): every quantity from its soliton lattice, exact where 1 − k² underflows |
 //! | [`FullEvaluation`] | `full` (here) | beyond ‖(a4, a5)‖ = 625: every quantity from one full evaluation |
 //! | [`ClosedForm`] | `closed_form` | where the closed form's error estimate holds (J to 1e-8); the verdict where a theorem or det J(1) decides |
 //! | [`ClosedScan`] | `closed_form` | the stability scans on the closed form, after the small-angle expansion's |
@@ -23,6 +24,7 @@ use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport}
 
 mod closed_form;
 mod ill_conditioned;
+mod separatrix_limit;
 mod series;
 mod small_angle;
 
@@ -32,6 +34,7 @@ pub(crate) use closed_form::{SUBSTEP_J_TOLERANCE, ZETA_ENERGY_ULPS};
 #[cfg(test)]
 pub(crate) use ill_conditioned::ill_conditioned_tip;
 pub(crate) use ill_conditioned::{IllConditioned, CROSS_CHECK_J, CROSS_CHECK_TIP};
+pub(crate) use separatrix_limit::SeparatrixLimit;
 pub(crate) use series::Series;
 pub(crate) use small_angle::SmallAngle;
 
@@ -66,7 +69,7 @@ pub(crate) trait Formulation {
     fn energy(&self) -> Answer<f64> {
         None
     }
-    /// The stability report (FINDINGS §5): the scan over this formulation's det J(t), or the
+    /// The stability report (docs/math.md §5): the scan over this formulation's det J(t), or the
     /// theorem that decides.
     fn stability(&self) -> Answer<StabilityReport> {
         None
@@ -142,7 +145,7 @@ pub(crate) struct Rod<'c> {
     pub(crate) closed: Option<&'c Closed<Dual3>>,
     /// What the closed form said at t = 1.
     pub(crate) need: Need,
-    /// The closed form's case (FINDINGS §2), where one was built.
+    /// The closed form's case (docs/math.md §2), where one was built.
     pub(crate) case: Option<Case>,
     /// Whether a series standing in for the closed form must be the double-double one
     /// ([`Closed::needs_precise_series`]; false without a closed form).

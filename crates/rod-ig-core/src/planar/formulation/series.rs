@@ -1,4 +1,4 @@
-//! The Taylor series (FINDINGS §4's fallback) as a formulation: gently bent rods, closed forms
+//! The Taylor series (docs/math.md §4's fallback) as a formulation: gently bent rods, closed forms
 //! that overflow, and rods whose closed-form J cancels.
 
 use super::super::closed::Closed;

@@ -1,11 +1,11 @@
 //! The stability scan of the heavy planar rod: det J(t) as a polynomial on every step of the
 //! series, its sign on [`crate::STABILITY_T_MIN`, 1] and its normalised minimum on [0.05, 1].
 //!
-//! Rule (FINDINGS §5, generalised Jacobi condition with a distributed load: Borum & Bretl
+//! Rule (docs/math.md §5, generalised Jacobi condition with a distributed load: Borum & Bretl
 //! 2014; Till & Rucker 2017): stable ⇔ det J(t) > 0 on (0, 1]. Near the base
 //! det J(t) = D0(t)(1 + O(t)) > 0 with
 //! D0(t) = t⁹ (a3²/8640 + a5² t²/33600 + (w ĝ_y)² t⁴/388800)
-//! (the leading terms of the weightless rod, FINDINGS §5, plus the one gravity across the rod
+//! (the leading terms of the weightless rod, docs/math.md §5, plus the one gravity across the rod
 //! adds, which is the only one left when a3 = a5 = 0: det J ~ t¹³), so the scan starts at
 //! t = 0.02 where f64 resolves det J, and the margin is min over t ∈ [0.05, 1] of
 //! g(t) = det J(t) / D0(t) (the normalisation of `shared/oracle/gravity_public.jsonl`).
@@ -18,7 +18,7 @@ const N: usize = ORDER + 1;
 /// oscillates at most once or twice, so 16 samples bracket every dip the grid of the
 /// reference (2,000 points) would see.
 const SAMPLES: usize = 16;
-/// Smallest t of the margin (FINDINGS §5).
+/// Smallest t of the margin (docs/math.md §5).
 pub(crate) const MARGIN_T_MIN: f64 = 0.05;
 /// Relative error of an entry of J per integration step, measured against DOP853 at rtol
 /// 1e-13 (worst 3e-14 over the tests' families) with a factor 10 of headroom.

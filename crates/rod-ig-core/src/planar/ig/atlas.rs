@@ -4,7 +4,7 @@
 //! Built once per process, lazily and in deadline-bounded steps ([`get`]), from rays of the weighted scaling
 //! a(s) = (s a3, s² a4, s² a5): the rod a restricted to [0, s] and rescaled to unit length is
 //! the rod a(s), so its tip is (x(s)/s, y(s)/s, θ(s)) and it is stable iff det J(τ, a) > 0 for
-//! τ ≤ s (FINDINGS §5). One RK4 integration of a ray end-point with its variational equations
+//! τ ≤ s (docs/math.md §5). One RK4 integration of a ray end-point with its variational equations
 //! therefore yields a whole family of stable rods and their tips, up to the first conjugate
 //! point. The ray end-points are a low-discrepancy (Halton) sample of a box somewhat larger than
 //! the public box |a3| ≤ 10, |a4|, |a5| ≤ 100.
@@ -177,7 +177,7 @@ pub(crate) fn same_branch(a: &[f64; 3], b: &[f64; 3]) -> bool {
     (a[0] - b[0]).abs() / 2.0 + (a[1] - b[1]).abs() / 20.0 + (a[2] - b[2]).abs() / 20.0 < 1.0
 }
 
-/// A ray end-point near the separatrix λ4 = a5² − a3²(a3²/4 + a4) = 0 (FINDINGS §1–2:
+/// A ray end-point near the separatrix λ4 = a5² − a3²(a3²/4 + a4) = 0 (docs/math.md §1–2:
 /// the boundary between cases I and II, where m → 1 and the tip depends on a so sharply that
 /// uniform sampling leaves its neighbourhood without seeds). λ4 scales as s⁴ along a ray, so the
 /// whole ray stays at the same relative offset from the separatrix. Offsets are log-uniform.

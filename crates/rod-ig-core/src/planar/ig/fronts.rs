@@ -3,7 +3,7 @@
 //! at the tip. There Υ depends exponentially on a3 (the front's position is ln(1/a3)/√a4), so
 //! atlas seeds, which stop near |a4| ≈ 150, are almost never in Newton's basin.
 //!
-//! Model. With a5 = 0 the rod equation θ'' = a4 sin θ (FINDINGS §1, κ' = a4 sin θ − a5 cos θ)
+//! Model. With a5 = 0 the rod equation θ'' = a4 sin θ (docs/math.md §1, κ' = a4 sin θ − a5 cos θ)
 //! is a pendulum about its unstable point θ = 0; for small a3 the solution stays near the
 //! separatrix, where every turn is the soliton θ(t) = 4 atan(e^{k (t − c)}), k = √a4, and
 //! θ' = 2k sin(θ/2). Integrating x' = cos θ, y' = sin θ through a turn gives (exact on the

@@ -8,7 +8,7 @@
 //!   can only enter (0, 1] through t = 1 (the index of the second variation changes only when
 //!   det J(1, a) = 0), so the sign of det J(1, a) — free with the Jacobian — is the cheap guard
 //!   that keeps short steps inside the stable set A_stable (paper §3.1). The full test of
-//!   FINDINGS §5 is applied to the converged point by the caller.
+//!   docs/math.md §5 is applied to the converged point by the caller.
 //!
 //! The weighted scaling a ↦ (s a3, s² a4, s² a5) maps the rod on [0, s] to the unit rod, so
 //! det J(t, a(s)) has the sign of det J(s t, a): scaling by s < t₁ (the first conjugate time)
@@ -281,7 +281,7 @@ fn run(
 }
 
 /// Brings `a` into the stable set by the weighted scaling a ↦ (s a3, s² a4, s² a5) with
-/// s = 0.9 t₁, t₁ the first conjugate time of `a` (FINDINGS §5 rule on an RK4 scan).
+/// s = 0.9 t₁, t₁ the first conjugate time of `a` (docs/math.md §5 rule on an RK4 scan).
 /// Returns `a` unchanged when it is already stable, `None` when the scan fails.
 pub(crate) fn pull_into_stable(a: &PlanarParams) -> Option<PlanarParams> {
     let s = scan::scan(a, scan::steps_for(a, 8.0))?;

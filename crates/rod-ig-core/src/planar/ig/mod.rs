@@ -5,7 +5,7 @@
 //! Two methods:
 //! - [`Method::Newton`], the paper's method (§3.1, eq. 3.1): a_{k+1} = a_k − α J(1, a_k)⁻¹ f(a_k)
 //!   with f(a) = Υ(a) − b (angle wrapped), fixed step length α, from a given a0, at most N
-//!   iterations, and the FINDINGS §8 protocol: an iterate fails as soon as it is unstable.
+//!   iterations, and the docs/math.md §8 protocol: an iterate fails as soon as it is unstable.
 //! - [`Method::Robust`] (default): a globalised Newton (backtracking on ‖f‖, Levenberg–Marquardt
 //!   steps when the Newton direction fails; steps that make det J(1, a) non-positive are
 //!   rejected, since the stable set can only be left through det J(1, a) = 0), multi-started
@@ -13,7 +13,7 @@
 //!   first step is free), with small-angle starts for targets near full extension and a final
 //!   polishing of the best iterate; where that fails, Newton from a second atlas of the rods
 //!   beyond the box (|a3| ≤ 36, |a4|, |a5| ≤ 300), then the branches of the seeds nearest the
-//!   target followed to it ([`BRANCH_STEPS`]). The stability test (FINDINGS §5) is applied to
+//!   target followed to it ([`BRANCH_STEPS`]). The stability test (docs/math.md §5) is applied to
 //!   every solution before it is returned. The caller's initial guess goes first when its
 //!   residual is no larger than the nearest seed's (it then selects the solution branch). A
 //!   failure says what was searched ([`IgError::SearchExhausted`]).
@@ -60,9 +60,9 @@ pub use crate::planar::model::check_target;
 /// Solves the planar inverse geometry for `target` with the closed forms: shorthand for
 /// [`crate::solver::solve`] on [`PlanarClosedForm`].
 ///
-/// With [`Method::Robust`] every returned solution is stable (checked by the FINDINGS §5 test)
+/// With [`Method::Robust`] every returned solution is stable (checked by the docs/math.md §5 test)
 /// and within `tolerance` of the target in position and in wrapped angle.
-/// With [`Method::Newton`] this is the paper's fixed-step Newton (§3.1) under the FINDINGS §8
+/// With [`Method::Newton`] this is the paper's fixed-step Newton (§3.1) under the docs/math.md §8
 /// protocol; its result is stable too, since every iterate is tested.
 pub fn solve(target: &PlanarPose, options: &SolveOptions) -> Result<Solution, Failure> {
     crate::solver::solve(&PlanarClosedForm, target, options)

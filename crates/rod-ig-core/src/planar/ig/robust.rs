@@ -1,6 +1,6 @@
 //! The robust solver: globalised Newton ([`super::local`]) multi-started from the initial guess
 //! (brought into the stable set by weighted scaling if needed) and from the atlas entries nearest
-//! the target; every converged point is checked with the stability test (FINDINGS §5) before it
+//! the target; every converged point is checked with the stability test (docs/math.md §5) before it
 //! is returned.
 //!
 //! Stages, each run only when the ones before found nothing: the box stage (the guess, the

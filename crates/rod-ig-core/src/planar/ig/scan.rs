@@ -1,13 +1,13 @@
 //! A fast stability pre-scan by fixed-step RK4 on the planar rod and its variational equations.
 //!
-//! The planar Kirchhoff rod (paper eq. 2.9, FINDINGS §1) reduces to a forced pendulum in the
+//! The planar Kirchhoff rod (paper eq. 2.9, docs/math.md §1) reduces to a forced pendulum in the
 //! tangent angle: θ' = κ, κ' = μ3' = −μ5 = a4 sin θ − a5 cos θ, x' = cos θ, y' = sin θ, with
 //! θ(0) = 0, κ(0) = a3. Its variational equations give J(t, a) = ∂(x, y, θ)(t)/∂(a3, a4, a5)
 //! at every step, hence det J(t) on the whole step grid at the cost of one integration.
 //!
 //! This is used where the solver needs many stability verdicts cheaply (the atlas build and
 //! the trust-region iterations); the final verdict on a returned solution comes from the
-//! closed-form test (`planar::stability`, FINDINGS §5) whenever this scan is not conclusive.
+//! closed-form test (`planar::stability`, docs/math.md §5) whenever this scan is not conclusive.
 //! cos θ and sin θ are integrated as a unit vector (renormalised after every step) so that the
 //! right-hand side needs no transcendental function.
 
@@ -66,7 +66,7 @@ pub(crate) struct Scan {
     pub first_conjugate_t: Option<f64>,
 }
 
-/// Smallest t at which the sign of det J(t) is trusted (FINDINGS §5: below ~0.02 rounding
+/// Smallest t at which the sign of det J(t) is trusted (docs/math.md §5: below ~0.02 rounding
 /// swamps det J, and a conjugate point that early needs |a| far outside any practical range).
 const T_MIN: f64 = crate::STABILITY_T_MIN;
 
@@ -147,7 +147,7 @@ where
 }
 
 /// Integrates the rod and its variational equations over [0, 1] with `n` RK4 steps, checking
-/// the sign of det J(t) at every step t ≥ 0.02 (FINDINGS §5 rule), stopping at the first
+/// the sign of det J(t) at every step t ≥ 0.02 (docs/math.md §5 rule), stopping at the first
 /// non-positive value. Returns `None` on non-finite input or values.
 pub(crate) fn scan(a: &PlanarParams, n: usize) -> Option<Scan> {
     let mut first_conjugate_t = None;
@@ -181,7 +181,7 @@ mod tests {
 
     #[test]
     fn euler_load() {
-        // FINDINGS §5: (0, −40, 1) loses stability at t = 0.9935.
+        // docs/math.md §5: (0, −40, 1) loses stability at t = 0.9935.
         let s = scan(&PlanarParams::new(0.0, -40.0, 1.0), 400).unwrap();
         assert!(!s.stable);
         let s = scan(&PlanarParams::new(0.0, -38.0, 1.0), 400).unwrap();

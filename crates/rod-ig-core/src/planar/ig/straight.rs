@@ -2,7 +2,7 @@
 //! rods: gently bent ones with little force, and rods under strong tension near the separatrix
 //! λ4 = 0, where Υ is so anisotropic that atlas seeds rarely fall in Newton's basin.
 //!
-//! Small-angle model of the rod equation θ'' = κ' = a4 sin θ − a5 cos θ (FINDINGS §1) about the
+//! Small-angle model of the rod equation θ'' = κ' = a4 sin θ − a5 cos θ (docs/math.md §1) about the
 //! straight rod: θ'' = T θ − a5 with T = a4, θ(0) = 0, θ'(0) = a3, solved by
 //!
 //! θ(t) = a3 S(t) − a5 C(t),  S = sinh(kt)/k, C = (cosh(kt) − 1)/k² for T = k² ≥ 0

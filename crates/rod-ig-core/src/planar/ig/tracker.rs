@@ -13,7 +13,7 @@ use crate::planar::model::{self as model, solve3};
 use crate::{wrap_angle, PlanarJacobian, PlanarParams, PlanarPose};
 use nalgebra::Vector3;
 
-/// Warm-started solver for a stream of targets. Every returned solution is stable (FINDINGS §5
+/// Warm-started solver for a stream of targets. Every returned solution is stable (docs/math.md §5
 /// test) and within the tolerance of its target.
 #[derive(Clone, Debug)]
 pub struct Tracker {

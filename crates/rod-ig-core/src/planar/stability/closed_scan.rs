@@ -1,9 +1,9 @@
-//! Stability scans on the closed form (FINDINGS §5), with the short series, the small-m
+//! Stability scans on the closed form (docs/math.md §5), with the short series, the small-m
 //! scan and the margin certification where its own error estimate fails.
 
 use super::*;
 
-/// Stability on the closed form (FINDINGS §5), with the series where the closed form's own
+/// Stability on the closed form (docs/math.md §5), with the series where the closed form's own
 /// error estimate fails.
 pub(crate) fn stability_of(
     c: &Closed<Dual3>,
@@ -679,7 +679,7 @@ pub(super) fn normalised_det_value(c: &Closed<Dual3>, a3: f64, a5: f64, t: f64) 
 /// conjugate point, so only margins are at stake.
 pub(super) const COLUMN_WISE_MAX_M: f64 = 0.01;
 
-/// g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (FINDINGS §5) and its error bound, from the
+/// g(t) = det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (docs/math.md §5) and its error bound, from the
 /// dual-number closed form. Each entry of J(t) is off by at most rel·|entry| + 64ε (rel =
 /// [`Closed::jacobian_rel_error_at`]), or on a near-circle (case II, m <
 /// [`COLUMN_WISE_MAX_M`]) by rel·‖its column‖ + 64ε: a column is the derivative along one
@@ -770,7 +770,7 @@ pub(super) fn plain_closed_scan(c: &Closed<Dual3>, a: &PlanarParams) -> bool {
 
 /// True where g(1) < 0 beyond [`END_UNSTABLE_BOUNDS`] times its error bound (on a rod of the
 /// plain scan, with the bound that scan uses): g → 1 as t → 0 (det J ~ t⁹(a3²/8640 +
-/// a5²t²/33600) > 0 off the straight rod, FINDINGS §5), so det J vanishes somewhere on
+/// a5²t²/33600) > 0 off the straight rod, docs/math.md §5), so det J vanishes somewhere on
 /// (0, 1), a conjugate point.
 pub(super) fn unstable_at_the_end(c: &Closed<Dual3>, a: &PlanarParams) -> bool {
     let (g, bound) = normalised_det(c, a[0], a[2], 1.0, false);

@@ -1,4 +1,4 @@
-//! Fast stability test on the closed form (FINDINGS §5).
+//! Fast stability test on the closed form (docs/math.md §5).
 
 use super::closed::{Case, Closed, DetFrame, SeriesNeed};
 use super::small_angle;
@@ -10,6 +10,7 @@ use crate::types::{det3, det_and_error, det_and_error_by_column};
 use crate::{PlanarParams, RodError, StabilityReport, StabilityVerdict};
 
 mod closed_scan;
+mod lattice_scan;
 mod scan;
 mod series;
 mod small_angle_scan;
@@ -17,14 +18,15 @@ mod small_angle_scan;
 mod tests;
 
 pub(crate) use closed_scan::*;
+pub(crate) use lattice_scan::lattice_report;
 use scan::*;
 pub(crate) use series::*;
 pub(crate) use small_angle_scan::*;
 
 /// Below this t the closed-form det J is dominated by rounding; it is positive there by its
-/// leading term (FINDINGS §5).
+/// leading term (docs/math.md §5).
 const T_MIN: f64 = crate::STABILITY_T_MIN;
-/// Smallest t entering the margin `det_min` (FINDINGS §5).
+/// Smallest t entering the margin `det_min` (docs/math.md §5).
 const T_MARGIN: f64 = 0.05;
 /// First t of the scan on the Taylor series. Its J entries are accurate relative to
 /// themselves, so det J ≈ t⁹·(…) is resolved down to small t (the cofactor terms are O(t⁸) and

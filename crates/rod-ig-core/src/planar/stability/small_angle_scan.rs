@@ -58,7 +58,7 @@ pub(super) fn small_angle_prefix(a: &PlanarParams, t: f64) -> Option<(f64, f64, 
     (g0.is_finite() && bound.is_finite()).then_some((g0, bound, slope))
 }
 
-/// Stability of a nearly straight rod from the small-angle limit g₀ of g (FINDINGS §5 on the
+/// Stability of a nearly straight rod from the small-angle limit g₀ of g (docs/math.md §5 on the
 /// linearised straight rod, [`small_angle`]), where its truncation C·Θ² is below
 /// [`SMALL_ANGLE_MAX_TRUNCATION`] and its rounding below [`SMALL_ANGLE_MAX_ROUNDING`]: no
 /// elliptic function, no series (the closed form's x row is swamped by rounding there, the

@@ -1,0 +1,96 @@
+//! The separatrix limit in log form ([`crate::planar::soliton`]): a barely bent rod under a
+//! strong force, every quantity from its lattice of solitons.
+
+use super::super::soliton::{self, Lattice};
+use super::super::taylor::pose_jac_from;
+use super::super::{shape::case_without_closed, shape::Backend, stability, PlanarRod};
+use super::{finite_tip, full_accuracy, Answer, Evaluation, Formulation, Precision};
+use crate::scalar::Dual3;
+use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
+
+/// The rod in the separatrix limit: asked before the closed form, whose phase is lost there
+/// (1 − k² ≈ ρ² underflows).
+pub(crate) struct SeparatrixLimit<'a> {
+    a: &'a PlanarParams,
+    lattice: Lattice<f64>,
+}
+
+impl<'a> SeparatrixLimit<'a> {
+    /// The rod a if it is in the lattice's domain (a few comparisons for the rods that are not).
+    #[inline]
+    pub(crate) fn of(a: &'a PlanarParams) -> Option<Self> {
+        if !soliton::may_apply(a[0], a[1], a[2]) {
+            return None;
+        }
+        Self::build(a)
+    }
+
+    #[cold]
+    fn build(a: &'a PlanarParams) -> Option<Self> {
+        let lattice = Lattice::new(a[0], a[1], a[2])?;
+        Some(SeparatrixLimit { a, lattice })
+    }
+
+    fn dual(&self) -> Option<Lattice<Dual3>> {
+        let a = self.a;
+        Lattice::new(
+            Dual3::variable(a[0], 0),
+            Dual3::variable(a[1], 1),
+            Dual3::variable(a[2], 2),
+        )
+    }
+
+    fn pose_and_jacobian_at(&self, t: f64) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+        let lattice = self.dual().ok_or_else(super::super::overflow)?;
+        pose_jac_from(lattice.pose(t.clamp(0.0, 1.0)))
+    }
+
+    fn finite_energy(&self) -> Result<f64, RodError> {
+        let e = self.lattice.energy();
+        if e.is_finite() {
+            Ok(e)
+        } else {
+            Err(super::super::overflow())
+        }
+    }
+
+    fn report(&self) -> Result<StabilityReport, RodError> {
+        stability::lattice_report(self.a).unwrap_or_else(|| Err(super::super::overflow()))
+    }
+}
+
+impl Formulation for SeparatrixLimit<'_> {
+    fn tip(&self) -> Answer<PlanarPose> {
+        Some(finite_tip(self.lattice.pose(1.0)))
+    }
+    fn pose_and_jacobian(&self, t: f64, _: Precision) -> Answer<(PlanarPose, PlanarJacobian)> {
+        Some(self.pose_and_jacobian_at(t))
+    }
+    fn energy(&self) -> Answer<f64> {
+        Some(self.finite_energy())
+    }
+    fn stability(&self) -> Answer<StabilityReport> {
+        Some(self.report())
+    }
+    fn evaluate(&self) -> Answer<Evaluation> {
+        Some((|| {
+            let (tip, jacobian) = self.pose_and_jacobian_at(1.0)?;
+            Ok(full_accuracy(
+                tip,
+                jacobian,
+                self.finite_energy()?,
+                self.report()?,
+            ))
+        })())
+    }
+    fn shape(&self) -> Answer<PlanarRod> {
+        let a = self.a;
+        let tip = self.lattice.pose(1.0);
+        Some(PlanarRod::from_parts(
+            a,
+            case_without_closed(a),
+            Backend::Separatrix(self.lattice),
+            tip,
+        ))
+    }
+}
