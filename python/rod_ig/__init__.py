@@ -143,7 +143,7 @@ class ForwardResult:
     jacobian: FloatArray
     """(..., 3, 3): J(1, a), rows x, y, theta; columns a3, a4, a5."""
     stable: BoolArray
-    """(...): the rod is a stable equilibrium (FINDINGS section 5 test)."""
+    """(...): the rod is a stable equilibrium (docs/math.md §5 test)."""
     margin: FloatArray
     """(...): normalised stability margin g_min (about 1 for a gently bent rod, < 0 unstable)."""
     uncertain: BoolArray
@@ -341,7 +341,7 @@ def forward3d(
     weight: npt.ArrayLike | None = None,
     gravity: npt.ArrayLike | None = None,
 ) -> Forward3dResult:
-    """3-D forward map of rods ``a`` (..., 6) by numerical integration (FINDINGS3D), with
+    """3-D forward map of rods ``a`` (..., 6) by numerical integration (docs/math.md §10), with
     stiffness (c1 torsion, c2, c3 bending) each in [1e-6, 1e6]. ``weight`` and ``gravity``
     ((..., 3), default (0, 0, -1)) broadcast against the batch: the 3-D rod with weight."""
     arr, _ = _batch("a", a, 6)

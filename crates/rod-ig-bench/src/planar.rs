@@ -35,7 +35,7 @@ impl ParamBox {
         a3_max: std::f64::consts::TAU,
         a45_max: 100.0,
     };
-    /// The public oracle box |a3| ≤ 10, |a4|, |a5| ≤ 100 (FINDINGS §7).
+    /// The public oracle box |a3| ≤ 10, |a4|, |a5| ≤ 100 (docs/math.md §7).
     pub const PUBLIC: ParamBox = ParamBox {
         a3_max: 10.0,
         a45_max: 100.0,
@@ -149,7 +149,7 @@ pub fn log_scale_component(r: &mut rod_ig_core::rng::SplitMix64, max: f64) -> f6
     }
 }
 
-/// Independent re-check of a returned solution: stable by the stability test (FINDINGS §5)
+/// Independent re-check of a returned solution: stable by the stability test (docs/math.md §5)
 /// and Υ(a) within `tolerance` of the target (position and wrapped angle).
 pub fn verify(target: &PlanarPose, a: &PlanarParams, tolerance: f64) -> bool {
     let Ok((tip, _)) = planar::tip_and_jacobian(a) else {

@@ -5,7 +5,7 @@ use rod_ig_core::solver::{self, observe, Counters, IgError, SolveOptions};
 use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
 
-/// Half-widths of the random-target box: |a1..3| ≤ 5, |a4..6| ≤ 30 (FINDINGS3D: ≈ 70 % stable,
+/// Half-widths of the random-target box: |a1..3| ≤ 5, |a4..6| ≤ 30 (docs/math.md §10: ≈ 70 % stable,
 /// straddles the Euler load 4π² and the twist limit 8.99).
 pub const TARGET_BOX: (f64, f64) = (5.0, 30.0);
 

@@ -13,7 +13,7 @@ use std::path::Path;
 /// The paper's fixed RK4 step (the baseline of its speed claim).
 pub const RK4_STEP: f64 = 1e-4;
 
-/// Random parameters in the public test box a3 ∈ [−10, 10], a4, a5 ∈ [−100, 100] (FINDINGS §7).
+/// Random parameters in the public test box a3 ∈ [−10, 10], a4, a5 ∈ [−100, 100] (docs/math.md §7).
 pub fn sample_box(n: usize, seed: u64) -> Vec<PlanarParams> {
     let mut rng = SplitMix64::new(seed);
     (0..n)
@@ -132,8 +132,8 @@ const PAPER_TABLE1: [(f64, f64, f64, f64); 6] = [
     (0.3, 97.3, 361.7, 41.6),
     (0.2, 97.4, 564.8, 64.9),
 ];
-/// The independent reference of FINDINGS §8 on ig_public.jsonl (success %, iterations).
-const FINDINGS_TABLE1: [(f64, f64); 6] = [
+/// The independent reference of docs/math.md §8 on ig_public.jsonl (success %, iterations).
+const REFERENCE_TABLE1: [(f64, f64); 6] = [
     (34.7, 7.6),
     (38.4, 9.8),
     (46.9, 14.7),
@@ -219,7 +219,7 @@ pub fn inverse_geometry(quick: bool, cases_path: &Path) {
             );
             let alphas: Vec<f64> = PAPER_TABLE1.iter().map(|r| r.0).collect();
             let rows = ig_bench::table1(&cases, &alphas, 100, 1e-6);
-            for ((row, paper), reference) in rows.iter().zip(PAPER_TABLE1).zip(FINDINGS_TABLE1) {
+            for ((row, paper), reference) in rows.iter().zip(PAPER_TABLE1).zip(REFERENCE_TABLE1) {
                 outln!(
                     "{:>5.1} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>8.1} {:>9.2} {:>9.2} | {:>9.1} {:>9.1} | {:>9.1} {:>8.1} {:>9.1}",
                     row.alpha, row.success_pct, row.instability_pct, row.max_iterations_pct,
@@ -227,7 +227,7 @@ pub fn inverse_geometry(quick: bool, cases_path: &Path) {
                     reference.0, reference.1, paper.1, paper.3, paper.2
                 );
             }
-            outln!("(ref = the independent reference of FINDINGS §8 on this file; paper = its Table 1, on its own unstated box and test)");
+            outln!("(ref = the independent reference of docs/math.md §8 on this file; paper = its Table 1, on its own unstated box and test)");
             outln!();
             robust_header();
             robust_row(&ig_bench::robust_from_starts(&cases, &options));

@@ -34,7 +34,7 @@ struct ForwardAnswer {
     jacobian: [[f64; 3]; 3],
     stable: bool,
     energy: f64,
-    /// Normalised g_min of FINDINGS §5 (≈ 1 for a gently bent rod).
+    /// Normalised g_min of docs/math.md §5 (≈ 1 for a gently bent rod).
     stability_margin: f64,
     /// The margin is within its rounding-error bound: the verdict is undecided (`stable` is
     /// false then). Always true for the exactly straight rod.

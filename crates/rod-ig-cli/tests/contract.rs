@@ -29,7 +29,7 @@ fn forward_contract() {
     assert!((first["energy"].as_f64().unwrap() - 19.23665709368305).abs() < 1e-9);
     assert!(out[1]["error"].as_str().unwrap().contains("length 3"));
     assert!(out[2]["error"].is_string());
-    // Straight rod: singular J, classified unstable (FINDINGS §5).
+    // Straight rod: singular J, classified unstable (docs/math.md §5).
     assert_eq!(out[3]["stable"], false);
     assert_eq!(out[3]["tip"]["x"], 1.0);
 }
@@ -114,7 +114,7 @@ fn shape_svg_and_json() {
 
 #[test]
 fn forward3d_planar_subset_matches_forward() {
-    // (a1, a2, a6) = 0 is the planar rod (FINDINGS3D): same tip, rotation about z by θ.
+    // (a1, a2, a6) = 0 is the planar rod (docs/math.md §10): same tip, rotation about z by θ.
     let planar = run(&["forward"], "{\"a\": [2.5, -12.0, 7.0]}\n");
     let spatial = run(
         &["forward3d"],

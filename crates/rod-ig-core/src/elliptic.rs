@@ -1,12 +1,12 @@
 //! Jacobi elliptic functions and incomplete elliptic integrals, generic over [`Real`].
 //!
 //! Every function takes the parameter m **and** the complementary parameter m1 = 1 − m as two
-//! separate inputs (FINDINGS §4): near the separatrix m1 is computed by the caller from λ4
+//! separate inputs (docs/math.md §4): near the separatrix m1 is computed by the caller from λ4
 //! without cancellation, and nothing here ever forms 1 − m.
 //!
 //! * Jacobi sn, cn, dn and the continuous, unbounded amplitude am(u|m) by the descending
 //!   arithmetic–geometric mean (Landen) sequence started at b0 = √m1 (A&S 16.4), with
-//!   dn = √(m1 + m cn²) (FINDINGS §4). The same descent gives Jacobi's zeta function
+//!   dn = √(m1 + m cn²) (docs/math.md §4). The same descent gives Jacobi's zeta function
 //!   Z(u|m) = Σ cₙ sin φₙ (A&S 17.6), hence E(am u|m) = u E(m)/K(m) + Z(u|m) at no extra cost.
 //! * Carlson's symmetric integrals R_F and R_D by duplication (Carlson 1995), and with them the
 //!   Legendre integrals F(φ|m), E(φ|m) and D(φ|m) = (F − E)/m for any real φ, through
@@ -186,7 +186,7 @@ pub fn ellip_complete<T: Real>(m: T, m1: T) -> (T, T, T) {
 }
 
 /// Legendre integrals (F, E, D)(ψ|m) for |ψ| ≤ π/2 given s = sin ψ and c = cos ψ ≥ 0, with
-/// Δ² = c² + m1 s² (FINDINGS §4). F = s R_F(c², Δ², 1) (DLMF 19.25.5). For m ≤ ½:
+/// Δ² = c² + m1 s² (docs/math.md §4). F = s R_F(c², Δ², 1) (DLMF 19.25.5). For m ≤ ½:
 /// D = s³/3 R_D(c², Δ², 1), E = F − m D (DLMF 19.25.9). For m > ½, where F − mD cancels:
 /// E = m1 s R_F + (m m1/3) s³ R_D(c², 1, Δ²) + m s c/Δ (DLMF 19.25.10), D = (F − E)/m.
 #[inline]
@@ -227,13 +227,13 @@ pub fn ellip_f<T: Real>(phi: T, m: T, m1: T) -> T {
 }
 
 /// Incomplete integral of the second kind E(φ|m) for any real φ
-/// (E(φ + kπ|m) = E(φ|m) + 2kE(m), FINDINGS §3).
+/// (E(φ + kπ|m) = E(φ|m) + 2kE(m), docs/math.md §3).
 pub fn ellip_e<T: Real>(phi: T, m: T, m1: T) -> T {
     ellip_fed(phi, m, m1).1
 }
 
 /// D(φ|m) = (F − E)/m = ∫₀^φ sin²/Δ, for any real φ (D(φ + kπ) = D(φ) + 2kD(m)); free of the
-/// 1/m cancellation as m → 0 (FINDINGS §3, case II).
+/// 1/m cancellation as m → 0 (docs/math.md §3, case II).
 pub fn ellip_d<T: Real>(phi: T, m: T, m1: T) -> T {
     ellip_fed(phi, m, m1).2
 }
@@ -251,7 +251,7 @@ pub fn ellip_fed<T: Real>(phi: T, m: T, m1: T) -> (T, T, T) {
     (f + kk * (2.0 * k), e + ee * (2.0 * k), d + dd * (2.0 * k))
 }
 
-/// The phase inverse of FINDINGS §2: φ = F(ψ|m) with ψ = atan2(s, c) ∈ (−π, π], fed the pair
+/// The phase inverse of docs/math.md §2: φ = F(ψ|m) with ψ = atan2(s, c) ∈ (−π, π], fed the pair
 /// (s, c) ∝ (sin ψ, cos ψ) directly (not ψ), so that no precision is lost near ψ = ±π/2.
 ///
 /// `kk` must be K(m). Near |ψ| = π/2 it uses the complementary-amplitude identity
@@ -350,7 +350,7 @@ pub struct JacobiValues<T> {
     pub sn: T,
     /// cn(u|m).
     pub cn: T,
-    /// dn(u|m) = √(m1 + m cn²) (FINDINGS §4).
+    /// dn(u|m) = √(m1 + m cn²) (docs/math.md §4).
     pub dn: T,
     /// Continuous, unbounded amplitude am(u|m) (am(u + 2K) = am(u) + π).
     pub am: T,

@@ -10,7 +10,7 @@
 //!   built once per [`Planner`] and reused across queries;
 //! - **edges**: straight segments in a-space to the [`NEIGHBOURS`] nearest nodes, checked
 //!   **lazily** (only when a shortest path uses them): every rod on the segment at spacing
-//!   ≤ [`CHECK_SPACING`]·(1 + |a|) must be stable with margin ≥ [`MIN_MARGIN`] (FINDINGS §5,
+//!   ≤ [`CHECK_SPACING`]·(1 + |a|) must be stable with margin ≥ [`MIN_MARGIN`] (docs/math.md §5,
 //!   normalised g_min); stability results are kept across queries, collisions per query;
 //! - **query**: the start rod and every stable rod reaching the goal pose ([`solve_all`]) join
 //!   the roadmap; the direct segment start → goal rod is tried first; then A* over the roadmap,

@@ -1,7 +1,7 @@
 //! Scalars for the closed forms: the [`Real`] trait, implemented for `f64` and for the
 //! forward-mode dual number [`Dual3`] (value + gradient with respect to three inputs).
 //!
-//! The planar closed forms (FINDINGS §1–§3) are written once, generic over [`Real`]. Run with
+//! The planar closed forms (docs/math.md §1–§3) are written once, generic over [`Real`]. Run with
 //! `f64` they give the pose; run with [`Dual3`] seeded with the identity on a = (a3, a4, a5)
 //! they give the pose and its exact Jacobian J = ∂q/∂a in one pass (no finite differences).
 //! Branch decisions inside generic code are taken on [`Real::re`], the f64 value.

@@ -43,7 +43,7 @@ impl PlanarPose {
     }
 }
 
-/// Verdict of the stability test (Bretl & McCarthy 2014; FINDINGS §5): the rod is a stable
+/// Verdict of the stability test (Bretl & McCarthy 2014; docs/math.md §5): the rod is a stable
 /// equilibrium iff det J(t, a) > 0 for every t ∈ (0, 1].
 ///
 /// Three outcomes: stable (`stable`), unstable (neither flag), or `uncertain` — the margin is
@@ -59,7 +59,7 @@ pub struct StabilityReport {
     /// on (0, 1] (by an inflectional rod's third inflection point), false and certain.
     pub stable: bool,
     /// Normalised margin g_min = min over t ∈ [0.05, 1] of
-    /// g(t) = det J(t) / (t⁹ (a3²/8640 + a5² t²/33600)) (FINDINGS §5 `det_min`): scale-free,
+    /// g(t) = det J(t) / (t⁹ (a3²/8640 + a5² t²/33600)) (docs/math.md §5 `det_min`): scale-free,
     /// ≈ 1 for a gently bent rod, → 1 as t → 0; negative iff det J changes sign. 0 for the
     /// straight rod.
     pub margin: f64,
@@ -107,13 +107,13 @@ impl StabilityVerdict {
 
 pub use crate::angle::wrap_angle;
 
-/// Smallest t at which the sign of det J(t, a) is trusted by the stability tests (FINDINGS §5):
+/// Smallest t at which the sign of det J(t, a) is trusted by the stability tests (docs/math.md §5):
 /// det J(t) ~ t⁹ near the base, so below t ≈ 0.02 its absolute rounding error swamps it. Every
 /// stability test (closed form, series, RK4 scan, 3-D grid) starts here.
 pub const STABILITY_T_MIN: f64 = 0.02;
 
 /// The leading small-t term of det J(t, a) for the planar rod, t⁹ (a3²/8640 + a5² t²/33600)
-/// (FINDINGS §5): the normalisation of the stability margin g(t) = det J(t) / this, written
+/// (docs/math.md §5): the normalisation of the stability margin g(t) = det J(t) / this, written
 /// once for the closed form's test and the reference integrator's.
 pub fn planar_det_leading_term(a3: f64, a5: f64, t: f64) -> f64 {
     let t2 = t * t;

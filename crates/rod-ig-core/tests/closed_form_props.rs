@@ -1,7 +1,7 @@
 //! Properties of the planar closed form: exact J vs central differences, robustness on any
-//! f64 input, continuity of θ(t), shape endpoints, and every degenerate family of FINDINGS §2
+//! f64 input, continuity of θ(t), shape endpoints, and every degenerate family of docs/math.md §2
 //! checked (a) for first-order consistency with neighbouring generic values and (b) against the
-//! adaptive ODE reference `ode::planar_reference` (FINDINGS §6 tolerances).
+//! adaptive ODE reference `ode::planar_reference` (docs/math.md §6 tolerances).
 
 use proptest::prelude::*;
 use rod_ig_core::ode::planar_reference as ode;
@@ -191,7 +191,7 @@ fn non_finite_inputs_are_rejected() {
     ));
 }
 
-/// The degenerate families of FINDINGS §2, with the case the closed form must select.
+/// The degenerate families of docs/math.md §2, with the case the closed form must select.
 fn degenerate_families() -> Vec<(&'static str, PlanarParams, Option<Case>)> {
     vec![
         ("a3 = 0, tension", p(0.0, 5.0, 7.0), Some(Case::I)),
@@ -313,7 +313,7 @@ fn degenerate_families_are_consistent_with_neighbours() {
 }
 
 /// Closed form vs the adaptive ODE reference (rtol 1e-13) on every degenerate family, at t = 1
-/// and t = 0.37: tip ≤ 1e-11 (FINDINGS §6; ≤ 1.1e-9 for near-straight rods under tension),
+/// and t = 0.37: tip ≤ 1e-11 (docs/math.md §6; ≤ 1.1e-9 for near-straight rods under tension),
 /// J ≤ 1e-8 relative, energy ≤ 1e-9.
 #[test]
 fn degenerate_families_match_ode_reference() {
@@ -350,7 +350,7 @@ fn degenerate_families_match_ode_reference() {
 }
 
 /// Known physical checks: (0, −40, 1) loses stability at t ≈ 0.9935 (clamped–clamped Euler
-/// load 4π², FINDINGS §5); circles (no force) are stable; the straight rod is unstable with
+/// load 4π², docs/math.md §5); circles (no force) are stable; the straight rod is unstable with
 /// margin 0.
 #[test]
 fn stability_landmarks() {
@@ -403,7 +403,7 @@ proptest! {
 
     /// Closed form vs the adaptive ODE reference (DOP853, rtol 1e-12) over the wide box
     /// |a3| ≤ 30, |a4|, |a5| ≤ 400 (four times the oracle's force range): tip ≤ 2e-9 abs
-    /// (FINDINGS §6: ≤ 1.1e-9 on near-straight rods under tension, ≤ 1e-11 elsewhere; the ODE's
+    /// (docs/math.md §6: ≤ 1.1e-9 on near-straight rods under tension, ≤ 1e-11 elsewhere; the ODE's
     /// own error grows with |a| as θ winds up to ~10 turns here), J ≤ 1e-7 relative, and the
     /// same stability verdict unless the rod sits on the boundary (|margin| < 1e-6 by either).
     /// Measured on 5,000 draws: tip ≤ 1e-10, J ≤ 1e-8; the bounds leave room for the rare

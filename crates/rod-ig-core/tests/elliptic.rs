@@ -25,7 +25,7 @@ fn f(v: &serde_json::Value, k: &str) -> f64 {
     v[k].as_f64().unwrap_or_else(|| panic!("field {k}"))
 }
 
-/// sn, cn, dn and E(am u|m) to ≤ 1e-14 absolute (FINDINGS §4) for |u| ≤ 10, and ≤ 1e-14·|u|/10
+/// sn, cn, dn and E(am u|m) to ≤ 1e-14 absolute (docs/math.md §4) for |u| ≤ 10, and ≤ 1e-14·|u|/10
 /// beyond (the argument itself carries a relative rounding of the order of 1e-16·|u|·r);
 /// am to 1e-14 relative to max(1, |am|).
 #[test]

@@ -1,7 +1,7 @@
 //! Acceptance tests of the planar inverse geometry (issue #3).
 //!
 //! Reference data: `data/oracle/ig_public.jsonl` (30 targets × 15 stable initial guesses) and
-//! the figures of FINDINGS.md §8 (the project's paper notes, cited, not copied).
+//! the figures of docs/math.md §8 (the project's paper notes, cited, not copied).
 
 mod workloads;
 use rod_ig_core::planar::ig::{self, IgError, Method, Objective, SolveOptions, Tracker};
@@ -27,7 +27,7 @@ fn ig_cases() -> Vec<IgCase> {
 
 /// Independent check of a returned solution, by the numerical reference (DOP853 at rtol 1e-12,
 /// independent of the closed forms the solver uses): forward map within tolerance (plus a
-/// small allowance for the reference's own error), stable by the FINDINGS §5 test.
+/// small allowance for the reference's own error), stable by the docs/math.md §5 test.
 fn check_solution(target: &PlanarPose, a: &PlanarParams, tol: f64) {
     use rod_ig_core::ode::planar_reference as reference;
     let (tip, _) = reference::tip_and_jacobian(a, 1e-12).expect("reference forward map");
@@ -43,8 +43,8 @@ fn check_solution(target: &PlanarPose, a: &PlanarParams, tol: f64) {
 
 const TOL: f64 = 1e-6;
 
-/// FINDINGS §8: (α, success %, mean iterations of successes).
-const FINDINGS_8: [(f64, f64, f64); 6] = [
+/// docs/math.md §8: (α, success %, mean iterations of successes).
+const REFERENCE_NEWTON: [(f64, f64, f64); 6] = [
     (1.0, 34.7, 7.6),
     (0.9, 38.4, 9.8),
     (0.7, 46.9, 14.7),
@@ -59,24 +59,24 @@ fn newton_reproduces_findings_table() {
     rod_ig_core::planar::ig::warm_up();
     let cases = ig_cases();
     assert_eq!(cases.len(), 30);
-    let alphas: Vec<f64> = FINDINGS_8.iter().map(|r| r.0).collect();
+    let alphas: Vec<f64> = REFERENCE_NEWTON.iter().map(|r| r.0).collect();
     let rows = bench::table1(&cases, &alphas, 100, TOL);
-    for (row, &(alpha, succ, iters)) in rows.iter().zip(FINDINGS_8.iter()) {
+    for (row, &(alpha, succ, iters)) in rows.iter().zip(REFERENCE_NEWTON.iter()) {
         eprintln!("{row:?}");
         assert_eq!(row.alpha, alpha);
         assert_eq!(row.runs, 450);
         // Success within 3 points (= 13 of 450 runs); iterations within 10 %.
         assert!(
             (row.success_pct - succ).abs() <= 3.0,
-            "α = {alpha}: success {:.1} % vs FINDINGS {succ} %",
+            "α = {alpha}: success {:.1} % vs the reference {succ} %",
             row.success_pct
         );
         assert!(
             (row.mean_iterations - iters).abs() <= 0.1 * iters,
-            "α = {alpha}: iterations {:.2} vs FINDINGS {iters}",
+            "α = {alpha}: iterations {:.2} vs the reference {iters}",
             row.mean_iterations
         );
-        // The paper's Newton fails only by instability in the large (FINDINGS §8).
+        // The paper's Newton fails only by instability in the large (docs/math.md §8).
         assert!(row.instability_pct >= 30.0);
     }
 }

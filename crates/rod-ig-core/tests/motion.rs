@@ -344,7 +344,7 @@ fn the_straight_rod_at_rest_is_held_and_buckles_deterministically() {
         m.event,
         BranchEvent::None | BranchEvent::Snap { .. }
     ));
-    // An unstable rod that is not straight is still refused (FINDINGS §5: (0, −40, 1) is past
+    // An unstable rod that is not straight is still refused (docs/math.md §5: (0, −40, 1) is past
     // the first clamped–clamped Euler load).
     let unstable = PlanarParams::new(0.0, -40.0, 1.0);
     assert!(BranchFollower::holding(PlanarClosedForm, SolveOptions::default(), unstable).is_err());

@@ -130,7 +130,7 @@ fn reference_special_cases() {
     assert!((p.theta - a3).abs() < 1e-12);
     assert!((p.x - a3.sin() / a3).abs() < 1e-12);
     assert!((p.y - 2.0 * (a3 / 2.0).sin().powi(2) / a3).abs() < 1e-12);
-    // Euler check of FINDINGS §5: (0, −40, 1) loses stability at t ≈ 0.9935.
+    // Euler check of docs/math.md §5: (0, −40, 1) loses stability at t ≈ 0.9935.
     let r = pr::stability(&Vector3::new(0.0, -40.0, 1.0)).unwrap();
     assert!(!r.stable);
     let tc = r.first_conjugate_t.unwrap();
@@ -143,7 +143,7 @@ fn reference_special_cases() {
         let (q, _) = pr::pose_and_jacobian(&a, *t, 1e-12).unwrap();
         assert!((q.to_vector() - p.to_vector()).amax() < 1e-10);
     }
-    // Energy identity of FINDINGS §1: ½∫κ² = λ2/2 − a4 x(1) − a5 y(1).
+    // Energy identity of docs/math.md §1: ½∫κ² = λ2/2 − a4 x(1) − a5 y(1).
     let (tip, _) = pr::tip_and_jacobian(&a, 1e-12).unwrap();
     let lam2 = a[0] * a[0] + 2.0 * a[1];
     let e = pr::energy(&a, 1e-12).unwrap();

@@ -158,7 +158,7 @@ fn relaxed_families_match_the_oracle() {
         for m in s.wrong_verdicts.iter().chain(&s.errors).take(12) {
             eprintln!("    {m}");
         }
-        // The margin is g_min over [0.05, 1] (FINDINGS §5): the oracle takes it on a grid of
+        // The margin is g_min over [0.05, 1] (docs/math.md §5): the oracle takes it on a grid of
         // spacing 5e-4 and we refine local minima, so they agree to ≈ the grid's resolution.
         let margin_tol = if name.starts_with("strong") {
             STRONG_MARGIN_TOL

@@ -383,7 +383,7 @@ fn shape_and_energy() {
 
 #[test]
 fn ig_random_targets_robust() {
-    // Box |a1..3| <= 5, |a4..6| <= 30 (FINDINGS3D: ~70 % stable); targets = tips of stable a.
+    // Box |a1..3| <= 5, |a4..6| <= 30 (docs/math.md §10: ~70 % stable); targets = tips of stable a.
     let k = Stiffness::default();
     let targets = random_targets(150, 2024, &k);
     assert_eq!(targets.len(), 150);

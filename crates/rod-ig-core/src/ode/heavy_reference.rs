@@ -12,7 +12,7 @@
 //! dx' = −sin θ dθ, dy' = cos θ dθ.
 //!
 //! Stability as `shared/oracle/gravity_public.jsonl` defines it: det J(t) > 0 on the grid of
-//! FINDINGS §5 ({i/2000} ∪ geomspace(1e-3, 0.05, 60)), margin = min over grid t ≥ 0.05 of
+//! docs/math.md §5 ({i/2000} ∪ geomspace(1e-3, 0.05, 60)), margin = min over grid t ≥ 0.05 of
 //! det J(t)/D0(t), D0(t) = t⁹(a3²/8640 + a5²t²/33600 + (w ĝ_y)²t⁴/388800).
 
 use super::dop853::{solve, solve_dense};
@@ -132,7 +132,7 @@ pub fn det_leading_term(a: &PlanarParams, g: &Gravity, t: f64) -> f64 {
             + cross * cross * t.powi(4) / 388800.0)
 }
 
-/// Everything at rtol 1e-12 (the oracle's tolerance), stability on the grid of FINDINGS §5.
+/// Everything at rtol 1e-12 (the oracle's tolerance), stability on the grid of docs/math.md §5.
 pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyReference, RodError> {
     let rtol = 1e-12;
     let (tip, jacobian, energy, elastic_energy) = tip_and_jacobian(a, g, rtol)?;

@@ -9,7 +9,7 @@
 //! J(t, a) = ∂(x, y, θ)(t)/∂(a3, a4, a5) is read from its rows x, y, θ (rows ordered as
 //! [`PlanarPose`]; the shared oracle file orders them θ, x, y).
 //!
-//! Stability (Bretl & McCarthy 2014; `FINDINGS.md` §5): stable ⇔ det J(t) > 0 at every t of
+//! Stability (Bretl & McCarthy 2014; docs/math.md §5): stable ⇔ det J(t) > 0 at every t of
 //! the grid {i/2000} ∪ geomspace(1e-3, 0.05, 60), integrated at rtol 1e-12, atol 1e-30.
 
 use super::dop853::{solve, solve_dense};
@@ -20,15 +20,15 @@ use std::ops::ControlFlow;
 
 /// Step budget of the adaptive reference integrations.
 pub const MAX_STEPS: u32 = 200_000;
-/// Relative tolerance of [`stability`] (FINDINGS §5).
+/// Relative tolerance of [`stability`] (docs/math.md §5).
 pub const STABILITY_RTOL: f64 = 1e-12;
-/// Absolute tolerance of [`stability`] (FINDINGS §5): tiny, so that the early entries of J,
+/// Absolute tolerance of [`stability`] (docs/math.md §5): tiny, so that the early entries of J,
 /// which scale like t…t⁵, are controlled relatively.
 pub const STABILITY_ATOL: f64 = 1e-30;
-/// Smallest t at which the fixed-step [`rk4_stability`] tests det J (FINDINGS §5: absolute
+/// Smallest t at which the fixed-step [`rk4_stability`] tests det J (docs/math.md §5: absolute
 /// rounding swamps det J below t ≈ 0.02).
 pub const RK4_STABILITY_T_MIN: f64 = crate::STABILITY_T_MIN;
-/// Smallest t entering the normalised margin `det_min` (FINDINGS §5).
+/// Smallest t entering the normalised margin `det_min` (docs/math.md §5).
 pub const MARGIN_T_MIN: f64 = 0.05;
 
 /// Planar rod right-hand side (eq. 2.9 + kinematics) on s = (μ3, μ4, μ5, θ, x, y).
@@ -203,7 +203,7 @@ pub fn shape(a: &PlanarParams, ts: &[f64], rtol: f64) -> Result<Vec<PlanarPose>,
 }
 
 /// Elastic energy ½∫₀¹ κ² dt (κ = μ3), integrated as an extra quadrature state at relative
-/// tolerance `rtol`. (FINDINGS §1: it equals λ2/2 − a4 x(1) − a5 y(1).)
+/// tolerance `rtol`. (docs/math.md §1: it equals λ2/2 − a4 x(1) − a5 y(1).)
 pub fn energy(a: &PlanarParams, rtol: f64) -> Result<f64, RodError> {
     check_params(a)?;
     let opts = options(rtol)?;
@@ -222,7 +222,7 @@ pub fn energy(a: &PlanarParams, rtol: f64) -> Result<f64, RodError> {
     Ok(s[6])
 }
 
-/// The stability grid of FINDINGS §5: {i/2000, i = 1..2000} ∪ geomspace(1e-3, 0.05, 60),
+/// The stability grid of docs/math.md §5: {i/2000, i = 1..2000} ∪ geomspace(1e-3, 0.05, 60),
 /// sorted, without duplicates.
 pub fn stability_grid() -> Vec<f64> {
     let mut g: Vec<f64> = (1..=2000).map(|i| i as f64 / 2000.0).collect();
@@ -236,7 +236,7 @@ pub fn stability_grid() -> Vec<f64> {
     g
 }
 
-/// Leading small-t term of det J (FINDINGS §5, [`crate::planar_det_leading_term`]).
+/// Leading small-t term of det J (docs/math.md §5, [`crate::planar_det_leading_term`]).
 pub fn det_leading_term(a: &PlanarParams, t: f64) -> f64 {
     crate::planar_det_leading_term(a[0], a[2], t)
 }
@@ -307,7 +307,7 @@ impl StabilityScan {
 
 fn straight_rod(a: &PlanarParams) -> Option<StabilityReport> {
     if a[0] == 0.0 && a[2] == 0.0 {
-        // FINDINGS §5: the x-row of J vanishes identically; det ≡ 0: undecidable.
+        // docs/math.md §5: the x-row of J vanishes identically; det ≡ 0: undecidable.
         Some(StabilityReport {
             stable: false,
             margin: 0.0,
@@ -319,7 +319,7 @@ fn straight_rod(a: &PlanarParams) -> Option<StabilityReport> {
     }
 }
 
-/// Stability by the rule of FINDINGS §5: det J(t, a) > 0 at every t of [`stability_grid`],
+/// Stability by the rule of docs/math.md §5: det J(t, a) > 0 at every t of [`stability_grid`],
 /// with J integrated at rtol 1e-12, atol 1e-30 and read by dense output. The margin is
 /// `det_min` = min over grid t ≥ 0.05 of det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) (the scan stops
 /// at the first non-positive det, so for unstable rods the margin is the value there). The

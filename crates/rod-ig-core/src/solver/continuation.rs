@@ -10,7 +10,7 @@
 //! failure Δs is halved; on success doubled (at most the whole remaining segment).
 //!
 //! Along a continuous branch, stability can only be lost where det J(1, a) = 0 (a conjugate
-//! point enters (0, 1] through t = 1: FINDINGS §5, paper §3.1), and there the branch folds: it
+//! point enters (0, 1] through t = 1: docs/math.md §5, paper §3.1), and there the branch folds: it
 //! cannot be continued in s. So when Δs falls below [`MIN_STEP`] with the corrector failing,
 //! the branch has ended at the last accepted rod: the **critical** rod and pose, located to
 //! within [`MIN_STEP`] of the segment.

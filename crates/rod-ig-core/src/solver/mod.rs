@@ -136,7 +136,7 @@ fn check<const N: usize, M: InverseGeometry<N> + ?Sized>(
 /// With [`Method::Robust`] every returned solution is stable (the model's stability test)
 /// and within `tolerance` of the target in position and orientation; with
 /// [`Objective::LeastEnergy`] it is the least energetic of the solutions found. With
-/// [`Method::Newton`] this is the paper's fixed-step Newton (§3.1) under the FINDINGS §8
+/// [`Method::Newton`] this is the paper's fixed-step Newton (§3.1) under the docs/math.md §8
 /// protocol; its result is stable too, since every iterate is tested. No call runs past
 /// `options.deadline`.
 pub fn solve<const N: usize, M: InverseGeometry<N> + ?Sized>(

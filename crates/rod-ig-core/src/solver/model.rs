@@ -18,7 +18,7 @@ pub struct ModelEvaluation<const N: usize, X> {
     pub jacobian: SMatrix<f64, N, N>,
     /// Elastic energy.
     pub energy: f64,
-    /// Stability verdict and normalised margin (FINDINGS §5).
+    /// Stability verdict and normalised margin (docs/math.md §5).
     pub stability: StabilityReport,
     /// False when computed at an iteration's reduced accuracy: a converged iterate is then
     /// re-evaluated with [`RodModel::evaluate`] before it is returned.
@@ -107,7 +107,7 @@ pub trait RodModel<const N: usize> {
     }
 
     /// det J(1, a): its sign changes exactly where a branch of equilibria folds (and where
-    /// stability can be lost along it, FINDINGS §5).
+    /// stability can be lost along it, docs/math.md §5).
     fn jacobian_det(&self, jacobian: &SMatrix<f64, N, N>) -> f64;
 
     /// The pose a fraction `s` ∈ [0, 1] of the way from `from` to `to` along the shortest

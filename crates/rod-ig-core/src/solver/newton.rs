@@ -2,7 +2,7 @@
 //! step length α, a_{k+1} = a_k + α δa_k with J(1, a_k) δa_k = b − Υ(a_k) (eq. 3.1; 3-D: the
 //! body-frame twist error), from one guess.
 //!
-//! Protocol of FINDINGS §8: every iterate (a0 included) must be a stable equilibrium
+//! Protocol of docs/math.md §8: every iterate (a0 included) must be a stable equilibrium
 //! (det J(t, a) > 0 on (0, 1]); the run fails as soon as one is not. Convergence: position
 //! error and orientation error both ≤ tolerance, confirmed at the model's full accuracy. A NaN
 //! residual never counts as converged.
@@ -92,7 +92,7 @@ fn run<const N: usize, M: RodModel<N> + ?Sized>(
 type Checked<const N: usize, X> = (ModelEvaluation<N, X>, (f64, f64));
 
 /// Iterate `k` evaluated (at the precision the run from `a0` uses) with its (position,
-/// orientation) errors; an error when it is not finite or not stable (FINDINGS §8: the run
+/// orientation) errors; an error when it is not finite or not stable (docs/math.md §8: the run
 /// fails as soon as an iterate is unstable).
 fn stable_iterate<const N: usize, M: RodModel<N> + ?Sized>(
     model: &M,

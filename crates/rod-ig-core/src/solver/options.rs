@@ -9,7 +9,7 @@ pub enum Method {
     /// Globalised, multi-start Newton; returns only stable, verified solutions.
     #[default]
     Robust,
-    /// The paper's fixed-step Newton (§3.1, eq. 3.1) from one guess, with the FINDINGS §8
+    /// The paper's fixed-step Newton (§3.1, eq. 3.1) from one guess, with the docs/math.md §8
     /// protocol (the run fails as soon as an iterate is unstable).
     Newton,
 }
@@ -81,7 +81,7 @@ pub const MIN_TOLERANCE: f64 = 1e-14;
 pub const MAX_TOLERANCE: f64 = 1e-2;
 /// Default tolerance: 1e-6 of the rod length (1 µm on a 1 m cable) and 1 µrad.
 pub const DEFAULT_TOLERANCE: f64 = 1e-6;
-/// Default iteration budget: the paper's protocol (FINDINGS §8).
+/// Default iteration budget: the paper's protocol (docs/math.md §8).
 pub const DEFAULT_MAX_ITERATIONS: u32 = 100;
 
 impl<P> SolveOptions<P> {

@@ -14,7 +14,7 @@ pub struct Solution<P, X> {
     /// Verdict of the stability test on a* (always true: every strategy returns only stable
     /// rods).
     pub stable: bool,
-    /// Normalised stability margin g_min (FINDINGS §5; positive when stable, ≈ 1 when gently
+    /// Normalised stability margin g_min (docs/math.md §5; positive when stable, ≈ 1 when gently
     /// bent).
     pub stability_margin: f64,
     /// Newton iterations, summed over every start tried.
@@ -106,7 +106,7 @@ pub enum Termination {
     Deadline,
     /// J(1, a) was singular: no Newton step.
     Singular,
-    /// An iterate left the stable set (paper's protocol, FINDINGS §8), or every trial step did.
+    /// An iterate left the stable set (paper's protocol, docs/math.md §8), or every trial step did.
     LeftStableSet,
     /// The line search found no decrease of the residual.
     Stalled,

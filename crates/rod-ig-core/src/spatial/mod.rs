@@ -1,6 +1,6 @@
 //! The 3-D Kirchhoff rod (paper §2.1, Bretl & McCarthy 2014), by numerical integration.
 //!
-//! Model (`FINDINGS3D.md`, verified form of the paper's eq. 2.2): with m = (μ1, μ2, μ3),
+//! Model (docs/math.md §10, verified form of the paper's eq. 2.2): with m = (μ1, μ2, μ3),
 //! f = (μ4, μ5, μ6), stiffnesses c = (c1, c2, c3) and body angular rate ω = m / c
 //! (component-wise; u_i = μ_i / c_i),
 //!
@@ -16,7 +16,7 @@
 //! δμ' = (∂μ'/∂μ) δμ, η' = δξ − ad_ξ η, where ξ = (ω, e1), δξ = (δm / c, 0) and
 //! ad_(ω, v)(ω_η, v_η) = (ω × ω_η, ω × v_η − ω_η × v); η(0) = 0, δμ(0) = e_j.
 //!
-//! Stability ([`stability`]): the rule of FINDINGS3D, det J(t) > 0 at every t = i/2000 in
+//! Stability ([`stability`]): the rule of docs/math.md §10, det J(t) > 0 at every t = i/2000 in
 //! [0.02, 1]; for exact planar-subset inputs (a1 = a2 = a6 = 0) J is block-diagonal and the
 //! in-plane and out-of-plane blocks are tested separately (their crossings could cancel in det).
 
@@ -454,7 +454,7 @@ pub fn pose_and_jacobian(
     Ok((reduced::pose(&s), reduced::jac(&s)))
 }
 
-/// Pose q(t) and J(t, a) from the literal μ-form of FINDINGS3D: μ' equations in components,
+/// Pose q(t) and J(t, a) from the literal μ-form of docs/math.md §10: μ' equations in components,
 /// quaternion, p, and the variational equations δμ' = (∂μ'/∂μ)δμ, η' = δξ − ad_ξ η
 /// (86 values). Slower; kept as the cross-check of [`pose_and_jacobian`].
 pub fn reference_pose_and_jacobian(

@@ -1,11 +1,11 @@
-//! The 3-D rod as a model of the solvers ([`RodModel`], FINDINGS3D).
+//! The 3-D rod as a model of the solvers ([`RodModel`], docs/math.md §10).
 
 use super::{SpatialPose, Stiffness};
 use crate::solver::{IgError, ModelEvaluation, RodModel};
 use crate::RodError;
 use nalgebra::{SMatrix, SVector};
 
-/// The 3-D rod (FINDINGS3D) by DOP853 on the Hamiltonian system with its variational
+/// The 3-D rod (docs/math.md §10) by DOP853 on the Hamiltonian system with its variational
 /// equations, for stiffnesses `stiffness` at relative tolerance `rtol`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Spatial {

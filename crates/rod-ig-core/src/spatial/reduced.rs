@@ -2,7 +2,7 @@
 //! conserved world wrench, with 6-dimensional variational equations per parameter.
 //!
 //! Equilibrium (m' = m × ω + f × e1, f' = f × ω) is equivalent to the conservation of the
-//! world wrench: R f = a_f and R m + p × R f = a_m (FINDINGS3D, checked first integrals). Hence
+//! world wrench: R f = a_f and R m + p × R f = a_m (docs/math.md §10, checked first integrals). Hence
 //! f = Rᵀ a_f, m = Rᵀ(a_m − p × a_f), and only q' = ½ q ⊗ (0, ω), p' = R e1 are integrated.
 //! Differentiating with δR = R[η_ω]×, δp = R η_v (η = q⁻¹ δq, the columns of J):
 //! δm = −η_ω × m − η_v × f + Rᵀ δa_m − Rᵀ(p × δa_f), δω = δm / c, and

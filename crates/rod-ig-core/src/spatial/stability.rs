@@ -1,9 +1,9 @@
-//! Stability of the 3-D rod (Bretl & McCarthy 2014; rule of `FINDINGS3D.md`): the equilibrium
+//! Stability of the 3-D rod (Bretl & McCarthy 2014; rule of docs/math.md §10): the equilibrium
 //! is stable iff det J(t, a) > 0 at every t = i/2000 in [0.02, 1]. Straight rods
 //! (a2 = a3 = a5 = a6 = 0) have det ≡ 0 and are classified unstable. For planar rods — the
 //! planar subset a1 = a2 = a6 = 0, or any rotation of it about the base tangent (a1 = 0 and
 //! (a2, a3) ⊥ (a5, a6), to 1e-12 relative) — J is block-diagonal in the rotated frame and both
-//! 3×3 blocks (in-plane and out-of-plane) must have det > 0 (FINDINGS3D trap 3: simultaneous
+//! 3×3 blocks (in-plane and out-of-plane) must have det > 0 (docs/math.md §10, trap 3: simultaneous
 //! crossings of the two blocks cancel in det).
 //!
 //! Fast scan: det is evaluated (dense output) on a coarse sub-grid of the rule's grid (every
@@ -20,7 +20,7 @@ use super::{check_params, options_for, Evaluation3d, SpatialParams, Stiffness};
 use crate::ode::{DenseStep, Dop853};
 use crate::{RodError, StabilityReport};
 
-/// Start of the scanned range (FINDINGS3D trap 2: atol 1e-16 cannot resolve det below 0.01).
+/// Start of the scanned range (docs/math.md §10, trap 2: atol 1e-16 cannot resolve det below 0.01).
 pub const STABILITY_T_MIN: f64 = crate::STABILITY_T_MIN;
 /// Number of intervals of the rule's grid on [0, 1].
 pub const GRID_N: u32 = 2000;
@@ -33,7 +33,7 @@ const GRID_START: u32 = 40; // 0.02 · 2000
 pub struct StabilityOptions {
     /// Relative tolerance of the integration.
     pub rtol: f64,
-    /// Absolute tolerance (FINDINGS3D trap 1: 1e-16, not 1e-30).
+    /// Absolute tolerance (docs/math.md §10, trap 1: 1e-16, not 1e-30).
     pub atol: f64,
     /// Coarse sampling stride in grid points (1 = every i/2000; 20 = every 0.01); 0 = step ends
     /// only, no dense output (fast, conservative; module docs).
@@ -70,7 +70,7 @@ impl StabilityOptions {
     }
 }
 
-/// Leading small-t term of det J for c = 1 (FINDINGS3D, fitted):
+/// Leading small-t term of det J for c = 1 (docs/math.md §10, fitted):
 /// (a2² + a3²) t¹⁴/103680, or (a5² + a6²) t¹⁶/403200 when a2 = a3 = 0.
 pub fn det_leading_term(a: &SpatialParams, t: f64) -> f64 {
     let b = a[1] * a[1] + a[2] * a[2];
@@ -468,10 +468,10 @@ where
     Ok(Some(*st.y()))
 }
 
-/// Stability verdict by the FINDINGS3D rule, fast scan at reference accuracy
+/// Stability verdict by the docs/math.md §10 rule, fast scan at reference accuracy
 /// ([`StabilityOptions::default`]: rtol 1e-12, atol 1e-16, coarse stride 0.01 with refinement).
 /// The margin is min over scanned t ≥ 0.05 of det J(t) / leading term ([`det_leading_term`];
-/// a weak margin, FINDINGS3D), ≤ 0 when unstable.
+/// a weak margin, docs/math.md §10), ≤ 0 when unstable.
 pub fn stability(a: &SpatialParams, k: &Stiffness) -> Result<StabilityReport, RodError> {
     stability_with(a, k, &StabilityOptions::default())
 }
@@ -485,7 +485,7 @@ pub fn stability_with(
     Ok(run(a, k, opts, true)?.1)
 }
 
-/// The FINDINGS3D rule checked at every t = i/2000 in [0.02, 1] (reference; slower).
+/// The docs/math.md §10 rule checked at every t = i/2000 in [0.02, 1] (reference; slower).
 pub fn stability_full_grid(a: &SpatialParams, k: &Stiffness) -> Result<StabilityReport, RodError> {
     stability_with(a, k, &StabilityOptions::full_grid())
 }
