@@ -99,6 +99,43 @@ pub fn to_value<T: Serialize>(answer: &T) -> Result<Value, String> {
     serde_json::to_value(answer).map_err(|e| format!("cannot encode answer: {e}"))
 }
 
+/// Adds the fields `fields_of` computes from a rod's `a` to a solve answer and to each of its
+/// `solutions` (an answer without `a`, a failure, gets none).
+pub fn with_fields_of_a(
+    value: &mut Value,
+    fields_of: impl Fn(&[f64]) -> Vec<(&'static str, Value)>,
+) {
+    let add = |v: &mut Value| {
+        let a: Option<Vec<f64>> = v
+            .get("a")
+            .and_then(Value::as_array)
+            .map(|a| a.iter().filter_map(Value::as_f64).collect());
+        if let Some(a) = a {
+            for (key, field) in fields_of(&a) {
+                v[key] = field;
+            }
+        }
+    };
+    add(value);
+    if let Some(list) = value.get_mut("solutions").and_then(Value::as_array_mut) {
+        list.iter_mut().for_each(add);
+    }
+}
+
+/// `base_wrench` and `tip_wrench` as answer fields (`rod_ig_core::wrench`: what the rod exerts
+/// on each gripper, in that gripper's frame); none where they cannot be evaluated.
+pub fn wrench_fields<W: Serialize>(
+    wrenches: Option<rod_ig_core::wrench::GripperWrenches<W>>,
+) -> Vec<(&'static str, Value)> {
+    let Some(w) = wrenches else {
+        return Vec::new();
+    };
+    match (serde_json::to_value(w.base), serde_json::to_value(w.tip)) {
+        (Ok(base), Ok(tip)) => vec![("base_wrench", base), ("tip_wrench", tip)],
+        _ => Vec::new(),
+    }
+}
+
 /// A request's `deadline_ms` as a duration: finite and positive (the solver checks the upper
 /// limit and says so).
 pub fn deadline_from_ms(ms: f64) -> Result<std::time::Duration, String> {

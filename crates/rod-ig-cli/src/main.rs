@@ -49,7 +49,9 @@ enum Command {
     /// "gravity"? ([gx, gy] in the base frame, default [0, -1])} on stdin; writes one line
     /// each: {"tip": {"x", "y", "theta"}, "jacobian": [[dx/da3, dx/da4, dx/da5], [dy/..],
     /// [dθ/..]], "stable", "energy", "stability_margin" (normalised g_min, ≈ 1 for a gently
-    /// bent rod), "stability_uncertain"; with weight also "elastic_energy", "tip_force" and
+    /// bent rod), "stability_uncertain", "base_wrench" and "tip_wrench" ({"force": [fx, fy],
+    /// "moment"}: what the rod exerts on each gripper, in that gripper's frame, as a wrist
+    /// force-torque sensor reads it); with weight also "elastic_energy", "tip_force" and
     /// "condition" (the tip's sensitivity to rounding a: above weight 200 and 1e9 the verdict
     /// is uncertain)}. theta is unwrapped (∫κ). A line that cannot be parsed or evaluated gets
     /// {"error": "why"}; the stream goes on.
@@ -63,7 +65,8 @@ enum Command {
     /// "orientation_error", "stability_margin", "reason" (on failure), "termination"
     /// ("converged", "deadline", "no_stable_solution", ...), "starts", "complete" (false when
     /// the deadline cut a least-energy search or the list of all), "solutions" (with all),
-    /// with weight "turns" (full turns of the tangent: 0 for a loop-free cable)}. One deadline
+    /// "base_wrench" and "tip_wrench" (as `forward`), with weight "turns" (full turns of the
+    /// tangent: 0 for a loop-free cable)}. One deadline
     /// holds for the whole line, `all` included.
     Solve {
         /// Print the solver's events (starts, iterations with residual and step, end) on
@@ -75,7 +78,8 @@ enum Command {
     /// "stiffness"?: [c1, c2, c3], "rtol"?, "weight"?, "gravity"?, "deadline_ms"? (default
     /// 1000, at most 10000)}; writes {"tip": {"position": [x, y, z],
     /// "quaternion": [qx, qy, qz, qw]}, "jacobian" (6×6, body twists, rows ω1 ω2 ω3 v1 v2 v3),
-    /// "stable", "energy", "stability_margin"}.
+    /// "stable", "energy", "stability_margin", "base_wrench" and "tip_wrench" ({"force": [3],
+    /// "moment": [3]}, each in its gripper's frame)}.
     Forward3d,
     /// 3-D inverse geometry. Reads JSON lines {"target": {"position": [..], "quaternion":
     /// [qx, qy, qz, qw]}, "a0"?: [6 numbers], "method"?, "alpha"?, "max_iterations"?,

@@ -279,7 +279,12 @@ impl Tracking {
         let m = follower.follow(&request.target, options);
         let held_a = follower.rod().map(|a| params3(&a));
         let answer = self.answer(&m, change, held_a, &gravity);
-        jsonl::to_value(&answer)
+        let mut value = jsonl::to_value(&answer)?;
+        jsonl::with_fields_of_a(&mut value, |a| match <[f64; 3]>::try_from(a) {
+            Ok(a) => crate::planar_cmds::wrench_fields(&PlanarParams::from(a), &gravity),
+            Err(_) => Vec::new(),
+        });
+        Ok(value)
     }
 
     /// The gravity of a line: the stream's, changed by the line's `weight` and `gravity`.

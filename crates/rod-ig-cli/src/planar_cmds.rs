@@ -5,6 +5,7 @@ use crate::jsonl::{self, Knobs, MethodName, ObjectiveName};
 use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
 use rod_ig_core::planar::ig::{self, SolveOptions};
 use rod_ig_core::planar::PlanarClosedForm;
+use rod_ig_core::wrench::PlanarWrench;
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -50,6 +51,12 @@ struct ForwardAnswer {
     /// verdict is `stability_uncertain`).
     #[serde(skip_serializing_if = "Option::is_none")]
     condition: Option<f64>,
+    /// The wrench the rod exerts on the base gripper, in the base frame (`rod_ig_core::wrench`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    base_wrench: Option<PlanarWrench>,
+    /// The wrench the rod exerts on the tip gripper, in the tip frame.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    tip_wrench: Option<PlanarWrench>,
 }
 
 fn rows(j: &rod_ig_core::PlanarJacobian) -> [[f64; 3]; 3] {
@@ -64,6 +71,12 @@ pub fn forward_line(line: &str) -> Result<Value, String> {
     let e = heavy::evaluate(&a, &g).map_err(|e| e.to_string())?;
     // Without a `weight` field the answer is the weightless contract's, byte for byte.
     let heavy = request.weight.is_some();
+    let wrenches = if g.is_weightless() {
+        let k1 = rod_ig_core::wrench::weightless_tip_curvature(&a, &e.tip);
+        Some(rod_ig_core::wrench::planar(&a, &e.tip, [a[1], a[2]], k1))
+    } else {
+        heavy::wrenches(&a, &g).ok()
+    };
     jsonl::to_value(&ForwardAnswer {
         tip: e.tip,
         jacobian: rows(&e.jacobian),
@@ -74,6 +87,8 @@ pub fn forward_line(line: &str) -> Result<Value, String> {
         elastic_energy: heavy.then_some(e.elastic_energy),
         tip_force: heavy.then(|| g.tip_force(&a)),
         condition: heavy.then_some(e.condition),
+        base_wrench: wrenches.map(|w| w.base),
+        tip_wrench: wrenches.map(|w| w.tip),
     })
 }
 
@@ -132,8 +147,18 @@ pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
         options.max_turns = turns;
     }
     let g = gravity_of(request.weight, request.gravity)?;
-    if !g.is_weightless() {
-        let mut value = jsonl::to_value(&answer(
+    let mut value = if g.is_weightless() {
+        jsonl::to_value(&answer(
+            &PlanarClosedForm,
+            &request.target,
+            &options,
+            request.all,
+            verbose,
+            |a| [a[0], a[1], a[2]],
+            |tip| *tip,
+        ))?
+    } else {
+        jsonl::to_value(&answer(
             &HeavyPlanar::new(g),
             &request.target,
             &options,
@@ -141,45 +166,34 @@ pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
             verbose,
             |a| [a[0], a[1], a[2]],
             |tip| *tip,
-        ))?;
-        with_turns(&mut value, &g);
-        return Ok(value);
-    }
-    jsonl::to_value(&answer(
-        &PlanarClosedForm,
-        &request.target,
-        &options,
-        request.all,
-        verbose,
-        |a| [a[0], a[1], a[2]],
-        |tip| *tip,
-    ))
+        ))?
+    };
+    with_rod_fields(&mut value, &g);
+    Ok(value)
 }
 
 /// Adds `turns` (full turns of the tangent along the rod, on 401 samples; 0 for a loop-free
-/// cable) to a heavy answer and to each of its `solutions`.
-fn with_turns(value: &mut Value, g: &Gravity) {
-    let turns = |v: &Value| -> Option<u32> {
-        let a: Vec<f64> = v
-            .get("a")?
-            .as_array()?
-            .iter()
-            .filter_map(Value::as_f64)
-            .collect();
-        let a = PlanarParams::new(*a.first()?, *a.get(1)?, *a.get(2)?);
-        let shape = heavy::shape(&a, g, heavy::cable::SHAPE_CHECK_SAMPLES).ok()?;
-        Some(heavy::cable::turns_of(&shape))
-    };
-    if let Some(t) = turns(value) {
-        value["turns"] = t.into();
-    }
-    if let Some(list) = value.get_mut("solutions").and_then(Value::as_array_mut) {
-        for v in list {
-            if let Some(t) = turns(v) {
-                v["turns"] = t.into();
+/// cable, heavy answers only) and the gripper wrenches to a planar answer and its `solutions`.
+fn with_rod_fields(value: &mut Value, g: &Gravity) {
+    jsonl::with_fields_of_a(value, |a| {
+        let Ok([a3, a4, a5]) = <[f64; 3]>::try_from(a) else {
+            return Vec::new();
+        };
+        let a = PlanarParams::new(a3, a4, a5);
+        let mut fields = wrench_fields(&a, g);
+        if !g.is_weightless() {
+            if let Ok(shape) = heavy::shape(&a, g, heavy::cable::SHAPE_CHECK_SAMPLES) {
+                fields.push(("turns", heavy::cable::turns_of(&shape).into()));
             }
         }
-    }
+        fields
+    });
+}
+
+/// `base_wrench` and `tip_wrench` of the planar rod a under g (none where they cannot be
+/// evaluated).
+pub fn wrench_fields(a: &PlanarParams, g: &Gravity) -> Vec<(&'static str, Value)> {
+    jsonl::wrench_fields(heavy::wrenches(a, g).ok())
 }
 
 /// Largest accepted `max_turns` (a coil of 100 turns is no cable a gripper holds).

@@ -9,6 +9,7 @@ use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
 use rod_ig_core::spatial::HeavySpatial;
 use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, SpatialParams, SpatialPose, StabilityOptions, Stiffness};
+use rod_ig_core::wrench::SpatialWrench;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
@@ -72,6 +73,10 @@ struct Forward3dAnswer {
     /// With weight: the elastic part of `energy` (elastic + gravitational).
     #[serde(skip_serializing_if = "Option::is_none")]
     elastic_energy: Option<f64>,
+    /// The wrench the rod exerts on the base gripper, in the base frame (`rod_ig_core::wrench`).
+    base_wrench: SpatialWrench,
+    /// The wrench the rod exerts on the tip gripper, in the tip frame.
+    tip_wrench: SpatialWrench,
 }
 
 /// `forward3d` with a `weight`: the heavy 3-D rod (`spatial::heavy`, rtol 1e-10).
@@ -87,6 +92,7 @@ fn forward3d_heavy(
         .map_err(|e| e.to_string())?;
     let a = SpatialParams::from(request.a);
     let e = heavy3::evaluate(&a, k, &g).map_err(|e| e.to_string())?;
+    let w = heavy3::wrenches(&a, k, &g).map_err(|e| e.to_string())?;
     jsonl::to_value(&Forward3dAnswer {
         tip: PoseJson::from_pose(&e.tip),
         jacobian: std::array::from_fn(|r| std::array::from_fn(|c| e.jacobian[(r, c)])),
@@ -94,6 +100,8 @@ fn forward3d_heavy(
         energy: e.energy,
         stability_margin: e.stability.margin,
         elastic_energy: Some(e.elastic_energy),
+        base_wrench: w.base,
+        tip_wrench: w.tip,
     })
 }
 
@@ -128,6 +136,12 @@ fn forward3d_within(request: &Forward3dRequest) -> Result<Value, String> {
     }
     let a = SpatialParams::from(request.a);
     let e = spatial::evaluate(&a, &k, &opts).map_err(|e| e.to_string())?;
+    // Without weight the world wrench is conserved: the tip's follows from the tip pose.
+    let (moment, force) = (
+        Vector3::new(a[0], a[1], a[2]),
+        Vector3::new(a[3], a[4], a[5]),
+    );
+    let w = rod_ig_core::wrench::spatial(&a, &e.tip, force, moment);
     jsonl::to_value(&Forward3dAnswer {
         tip: PoseJson::from_pose(&e.tip),
         jacobian: std::array::from_fn(|r| std::array::from_fn(|c| e.jacobian[(r, c)])),
@@ -135,6 +149,8 @@ fn forward3d_within(request: &Forward3dRequest) -> Result<Value, String> {
         energy: e.energy,
         stability_margin: e.stability.margin,
         elastic_energy: None,
+        base_wrench: w.base,
+        tip_wrench: w.tip,
     })
 }
 
@@ -185,7 +201,7 @@ pub fn solve3d_line(line: &str, verbose: bool) -> Result<Value, String> {
             stiffness: model.stiffness,
             gravity,
         };
-        return jsonl::to_value(&answer(
+        let mut value = jsonl::to_value(&answer(
             &heavy,
             &target,
             &options,
@@ -193,9 +209,11 @@ pub fn solve3d_line(line: &str, verbose: bool) -> Result<Value, String> {
             verbose,
             |a| std::array::from_fn::<f64, 6, _>(|i| a[i]),
             PoseJson::from_pose,
-        ));
+        ))?;
+        with_wrenches(&mut value, &model.stiffness, &gravity);
+        return Ok(value);
     }
-    jsonl::to_value(&answer(
+    let mut value = jsonl::to_value(&answer(
         &model,
         &target,
         &options,
@@ -203,5 +221,16 @@ pub fn solve3d_line(line: &str, verbose: bool) -> Result<Value, String> {
         verbose,
         |a| std::array::from_fn::<f64, 6, _>(|i| a[i]),
         PoseJson::from_pose,
-    ))
+    ))?;
+    with_wrenches(&mut value, &model.stiffness, &Gravity3::NONE);
+    Ok(value)
+}
+
+/// Adds the gripper wrenches (`base_wrench`, `tip_wrench`) to a `solve3d` answer and its
+/// `solutions`.
+fn with_wrenches(value: &mut Value, k: &Stiffness, g: &Gravity3) {
+    jsonl::with_fields_of_a(value, |a| match <[f64; 6]>::try_from(a) {
+        Ok(a) => jsonl::wrench_fields(heavy3::wrenches(&SpatialParams::from(a), k, g).ok()),
+        Err(_) => Vec::new(),
+    });
 }

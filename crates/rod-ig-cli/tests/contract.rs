@@ -693,3 +693,75 @@ fn track_carries_and_follows_a_long_cable() {
         out[7]
     );
 }
+
+/// Issue 52, item 2: every answer with a rod carries `base_wrench` and `tip_wrench`, each
+/// {"force", "moment"} in its gripper's frame (what the rod exerts on that gripper): the base's
+/// is a itself, and without weight the tip's balances it (forces opposite in the base frame,
+/// moments about the base summing to zero); with weight the grippers carry it.
+#[test]
+fn answers_carry_both_gripper_wrenches() {
+    let f = |v: &Value| v.as_f64().unwrap();
+    let check_planar = |v: &Value, load: [f64; 2]| {
+        let a: Vec<f64> = v["a"].as_array().unwrap().iter().map(f).collect();
+        let (base, tip) = (&v["base_wrench"], &v["tip_wrench"]);
+        assert_eq!(f(&base["moment"]), a[0]);
+        assert_eq!((f(&base["force"][0]), f(&base["force"][1])), (a[1], a[2]));
+        let th = f(&v["tip"]["theta"]);
+        let (fx, fy) = (f(&tip["force"][0]), f(&tip["force"][1]));
+        let world = [th.cos() * fx - th.sin() * fy, th.sin() * fx + th.cos() * fy];
+        assert!((a[1] + world[0] - load[0]).abs() < 1e-9, "{v}");
+        assert!((a[2] + world[1] - load[1]).abs() < 1e-9, "{v}");
+        if load == [0.0, 0.0] {
+            let (x, y) = (f(&v["tip"]["x"]), f(&v["tip"]["y"]));
+            let m = a[0] + f(&tip["moment"]) + x * world[1] - y * world[0];
+            assert!(m.abs() < 1e-6, "{v}: moments {m}");
+        }
+    };
+    let target = "{\"x\": 0.5, \"y\": 0.2, \"theta\": 1.0}";
+    let solved = run(
+        &["solve"],
+        &format!(
+            "{{\"target\": {target}, \"all\": true}}\n{{\"target\": {target}, \"weight\": 5}}\n"
+        ),
+    );
+    check_planar(&solved[0], [0.0, 0.0]);
+    for s in solved[0]["solutions"].as_array().unwrap() {
+        check_planar(s, [0.0, 0.0]);
+    }
+    check_planar(&solved[1], [0.0, -5.0]);
+    let tracked = run(&["track"], &format!("{{\"target\": {target}}}\n"));
+    check_planar(&tracked[0], [0.0, 0.0]);
+    let forward = run(&["forward"], "{\"a\": [1, 2, 3]}\n");
+    let mut fwd = forward[0].clone();
+    fwd["a"] = serde_json::json!([1.0, 2.0, 3.0]);
+    check_planar(&fwd, [0.0, 0.0]);
+    // 3-D: 3-vectors; the base's is (a1..a3, a4..a6).
+    for line in [
+        "{\"a\": [0.3, -0.8, 1.2, 2, -3, 1.5]}",
+        "{\"a\": [0.3, -0.8, 1.2, 2, -3, 1.5], \"weight\": 2}",
+    ] {
+        let v = &run(&["forward3d"], &format!("{line}\n"))[0];
+        let base: Vec<f64> = v["base_wrench"]["moment"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(f)
+            .collect();
+        assert_eq!(base, vec![0.3, -0.8, 1.2], "{v}");
+        assert_eq!(v["tip_wrench"]["force"].as_array().unwrap().len(), 3, "{v}");
+    }
+    let target3 = "{\"position\": [0.7, 0.2, 0.1], \"quaternion\": [0, 0, 0.2, 1]}";
+    let v = &run(&["solve3d"], &format!("{{\"target\": {target3}}}\n"))[0];
+    assert_eq!(v["success"], true, "{v}");
+    assert_eq!(
+        v["tip_wrench"]["moment"].as_array().unwrap().len(),
+        3,
+        "{v}"
+    );
+    // A failure has no rod, and no wrench.
+    let v = &run(
+        &["solve"],
+        "{\"target\": {\"x\": 2, \"y\": 0, \"theta\": 0}}\n",
+    )[0];
+    assert!(v.get("base_wrench").is_none(), "{v}");
+}
