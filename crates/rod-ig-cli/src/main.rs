@@ -78,8 +78,8 @@ enum Command {
     /// "stiffness"?: [c1, c2, c3], "rtol"?, "weight"?, "gravity"?, "deadline_ms"? (default
     /// 1000, at most 10000)}; writes {"tip": {"position": [x, y, z],
     /// "quaternion": [qx, qy, qz, qw]}, "jacobian" (6×6, body twists, rows ω1 ω2 ω3 v1 v2 v3),
-    /// "stable", "energy", "stability_margin", "base_wrench" and "tip_wrench" ({"force": [3],
-    /// "moment": [3]}, each in its gripper's frame)}.
+    /// "stable", "energy", "stability_margin", "base_wrench" and "tip_wrench" ({"force": [fx, fy, fz],
+    /// "moment": [mx, my, mz]}, each in its gripper's frame)}.
     Forward3d,
     /// 3-D inverse geometry. Reads JSON lines {"target": {"position": [..], "quaternion":
     /// [qx, qy, qz, qw]}, "a0"?: [6 numbers], "method"?, "alpha"?, "max_iterations"?,
