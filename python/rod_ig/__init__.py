@@ -39,9 +39,12 @@ __all__ = [
     "solve",
     "forward3d",
     "solve3d",
+    "wrenches",
+    "wrenches3d",
     "warm_up",
     "Tracker",
     "Planner",
+    "Wrench",
     "ForwardResult",
     "Forward3dResult",
     "SolveResult",
@@ -134,6 +137,27 @@ def _weight_kwargs(flat: list[FloatArray], start: int) -> dict[str, FloatArray]:
 
 
 @dataclass(frozen=True)
+class Wrench:
+    """A wrench the rod exerts on one gripper, in that gripper's own frame, about its grasp
+    point: what a wrist force-torque sensor between flange and gripper reads (the gripper's
+    weight aside). Unit rod: force in EI/L^2, moment in EI/L. The base's is ``a`` itself; the
+    tip's is minus the internal wrench at the tip (docs/math.md §11)."""
+
+    force: FloatArray
+    """(..., 2) planar or (..., 3) 3-D."""
+    moment: FloatArray
+    """(...) planar (counter-clockwise) or (..., 3) 3-D."""
+
+
+def _wrench(rows: FloatArray, shape: tuple[int, ...], dim: int) -> Wrench:
+    """A batch of wrenches from flattened rows (force, moment): dim 2 (planar) or 3."""
+    r = rows.reshape(shape + (6 if dim == 3 else 3,))
+    if dim == 3:
+        return Wrench(force=r[..., :3], moment=r[..., 3:])
+    return Wrench(force=r[..., :2], moment=r[..., 2])
+
+
+@dataclass(frozen=True)
 class ForwardResult:
     """Planar forward map of a batch of rods (shape ``(...)``)."""
 
@@ -152,6 +176,10 @@ class ForwardResult:
     """(...): energy (unit stiffness): elastic, plus gravitational with ``weight``."""
     elastic_energy: FloatArray | None = None
     """(...): the elastic part of ``energy`` (equal to it without weight)."""
+    base_wrench: Wrench | None = None
+    """What the rod exerts on the base gripper, in the base frame (:class:`Wrench`)."""
+    tip_wrench: Wrench | None = None
+    """What the rod exerts on the tip gripper, in the tip frame (:class:`Wrench`)."""
 
 
 @dataclass(frozen=True)
@@ -167,6 +195,10 @@ class Forward3dResult:
     stable: BoolArray
     margin: FloatArray
     energy: FloatArray
+    base_wrench: Wrench | None = None
+    """What the rod exerts on the base gripper, in the base frame (:class:`Wrench`)."""
+    tip_wrench: Wrench | None = None
+    """What the rod exerts on the tip gripper, in the tip frame (:class:`Wrench`)."""
 
 
 @dataclass(frozen=True)
@@ -194,10 +226,18 @@ class SolveResult:
     solutions: npt.NDArray[np.object_] | None = None
     """With ``all=True``: (...) object array, each entry an (k, 3) or (k, 6) array of every
     distinct stable solution found, least energy first."""
+    base_wrench: Wrench | None = None
+    """What the rod found exerts on the base gripper (NaN where the solve failed)."""
+    tip_wrench: Wrench | None = None
+    """What the rod found exerts on the tip gripper, in the tip frame."""
 
 
 def _solve_result(
-    d: dict[str, Any], shape: tuple[int, ...], dim: int, all: bool
+    d: dict[str, Any],
+    shape: tuple[int, ...],
+    dim: int,
+    all: bool,
+    wrenches: tuple[Wrench, Wrench] | None = None,
 ) -> SolveResult:
     solutions = None
     if all:
@@ -218,6 +258,8 @@ def _solve_result(
         starts=_shaped(d["starts"], shape),
         complete=_shaped(d["complete"], shape),
         solutions=solutions,
+        base_wrench=wrenches[0] if wrenches else None,
+        tip_wrench=wrenches[1] if wrenches else None,
     )
 
 
@@ -237,6 +279,7 @@ def forward(
     arr, _ = _batch("a", a, 3)
     flat, shape = _broadcast(arr, *_weight_arrays(weight, gravity))
     d = _rod_ig.forward(flat[0], threads=_threads(threads), **_weight_kwargs(flat, 1))
+    w = _rod_ig.wrenches(flat[0], threads=_threads(threads), **_weight_kwargs(flat, 1))
     return ForwardResult(
         tip=d["tip"].reshape(shape + (3,)),
         jacobian=d["jacobian"].reshape(shape + (3, 3)),
@@ -245,6 +288,8 @@ def forward(
         uncertain=_shaped(d["uncertain"], shape),
         energy=_shaped(d["energy"], shape),
         elastic_energy=_shaped(d["elastic_energy"], shape),
+        base_wrench=_wrench(w["base"], shape, 2),
+        tip_wrench=_wrench(w["tip"], shape, 2),
     )
 
 
@@ -331,7 +376,9 @@ def solve(
         max_turns=_integer("max_turns", max_turns, 0, 100),
         **_weight_kwargs(flat, len(arrays)),
     )
-    return _solve_result(d, batch, 3, all)
+    w = _rod_ig.wrenches(d["a"], threads=_threads(threads), **_weight_kwargs(flat, len(arrays)))
+    pair = (_wrench(w["base"], batch, 2), _wrench(w["tip"], batch, 2))
+    return _solve_result(d, batch, 3, all, pair)
 
 
 def forward3d(
@@ -349,6 +396,9 @@ def forward3d(
     d = _rod_ig.forward3d(
         flat[0], stiffness=tuple(stiffness), threads=_threads(threads), **_weight_kwargs(flat, 1)
     )
+    w = _rod_ig.wrenches3d(
+        flat[0], stiffness=tuple(stiffness), threads=_threads(threads), **_weight_kwargs(flat, 1)
+    )
     return Forward3dResult(
         position=d["position"].reshape(batch + (3,)),
         quaternion=d["quaternion"].reshape(batch + (4,)),
@@ -356,6 +406,8 @@ def forward3d(
         stable=d["stable"].reshape(batch),
         margin=d["margin"].reshape(batch),
         energy=d["energy"].reshape(batch),
+        base_wrench=_wrench(w["base"], batch, 3),
+        tip_wrench=_wrench(w["tip"], batch, 3),
     )
 
 
@@ -399,7 +451,46 @@ def solve3d(
         threads=_threads(threads),
         **_weight_kwargs(flat, len(arrays)),
     )
-    return _solve_result(d, batch, 6, all)
+    w = _rod_ig.wrenches3d(
+        d["a"],
+        stiffness=tuple(stiffness),
+        threads=_threads(threads),
+        **_weight_kwargs(flat, len(arrays)),
+    )
+    pair = (_wrench(w["base"], batch, 3), _wrench(w["tip"], batch, 3))
+    return _solve_result(d, batch, 6, all, pair)
+
+
+def wrenches(
+    a: npt.ArrayLike,
+    threads: int | None = None,
+    weight: npt.ArrayLike | None = None,
+    gravity: npt.ArrayLike | None = None,
+) -> tuple[Wrench, Wrench]:
+    """The (base, tip) wrenches planar rods ``a`` (..., 3) exert on their grippers, each in its
+    gripper's frame (:class:`Wrench`); ``weight`` and ``gravity`` as for :func:`forward`. NaN
+    where a rod cannot be evaluated."""
+    arr, _ = _batch("a", a, 3)
+    flat, shape = _broadcast(arr, *_weight_arrays(weight, gravity))
+    w = _rod_ig.wrenches(flat[0], threads=_threads(threads), **_weight_kwargs(flat, 1))
+    return _wrench(w["base"], shape, 2), _wrench(w["tip"], shape, 2)
+
+
+def wrenches3d(
+    a: npt.ArrayLike,
+    stiffness: tuple[float, float, float] = (1.0, 1.0, 1.0),
+    threads: int | None = None,
+    weight: npt.ArrayLike | None = None,
+    gravity: npt.ArrayLike | None = None,
+) -> tuple[Wrench, Wrench]:
+    """The (base, tip) wrenches 3-D rods ``a`` (..., 6) exert on their grippers (3-vectors in
+    each gripper's frame); the options of :func:`forward3d`."""
+    arr, _ = _batch("a", a, 6)
+    flat, shape = _broadcast(arr, *_weight_arrays(weight, gravity, 3))
+    w = _rod_ig.wrenches3d(
+        flat[0], stiffness=tuple(stiffness), threads=_threads(threads), **_weight_kwargs(flat, 1)
+    )
+    return _wrench(w["base"], shape, 3), _wrench(w["tip"], shape, 3)
 
 
 def warm_up() -> int:

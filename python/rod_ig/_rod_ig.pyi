@@ -42,6 +42,19 @@ def solve(
     gravity: npt.NDArray[np.float64] | None = None,
     max_turns: int = 0,
 ) -> dict[str, Any]: ...
+def wrenches(
+    a: npt.NDArray[np.float64],
+    threads: int | None = None,
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
+) -> dict[str, Any]: ...
+def wrenches3d(
+    a: npt.NDArray[np.float64],
+    stiffness: tuple[float, ...] = (1.0, 1.0, 1.0),
+    threads: int | None = None,
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
+) -> dict[str, Any]: ...
 def forward3d(
     a: npt.NDArray[np.float64],
     stiffness: tuple[float, ...] = (1.0, 1.0, 1.0),

@@ -234,6 +234,93 @@ fn forward<'py>(
     Ok(d)
 }
 
+/// The wrenches n planar rods `a` (flattened (n, 3)) exert on their grippers
+/// (`rod_ig_core::wrench`: each in its gripper's frame, as a wrist sensor reads it): a dict of
+/// "base" and "tip", each flattened (n, 3) rows (fx, fy, moment). NaN where a rod cannot be
+/// evaluated.
+#[pyfunction]
+#[pyo3(signature = (a, threads=None, weight=None, gravity=None))]
+fn wrenches<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    threads: Option<i64>,
+    weight: Option<PyReadonlyArray1<'py, f64>>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let a = a.as_slice()?;
+    let n = a.len() / 3;
+    let threads = thread_count(threads)?;
+    let g = gravities2(n, weight.as_ref(), gravity.as_ref())?;
+    let mut base = buffer(n, 3, f64::NAN)?;
+    let mut tip = buffer(n, 3, f64::NAN)?;
+    batch(
+        py,
+        n,
+        threads,
+        FORWARD_BLOCK,
+        |i| {
+            let gi = g.as_ref().map_or(Gravity::NONE, |g| g[i]);
+            heavy::wrenches(&planar_params(a, i), &gi).ok()
+        },
+        |i, w| {
+            if let Some(w) = w {
+                let (b, t) = (w.base, w.tip);
+                base[3 * i..3 * i + 3].copy_from_slice(&[b.force[0], b.force[1], b.moment]);
+                tip[3 * i..3 * i + 3].copy_from_slice(&[t.force[0], t.force[1], t.moment]);
+            }
+        },
+    )?;
+    let d = PyDict::new(py);
+    d.set_item("base", f64_out(py, base))?;
+    d.set_item("tip", f64_out(py, tip))?;
+    Ok(d)
+}
+
+/// The wrenches n 3-D rods `a` (flattened (n, 6)) exert on their grippers: "base" and "tip",
+/// each flattened (n, 6) rows (fx, fy, fz, mx, my, mz) in its gripper's frame. NaN where a rod
+/// cannot be evaluated.
+#[pyfunction]
+#[pyo3(signature = (a, stiffness=(1.0, 1.0, 1.0), threads=None, weight=None, gravity=None))]
+fn wrenches3d<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    stiffness: (f64, f64, f64),
+    threads: Option<i64>,
+    weight: Option<PyReadonlyArray1<'py, f64>>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let a = a.as_slice()?;
+    let n = a.len() / 6;
+    let k = stiffness_of(stiffness)?;
+    let threads = thread_count(threads)?;
+    let g = gravities3(n, weight.as_ref(), gravity.as_ref())?;
+    let mut base = buffer(n, 6, f64::NAN)?;
+    let mut tip = buffer(n, 6, f64::NAN)?;
+    batch(
+        py,
+        n,
+        threads,
+        SOLVE_BLOCK,
+        |i| {
+            let ai = Vector6::from_column_slice(&a[6 * i..6 * i + 6]);
+            let gi = g.as_ref().map_or(heavy3::Gravity3::NONE, |g| g[i]);
+            heavy3::wrenches(&ai, &k, &gi).ok()
+        },
+        |i, w| {
+            if let Some(w) = w {
+                for (out, x) in [(&mut base, w.base), (&mut tip, w.tip)] {
+                    out[6 * i..6 * i + 3].copy_from_slice(&x.force);
+                    out[6 * i + 3..6 * i + 6].copy_from_slice(&x.moment);
+                }
+            }
+        },
+    )?;
+    let d = PyDict::new(py);
+    d.set_item("base", f64_out(py, base))?;
+    d.set_item("tip", f64_out(py, tip))?;
+    Ok(d)
+}
+
 /// Stability verdicts of n rods `a` (flattened (n, 3)) by `planar::stability_verdict`: true
 /// iff the rod is established stable (what `forward` gives as `stable`), without the margin
 /// it refines. A rod that cannot be evaluated gets false.
@@ -984,6 +1071,8 @@ fn _rod_ig(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve, m)?)?;
     m.add_function(wrap_pyfunction!(forward3d, m)?)?;
     m.add_function(wrap_pyfunction!(solve3d, m)?)?;
+    m.add_function(wrap_pyfunction!(wrenches, m)?)?;
+    m.add_function(wrap_pyfunction!(wrenches3d, m)?)?;
     m.add_function(wrap_pyfunction!(warm_up, m)?)?;
     m.add_function(wrap_pyfunction!(_time_evaluate, m)?)?;
     m.add_class::<Tracker>()?;

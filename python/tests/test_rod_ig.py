@@ -571,3 +571,38 @@ def test_a_failure_counts_its_starts_and_says_what_was_searched() -> None:
     assert not r.success and r.termination == "no_stable_solution"
     assert r.starts > 0
     assert "Newton starts" in r.reason and "branches followed" in r.reason
+
+
+def test_gripper_wrenches_balance_the_rod() -> None:
+    """Issue 52, item 2: ``base_wrench``/``tip_wrench`` in forward and solve results (what the
+    rod exerts on each gripper, in its own frame): the base's is ``a``; without weight the
+    tip's balances it in the base frame (forces and moments about the base), with weight the
+    grippers carry it; the CLI gives the same numbers."""
+    a = np.array([[1.3, -20.0, 4.0], [-0.4, 35.0, -2.5], [2.0, 3.0, 1.0]])
+    f = rod_ig.forward(a)
+    assert f.base_wrench is not None and f.tip_wrench is not None
+    np.testing.assert_array_equal(f.base_wrench.force, a[:, 1:])
+    np.testing.assert_array_equal(f.base_wrench.moment, a[:, 0])
+    th = f.tip[:, 2]
+    fx, fy = f.tip_wrench.force[:, 0], f.tip_wrench.force[:, 1]
+    wx, wy = np.cos(th) * fx - np.sin(th) * fy, np.sin(th) * fx + np.cos(th) * fy
+    np.testing.assert_allclose(wx, -a[:, 1], atol=1e-9)
+    np.testing.assert_allclose(wy, -a[:, 2], atol=1e-9)
+    moments = a[:, 0] + f.tip_wrench.moment + f.tip[:, 0] * wy - f.tip[:, 1] * wx
+    np.testing.assert_allclose(moments, 0.0, atol=1e-8)
+    # With weight 5 along -y, the two grippers carry the whole weight.
+    h = rod_ig.forward(a, weight=5.0)
+    assert h.tip_wrench is not None
+    th = h.tip[:, 2]
+    fx, fy = h.tip_wrench.force[:, 0], h.tip_wrench.force[:, 1]
+    np.testing.assert_allclose(a[:, 2] + np.sin(th) * fx + np.cos(th) * fy, -5.0, atol=1e-9)
+    s = rod_ig.solve([0.5, 0.2, 1.0])
+    assert s.base_wrench is not None and s.tip_wrench is not None
+    np.testing.assert_array_equal(s.base_wrench.moment, s.a[0])
+    cli = run_cli("solve", [{"target": {"x": 0.5, "y": 0.2, "theta": 1.0}}])[0]
+    np.testing.assert_allclose(s.tip_wrench.force, cli["tip_wrench"]["force"], rtol=1e-12)
+    base, tip = rod_ig.wrenches3d([0.3, -0.8, 1.2, 2.0, -3.0, 1.5])
+    np.testing.assert_array_equal(base.moment, [0.3, -0.8, 1.2])
+    assert tip.force.shape == (3,)
+    failed = rod_ig.solve([2.0, 0.0, 0.0])
+    assert failed.tip_wrench is not None and np.isnan(failed.tip_wrench.moment)
