@@ -252,3 +252,35 @@ def test_base_wrench_is_published_as_wrench_stamped(node_and_client):
         assert not c.wait_for(lambda: any(w.header.stamp == t.header.stamp for w in got), timeout=0.5)
     finally:
         c.node.destroy_subscription(sub)
+
+
+def test_tip_wrench_balances_the_base_wrench(node_and_client):
+    """Issue 52, item 2: RodSolution.tip_wrench and rod/tip_wrench (WrenchStamped in the tip
+    frame, "rod_tip" without tip_frame) carry what the rod exerts on the tip gripper. Without
+    weight it balances the base wrench: rotated into the base frame the forces cancel, and the
+    moments about the base sum to zero (the tip at x, y in metres)."""
+    from geometry_msgs.msg import WrenchStamped
+    _, c = node_and_client
+    got = []
+    sub = c.node.create_subscription(WrenchStamped, "/rod/tip_wrench", got.append, h.topic_qos())
+    try:
+        assert all(r.successful for r in c.set_params(bending_stiffness=2.0, rod_length=0.5))
+        t, sol, _ = solve_topic(c, 0.3, 0.15, 0.5)
+        assert sol.success and sol.wrench_valid
+        q = sol.tip.orientation
+        theta = 2.0 * math.atan2(q.z, q.w)
+        tw, bw = sol.tip_wrench, sol.base_wrench
+        fx = math.cos(theta) * tw.force.x - math.sin(theta) * tw.force.y
+        fy = math.sin(theta) * tw.force.x + math.cos(theta) * tw.force.y
+        assert abs(fx + bw.force.x) < 1e-6 * (1 + abs(bw.force.x)), (fx, bw.force.x)
+        assert abs(fy + bw.force.y) < 1e-6 * (1 + abs(bw.force.y)), (fy, bw.force.y)
+        x, y = sol.tip.position.x, sol.tip.position.y
+        moment = bw.torque.z + tw.torque.z + x * fy - y * fx
+        assert abs(moment) < 1e-6 * (1 + abs(bw.torque.z)), moment
+        assert c.wait_for(lambda: any(w.header.stamp == t.header.stamp for w in got), timeout=5.0)
+        w = next(w for w in got if w.header.stamp == t.header.stamp)
+        assert w.header.frame_id == "rod_tip"
+        assert w.wrench.torque.z == tw.torque.z and w.wrench.force.x == tw.force.x
+    finally:
+        assert all(r.successful for r in c.set_params(bending_stiffness=0.0, rod_length=1.0))
+        c.node.destroy_subscription(sub)

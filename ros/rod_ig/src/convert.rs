@@ -452,6 +452,26 @@ pub fn base_wrench_3d(a: &SpatialParams, rod_length: f64, bending_stiffness: f64
     }
 }
 
+/// A normalised wrench (force xyz, moment xyz) in physical units: force ×EI/L², moment ×EI/L.
+pub fn scaled_wrench(w: &[f64; 6], rod_length: f64, bending_stiffness: f64) -> Wrench {
+    let (f, m) = (
+        bending_stiffness / (rod_length * rod_length),
+        bending_stiffness / rod_length,
+    );
+    Wrench {
+        force: Vector3 {
+            x: w[0] * f,
+            y: w[1] * f,
+            z: w[2] * f,
+        },
+        torque: Vector3 {
+            x: w[3] * m,
+            y: w[4] * m,
+            z: w[5] * m,
+        },
+    }
+}
+
 /// The model-dependent parts of a converged RodSolution (the rest comes from the solver's
 /// one `Solution` type, whichever model produced it).
 struct ModelParts {
@@ -463,6 +483,8 @@ struct ModelParts {
     spatial: bool,
     /// The base wrench in SI units for EI = `bending_stiffness`.
     wrench: Wrench,
+    /// The tip wrench in SI units, tip frame.
+    tip_wrench: Wrench,
     /// The reached tip, metres.
     tip: Pose,
     /// Branch event ("" when not followed) and the critical gripper pose after a snap (m).
@@ -521,6 +543,11 @@ fn converged_message<P, X>(
         critical_pose: c.critical.unwrap_or_else(nan_pose),
         weight: c.weight,
         total_energy: s.energy,
+        tip_wrench: if wrench_valid {
+            c.tip_wrench
+        } else {
+            Wrench::default()
+        },
     }
 }
 
@@ -551,7 +578,7 @@ pub fn solution_message_3d(
     params: &Params,
     solve_time: f64,
 ) -> RodSolution {
-    let (weight, elastic_energy) = (s.weight, s.elastic_energy);
+    let (weight, elastic_energy, tip_wrench) = (s.weight, s.elastic_energy, s.tip_wrench);
     let s = &s.solution;
     let (l, ei) = (params.rod_length, params.bending_stiffness);
     let a_spatial: [f64; 6] = std::array::from_fn(|i| s.a[i]);
@@ -561,6 +588,7 @@ pub fn solution_message_3d(
         a_spatial,
         spatial: true,
         wrench: base_wrench_3d(&s.a, l, ei),
+        tip_wrench: scaled_wrench(&tip_wrench, l, ei),
         tip: spatial_to_pose(&s.tip, l),
         event: "",
         critical: None,
@@ -586,6 +614,7 @@ pub fn solution_message(
         a_spatial: [0.0; 6],
         spatial: false,
         wrench: base_wrench(&a, l, ei),
+        tip_wrench: scaled_wrench(&solved.tip_wrench, l, ei),
         tip: planar_to_pose(&s.tip, l),
         event: solved.event,
         critical: solved.critical.map(|c| planar_to_pose(&c, l)),
@@ -640,6 +669,7 @@ pub fn failure_message(
         critical_pose: nan_pose(),
         weight: gravity_3d_of(params).map_or(f64::NAN, |g| g.weight()),
         total_energy: nan,
+        tip_wrench: Wrench::default(),
     }
 }
 
@@ -817,6 +847,7 @@ mod tests {
             critical: None,
             weight: 0.0,
             elastic_energy: 1.5,
+            tip_wrench: [1.0, -2.0, 0.0, 0.0, 0.0, 0.5],
         };
         let p = Params {
             rod_length: 0.5,
@@ -829,6 +860,9 @@ mod tests {
         assert_eq!(m.position_error, 5e-8);
         assert_eq!(m.tip.position.x, 0.25);
         assert_eq!(m.a, [1.0, 2.0, -3.0]);
+        // The tip wrench scales as the base's: force × 8, moment × 4.
+        let t = m.tip_wrench;
+        assert_eq!((t.force.x, t.force.y, t.torque.z), (8.0, -16.0, 2.0));
         let p0 = Params {
             rod_length: 0.5,
             ..Params::default()

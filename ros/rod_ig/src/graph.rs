@@ -26,6 +26,8 @@ pub mod names {
     pub const DIAGNOSTICS: &str = "/diagnostics";
     /// The base wrench out (geometry_msgs/WrenchStamped), with `bending_stiffness` set.
     pub const BASE_WRENCH: &str = "rod/base_wrench";
+    /// The tip wrench out (geometry_msgs/WrenchStamped, tip frame), with `bending_stiffness` set.
+    pub const TIP_WRENCH: &str = "rod/tip_wrench";
     /// Transforms in (tf2_msgs/TFMessage), absolute as tf2's.
     pub const TF: &str = "/tf";
     /// Static transforms in (tf2_msgs/TFMessage, transient local).

@@ -303,6 +303,9 @@ pub struct RodSolution {
     pub weight: f64,
     /// Elastic + gravitational energy, normalised (appended field; NaN on failure).
     pub total_energy: f64,
+    /// The wrench the rod exerts on the tip gripper (N, N·m), in the tip frame (appended
+    /// field; zeros unless `wrench_valid`).
+    pub tip_wrench: Wrench,
 }
 impl Message for RodSolution {}
 
@@ -753,6 +756,18 @@ pub(crate) mod tests {
             critical_pose: pose(2),
             weight: 15.1,
             total_energy: 3.25,
+            tip_wrench: Wrench {
+                force: Vector3 {
+                    x: -0.5,
+                    y: 0.25,
+                    z: 0.0,
+                },
+                torque: Vector3 {
+                    x: 0.0,
+                    y: 0.0,
+                    z: 1.75,
+                },
+            },
         }
     }
 

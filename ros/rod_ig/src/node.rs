@@ -362,6 +362,10 @@ struct Outputs {
     plan_rods: Arc<Publisher<Marker>>,
     /// The base wrench of each solution, when `bending_stiffness` is set.
     base_wrench: Publisher<WrenchStamped>,
+    /// The tip wrench of each solution (tip frame), when `bending_stiffness` is set.
+    tip_wrench: Publisher<WrenchStamped>,
+    /// The frame id of the tip wrench: `tip_frame` when set, else [`DEFAULT_TIP_WRENCH_FRAME`].
+    tip_frame: String,
     /// The resolved names, for the logs (remapped and namespaced as the graph shows them).
     names: Names,
 }
@@ -375,8 +379,27 @@ struct Names {
     marker: String,
     plan_rods: String,
     base_wrench: String,
+    tip_wrench: String,
     solve: String,
     plan: String,
+}
+
+impl Names {
+    /// The names from the resolved topics (in their order of creation) and services.
+    fn of(topics: &[String], [solve, plan]: [&String; 2]) -> Self {
+        let topic = |i: usize| topics.get(i).cloned().unwrap_or_default();
+        Names {
+            target: topic(0),
+            path: topic(1),
+            solution: topic(2),
+            marker: topic(3),
+            plan_rods: topic(4),
+            base_wrench: topic(6),
+            tip_wrench: topic(7),
+            solve: solve.clone(),
+            plan: plan.clone(),
+        }
+    }
 }
 
 /// Creates the DDS context for `mw` (domain, loopback restriction).
@@ -584,6 +607,19 @@ struct Endpoints {
     services: [String; 2],
 }
 
+/// The tip wrench's frame id when `tip_frame` is not set: the rod's tip (x along its tangent
+/// there), a frame the node does not broadcast (docs/node.md).
+const DEFAULT_TIP_WRENCH_FRAME: &str = "rod_tip";
+
+/// The frame id of `rod/tip_wrench`: the tip gripper's TF frame when the node follows one.
+fn tip_wrench_frame(params: &Params) -> String {
+    if params.tip_frame.is_empty() {
+        DEFAULT_TIP_WRENCH_FRAME.to_string()
+    } else {
+        params.tip_frame.clone()
+    }
+}
+
 /// Creates the topics and the output publishers (the inputs come after the warm-up).
 fn create_endpoints(
     node: &mut ros2_client::Node,
@@ -605,6 +641,7 @@ fn create_endpoints(
     let plan_rods_topic = topic(node, names::PLAN_RODS, type_names::marker())?;
     let diagnostics_topic = topic(node, names::DIAGNOSTICS, type_names::diagnostic_array())?;
     let wrench_topic = topic(node, names::BASE_WRENCH, type_names::wrench_stamped())?;
+    let tip_wrench_topic = topic(node, names::TIP_WRENCH, type_names::wrench_stamped())?;
     // Absolute, as tf2's: not under the node's namespace (remappable).
     let tf_topic = |name: &str| -> Result<_, NodeError> {
         let (n, _) = resolved_name(identity, name)?;
@@ -638,16 +675,11 @@ fn create_endpoints(
         base_wrench: node
             .create_publisher(&wrench_topic, out_qos(names::BASE_WRENCH))
             .map_err(create_err("/rod/base_wrench publisher"))?,
-        names: Names {
-            target: resolved[0].clone(),
-            path: resolved[1].clone(),
-            solution: resolved[2].clone(),
-            marker: resolved[3].clone(),
-            plan_rods: resolved[4].clone(),
-            base_wrench: resolved[6].clone(),
-            solve: solve_full.clone(),
-            plan: plan_full.clone(),
-        },
+        tip_wrench: node
+            .create_publisher(&tip_wrench_topic, out_qos(names::TIP_WRENCH))
+            .map_err(create_err("/rod/tip_wrench publisher"))?,
+        tip_frame: tip_wrench_frame(params),
+        names: Names::of(&resolved, [&solve_full, &plan_full]),
     };
     let endpoints = Endpoints {
         target_topic,
@@ -1638,6 +1670,20 @@ fn publish(log: &Logger, outputs: &Outputs, outcome: Outcome) {
                 Error,
                 "cannot publish {}: {e:?}",
                 outputs.names.base_wrench
+            );
+        }
+        let mut header = outcome.solution.header.clone();
+        header.frame_id.clone_from(&outputs.tip_frame);
+        let tip = WrenchStamped {
+            header,
+            wrench: outcome.solution.tip_wrench,
+        };
+        if let Err(e) = outputs.tip_wrench.publish(tip) {
+            node_log!(
+                log,
+                Error,
+                "cannot publish {}: {e:?}",
+                outputs.names.tip_wrench
             );
         }
     }

@@ -126,7 +126,7 @@ pub struct QosOverride {
 
 /// The endpoints whose QoS the `qos_overrides` parameters set: the target subscription, then
 /// the publishers.
-const QOS_ENDPOINTS: [(&str, &str); 7] = {
+const QOS_ENDPOINTS: [(&str, &str); 8] = {
     use crate::graph::names;
     [
         (names::TARGET, "subscription"),
@@ -136,6 +136,7 @@ const QOS_ENDPOINTS: [(&str, &str); 7] = {
         (names::PLAN_RODS, "publisher"),
         (names::DIAGNOSTICS, "publisher"),
         (names::BASE_WRENCH, "publisher"),
+        (names::TIP_WRENCH, "publisher"),
     ]
 };
 

@@ -59,6 +59,18 @@ pub struct WithShape<S, P> {
     pub weight: f64,
     /// The elastic part of the solution's energy (all of it without weight).
     pub elastic_energy: f64,
+    /// The wrench the rod exerts on the tip gripper, normalised, in the tip frame: force
+    /// (x, y, z) then moment (x, y, z) (`rod_ig_core::wrench`; NaN where it could not be
+    /// evaluated).
+    pub tip_wrench: [f64; 6],
+}
+
+/// The planar tip wrench as [`WithShape::tip_wrench`]: (fx, fy, 0, 0, 0, m).
+fn planar_tip_wrench(a: &rod_ig_core::PlanarParams, g: &Gravity) -> [f64; 6] {
+    heavy::wrenches(a, g).map_or([f64::NAN; 6], |w| {
+        let t = w.tip;
+        [t.force[0], t.force[1], 0.0, 0.0, 0.0, t.moment]
+    })
 }
 
 /// A converged planar solve and its shape.
@@ -413,6 +425,7 @@ fn with_heavy_shape(s: &Solution, g: &Gravity, samples: usize) -> Result<Solved,
         critical: None,
         weight: g.weight(),
         elastic_energy: elastic,
+        tip_wrench: planar_tip_wrench(&s.a, g),
     })
 }
 
@@ -425,6 +438,7 @@ fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
         critical: None,
         weight: 0.0,
         elastic_energy: s.energy,
+        tip_wrench: planar_tip_wrench(&s.a, &Gravity::NONE),
     })
 }
 
@@ -459,5 +473,16 @@ fn with_shape_3d(s: &Solution3d, g: &Gravity3, samples: usize) -> Result<Solved3
         critical: None,
         weight: g.weight(),
         elastic_energy,
+        tip_wrench: heavy3::wrenches(&s.a, &k, g).map_or([f64::NAN; 6], |w| {
+            let t = w.tip;
+            [
+                t.force[0],
+                t.force[1],
+                t.force[2],
+                t.moment[0],
+                t.moment[1],
+                t.moment[2],
+            ]
+        }),
     })
 }
