@@ -8,7 +8,8 @@
 #      CLI fuzz), then the release CLI and node as scripts/run-node.sh builds them;
 #   4. the pytest suite in tests/ (real rclpy client, node as a subprocess on random ROS
 #      domains, loopback only);
-#   5. the Python package: `pip install ./python` into its own venv, its pytest suite and
+#   5. the Python package: its manylinux2014 abi3 wheel (scripts/build-wheel.sh) installed into a
+#      fresh venv with no Rust on PATH, its pytest suite and
 #      `mypy --strict`.
 # Prints cargo's and pytest's summary lines; exits non-zero if anything fails.
 #
@@ -83,24 +84,33 @@ python -m pytest "$REPO/tests" -q -p no:cacheprovider -W ignore::DeprecationWarn
 pytest_rc=${PIPESTATUS[0]}
 [ "$pytest_rc" = 0 ] || { echo "pytest FAILED (full log: $LOGS/pytest.log; node logs in $LOGS)"; status=1; }
 
-echo "== Python package rod_ig: pip install ./python, pytest python/tests, mypy --strict"
-# Its own venv (numpy 2, dask, matplotlib): the ROS venv's wheels pin their own numpy.
+echo "== Python package rod_ig: its wheel (scripts/build-wheel.sh), installed into a fresh venv with no Rust on PATH; pytest python/tests, mypy --strict"
+# Its own venv (numpy 2, dask, matplotlib): the ROS venv's wheels pin their own numpy. Fresh on
+# every run, and used with PATH stripped of cargo and rustc: the wheel must need neither.
 PYVENV="${ROD_IG_BUILD:-$REPO/build}/py-venv"
-[ -x "$PYVENV/bin/python" ] || python3 -m venv "$PYVENV"
+rm -rf "$PYVENV" && python3 -m venv "$PYVENV"
+NORUST_PATH=""
+IFS=: read -ra _dirs <<<"$PATH"
+for _d in "${_dirs[@]}"; do
+    [ -x "$_d/cargo" ] || [ -x "$_d/rustc" ] || NORUST_PATH="${NORUST_PATH:+$NORUST_PATH:}$_d"
+done
 py_ok=1
-"$PYVENV/bin/python" -m pip install --quiet --disable-pip-version-check \
-    pytest hypothesis mypy "dask[array]" matplotlib numpy >"$LOGS/py-deps.log" 2>&1 || py_ok=0
-# Same target dir as the package's own builds (python/target), so that reruns are incremental.
-"$PYVENV/bin/python" -m pip install --quiet --disable-pip-version-check --force-reinstall \
-    --no-deps ./python >"$LOGS/py-build.log" 2>&1 || py_ok=0
+"$REPO/scripts/build-wheel.sh" >"$LOGS/py-build.log" 2>&1 || py_ok=0
+WHEEL="$(ls "$REPO"/target/wheels/rod_ig-*manylinux*.whl 2>/dev/null | head -n 1)"
+[ -n "$WHEEL" ] || py_ok=0
+[ "$py_ok" = 1 ] && env PATH="$NORUST_PATH" "$PYVENV/bin/python" -m pip install --quiet \
+    --disable-pip-version-check pytest hypothesis mypy "dask[array]" matplotlib numpy "$WHEEL" \
+    >"$LOGS/py-deps.log" 2>&1 || py_ok=0
 if [ "$py_ok" = 1 ]; then
-    (cd "$LOGS" && ROD_IG_CLI="$TARGET/release/rod-ig" "$PYVENV/bin/python" -m pytest \
-        "$REPO/python/tests" -q -p no:cacheprovider 2>&1) | tee "$LOGS/py-test.log" | tail -n 5
+    echo "wheel: $(basename "$WHEEL")"
+    (cd "$LOGS" && env PATH="$NORUST_PATH" ROD_IG_CLI="$TARGET/release/rod-ig" \
+        "$PYVENV/bin/python" -m pytest "$REPO/python/tests" -q -p no:cacheprovider 2>&1) \
+        | tee "$LOGS/py-test.log" | tail -n 5
     [ "${PIPESTATUS[0]}" = 0 ] || { echo "python package tests FAILED (see $LOGS/py-test.log)"; status=1; }
-    "$PYVENV/bin/python" -m mypy --strict "$REPO/python/rod_ig" >"$LOGS/mypy.log" 2>&1 \
-        || { echo "mypy --strict FAILED (see $LOGS/mypy.log)"; status=1; }
+    env PATH="$NORUST_PATH" "$PYVENV/bin/python" -m mypy --strict "$REPO/python/rod_ig" \
+        >"$LOGS/mypy.log" 2>&1 || { echo "mypy --strict FAILED (see $LOGS/mypy.log)"; status=1; }
 else
-    echo "python package build FAILED (see $LOGS/py-deps.log, $LOGS/py-build.log)"; status=1
+    echo "python wheel build or install FAILED (see $LOGS/py-build.log, $LOGS/py-deps.log)"; status=1
 fi
 
 echo "== summary"
