@@ -8,7 +8,7 @@ ExecuteProcess rather than Node(package=...). Usage, from the repository root af
     ros2 launch launch_notes/rod_ig.launch.py params_file:=/path/to/params.yaml
     ros2 launch launch_notes/rod_ig.launch.py rviz:=true fixed_frame:=rod_base   # and RViz
 
-Parameters come from the YAML file (edit launch_notes/rod_ig_params.yaml or pass your own);
+Parameters come from the YAML file (the package's ros/rod_ig/config/rod_ig_params.yaml, the one parameters file, or your own);
 change them at run time with `ros2 param set /rod_ig_node rod_length 0.8`.
 
 The node reads ROS_DOMAIN_ID and ROS_AUTOMATIC_DISCOVERY_RANGE from the environment.
@@ -29,7 +29,7 @@ def generate_launch_description():
     return LaunchDescription([
         DeclareLaunchArgument("node_bin", default_value=os.path.join(REPO, "target", "release", "rod_ig_node"),
                               description="path of the rod_ig_node binary"),
-        DeclareLaunchArgument("params_file", default_value=os.path.join(HERE, "rod_ig_params.yaml"),
+        DeclareLaunchArgument("params_file", default_value=os.path.join(REPO, "ros", "rod_ig", "config", "rod_ig_params.yaml"),
                               description="ROS 2 parameters file for rod_ig_node"),
         DeclareLaunchArgument("rviz", default_value="false", description="also start RViz"),
         DeclareLaunchArgument("fixed_frame", default_value="rod_base",

@@ -47,7 +47,7 @@ def generate_launch_description():
     return LaunchDescription([
         DeclareLaunchArgument("node_bin", default_value=os.path.join(REPO, "target", "release", "rod_ig_node"),
                               description="path of the rod_ig_node binary"),
-        DeclareLaunchArgument("params_file", default_value=os.path.join(HERE, "rod_ig_params.yaml"),
+        DeclareLaunchArgument("params_file", default_value=os.path.join(REPO, "ros", "rod_ig", "config", "rod_ig_params.yaml"),
                               description="ROS 2 parameters file (its /** section serves both nodes)"),
         DeclareLaunchArgument("use_sim_time", default_value="false",
                               description="stamp zero-stamped targets with /clock time"),

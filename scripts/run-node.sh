@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds (if needed) and runs rod_ig_node with working defaults; extra arguments go to the node,
-# e.g.   scripts/run-node.sh -p rod_length:=0.8 --params-file launch_notes/rod_ig_params.yaml
+# e.g.   scripts/run-node.sh -p rod_length:=0.8 --params-file ros/rod_ig/config/rod_ig_params.yaml
 #
 # The node itself needs no Python or ROS install (pure Rust DDS). Environment honoured:
 # ROS_DOMAIN_ID (default 0), ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST or ROS_LOCALHOST_ONLY=1

@@ -126,7 +126,7 @@ def test_startup_flags_and_params_file(tmp_path):
 
 def test_shipped_params_file_starts(tmp_path):
     domain = h.free_domain()
-    node = h.NodeProcess(domain, ["--params-file", str(h.REPO / "launch_notes" / "rod_ig_params.yaml")])
+    node = h.NodeProcess(domain, ["--params-file", str(h.REPO / "ros" / "rod_ig" / "config" / "rod_ig_params.yaml")])
     try:
         assert node.wait_log("rod_ig_node ready", timeout=20), node.log_text()
     finally:

@@ -1522,8 +1522,7 @@ mod tests {
 
     #[test]
     fn shipped_params_file_loads() {
-        let path =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../launch_notes/rod_ig_params.yaml");
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("config/rod_ig_params.yaml");
         let mut p = Params::default();
         load_params_file(&mut p, &path).unwrap();
     }
