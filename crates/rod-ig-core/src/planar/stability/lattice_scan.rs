@@ -13,6 +13,9 @@ use crate::planar::soliton::Lattice;
 /// `tests/separatrix_limit.rs`), ×10.
 const LATTICE_ENTRY_REL: f64 = 5e-12;
 
+/// The scan's spacing in soliton widths 1/√R.
+const LATTICE_SPACING_WIDTHS: f64 = 3.0;
+
 /// Largest ln |g|: beyond, g is capped (its sign and relative error are kept; a margin of
 /// e^700 says as much as a larger one).
 const MAX_LN_FACTOR: f64 = 700.0;
@@ -28,9 +31,13 @@ pub(crate) fn lattice_report(a: &PlanarParams) -> Option<Result<StabilityReport,
 }
 
 fn report(lattice: &Lattice<Dual3>, a: &PlanarParams) -> Result<StabilityReport, RodError> {
-    // Nearly straight rods: the expansion's certified verdict, as everywhere else.
-    if let Some(r) = small_angle_report(a)? {
-        return Ok(r);
+    let (extra, n_extra) = lattice.features();
+    // Nearly straight rods (no soliton on the rod): the expansion's certified verdict, as
+    // everywhere else. A soliton on the rod bends it by 2π: the expansion cannot apply.
+    if n_extra == 0 {
+        if let Some(r) = small_angle_report(a)? {
+            return Ok(r);
+        }
     }
     let (a3, a5) = (a[0], a[2]);
     let inflections = lattice.inflections();
@@ -58,8 +65,9 @@ fn report(lattice: &Lattice<Dual3>, a: &PlanarParams) -> Result<StabilityReport,
     // g varies on the solitons' width 1/√R: sample them, and the inflection points, as
     // extra times.
     let root_r = a[1].hypot(a[2]).sqrt();
-    let (extra, n_extra) = lattice.features();
-    let spacing = (1.0 / root_r).clamp(0.01, SERIES_SPACING);
+    // g grows like e^{2√R t} away from the solitons, which are sampled by their centres: a
+    // grid of a few soliton widths finds the margin's minima between them.
+    let spacing = (LATTICE_SPACING_WIDTHS / root_r).clamp(0.02, SERIES_SPACING);
     let s = scan(
         &value_only(probe),
         T_MARGIN,
