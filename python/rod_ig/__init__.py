@@ -226,6 +226,9 @@ class SolveResult:
     solutions: npt.NDArray[np.object_] | None = None
     """With ``all=True``: (...) object array, each entry an (k, 3) or (k, 6) array of every
     distinct stable solution found, least energy first."""
+    turns: npt.NDArray[np.int64] | None = None
+    """With ``weight`` (planar): full turns of the tangent along the rod found, 0 for a
+    loop-free cable (-1 where the solve failed), as the CLI's ``turns``."""
     base_wrench: Wrench | None = None
     """What the rod found exerts on the base gripper (NaN where the solve failed)."""
     tip_wrench: Wrench | None = None
@@ -238,6 +241,7 @@ def _solve_result(
     dim: int,
     all: bool,
     wrenches: tuple[Wrench, Wrench] | None = None,
+    turns: npt.NDArray[np.int64] | None = None,
 ) -> SolveResult:
     solutions = None
     if all:
@@ -258,6 +262,7 @@ def _solve_result(
         starts=_shaped(d["starts"], shape),
         complete=_shaped(d["complete"], shape),
         solutions=solutions,
+        turns=None if turns is None else _shaped(turns, shape),
         base_wrench=wrenches[0] if wrenches else None,
         tip_wrench=wrenches[1] if wrenches else None,
     )
@@ -376,9 +381,11 @@ def solve(
         max_turns=_integer("max_turns", max_turns, 0, 100),
         **_weight_kwargs(flat, len(arrays)),
     )
-    w = _rod_ig.wrenches(d["a"], threads=_threads(threads), **_weight_kwargs(flat, len(arrays)))
+    kwargs = _weight_kwargs(flat, len(arrays))
+    w = _rod_ig.wrenches(d["a"], threads=_threads(threads), **kwargs)
     pair = (_wrench(w["base"], batch, 2), _wrench(w["tip"], batch, 2))
-    return _solve_result(d, batch, 3, all, pair)
+    turns = _rod_ig.turns(d["a"], threads=_threads(threads), **kwargs) if heavy else None
+    return _solve_result(d, batch, 3, all, pair, turns)
 
 
 def forward3d(

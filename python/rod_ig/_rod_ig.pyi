@@ -48,6 +48,12 @@ def wrenches(
     weight: npt.NDArray[np.float64] | None = None,
     gravity: npt.NDArray[np.float64] | None = None,
 ) -> dict[str, Any]: ...
+def turns(
+    a: npt.NDArray[np.float64],
+    threads: int | None = None,
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
+) -> npt.NDArray[np.int64]: ...
 def wrenches3d(
     a: npt.NDArray[np.float64],
     stiffness: tuple[float, ...] = (1.0, 1.0, 1.0),

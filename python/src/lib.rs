@@ -276,6 +276,43 @@ fn wrenches<'py>(
     Ok(d)
 }
 
+/// Full turns of the tangent along n planar rods `a` (flattened (n, 3)) under their weight
+/// (`heavy::cable::turns_of` on the shape's check samples: 0 for a loop-free cable); -1 where a
+/// rod cannot be evaluated.
+#[pyfunction]
+#[pyo3(signature = (a, threads=None, weight=None, gravity=None))]
+fn turns<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    threads: Option<i64>,
+    weight: Option<PyReadonlyArray1<'py, f64>>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyArray1<i64>>> {
+    let a = a.as_slice()?;
+    let n = a.len() / 3;
+    let threads = thread_count(threads)?;
+    let g = gravities2(n, weight.as_ref(), gravity.as_ref())?;
+    let mut out = buffer(n, 1, -1i64)?;
+    batch(
+        py,
+        n,
+        threads,
+        FORWARD_BLOCK,
+        |i| {
+            let gi = g.as_ref().map_or(Gravity::NONE, |g| g[i]);
+            heavy::shape(&planar_params(a, i), &gi, heavy::cable::SHAPE_CHECK_SAMPLES)
+                .ok()
+                .map(|s| heavy::cable::turns_of(&s))
+        },
+        |i, t| {
+            if let Some(t) = t {
+                out[i] = i64::from(t);
+            }
+        },
+    )?;
+    Ok(out.into_pyarray(py))
+}
+
 /// The wrenches n 3-D rods `a` (flattened (n, 6)) exert on their grippers: "base" and "tip",
 /// each flattened (n, 6) rows (fx, fy, fz, mx, my, mz) in its gripper's frame. NaN where a rod
 /// cannot be evaluated.
@@ -1073,6 +1110,7 @@ fn _rod_ig(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve3d, m)?)?;
     m.add_function(wrap_pyfunction!(wrenches, m)?)?;
     m.add_function(wrap_pyfunction!(wrenches3d, m)?)?;
+    m.add_function(wrap_pyfunction!(turns, m)?)?;
     m.add_function(wrap_pyfunction!(warm_up, m)?)?;
     m.add_function(wrap_pyfunction!(_time_evaluate, m)?)?;
     m.add_class::<Tracker>()?;

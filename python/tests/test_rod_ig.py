@@ -606,3 +606,14 @@ def test_gripper_wrenches_balance_the_rod() -> None:
     assert tip.force.shape == (3,)
     failed = rod_ig.solve([2.0, 0.0, 0.0])
     assert failed.tip_wrench is not None and np.isnan(failed.tip_wrench.moment)
+
+
+def test_heavy_solves_report_turns() -> None:
+    """Issue 51, item 3: with weight, ``turns`` (full turns of the tangent) as the CLI's: 0 for
+    the hanging cable; without weight, None."""
+    s = rod_ig.solve([[0.6, 0.0, 0.0], [2.0, 0.0, 0.0]], weight=50.0)
+    assert s.turns is not None
+    assert s.turns.tolist() == [0, -1]
+    cli = run_cli("solve", [{"target": {"x": 0.6, "y": 0.0, "theta": 0.0}, "weight": 50.0}])[0]
+    assert cli["turns"] == 0
+    assert rod_ig.solve([0.5, 0.2, 1.0]).turns is None
