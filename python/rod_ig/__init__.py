@@ -284,7 +284,6 @@ def forward(
     arr, _ = _batch("a", a, 3)
     flat, shape = _broadcast(arr, *_weight_arrays(weight, gravity))
     d = _rod_ig.forward(flat[0], threads=_threads(threads), **_weight_kwargs(flat, 1))
-    w = _rod_ig.wrenches(flat[0], threads=_threads(threads), **_weight_kwargs(flat, 1))
     return ForwardResult(
         tip=d["tip"].reshape(shape + (3,)),
         jacobian=d["jacobian"].reshape(shape + (3, 3)),
@@ -293,8 +292,8 @@ def forward(
         uncertain=_shaped(d["uncertain"], shape),
         energy=_shaped(d["energy"], shape),
         elastic_energy=_shaped(d["elastic_energy"], shape),
-        base_wrench=_wrench(w["base"], shape, 2),
-        tip_wrench=_wrench(w["tip"], shape, 2),
+        base_wrench=_wrench(d["base_wrench"], shape, 2),
+        tip_wrench=_wrench(d["tip_wrench"], shape, 2),
     )
 
 
@@ -403,9 +402,6 @@ def forward3d(
     d = _rod_ig.forward3d(
         flat[0], stiffness=tuple(stiffness), threads=_threads(threads), **_weight_kwargs(flat, 1)
     )
-    w = _rod_ig.wrenches3d(
-        flat[0], stiffness=tuple(stiffness), threads=_threads(threads), **_weight_kwargs(flat, 1)
-    )
     return Forward3dResult(
         position=d["position"].reshape(batch + (3,)),
         quaternion=d["quaternion"].reshape(batch + (4,)),
@@ -413,8 +409,8 @@ def forward3d(
         stable=d["stable"].reshape(batch),
         margin=d["margin"].reshape(batch),
         energy=d["energy"].reshape(batch),
-        base_wrench=_wrench(w["base"], batch, 3),
-        tip_wrench=_wrench(w["tip"], batch, 3),
+        base_wrench=_wrench(d["base_wrench"], batch, 3),
+        tip_wrench=_wrench(d["tip_wrench"], batch, 3),
     )
 
 

@@ -15,6 +15,7 @@ use rod_ig_core::solver::{self, BranchEvent, BranchFollower, Method, Objective, 
 use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
 use rod_ig_core::spatial::{self, SpatialPose, StabilityOptions, Stiffness};
 use rod_ig_core::spatial::{HeavySpatial, Spatial};
+use rod_ig_core::wrench::{self, GripperWrenches, PlanarWrench, SpatialWrench};
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use std::time::Duration;
 
@@ -198,17 +199,26 @@ fn forward<'py>(
     let mut margin = buffer(n, 1, f64::NAN)?;
     let mut uncertain = buffer(n, 1, true)?;
     let mut energy = buffer(n, 1, f64::NAN)?;
+    let (mut base_w, mut tip_w) = (buffer(n, 3, f64::NAN)?, buffer(n, 3, f64::NAN)?);
     batch(
         py,
         n,
         threads,
         FORWARD_BLOCK,
         |i| {
-            let gi = g.as_ref().map_or(Gravity::NONE, |g| g[i]);
-            heavy::evaluate(&planar_params(a, i), &gi).ok()
+            let (ai, gi) = (
+                planar_params(a, i),
+                g.as_ref().map_or(Gravity::NONE, |g| g[i]),
+            );
+            let e = heavy::evaluate(&ai, &gi).ok()?;
+            Some((e, planar_wrenches_of(&ai, &gi, &e.tip)))
         },
         |i, e| {
-            if let Some(e) = e {
+            if let Some((e, w)) = e {
+                if let Some([b, t]) = w.as_ref().map(planar_rows) {
+                    base_w[3 * i..3 * i + 3].copy_from_slice(&b);
+                    tip_w[3 * i..3 * i + 3].copy_from_slice(&t);
+                }
                 elastic[i] = e.elastic_energy;
                 tip[3 * i..3 * i + 3].copy_from_slice(&[e.tip.x, e.tip.y, e.tip.theta]);
                 for r in 0..3 {
@@ -231,6 +241,8 @@ fn forward<'py>(
     d.set_item("uncertain", uncertain.into_pyarray(py))?;
     d.set_item("energy", f64_out(py, energy))?;
     d.set_item("elastic_energy", f64_out(py, elastic))?;
+    d.set_item("base_wrench", f64_out(py, base_w))?;
+    d.set_item("tip_wrench", f64_out(py, tip_w))?;
     Ok(d)
 }
 
@@ -264,9 +276,9 @@ fn wrenches<'py>(
         },
         |i, w| {
             if let Some(w) = w {
-                let (b, t) = (w.base, w.tip);
-                base[3 * i..3 * i + 3].copy_from_slice(&[b.force[0], b.force[1], b.moment]);
-                tip[3 * i..3 * i + 3].copy_from_slice(&[t.force[0], t.force[1], t.moment]);
+                let [b, t] = planar_rows(&w);
+                base[3 * i..3 * i + 3].copy_from_slice(&b);
+                tip[3 * i..3 * i + 3].copy_from_slice(&t);
             }
         },
     )?;
@@ -274,6 +286,36 @@ fn wrenches<'py>(
     d.set_item("base", f64_out(py, base))?;
     d.set_item("tip", f64_out(py, tip))?;
     Ok(d)
+}
+
+/// A planar wrench pair as two rows (fx, fy, moment).
+fn planar_rows(w: &GripperWrenches<PlanarWrench>) -> [[f64; 3]; 2] {
+    let row = |x: &PlanarWrench| [x.force[0], x.force[1], x.moment];
+    [row(&w.base), row(&w.tip)]
+}
+
+/// A 3-D wrench pair as two rows (fx, fy, fz, mx, my, mz).
+fn spatial_rows(w: &GripperWrenches<SpatialWrench>) -> [[f64; 6]; 2] {
+    let row = |x: &SpatialWrench| {
+        let (f, m) = (x.force, x.moment);
+        [f[0], f[1], f[2], m[0], m[1], m[2]]
+    };
+    [row(&w.base), row(&w.tip)]
+}
+
+/// The planar wrenches of a rod already evaluated: without weight from its tip (the moment
+/// balance, no second evaluation), with weight by `heavy::wrenches`.
+fn planar_wrenches_of(
+    a: &PlanarParams,
+    g: &Gravity,
+    tip: &PlanarPose,
+) -> Option<GripperWrenches<PlanarWrench>> {
+    if g.is_weightless() {
+        let k1 = wrench::weightless_tip_curvature(a, tip);
+        Some(wrench::planar(a, tip, [a[1], a[2]], k1))
+    } else {
+        heavy::wrenches(a, g).ok()
+    }
 }
 
 /// Full turns of the tangent along n planar rods `a` (flattened (n, 3)) under their weight
@@ -345,10 +387,9 @@ fn wrenches3d<'py>(
         },
         |i, w| {
             if let Some(w) = w {
-                for (out, x) in [(&mut base, w.base), (&mut tip, w.tip)] {
-                    out[6 * i..6 * i + 3].copy_from_slice(&x.force);
-                    out[6 * i + 3..6 * i + 6].copy_from_slice(&x.moment);
-                }
+                let [b, t] = spatial_rows(&w);
+                base[6 * i..6 * i + 6].copy_from_slice(&b);
+                tip[6 * i..6 * i + 6].copy_from_slice(&t);
             }
         },
     )?;
@@ -766,6 +807,7 @@ fn forward3d<'py>(
     let mut stable = buffer(n, 1, false)?;
     let mut margin = buffer(n, 1, f64::NAN)?;
     let mut energy = buffer(n, 1, f64::NAN)?;
+    let (mut base_w, mut tip_w) = (buffer(n, 6, f64::NAN)?, buffer(n, 6, f64::NAN)?);
     batch(
         py,
         n,
@@ -773,21 +815,31 @@ fn forward3d<'py>(
         SOLVE_BLOCK,
         |i| {
             let ai = Vector6::from_column_slice(&a[6 * i..6 * i + 6]);
+            let (am, af) = (ai.fixed_rows::<3>(0).into(), ai.fixed_rows::<3>(3).into());
             match &g {
-                Some(g) => heavy3::evaluate(&ai, &k, &g[i])
-                    .ok()
-                    .map(|e| (e.tip, e.jacobian, e.stability, e.energy)),
-                None => spatial::evaluate(&ai, &k, &opts)
-                    .ok()
-                    .map(|e| (e.tip, e.jacobian, e.stability, e.energy)),
+                Some(g) => heavy3::evaluate(&ai, &k, &g[i]).ok().map(|e| {
+                    let w = heavy3::wrenches(&ai, &k, &g[i]).ok();
+                    (e.tip, e.jacobian, e.stability, e.energy, w)
+                }),
+                // Without weight the world wrench is conserved: the tip's follows from the tip.
+                None => spatial::evaluate(&ai, &k, &opts).ok().map(|e| {
+                    let w = Some(wrench::spatial(&ai, &e.tip, af, am));
+                    (e.tip, e.jacobian, e.stability, e.energy, w)
+                }),
             }
         },
         |i, e| {
-            let e = e.map(|(tip, jacobian, stability, energy)| Evaluated3d {
-                tip,
-                jacobian,
-                stability,
-                energy,
+            let e = e.map(|(tip, jacobian, stability, energy, w)| {
+                if let Some([b, t]) = w.as_ref().map(spatial_rows) {
+                    base_w[6 * i..6 * i + 6].copy_from_slice(&b);
+                    tip_w[6 * i..6 * i + 6].copy_from_slice(&t);
+                }
+                Evaluated3d {
+                    tip,
+                    jacobian,
+                    stability,
+                    energy,
+                }
             });
             if let Some(e) = e {
                 let p = e.tip.position;
@@ -811,6 +863,8 @@ fn forward3d<'py>(
     d.set_item("stable", stable.into_pyarray(py))?;
     d.set_item("margin", f64_out(py, margin))?;
     d.set_item("energy", f64_out(py, energy))?;
+    d.set_item("base_wrench", f64_out(py, base_w))?;
+    d.set_item("tip_wrench", f64_out(py, tip_w))?;
     Ok(d)
 }
 

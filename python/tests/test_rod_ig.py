@@ -604,6 +604,15 @@ def test_gripper_wrenches_balance_the_rod() -> None:
     base, tip = rod_ig.wrenches3d([0.3, -0.8, 1.2, 2.0, -3.0, 1.5])
     np.testing.assert_array_equal(base.moment, [0.3, -0.8, 1.2])
     assert tip.force.shape == (3,)
+    # forward3d's, from its own tip (the conserved world wrench), agree with the separate call.
+    f3 = rod_ig.forward3d([0.3, -0.8, 1.2, 2.0, -3.0, 1.5])
+    assert f3.tip_wrench is not None
+    np.testing.assert_allclose(f3.tip_wrench.force, tip.force, atol=1e-6)
+    np.testing.assert_allclose(f3.tip_wrench.moment, tip.moment, atol=1e-6)
+    # forward's, from its evaluation, equal the separate call's (whose tip skips the closed
+    # form's phase: the last bits may differ).
+    _, tip2 = rod_ig.wrenches(a)
+    np.testing.assert_allclose(f.tip_wrench.moment, tip2.moment, rtol=1e-12, atol=1e-12)
     failed = rod_ig.solve([2.0, 0.0, 0.0])
     assert failed.tip_wrench is not None and np.isnan(failed.tip_wrench.moment)
 
