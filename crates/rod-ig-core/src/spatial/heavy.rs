@@ -19,7 +19,7 @@ use crate::{RodError, StabilityReport};
 use std::ops::ControlFlow;
 
 /// Base state: q (w, x, y, z), p, elastic energy, P = ∫p.
-const NB: usize = 11;
+pub(super) const NB: usize = 11;
 /// Base + η (6 rows × 6 columns, row-major) + δP (3 rows × 6 columns, row-major).
 const NV: usize = NB + 36 + 18;
 /// Relative tolerance of every integration here (tip ≤ 1e-9, J ≤ 1e-6 relative).
@@ -98,14 +98,17 @@ fn rv(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
     std::array::from_fn(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2])
 }
 
-/// The right-hand side (module docs); `var`: with the variational equations.
-fn rhs(
+/// The right-hand side (module docs); `var`: with the variational equations of its `C`
+/// columns (state size `N` = [`NB`] + 9 `C`; the last six columns are ∂/∂a, the first `C` − 6
+/// start from unit perturbations of the state at the start of the integration, as the
+/// segments of [`super::cable`] do).
+pub(super) fn rhs<const N: usize, const C: usize>(
     ci: &[f64; 3],
     a: &[f64; 6],
     load: [f64; 3],
     t: f64,
-    s: &[f64; NV],
-    ds: &mut [f64; NV],
+    s: &[f64; N],
+    ds: &mut [f64; N],
     var: bool,
 ) {
     let (w, x, y, z) = (s[0], s[1], s[2], s[3]);
@@ -137,26 +140,29 @@ fn rhs(
     ds[9] = p[1];
     ds[10] = p[2];
     if var {
-        variations(ci, load, &r, (p, f, m, om), s, ds);
+        variations::<N, C>(ci, load, &r, (p, f, m, om), s, ds);
     }
 }
 
 /// The variational equations of [`rhs`], given R and the body wrench (p, f, m, ω) there.
-fn variations(
+fn variations<const N: usize, const C: usize>(
     ci: &[f64; 3],
     load: [f64; 3],
     r: &[[f64; 3]; 3],
     (p, f, m, om): ([f64; 3], [f64; 3], [f64; 3], [f64; 3]),
-    s: &[f64; NV],
-    ds: &mut [f64; NV],
+    s: &[f64; N],
+    ds: &mut [f64; N],
 ) {
+    debug_assert!(N == NB + 9 * C && C >= 6);
     let r = *r;
-    let eta = |k: usize, c: usize| s[NB + 6 * k + c];
-    let dp = |k: usize, c: usize| s[NB + 36 + 6 * k + c];
-    for c in 0..6 {
+    let eta = |k: usize, c: usize| s[NB + C * k + c];
+    let dp = |k: usize, c: usize| s[NB + 6 * C + C * k + c];
+    for c in 0..C {
         // g_c = Rᵀ δa_m − Rᵀ (p × δa_f) − Rᵀ (δP × w ĝ).
         let mut unit = [0.0; 6];
-        unit[c] = 1.0;
+        if c + 6 >= C {
+            unit[c + 6 - C] = 1.0;
+        }
         let dam = [unit[0], unit[1], unit[2]];
         let daf = [unit[3], unit[4], unit[5]];
         let dpp = [dp(0, c), dp(1, c), dp(2, c)];
@@ -182,17 +188,17 @@ fn variations(
         let oxe = cross(om, e);
         let oxv = cross(om, v);
         ds[NB + c] = dm[0] * ci[0] - oxe[0];
-        ds[NB + 6 + c] = dm[1] * ci[1] - oxe[1];
-        ds[NB + 12 + c] = dm[2] * ci[2] - oxe[2];
+        ds[NB + C + c] = dm[1] * ci[1] - oxe[1];
+        ds[NB + C * 2 + c] = dm[2] * ci[2] - oxe[2];
         // η_v' = −ω × η_v + η_ω × e1, with η_ω × e1 = (0, η_ω3, −η_ω2).
-        ds[NB + 18 + c] = -oxv[0];
-        ds[NB + 24 + c] = -oxv[1] + e[2];
-        ds[NB + 30 + c] = -oxv[2] - e[1];
+        ds[NB + C * 3 + c] = -oxv[0];
+        ds[NB + C * 4 + c] = -oxv[1] + e[2];
+        ds[NB + C * 5 + c] = -oxv[2] - e[1];
         // δP' = δp = R η_v.
         let dpw = rv(&r, v);
-        ds[NB + 36 + c] = dpw[0];
-        ds[NB + 42 + c] = dpw[1];
-        ds[NB + 48 + c] = dpw[2];
+        ds[NB + 6 * C + c] = dpw[0];
+        ds[NB + 6 * C + C + c] = dpw[1];
+        ds[NB + 6 * C + 2 * C + c] = dpw[2];
     }
 }
 
@@ -248,7 +254,7 @@ pub fn tip_and_jacobian(
     check(a, k)?;
     let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
     let (s, _) = solve(
-        |t, s, ds| rhs(&ci, &av, load, t, s, ds, true),
+        |t, s, ds| rhs::<NV, 6>(&ci, &av, load, t, s, ds, true),
         0.0,
         initial(),
         1.0,
@@ -282,7 +288,7 @@ pub fn evaluate(
     let mut scan = crate::ode::GridScan::new(super::stability::MARGIN_T_MIN);
     let mut finite = true;
     solve_dense(
-        |t, s, ds| rhs(&ci, &av, load, t, s, ds, true),
+        |t, s, ds| rhs::<NV, 6>(&ci, &av, load, t, s, ds, true),
         0.0,
         initial(),
         &grid,
@@ -345,7 +351,7 @@ pub fn wrenches(
     check(a, k)?;
     let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
     let (s, _) = solve(
-        |t, s, ds| rhs(&ci, &av, load, t, s, ds, false),
+        |t, s, ds| rhs::<NV, 6>(&ci, &av, load, t, s, ds, false),
         0.0,
         initial(),
         1.0,
@@ -377,7 +383,7 @@ pub fn shape(
         .collect();
     let mut out = Vec::with_capacity(samples);
     solve_dense(
-        |t, s, ds| rhs(&ci, &av, load, t, s, ds, false),
+        |t, s, ds| rhs::<NV, 6>(&ci, &av, load, t, s, ds, false),
         0.0,
         initial(),
         &ts,

@@ -2,11 +2,13 @@
 //! ([`LoadedModel`]) and its search ([`InverseGeometry`]), which starts from the weightless
 //! 3-D rods that reach the target (the 3-D robust search) and follows each to the weight.
 
+use super::cable_search::{self, PlanarReduction};
 use super::heavy::{self, Gravity3};
 use super::{Spatial, SpatialParams, SpatialPose, Stiffness};
 use crate::solver::load::{self, LoadedModel};
 use crate::solver::{
-    Failure, Found, IgError, InverseGeometry, ModelEvaluation, RodModel, Solution, SolveOptions,
+    relative_distance, Failure, Found, IgError, InverseGeometry, ModelEvaluation, RodModel,
+    Solution, SolveOptions, DISTINCT,
 };
 use crate::RodError;
 use nalgebra::{SMatrix, SVector};
@@ -27,6 +29,13 @@ impl HeavySpatial {
             gravity: Gravity3::NONE,
             ..*self
         }
+    }
+
+    /// True when single shooting from the base loses its digits (w above
+    /// [`crate::planar::heavy::cable_search::LONG_CABLE_WEIGHT`], as for the planar rod): the
+    /// search keeps to the nearest planar problem's rods (module `spatial::cable_search`).
+    pub fn is_long_cable(&self) -> bool {
+        self.gravity.weight() > crate::planar::heavy::cable_search::LONG_CABLE_WEIGHT
     }
 
     fn spatial(&self) -> Spatial {
@@ -200,6 +209,13 @@ impl InverseGeometry<6> for HeavySpatial {
         if self.gravity.is_weightless() {
             return self.spatial().robust(target, options);
         }
+        // The planar problem nearest to the target first (exact where the target is planar),
+        // then the weightless 3-D rods carried in load.
+        if let Some(reduction) = PlanarReduction::nearest(target, &self.stiffness, &self.gravity) {
+            if let Some(s) = cable_search::first(self, &reduction, target, options) {
+                return Ok(s);
+            }
+        }
         let starts = weightless_starts(self.spatial(), target, options);
         load::first(&self.weightless(), self, target, options, starts)
     }
@@ -212,8 +228,35 @@ impl InverseGeometry<6> for HeavySpatial {
         if self.gravity.is_weightless() {
             return self.spatial().robust_all(target, options);
         }
+        let mut found = PlanarReduction::nearest(target, &self.stiffness, &self.gravity)
+            .map(|r| cable_search::all(self, &r, target, options))
+            .unwrap_or(Found {
+                solutions: Vec::new(),
+                iterations: 0,
+                evaluations: 0,
+                starts: 0,
+            });
+        if self.is_long_cable() && !found.solutions.is_empty() {
+            return found;
+        }
+        // Where single shooting keeps its digits, the weightless rods carried in load too
+        // (rods out of the plane among them).
         let starts = weightless_starts(self.spatial(), target, options);
-        load::every(&self.weightless(), self, target, options, starts)
+        let carried = load::every(&self.weightless(), self, target, options, starts);
+        let scale = self.param_scale();
+        for s in carried.solutions {
+            if found
+                .solutions
+                .iter()
+                .all(|o| relative_distance(&o.a, &s.a, &scale) > DISTINCT)
+            {
+                found.solutions.push(s);
+            }
+        }
+        found.iterations += carried.iterations;
+        found.evaluations += carried.evaluations;
+        found.starts += carried.starts;
+        found
     }
 
     fn default_start(&self, target: &SpatialPose) -> Option<SpatialParams> {

@@ -23,6 +23,8 @@
 // `!(x > y)` comparisons deliberately reject NaN; index loops mirror the formulas.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
+pub mod cable;
+mod cable_search;
 pub mod heavy;
 mod heavy_model;
 pub mod ig;

@@ -238,6 +238,16 @@ impl Cable {
         self.mesh.len() - 1
     }
 
+    /// The mesh t₀ = 0 < … < t_M = 1.
+    pub fn mesh(&self) -> &[f64] {
+        &self.mesh
+    }
+
+    /// The node states (x, y, θ, κ) at t₀ … t_{M−1}.
+    pub fn nodes(&self) -> &[[f64; 4]] {
+        &self.nodes
+    }
+
     /// The state at the end of the last segment: the tip (x, y, θ), θ unwrapped.
     pub fn tip(&self) -> Result<PlanarPose, RodError> {
         let e = self.last_segment()?;

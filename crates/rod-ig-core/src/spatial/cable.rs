@@ -1,0 +1,530 @@
+//! Long cables in 3-D: the heavy 3-D rod by multiple shooting (issue 51, item 5).
+//!
+//! Single shooting from the base ([`super::heavy`]) amplifies every rounding of a by the growth
+//! of the linearised rod, ≈ e^{√(‖n‖/c)}: at w = 2,000 an f64 `a` no longer reproduces the
+//! tip. As for the planar cable ([`crate::planar::heavy::cable`]), the rod is cut at nodes
+//! 0 = t₀ < … < t_M = 1, each segment amplifying errors by at most e^{`GROWTH_PER_SEGMENT`},
+//! and the unknowns are a and the state of every interior node in the reduced formulation of
+//! [`super::heavy`]: its orientation R_k, position p_k and P_k = ∫₀^{t_k} p (which, with a,
+//! gives the internal moment there: m = Rᵀ(a_m − P × w ĝ − p × n(t))).
+//!
+//! Node corrections are body twists (R ← R exp(ε_ω), p ← p + R ε_v) and world δP, so the
+//! segments' variational columns (∂/∂ε, ∂/∂δP, ∂/∂a; 15 columns of 9 rows) are the blocks of
+//! the Newton matrix. The equations: each segment ends where the next begins
+//! (log(R_{k+1}ᵀ R_e), R_{k+1}ᵀ(p_e − p_{k+1}), P_e − P_{k+1}) and the last ends at the
+//! target (its body error). The condition of this system does not grow with w.
+//!
+//! Stability (docs/math.md §10): det J(t) > 0 on the grid t = i/2000 ∈ [0.02, 1], as for the
+//! single-shooting rod, but with J(t) carried across the nodes as an orthonormal basis: the
+//! columns X(t) = ∂(η, P, a)/∂a (15 × 6) are re-orthonormalised at every node (X = Q U, the
+//! sign and the log of det U kept), so that det J(t) = det X_η(t) · det U never overflows. The
+//! margin is the single-shooting rod's (det J / its small-t leading term), formed in logs.
+
+// `!(x > y)` comparisons deliberately reject NaN; index loops mirror the formulas.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+
+use super::heavy::{self, Gravity3, NB};
+use super::{SpatialParams, SpatialPose, Stiffness};
+use crate::ode::{dop853, GridScan, OdeOptions};
+use crate::planar::heavy::cable::{CableError, GROWTH_PER_SEGMENT, MAX_SEGMENTS};
+use crate::{RodError, StabilityReport};
+use nalgebra::{DMatrix, DVector, Quaternion, SMatrix, UnitQuaternion, Vector3};
+use std::ops::ControlFlow;
+
+/// Variational columns of a segment: ε_ω, ε_v, δP at its start (9), then δa (6).
+const COLUMNS: usize = 15;
+/// Rows per column: η (6), δP (3).
+const ROWS: usize = 9;
+/// State of a segment with its variations.
+const FULL: usize = NB + ROWS * COLUMNS;
+/// Relative tolerance of each segment's integration.
+const SEGMENT_RTOL: f64 = 1e-12;
+/// Newton iterations of one solve.
+const NEWTON_ITERATIONS: usize = 30;
+/// Residual (rod lengths, radians) at which Newton has converged.
+const RESIDUAL_TOLERANCE: f64 = 1e-11;
+/// The stability grid: t = i / `GRID` for i ≥ `GRID_FROM` (docs/math.md §10).
+const GRID: u32 = 2000;
+const GRID_FROM: u32 = 40;
+/// |det X_η| / Π‖rows of X_η‖ below which the verdict is left undecided (rounding of the
+/// segments' columns).
+const MARGIN_FLOOR: f64 = 1e-12;
+
+/// The state of the rod at one node (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Node {
+    rotation: UnitQuaternion<f64>,
+    position: Vector3<f64>,
+    /// P = ∫₀ᵗ p.
+    moment_arm: Vector3<f64>,
+}
+
+impl Node {
+    const BASE: Node = Node {
+        rotation: UnitQuaternion::new_unchecked(Quaternion::new(1.0, 0.0, 0.0, 0.0)),
+        position: Vector3::new(0.0, 0.0, 0.0),
+        moment_arm: Vector3::new(0.0, 0.0, 0.0),
+    };
+
+    fn of_state(s: &[f64]) -> Self {
+        let q = Quaternion::new(s[0], s[1], s[2], s[3]);
+        Self {
+            rotation: UnitQuaternion::new_normalize(q),
+            position: Vector3::new(s[4], s[5], s[6]),
+            moment_arm: Vector3::new(s[8], s[9], s[10]),
+        }
+    }
+
+    /// The node moved by the correction (ε_ω, ε_v, δP) (module docs).
+    fn moved(&self, d: &[f64]) -> Self {
+        let eps = Vector3::new(d[0], d[1], d[2]);
+        Self {
+            rotation: self.rotation * UnitQuaternion::from_scaled_axis(eps),
+            position: self.position + self.rotation * Vector3::new(d[3], d[4], d[5]),
+            moment_arm: self.moment_arm + Vector3::new(d[6], d[7], d[8]),
+        }
+    }
+}
+
+/// A heavy 3-D rod in equilibrium as the states of its nodes: what multiple shooting solves
+/// for (module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpatialCable {
+    stiffness: Stiffness,
+    gravity: Gravity3,
+    mesh: Vec<f64>,
+    a: [f64; 6],
+    /// Node states at t₀ … t_{M−1}; the first is the base.
+    nodes: Vec<Node>,
+}
+
+fn ode_options() -> OdeOptions {
+    OdeOptions {
+        rtol: SEGMENT_RTOL,
+        atol: SEGMENT_RTOL,
+        max_steps: 20_000,
+        error_components: NB,
+        ..OdeOptions::default()
+    }
+}
+
+/// Segments for internal forces up to `force_max` on bending stiffness `c`:
+/// √(force_max / c) · h ≤ [`GROWTH_PER_SEGMENT`].
+pub fn segments_for(force_max: f64, c: f64) -> usize {
+    let m = ((force_max.max(0.0) / c).sqrt() / GROWTH_PER_SEGMENT).ceil() as usize;
+    m.clamp(2, MAX_SEGMENTS)
+}
+
+impl SpatialCable {
+    /// The cable whose base wrench is `a`, its nodes integrated from the base on a mesh fit
+    /// for its forces: exact where single shooting is (w ≲ 300), elsewhere a starting guess
+    /// that [`SpatialCable::solve`] corrects.
+    pub fn from_params(
+        a: &SpatialParams,
+        stiffness: &Stiffness,
+        gravity: &Gravity3,
+    ) -> Result<Self, RodError> {
+        super::check_params(a, stiffness)?;
+        let a: [f64; 6] = std::array::from_fn(|i| a[i]);
+        let load = gravity.load();
+        let n0 = Vector3::new(a[3], a[4], a[5]);
+        let n1 = n0 - Vector3::from(load);
+        let c = stiffness.c2.min(stiffness.c3);
+        let segments = segments_for(n0.norm().max(n1.norm()), c);
+        let mesh: Vec<f64> = (0..=segments).map(|i| i as f64 / segments as f64).collect();
+        let mut cable = Self {
+            stiffness: *stiffness,
+            gravity: *gravity,
+            mesh,
+            a,
+            nodes: vec![Node::BASE],
+        };
+        for k in 0..segments - 1 {
+            let e = cable.segment::<NB>(k)?;
+            cable.nodes.push(Node::of_state(&e));
+        }
+        Ok(cable)
+    }
+
+    /// The cable with base wrench `a` whose nodes on `mesh` (t₀ = 0 < … < t_M = 1) have the
+    /// orientations and positions `poses` (at t₀ … t_{M−1}; the first is the base): each
+    /// node's P = ∫p is carried from the previous one by its segment. How an answer of another
+    /// formulation (the planar cable's nodes) becomes a start of this one.
+    pub fn from_poses(
+        a: &SpatialParams,
+        stiffness: &Stiffness,
+        gravity: &Gravity3,
+        mesh: Vec<f64>,
+        poses: &[(UnitQuaternion<f64>, Vector3<f64>)],
+    ) -> Result<Self, RodError> {
+        super::check_params(a, stiffness)?;
+        if mesh.len() < 2 || poses.len() + 1 != mesh.len() {
+            return Err(RodError::OutOfDomain(
+                "a cable needs one pose per node of its mesh".into(),
+            ));
+        }
+        let mut cable = Self {
+            stiffness: *stiffness,
+            gravity: *gravity,
+            mesh,
+            a: std::array::from_fn(|i| a[i]),
+            nodes: vec![Node::BASE],
+        };
+        for (rotation, position) in &poses[1..] {
+            let k = cable.nodes.len() - 1;
+            let e = cable.segment::<NB>(k)?;
+            cable.nodes.push(Node {
+                rotation: *rotation,
+                position: *position,
+                moment_arm: Vector3::new(e[8], e[9], e[10]),
+            });
+        }
+        Ok(cable)
+    }
+
+    /// a = (a_m, a_f): the base wrench.
+    pub fn params(&self) -> SpatialParams {
+        SpatialParams::from_row_slice(&self.a)
+    }
+
+    /// Segments of the mesh.
+    pub fn segments(&self) -> usize {
+        self.mesh.len() - 1
+    }
+
+    /// The gravity this cable carries.
+    pub fn gravity(&self) -> &Gravity3 {
+        &self.gravity
+    }
+
+    /// Segment `k` from its start node; with `N` = the full state, its variational columns.
+    fn segment<const N: usize>(&self, k: usize) -> Result<[f64; N], RodError> {
+        let y = self.start_state::<N>(k);
+        let var = N == FULL;
+        let (ci, a, load) = (self.stiffness.inv(), self.a, self.gravity.load());
+        let (end, _) = dop853::solve(
+            |t, s: &[f64; N], ds: &mut [f64; N]| {
+                heavy::rhs::<N, COLUMNS>(&ci, &a, load, t, s, ds, var)
+            },
+            self.mesh[k],
+            y,
+            self.mesh[k + 1],
+            &ode_options(),
+        )?;
+        super::finite(&end)?;
+        Ok(end)
+    }
+
+    /// The tip pose (the last segment's end).
+    pub fn tip(&self) -> Result<SpatialPose, RodError> {
+        let e = self.segment::<NB>(self.segments() - 1)?;
+        Ok(super::pose_from_parts(
+            [e[0], e[1], e[2], e[3]],
+            [e[4], e[5], e[6]],
+        ))
+    }
+
+    /// Elastic energy and total energy (elastic + gravitational, −w ĝ · P(1)).
+    pub fn energies(&self) -> Result<(f64, f64), RodError> {
+        let mut elastic = 0.0;
+        let mut last = [0.0; NB];
+        for k in 0..self.segments() {
+            last = self.segment::<NB>(k)?;
+            elastic += last[7];
+        }
+        let load = self.gravity.load();
+        let potential = -(load[0] * last[8] + load[1] * last[9] + load[2] * last[10]);
+        Ok((elastic, elastic + potential))
+    }
+
+    fn dimension(&self) -> usize {
+        6 + ROWS * (self.segments() - 1)
+    }
+
+    fn set_unknowns_moved(&mut self, step: &DVector<f64>, alpha: f64) {
+        for i in 0..6 {
+            self.a[i] += alpha * step[i];
+        }
+        for k in 1..self.segments() {
+            let d: [f64; ROWS] = std::array::from_fn(|c| alpha * step[6 + ROWS * (k - 1) + c]);
+            self.nodes[k] = self.nodes[k].moved(&d);
+        }
+    }
+
+    /// Residual of the multiple-shooting equations (module docs) and, with `jacobian`, their
+    /// derivative in the unknowns (a, then each node's correction).
+    fn residual(
+        &self,
+        target: &SpatialPose,
+        jacobian: bool,
+    ) -> Result<(DVector<f64>, Option<DMatrix<f64>>), RodError> {
+        let m = self.segments();
+        let dim = self.dimension();
+        let mut r = DVector::zeros(dim);
+        let mut j = jacobian.then(|| DMatrix::zeros(dim, dim));
+        for k in 0..m {
+            let e = if jacobian {
+                self.segment::<FULL>(k)?
+            } else {
+                let mut e = [0.0; FULL];
+                e[..NB].copy_from_slice(&self.segment::<NB>(k)?);
+                e
+            };
+            if k + 1 < m {
+                self.continuity_rows(k, &e, &mut r, j.as_mut());
+            } else {
+                tip_rows(k, &e, target, &mut r, j.as_mut());
+            }
+        }
+        Ok((r, j))
+    }
+
+    /// The rows "segment `k`, ended at `e`, ends at node k + 1" (module docs).
+    fn continuity_rows(
+        &self,
+        k: usize,
+        e: &[f64; FULL],
+        r: &mut DVector<f64>,
+        j: Option<&mut DMatrix<f64>>,
+    ) {
+        let (end, goal, row) = (Node::of_state(e), &self.nodes[k + 1], ROWS * k);
+        let rel = goal.rotation.inverse() * end.rotation;
+        let rho_w = rel.scaled_axis();
+        let rho_v = goal.rotation.inverse() * (end.position - goal.position);
+        let rho_p = end.moment_arm - goal.moment_arm;
+        for i in 0..3 {
+            r[row + i] = rho_w[i];
+            r[row + 3 + i] = rho_v[i];
+            r[row + 6 + i] = rho_p[i];
+        }
+        let Some(j) = j else { return };
+        let rel_m = rel.to_rotation_matrix().into_inner();
+        let col = |rr: usize, c: usize| e[NB + COLUMNS * rr + c];
+        for c in 0..COLUMNS {
+            let Some(jc) = start_column(k, c) else {
+                continue;
+            };
+            let v = rel_m * Vector3::new(col(3, c), col(4, c), col(5, c));
+            for i in 0..3 {
+                j[(row + i, jc)] = col(i, c);
+                j[(row + 3 + i, jc)] = v[i];
+                j[(row + 6 + i, jc)] = col(6 + i, c);
+            }
+        }
+        // The next node's own columns: R exp(ε) and p + R ε_v move the residual by −ε_ω,
+        // ρ_v × ε_ω − ε_v and −δP.
+        let next = 6 + ROWS * k;
+        let skew = rho_v.cross_matrix();
+        for i in 0..3 {
+            j[(row + i, next + i)] = -1.0;
+            j[(row + 3 + i, next + 3 + i)] = -1.0;
+            j[(row + 6 + i, next + 6 + i)] = -1.0;
+            for c in 0..3 {
+                j[(row + 3 + i, next + c)] += skew[(i, c)];
+            }
+        }
+    }
+
+    /// Newton on the multiple-shooting equations from this cable's state: the equilibrium whose
+    /// tip is at `target`. Backtracks on the residual's max norm. Returns the iterations.
+    pub fn solve(&mut self, target: &SpatialPose) -> Result<usize, CableError> {
+        let (r, _) = self.residual(target, false)?;
+        let mut norm = r.amax();
+        for it in 0..NEWTON_ITERATIONS {
+            if norm <= 1e-14 {
+                return Ok(it);
+            }
+            let (r, j) = self.residual(target, true)?;
+            let Some(j) = j else {
+                return Err(CableError::Singular);
+            };
+            let Some(step) = j.lu().solve(&(-&r)) else {
+                return Err(CableError::Singular);
+            };
+            if !step.iter().all(|v| v.is_finite()) {
+                return Err(CableError::Singular);
+            }
+            let mut alpha = 1.0;
+            loop {
+                let mut trial = self.clone();
+                trial.set_unknowns_moved(&step, alpha);
+                match trial.residual(target, false) {
+                    Ok((rt, _)) if rt.amax() < (1.0 - 1e-4 * alpha) * norm => {
+                        *self = trial;
+                        norm = rt.amax();
+                        break;
+                    }
+                    Err(RodError::Deadline { t }) => return Err(RodError::Deadline { t }.into()),
+                    _ if alpha > 1.0 / 64.0 => alpha *= 0.5,
+                    _ if norm <= RESIDUAL_TOLERANCE => return Ok(it),
+                    _ => {
+                        return Err(CableError::NoConvergence {
+                            iterations: it,
+                            residual: norm,
+                        })
+                    }
+                }
+            }
+            let small = alpha * step.amax()
+                <= 1e-10 * (1.0 + self.a.iter().fold(0.0, |m: f64, v| m.max(v.abs())));
+            if norm <= RESIDUAL_TOLERANCE && small {
+                return Ok(it + 1);
+            }
+        }
+        if norm <= RESIDUAL_TOLERANCE {
+            return Ok(NEWTON_ITERATIONS);
+        }
+        Err(CableError::NoConvergence {
+            iterations: NEWTON_ITERATIONS,
+            residual: norm,
+        })
+    }
+
+    /// The residual's max norm at `target` (rod lengths, radians).
+    pub fn residual_at(&self, target: &SpatialPose) -> Result<f64, RodError> {
+        Ok(self.residual(target, false)?.0.amax())
+    }
+
+    /// Stability by the orthonormalised conjugate-point scan (module docs): det J(t) > 0 on
+    /// the grid. The margin is the single-shooting rod's, min over t ≥ 0.05 of
+    /// det J(t) / [`super::det_leading_term`], formed in logarithms; the verdict is left
+    /// undecided where det X_η is within 1e-12 of the product of its rows' norms (the bound on
+    /// its rounding, Hadamard's inequality).
+    pub fn stability(&self) -> Result<StabilityReport, RodError> {
+        let mut basis = SMatrix::<f64, COLUMNS, 6>::zeros();
+        for c in 0..6 {
+            basis[(ROWS + c, c)] = 1.0;
+        }
+        // det U = sign_u · e^{log_u} (module docs).
+        let (mut sign_u, mut log_u) = (1.0, 0.0);
+        let mut scan = GridScan::new(super::stability::MARGIN_T_MIN);
+        let mut least_ratio = f64::INFINITY;
+        let a_vec = self.params();
+        let (ci, a, load) = (self.stiffness.inv(), self.a, self.gravity.load());
+        for k in 0..self.segments() {
+            let (t0, t1) = (self.mesh[k], self.mesh[k + 1]);
+            let mut ts: Vec<f64> = (GRID_FROM..=GRID)
+                .map(|i| f64::from(i) / f64::from(GRID))
+                .filter(|&t| t > t0 && t < t1)
+                .collect();
+            ts.push(t1);
+            let mut at_end = basis;
+            dop853::solve_dense(
+                |t, s: &[f64; FULL], ds: &mut [f64; FULL]| {
+                    heavy::rhs::<FULL, COLUMNS>(&ci, &a, load, t, s, ds, true)
+                },
+                t0,
+                self.start_state::<FULL>(k),
+                &ts,
+                &ode_options(),
+                |_, t, s| {
+                    let x = propagated(s, &basis);
+                    at_end = x;
+                    if t < f64::from(GRID_FROM) / f64::from(GRID) - 1e-12 {
+                        return ControlFlow::Continue(());
+                    }
+                    let pose = x.fixed_view::<6, 6>(0, 0).into_owned();
+                    let det = pose.determinant();
+                    let rows: f64 = (0..6).map(|i| pose.row(i).norm()).product();
+                    if rows > 0.0 && t >= super::stability::MARGIN_T_MIN - 1e-12 {
+                        least_ratio = least_ratio.min((det / rows).abs());
+                    }
+                    let lead = super::det_leading_term(&a_vec, t);
+                    let sign = det.signum() * sign_u;
+                    if lead > 0.0 && det != 0.0 {
+                        let log_ratio = det.abs().ln() + log_u - lead.ln();
+                        scan.push(t, sign * log_ratio.min(690.0).exp(), 1.0);
+                    } else {
+                        scan.push(t, if det == 0.0 { 0.0 } else { sign }, 0.0);
+                    }
+                    ControlFlow::Continue(())
+                },
+            )?;
+            let qr = at_end.qr();
+            let u = qr.r();
+            for i in 0..6 {
+                sign_u *= u[(i, i)].signum();
+                log_u += u[(i, i)].abs().ln();
+            }
+            basis = qr.q();
+        }
+        let mut report = scan.report();
+        if report.stable && !(least_ratio > MARGIN_FLOOR) {
+            report.stable = false;
+            report.uncertain = true;
+        }
+        Ok(report)
+    }
+
+    /// The state at the start of segment `k`; with `N` = the full state, unit columns.
+    fn start_state<const N: usize>(&self, k: usize) -> [f64; N] {
+        let node = &self.nodes[k];
+        let mut y = [0.0; N];
+        let q = node.rotation.quaternion();
+        y[..4].copy_from_slice(&[q.w, q.i, q.j, q.k]);
+        y[4..7].copy_from_slice(node.position.as_slice());
+        y[8..11].copy_from_slice(node.moment_arm.as_slice());
+        if N == FULL {
+            // Row r of column r (η then δP rows share the layout NB + COLUMNS · r + c).
+            for r in 0..ROWS {
+                y[NB + COLUMNS * r + r] = 1.0;
+            }
+        }
+        y
+    }
+}
+
+/// X(t) = Φ(t) X(t_k) for a segment's state `s` (its 15 columns) and the basis at its start.
+fn propagated(s: &[f64; FULL], basis: &SMatrix<f64, COLUMNS, 6>) -> SMatrix<f64, COLUMNS, 6> {
+    let phi = SMatrix::<f64, ROWS, COLUMNS>::from_fn(|r, c| s[NB + COLUMNS * r + c]);
+    let mut x = SMatrix::<f64, COLUMNS, 6>::zeros();
+    x.fixed_view_mut::<ROWS, 6>(0, 0).copy_from(&(phi * basis));
+    x.fixed_view_mut::<6, 6>(ROWS, 0)
+        .copy_from(&basis.fixed_view::<6, 6>(ROWS, 0));
+    x
+}
+
+/// The unknown moved by column `c` of segment `k`'s variations: its start node's correction
+/// (none at the base), then a.
+fn start_column(k: usize, c: usize) -> Option<usize> {
+    if c >= ROWS {
+        Some(c - ROWS)
+    } else if k > 0 {
+        Some(6 + ROWS * (k - 1) + c)
+    } else {
+        None
+    }
+}
+
+/// The rows "the last segment, `k`, ended at `e`, ends at `target`": minus its body error.
+fn tip_rows(
+    k: usize,
+    e: &[f64; FULL],
+    target: &SpatialPose,
+    r: &mut DVector<f64>,
+    j: Option<&mut DMatrix<f64>>,
+) {
+    let (end, row) = (Node::of_state(e), ROWS * k);
+    let err = SpatialPose {
+        position: end.position,
+        rotation: end.rotation,
+    }
+    .body_error_to(target);
+    for i in 0..6 {
+        r[row + i] = -err[i];
+    }
+    let Some(j) = j else { return };
+    let ev = Vector3::new(err[3], err[4], err[5]);
+    let col = |rr: usize, c: usize| e[NB + COLUMNS * rr + c];
+    for c in 0..COLUMNS {
+        let Some(jc) = start_column(k, c) else {
+            continue;
+        };
+        let w = Vector3::new(col(0, c), col(1, c), col(2, c));
+        let v = Vector3::new(col(3, c), col(4, c), col(5, c)) + w.cross(&ev);
+        for i in 0..3 {
+            j[(row + i, jc)] = w[i];
+            j[(row + 3 + i, jc)] = v[i];
+        }
+    }
+}

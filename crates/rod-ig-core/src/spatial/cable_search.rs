@@ -1,0 +1,270 @@
+//! The heavy 3-D rod's inverse geometry where the problem is planar (issue 51, item 5).
+//!
+//! With isotropic bending (c2 = c3), a target in the plane Π through the base tangent e1 and
+//! gravity ĝ, its orientation a rotation about Π's normal n̂, the rod that stays in Π with no
+//! twist is an equilibrium of the 3-D rod: it is the planar heavy rod (stiffness c = c2, weight
+//! w / c) with R(t) = Rot(n̂, θ(t)), p = x e1 + y b2 (b2 = n̂ × e1), a_m = c κ(0) n̂ and
+//! a_f = c (n_x e1 + n_y b2). So the planar search, its multiple shooting at large w and its
+//! loop-free admission answer these targets — the cable held level among them, and the
+//! symmetric targets (tip on the base's axis, identity orientation), where the weightless 3-D
+//! rods form a one-parameter family (turned about e1) that no 3-D continuation can start
+//! from. Each planar answer is lifted, polished by the 3-D multiple shooting
+//! ([`super::cable`]) on the exact target, and admitted only if the 3-D stability test (in
+//! and out of Π) passes.
+//!
+//! Any other target (isotropic bending) starts from the planar problem nearest to it (the
+//! target projected on Π) and is reached by a continuation in the target with the 3-D multiple
+//! shooting ([`PlanarReduction::nearest`]).
+
+use super::cable::SpatialCable;
+use super::heavy::Gravity3;
+use super::heavy_model::HeavySpatial;
+use super::{SpatialParams, SpatialPose, Stiffness};
+use crate::planar::heavy::cable::CableError;
+use crate::planar::heavy::{cable_search, Gravity, HeavyPlanar};
+use crate::planar::ig::SolveOptions as PlanarOptions;
+use crate::solver::{Found, InverseGeometry, Solution, SolveOptions, Verified, Work};
+use crate::{PlanarParams, PlanarPose, RodError};
+use nalgebra::{SVector, Unit, UnitQuaternion, Vector3};
+
+/// How far from Π a target may be and still start from the planar rods (rod lengths,
+/// radians): the 3-D polish then moves the rod onto the exact target.
+const PLANE_TOLERANCE: f64 = 1e-6;
+
+/// The plane of a planar 3-D problem (module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct PlanarReduction {
+    normal: Vector3<f64>,
+    in_plane: Vector3<f64>,
+    /// Bending stiffness c = c2 = c3.
+    c: f64,
+    /// The target in Π's coordinates (x along e1, y along b2, θ about n̂).
+    pub(crate) target: PlanarPose,
+    /// Gravity in Π's coordinates, weight w / c.
+    pub(crate) gravity: Gravity,
+}
+
+impl PlanarReduction {
+    /// The planar problem nearest to a 3-D one: Π through e1 and ĝ (or, with ĝ along e1,
+    /// through e1 and the target), the target projected on Π (its position, and the angle of
+    /// its tangent's projection). None when bending is anisotropic or there is no weight.
+    pub(crate) fn nearest(target: &SpatialPose, k: &Stiffness, g: &Gravity3) -> Option<Self> {
+        if !k.is_bending_isotropic() || g.is_weightless() {
+            return None;
+        }
+        let e1 = Vector3::x();
+        let gd = Vector3::from(g.direction());
+        let p = target.position;
+        let tangent = target.rotation * e1;
+        let normal = [
+            e1.cross(&gd),
+            e1.cross(&p),
+            e1.cross(&tangent),
+            target.rotation.scaled_axis(),
+            Vector3::z(),
+        ]
+        .into_iter()
+        .find(|v| v.norm() > 1e-6 && v.dot(&e1).abs() <= PLANE_TOLERANCE * v.norm())?
+        .normalize();
+        if gd.dot(&normal).abs() > PLANE_TOLERANCE {
+            return None;
+        }
+        let in_plane = normal.cross(&e1);
+        let c = k.c2;
+        let gravity = Gravity::new(g.weight() / c, [gd.dot(&e1), gd.dot(&in_plane)]).ok()?;
+        Some(Self {
+            normal,
+            in_plane,
+            c,
+            target: PlanarPose::new(
+                p.dot(&e1),
+                p.dot(&in_plane),
+                tangent.dot(&in_plane).atan2(tangent.dot(&e1)),
+            ),
+            gravity,
+        })
+    }
+
+    /// The planar target as a 3-D pose.
+    pub(crate) fn lifted_target(&self) -> SpatialPose {
+        lift_pose(self.normal, self.in_plane, &self.target)
+    }
+
+    /// The 3-D base wrench of the planar rod `a` (module docs).
+    pub(crate) fn lift_params(&self, a: &PlanarParams) -> SpatialParams {
+        let m = self.normal * (self.c * a[0]);
+        let f = (Vector3::x() * a[1] + self.in_plane * a[2]) * self.c;
+        SpatialParams::new(m.x, m.y, m.z, f.x, f.y, f.z)
+    }
+
+    fn lift_node(&self, node: &[f64; 4]) -> (UnitQuaternion<f64>, Vector3<f64>) {
+        let pose = lift_pose(
+            self.normal,
+            self.in_plane,
+            &PlanarPose::new(node[0], node[1], node[2]),
+        );
+        (pose.rotation, pose.position)
+    }
+}
+
+fn lift_pose(normal: Vector3<f64>, in_plane: Vector3<f64>, pose: &PlanarPose) -> SpatialPose {
+    SpatialPose {
+        position: Vector3::x() * pose.x + in_plane * pose.y,
+        rotation: UnitQuaternion::from_axis_angle(&Unit::new_unchecked(normal), pose.theta),
+    }
+}
+
+fn planar_options(options: &SolveOptions<SVector<f64, 6>>) -> PlanarOptions {
+    PlanarOptions {
+        method: options.method,
+        alpha: options.alpha,
+        max_iterations: options.max_iterations,
+        tolerance: options.tolerance,
+        initial_guess: None,
+        objective: options.objective,
+        deadline: options.deadline,
+        max_starts: options.max_starts,
+        max_turns: options.max_turns,
+    }
+}
+
+/// The 3-D cable of a planar answer `a`: the planar cable's nodes lifted when the planar
+/// search solved it by multiple shooting, else integrated from the base (single shooting
+/// keeps its digits there).
+fn lifted_cable(
+    model: &HeavySpatial,
+    reduction: &PlanarReduction,
+    a: &PlanarParams,
+) -> Result<SpatialCable, RodError> {
+    let a3 = reduction.lift_params(a);
+    match cable_search::recall(a, &reduction.gravity) {
+        Some(planar) => {
+            let poses: Vec<_> = planar
+                .nodes()
+                .iter()
+                .map(|n| reduction.lift_node(n))
+                .collect();
+            SpatialCable::from_poses(
+                &a3,
+                &model.stiffness,
+                &model.gravity,
+                planar.mesh().to_vec(),
+                &poses,
+            )
+        }
+        None => SpatialCable::from_params(&a3, &model.stiffness, &model.gravity),
+    }
+}
+
+/// The planar answer `s` as a 3-D solution on `target`: polished there by the 3-D multiple
+/// shooting, admitted by the 3-D stability test.
+fn lifted_solution(
+    model: &HeavySpatial,
+    reduction: &PlanarReduction,
+    s: &Solution<PlanarParams, PlanarPose>,
+    target: &SpatialPose,
+) -> Option<Solution<SpatialParams, SpatialPose>> {
+    let mut cable = lifted_cable(model, reduction, &s.a).ok()?;
+    let polish = carried(&mut cable, &reduction.lifted_target(), target)?;
+    let stability = cable.stability().ok()?;
+    if !stability.stable {
+        return None;
+    }
+    let tip = cable.tip().ok()?;
+    let (_, energy) = cable.energies().ok()?;
+    let mut out = Solution::new(
+        cable.params(),
+        Verified {
+            tip,
+            errors: tip.distance_to(target),
+            energy,
+            margin: stability.margin,
+        },
+        Work {
+            iterations: s.iterations + polish as u32,
+            evaluations: s.evaluations + polish as u32,
+            starts: s.starts,
+        },
+    );
+    out.complete = s.complete;
+    Some(out)
+}
+
+/// Smallest step of the continuation in the target, as a share of the way.
+const MIN_TARGET_STEP: f64 = 1.0 / 1024.0;
+
+/// Moves `cable`, in equilibrium on `from`, to an equilibrium on `to` along the straight path
+/// of targets between them (positions on a line, orientations by slerp), each step solved by
+/// the 3-D multiple shooting from the last: halved where Newton fails, lengthened by half
+/// where it succeeds. Returns the Newton iterations; None where the step falls below
+/// [`MIN_TARGET_STEP`] (a fold of the branch on the way) or the deadline passes.
+fn carried(cable: &mut SpatialCable, from: &SpatialPose, to: &SpatialPose) -> Option<usize> {
+    let (dp, dr) = from.distance_to(to);
+    if dp <= PLANE_TOLERANCE && dr <= PLANE_TOLERANCE {
+        return cable.solve(to).ok();
+    }
+    let (mut s, mut ds, mut iterations) = (0.0_f64, 0.25_f64, 0);
+    while s < 1.0 {
+        let next = (s + ds).min(1.0);
+        let goal = SpatialPose {
+            position: from.position + (to.position - from.position) * next,
+            rotation: from.rotation.slerp(&to.rotation, next),
+        };
+        let mut trial = cable.clone();
+        match trial.solve(&goal) {
+            Ok(it) => {
+                *cable = trial;
+                iterations += it;
+                s = next;
+                ds *= 1.5;
+            }
+            Err(CableError::Rod(RodError::Deadline { .. })) => return None,
+            Err(_) if ds > MIN_TARGET_STEP => ds *= 0.5,
+            Err(_) => return None,
+        }
+    }
+    Some(iterations)
+}
+
+/// The planar search's first rod, lifted (module docs); None when it finds none that is
+/// stable in 3-D.
+pub(crate) fn first(
+    model: &HeavySpatial,
+    reduction: &PlanarReduction,
+    target: &SpatialPose,
+    options: &SolveOptions<SVector<f64, 6>>,
+) -> Option<Solution<SpatialParams, SpatialPose>> {
+    let planar = HeavyPlanar::new(reduction.gravity);
+    let opts = planar_options(options);
+    if let Ok(s) = planar.robust(&reduction.target, &opts) {
+        if let Some(out) = lifted_solution(model, reduction, &s, target) {
+            return Some(out);
+        }
+    }
+    // The first planar rod may buckle out of Π: the others, least energy first.
+    all(model, reduction, target, options)
+        .solutions
+        .into_iter()
+        .min_by(|a, b| a.energy.total_cmp(&b.energy))
+}
+
+/// Every planar rod the planar search finds that is stable in 3-D, lifted.
+pub(crate) fn all(
+    model: &HeavySpatial,
+    reduction: &PlanarReduction,
+    target: &SpatialPose,
+    options: &SolveOptions<SVector<f64, 6>>,
+) -> Found<SpatialParams, SpatialPose> {
+    let planar = HeavyPlanar::new(reduction.gravity);
+    let found = planar.robust_all(&reduction.target, &planar_options(options));
+    Found {
+        solutions: found
+            .solutions
+            .iter()
+            .filter_map(|s| lifted_solution(model, reduction, s, target))
+            .collect(),
+        iterations: found.iterations,
+        evaluations: found.evaluations,
+        starts: found.starts,
+    }
+}
