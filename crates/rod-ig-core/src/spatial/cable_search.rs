@@ -18,7 +18,6 @@
 
 use super::cable::SpatialCable;
 use super::heavy::Gravity3;
-use super::heavy_model::HeavySpatial;
 use super::{SpatialParams, SpatialPose, Stiffness};
 use crate::planar::heavy::cable::CableError;
 use crate::planar::heavy::{cable_search, Gravity, HeavyPlanar};
@@ -30,6 +29,9 @@ use nalgebra::{SVector, Unit, UnitQuaternion, Vector3};
 /// How far from Π a target may be and still start from the planar rods (rod lengths,
 /// radians): the 3-D polish then moves the rod onto the exact target.
 const PLANE_TOLERANCE: f64 = 1e-6;
+
+/// The heavy 3-D rod: its stiffnesses and gravity.
+pub(crate) type Rod<'a> = (&'a Stiffness, &'a Gravity3);
 
 /// The plane of a planar 3-D problem (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -132,7 +134,7 @@ fn planar_options(options: &SolveOptions<SVector<f64, 6>>) -> PlanarOptions {
 /// search solved it by multiple shooting, else integrated from the base (single shooting
 /// keeps its digits there).
 fn lifted_cable(
-    model: &HeavySpatial,
+    rod: Rod<'_>,
     reduction: &PlanarReduction,
     a: &PlanarParams,
 ) -> Result<SpatialCable, RodError> {
@@ -144,27 +146,21 @@ fn lifted_cable(
                 .iter()
                 .map(|n| reduction.lift_node(n))
                 .collect();
-            SpatialCable::from_poses(
-                &a3,
-                &model.stiffness,
-                &model.gravity,
-                planar.mesh().to_vec(),
-                &poses,
-            )
+            SpatialCable::from_poses(&a3, rod.0, rod.1, planar.mesh().to_vec(), &poses)
         }
-        None => SpatialCable::from_params(&a3, &model.stiffness, &model.gravity),
+        None => SpatialCable::from_params(&a3, rod.0, rod.1),
     }
 }
 
 /// The planar answer `s` as a 3-D solution on `target`: polished there by the 3-D multiple
 /// shooting, admitted by the 3-D stability test.
 fn lifted_solution(
-    model: &HeavySpatial,
+    rod: Rod<'_>,
     reduction: &PlanarReduction,
     s: &Solution<PlanarParams, PlanarPose>,
     target: &SpatialPose,
 ) -> Option<Solution<SpatialParams, SpatialPose>> {
-    let mut cable = lifted_cable(model, reduction, &s.a).ok()?;
+    let mut cable = lifted_cable(rod, reduction, &s.a).ok()?;
     let polish = carried(&mut cable, &reduction.lifted_target(), target)?;
     let stability = cable.stability().ok()?;
     if !stability.stable {
@@ -229,7 +225,7 @@ fn carried(cable: &mut SpatialCable, from: &SpatialPose, to: &SpatialPose) -> Op
 /// The planar search's first rod, lifted (module docs); None when it finds none that is
 /// stable in 3-D.
 pub(crate) fn first(
-    model: &HeavySpatial,
+    rod: Rod<'_>,
     reduction: &PlanarReduction,
     target: &SpatialPose,
     options: &SolveOptions<SVector<f64, 6>>,
@@ -237,12 +233,12 @@ pub(crate) fn first(
     let planar = HeavyPlanar::new(reduction.gravity);
     let opts = planar_options(options);
     if let Ok(s) = planar.robust(&reduction.target, &opts) {
-        if let Some(out) = lifted_solution(model, reduction, &s, target) {
+        if let Some(out) = lifted_solution(rod, reduction, &s, target) {
             return Some(out);
         }
     }
     // The first planar rod may buckle out of Π: the others, least energy first.
-    all(model, reduction, target, options)
+    all(rod, reduction, target, options)
         .solutions
         .into_iter()
         .min_by(|a, b| a.energy.total_cmp(&b.energy))
@@ -250,7 +246,7 @@ pub(crate) fn first(
 
 /// Every planar rod the planar search finds that is stable in 3-D, lifted.
 pub(crate) fn all(
-    model: &HeavySpatial,
+    rod: Rod<'_>,
     reduction: &PlanarReduction,
     target: &SpatialPose,
     options: &SolveOptions<SVector<f64, 6>>,
@@ -261,7 +257,7 @@ pub(crate) fn all(
         solutions: found
             .solutions
             .iter()
-            .filter_map(|s| lifted_solution(model, reduction, s, target))
+            .filter_map(|s| lifted_solution(rod, reduction, s, target))
             .collect(),
         iterations: found.iterations,
         evaluations: found.evaluations,

@@ -212,7 +212,12 @@ impl InverseGeometry<6> for HeavySpatial {
         // The planar problem nearest to the target first (exact where the target is planar),
         // then the weightless 3-D rods carried in load.
         if let Some(reduction) = PlanarReduction::nearest(target, &self.stiffness, &self.gravity) {
-            if let Some(s) = cable_search::first(self, &reduction, target, options) {
+            if let Some(s) = cable_search::first(
+                (&self.stiffness, &self.gravity),
+                &reduction,
+                target,
+                options,
+            ) {
                 return Ok(s);
             }
         }
@@ -229,7 +234,7 @@ impl InverseGeometry<6> for HeavySpatial {
             return self.spatial().robust_all(target, options);
         }
         let mut found = PlanarReduction::nearest(target, &self.stiffness, &self.gravity)
-            .map(|r| cable_search::all(self, &r, target, options))
+            .map(|r| cable_search::all((&self.stiffness, &self.gravity), &r, target, options))
             .unwrap_or(Found {
                 solutions: Vec::new(),
                 iterations: 0,
