@@ -83,8 +83,10 @@ enum Command {
     Forward3d,
     /// 3-D inverse geometry. Reads JSON lines {"target": {"position": [..], "quaternion":
     /// [qx, qy, qz, qw]}, "a0"?: [6 numbers], "method"?, "alpha"?, "max_iterations"?,
-    /// "tolerance"?, "objective"?, "all"?, "stiffness"?, "deadline_ms"? (default 1000)};
-    /// writes the fields of `solve` with 3-D a and tip.
+    /// "tolerance"?, "objective"?, "all"?, "stiffness"?, "deadline_ms"? (default 1000),
+    /// "weight"? (w = ρgAL³/EI, 0 ..= 1e4), "gravity"? (direction, default [0, 0, -1])};
+    /// writes the fields of `solve` with 3-D a and tip. Long cables (weight > 200) are solved
+    /// by multiple shooting from the nearest planar rod.
     Solve3d {
         /// Print the solver's events on stderr as JSON lines (as `solve --verbose`).
         #[arg(long)]

@@ -73,6 +73,15 @@ struct Forward3dAnswer {
     /// With weight: the elastic part of `energy` (elastic + gravitational).
     #[serde(skip_serializing_if = "Option::is_none")]
     elastic_energy: Option<f64>,
+    /// With weight: the verdict is undecided (`stable` is false then): above weight 200 the
+    /// tip of this f64 `a` is not determined by single shooting (`condition` > 1e9), unless
+    /// the rod is one `solve3d` returned in this process.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    stability_uncertain: Option<bool>,
+    /// With weight: ‖J(1)‖∞ · max(1, ‖a‖∞), the tip's sensitivity to a relative rounding of
+    /// a (the tip is uncertain by about condition × 1.1e-16).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    condition: Option<f64>,
     /// The wrench the rod exerts on the base gripper, in the base frame (`rod_ig_core::wrench`).
     base_wrench: SpatialWrench,
     /// The wrench the rod exerts on the tip gripper, in the tip frame.
@@ -100,6 +109,8 @@ fn forward3d_heavy(
         energy: e.energy,
         stability_margin: e.stability.margin,
         elastic_energy: Some(e.elastic_energy),
+        stability_uncertain: Some(e.stability.uncertain),
+        condition: Some(e.condition),
         base_wrench: w.base,
         tip_wrench: w.tip,
     })
@@ -149,6 +160,8 @@ fn forward3d_within(request: &Forward3dRequest) -> Result<Value, String> {
         energy: e.energy,
         stability_margin: e.stability.margin,
         elastic_energy: None,
+        stability_uncertain: None,
+        condition: None,
         base_wrench: w.base,
         tip_wrench: w.tip,
     })

@@ -765,3 +765,30 @@ fn answers_carry_both_gripper_wrenches() {
     )[0];
     assert!(v.get("base_wrench").is_none(), "{v}");
 }
+
+/// A 1 m cable in 3-D (w = 2,000, held level 0.8 apart): `solve3d` answers the hanging rod
+/// (issue 51, item 5), and `forward3d` of that `a` in another process says its tip cannot be
+/// placed by single shooting (`condition` > 1e9, `stability_uncertain`) rather than a
+/// confident verdict; weightless `forward3d` answers carry neither field.
+#[test]
+fn long_cables_in_3d_are_solved_and_forward3d_says_when_it_cannot_place_a_tip() {
+    let solved = run(
+        &["solve3d"],
+        "{\"target\": {\"position\": [0.8, 0, 0], \"quaternion\": [0, 0, 0, 1]}, \"weight\": 2000}\n",
+    );
+    let s = &solved[0];
+    assert_eq!(s["success"], true, "{s}");
+    assert!(s["residual"].as_f64().unwrap() < 1e-10, "{s}");
+    let a = s["a"].clone();
+    assert!((a[5].as_f64().unwrap() + 1000.0).abs() < 1e-6, "{s}");
+    let forward = run(
+        &["forward3d"],
+        &format!("{{\"a\": {a}, \"weight\": 2000}}\n{{\"a\": [0, 1, 0, 0, 0, 0]}}\n"),
+    );
+    assert_eq!(forward[0]["stability_uncertain"], true, "{}", forward[0]);
+    assert_eq!(forward[0]["stable"], false);
+    assert!(forward[0]["condition"].as_f64().unwrap() > 1e9);
+    assert!(
+        forward[1].get("condition").is_none() && forward[1].get("stability_uncertain").is_none()
+    );
+}

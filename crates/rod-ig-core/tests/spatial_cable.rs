@@ -230,3 +230,61 @@ fn level_cables_hang_in_3d_to_ten_thousand() {
         }
     }
 }
+
+/// A 1 m cable (w = 2,000) held level 0.8 apart: the answer's `a` evaluated again (`evaluate`,
+/// `shape`, `wrenches`) comes from the solved node states — on target to 1e-10, stable, the
+/// shape from the base to the target sagging 0.2676 (the planar reference, to 1e-4),
+/// the tip gripper holding the other half of the weight and the mirrored moment — while the same `a` nudged by 1e-12 (not a solver's answer) is
+/// reported `uncertain` with its condition (> 1e9: single shooting cannot place its tip).
+/// `robust` keeps a good guess (one start) and `newton` converges from it at this weight.
+#[test]
+fn a_solved_long_cable_is_evaluated_from_its_nodes() {
+    let model = HeavySpatial {
+        stiffness: Stiffness::default(),
+        gravity: Gravity3::new(2000.0, [0.0, 0.0, -1.0]).unwrap(),
+    };
+    let (k, g) = (model.stiffness, model.gravity);
+    let target = SpatialPose::from_xyzw(Vector3::new(0.8, 0.0, 0.0), [0.0, 0.0, 0.0, 1.0]).unwrap();
+    let s = solver::solve(&model, &target, &options(Objective::FirstFound)).unwrap();
+    let e = heavy::evaluate(&s.a, &k, &g).unwrap();
+    assert!(
+        e.stability.stable && !e.stability.uncertain,
+        "{:?}",
+        e.stability
+    );
+    let (dp, dr) = e.tip.distance_to(&target);
+    assert!(dp < 1e-10 && dr < 1e-10);
+    let shape = heavy::shape(&s.a, &k, &g, 401).unwrap();
+    assert_eq!(shape.len(), 401);
+    assert!(shape[0].position.norm() < 1e-15);
+    assert!((shape[400].position - target.position).norm() < 1e-10);
+    let sag = shape.iter().map(|p| -p.position.z).fold(0.0, f64::max);
+    assert!((sag - 0.2676).abs() < 1e-4, "sag {sag}");
+    // The mirror-symmetric cable: the tip gripper holds the other half of the weight and the
+    // mirrored moment (rod on gripper: the tip force is −n(1) = −(a_f − w ĝ)).
+    let w = heavy::wrenches(&s.a, &k, &g).unwrap();
+    let want = [-s.a[3], 0.0, -1000.0];
+    for (got, want) in w.tip.force.iter().zip(want) {
+        assert!((got - want).abs() < 1e-9 * 2000.0, "{:?}", w.tip);
+    }
+    assert!(
+        (w.tip.moment[1].abs() - s.a[1]).abs() < 1e-9 * s.a[1],
+        "{:?}",
+        w.tip
+    );
+    let nudged = s.a * (1.0 + 1e-12);
+    let u = heavy::evaluate(&nudged, &k, &g).unwrap();
+    assert!(u.stability.uncertain && !u.stability.stable && u.condition > 1e9);
+    let guess = SolveOptions {
+        initial_guess: Some(s.a),
+        ..options(Objective::FirstFound)
+    };
+    let again = solver::solve(&model, &target, &guess).unwrap();
+    assert!(rel(&again.a, &s.a) < 1e-12 && again.starts == 1);
+    let newton = SolveOptions {
+        method: rod_ig_core::solver::Method::Newton,
+        ..guess
+    };
+    let n = solver::solve(&model, &target, &newton).unwrap();
+    assert!(rel(&n.a, &s.a) < 1e-12 && n.stable);
+}

@@ -23,13 +23,14 @@
 // `!(x > y)` comparisons deliberately reject NaN; index loops mirror the formulas.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
-use super::heavy::{self, Gravity3, NB};
+use super::heavy_ode::{self, Gravity3, NB};
 use super::{SpatialParams, SpatialPose, Stiffness};
 use crate::ode::{dop853, GridScan, OdeOptions};
 use crate::planar::heavy::cable::{CableError, GROWTH_PER_SEGMENT, MAX_SEGMENTS};
 use crate::{RodError, StabilityReport};
 use nalgebra::{DMatrix, DVector, Quaternion, SMatrix, UnitQuaternion, Vector3};
 use std::ops::ControlFlow;
+use std::sync::Mutex;
 
 /// Variational columns of a segment: ε_ω, ε_v, δP at its start (9), then δa (6).
 const COLUMNS: usize = 15;
@@ -204,7 +205,7 @@ impl SpatialCable {
         let (ci, a, load) = (self.stiffness.inv(), self.a, self.gravity.load());
         let (end, _) = dop853::solve(
             |t, s: &[f64; N], ds: &mut [f64; N]| {
-                heavy::rhs::<N, COLUMNS>(&ci, &a, load, t, s, ds, var)
+                heavy_ode::rhs::<N, COLUMNS>(&ci, &a, load, t, s, ds, var)
             },
             self.mesh[k],
             y,
@@ -217,11 +218,63 @@ impl SpatialCable {
 
     /// The tip pose (the last segment's end).
     pub fn tip(&self) -> Result<SpatialPose, RodError> {
+        Ok(self.tip_and_moment_arm()?.0)
+    }
+
+    /// The tip pose and P(1) = ∫₀¹ p (the world moment at the tip is a_m − P(1) × w ĝ).
+    pub fn tip_and_moment_arm(&self) -> Result<(SpatialPose, Vector3<f64>), RodError> {
         let e = self.segment::<NB>(self.segments() - 1)?;
-        Ok(super::pose_from_parts(
-            [e[0], e[1], e[2], e[3]],
-            [e[4], e[5], e[6]],
+        Ok((
+            super::pose_from_parts([e[0], e[1], e[2], e[3]], [e[4], e[5], e[6]]),
+            Vector3::new(e[8], e[9], e[10]),
         ))
+    }
+
+    /// The poses at `ts` (sorted, in [0, 1]), each from the segment holding it.
+    pub fn poses_at(&self, ts: &[f64]) -> Result<Vec<SpatialPose>, RodError> {
+        let mut out = Vec::with_capacity(ts.len());
+        let (ci, a, load) = (self.stiffness.inv(), self.a, self.gravity.load());
+        for k in 0..self.segments() {
+            let (t0, t1) = (self.mesh[k], self.mesh[k + 1]);
+            let last = k + 1 == self.segments();
+            let inside: Vec<f64> = ts
+                .iter()
+                .copied()
+                .filter(|&t| t >= t0 && (t < t1 || (last && t <= t1)))
+                .collect();
+            if inside.is_empty() {
+                continue;
+            }
+            let mut start = self.start_state::<NB>(k);
+            if inside[0] == t0 {
+                out.push(super::pose_from_parts(
+                    [start[0], start[1], start[2], start[3]],
+                    [start[4], start[5], start[6]],
+                ));
+            }
+            let rest: Vec<f64> = inside.into_iter().filter(|&t| t > t0).collect();
+            if rest.is_empty() {
+                continue;
+            }
+            start[7] = 0.0;
+            dop853::solve_dense(
+                |t, s: &[f64; NB], ds: &mut [f64; NB]| {
+                    heavy_ode::rhs::<NB, COLUMNS>(&ci, &a, load, t, s, ds, false)
+                },
+                t0,
+                start,
+                &rest,
+                &ode_options(),
+                |_, _, s| {
+                    out.push(super::pose_from_parts(
+                        [s[0], s[1], s[2], s[3]],
+                        [s[4], s[5], s[6]],
+                    ));
+                    ControlFlow::Continue(())
+                },
+            )?;
+        }
+        Ok(out)
     }
 
     /// Elastic energy and total energy (elastic + gravitational, −w ĝ · P(1)).
@@ -411,7 +464,7 @@ impl SpatialCable {
             let mut at_end = basis;
             dop853::solve_dense(
                 |t, s: &[f64; FULL], ds: &mut [f64; FULL]| {
-                    heavy::rhs::<FULL, COLUMNS>(&ci, &a, load, t, s, ds, true)
+                    heavy_ode::rhs::<FULL, COLUMNS>(&ci, &a, load, t, s, ds, true)
                 },
                 t0,
                 self.start_state::<FULL>(k),
@@ -527,4 +580,39 @@ fn tip_rows(
             j[(row + 3 + i, jc)] = v[i];
         }
     }
+}
+
+/// Cables the 3-D solvers returned, remembered so that the energy and stability of an
+/// answer's `a` come from its node states (an f64 `a` alone does not reproduce the rod at
+/// large w): the last [`REMEMBERED`] of the process.
+static SOLVED: Mutex<Vec<SpatialCable>> = Mutex::new(Vec::new());
+/// Cables remembered.
+pub const REMEMBERED: usize = 256;
+
+/// Remembers a cable a solver returns ([`recall`]).
+pub(crate) fn remember(c: &SpatialCable) {
+    if let Ok(mut v) = SOLVED.lock() {
+        if v.iter()
+            .any(|o| o.a == c.a && o.gravity == c.gravity && o.stiffness == c.stiffness)
+        {
+            return;
+        }
+        if v.len() >= REMEMBERED {
+            v.remove(0);
+        }
+        v.push(c.clone());
+    }
+}
+
+/// The cable a 3-D solve returned with base wrench exactly `a`, if remembered.
+pub fn recall(
+    a: &SpatialParams,
+    stiffness: &Stiffness,
+    gravity: &Gravity3,
+) -> Option<SpatialCable> {
+    let v = SOLVED.lock().ok()?;
+    v.iter()
+        .rev()
+        .find(|c| c.params() == *a && c.gravity == *gravity && c.stiffness == *stiffness)
+        .cloned()
 }

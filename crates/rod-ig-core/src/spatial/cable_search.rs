@@ -17,12 +17,14 @@
 //! shooting ([`PlanarReduction::nearest`]).
 
 use super::cable::SpatialCable;
-use super::heavy::Gravity3;
+use super::heavy_ode::Gravity3;
 use super::{SpatialParams, SpatialPose, Stiffness};
 use crate::planar::heavy::cable::CableError;
 use crate::planar::heavy::{cable_search, Gravity, HeavyPlanar};
 use crate::planar::ig::SolveOptions as PlanarOptions;
-use crate::solver::{Found, InverseGeometry, Solution, SolveOptions, Verified, Work};
+use crate::solver::{
+    Failure, Found, IgError, InverseGeometry, Solution, SolveOptions, Verified, Work,
+};
 use crate::{PlanarParams, PlanarPose, RodError};
 use nalgebra::{SVector, Unit, UnitQuaternion, Vector3};
 
@@ -168,6 +170,7 @@ fn lifted_solution(
     }
     let tip = cable.tip().ok()?;
     let (_, energy) = cable.energies().ok()?;
+    super::cable::remember(&cable);
     let mut out = Solution::new(
         cable.params(),
         Verified {
@@ -263,4 +266,66 @@ pub(crate) fn all(
         evaluations: found.evaluations,
         starts: found.starts,
     }
+}
+
+/// The rod through `target` reached by the 3-D multiple shooting from the caller's `a0` at the
+/// full weight (its nodes integrated from a0: a start wherever single shooting from a0 keeps a
+/// few digits, and from an a0 good to ~1e-12 at any weight), admitted by the 3-D stability
+/// test. How `robust` keeps a good guess and how `newton` runs above w = 200.
+pub(crate) fn from_guess(
+    rod: Rod<'_>,
+    a0: &SpatialParams,
+    target: &SpatialPose,
+) -> Result<Solution<SpatialParams, SpatialPose>, Failure<SpatialParams>> {
+    let fail = |reason: IgError, iterations: u32| Failure {
+        reason,
+        iterations,
+        residual: f64::INFINITY,
+        last_a: Some(*a0),
+        starts: 1,
+        elapsed_us: 0.0,
+    };
+    let evaluation = |e: RodError| IgError::Evaluation {
+        iteration: 0,
+        detail: e.to_string(),
+    };
+    let mut cable =
+        SpatialCable::from_params(a0, rod.0, rod.1).map_err(|e| fail(evaluation(e), 0))?;
+    let iterations = match cable.solve(target) {
+        Ok(it) => it as u32,
+        Err(CableError::Rod(RodError::Deadline { .. })) => {
+            return Err(fail(IgError::Deadline { iteration: 0 }, 0))
+        }
+        Err(e) => return Err(fail(evaluation(RodError::Overflow(e.to_string())), 0)),
+    };
+    let stability = cable
+        .stability()
+        .map_err(|e| fail(evaluation(e), iterations))?;
+    if !stability.stable {
+        return Err(fail(
+            IgError::LeftStableSet {
+                iteration: iterations,
+            },
+            iterations,
+        ));
+    }
+    let (tip, (_, energy)) = match (cable.tip(), cable.energies()) {
+        (Ok(t), Ok(e)) => (t, e),
+        (Err(e), _) | (_, Err(e)) => return Err(fail(evaluation(e), iterations)),
+    };
+    super::cable::remember(&cable);
+    Ok(Solution::new(
+        cable.params(),
+        Verified {
+            tip,
+            errors: tip.distance_to(target),
+            energy,
+            margin: stability.margin,
+        },
+        Work {
+            iterations,
+            evaluations: iterations,
+            starts: 1,
+        },
+    ))
 }

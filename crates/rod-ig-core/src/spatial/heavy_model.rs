@@ -209,8 +209,13 @@ impl InverseGeometry<6> for HeavySpatial {
         if self.gravity.is_weightless() {
             return self.spatial().robust(target, options);
         }
-        // The planar problem nearest to the target first (exact where the target is planar),
-        // then the weightless 3-D rods carried in load.
+        // The caller's guess at the full weight, then the planar problem nearest to the target
+        // (exact where the target is planar), then the weightless 3-D rods carried in load.
+        if let Some(a0) = options.initial_guess {
+            if let Ok(s) = cable_search::from_guess((&self.stiffness, &self.gravity), &a0, target) {
+                return Ok(s);
+            }
+        }
         if let Some(reduction) = PlanarReduction::nearest(target, &self.stiffness, &self.gravity) {
             if let Some(s) = cable_search::first(
                 (&self.stiffness, &self.gravity),
@@ -262,6 +267,20 @@ impl InverseGeometry<6> for HeavySpatial {
         found.evaluations += carried.evaluations;
         found.starts += carried.starts;
         found
+    }
+
+    /// Above w = 200 the Newton iterates on the node states of the 3-D multiple shooting from
+    /// the cable `a0` integrates to (single shooting from an f64 `a0` loses its digits there).
+    fn newton(
+        &self,
+        target: &SpatialPose,
+        a0: &SpatialParams,
+        options: &Options6,
+    ) -> Result<Solution<SpatialParams, SpatialPose>, Failure<SpatialParams>> {
+        if !self.is_long_cable() {
+            return crate::solver::newton_solve(self, target, a0, options);
+        }
+        cable_search::from_guess((&self.stiffness, &self.gravity), a0, target)
     }
 
     fn default_start(&self, target: &SpatialPose) -> Option<SpatialParams> {

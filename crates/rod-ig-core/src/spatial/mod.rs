@@ -27,6 +27,7 @@ pub mod cable;
 mod cable_search;
 pub mod heavy;
 mod heavy_model;
+mod heavy_ode;
 pub mod ig;
 mod model;
 mod reduced;
