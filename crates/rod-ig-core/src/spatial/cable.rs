@@ -387,6 +387,14 @@ impl SpatialCable {
             if norm <= 1e-14 {
                 return Ok(it);
             }
+            // Newton that has not come near after a third of its budget will not: give the
+            // caller (a continuation halving its step) its time back.
+            if it >= NEWTON_ITERATIONS / 3 && norm > 1e-6 {
+                return Err(CableError::NoConvergence {
+                    iterations: it,
+                    residual: norm,
+                });
+            }
             let (r, j) = self.residual(target, true)?;
             let Some(j) = j else {
                 return Err(CableError::Singular);
@@ -431,6 +439,52 @@ impl SpatialCable {
             iterations: NEWTON_ITERATIONS,
             residual: norm,
         })
+    }
+
+    /// Moves this cable, in equilibrium on `from`, to an equilibrium on `to` along the straight
+    /// path of targets between them (positions on a line, orientations by slerp), each step
+    /// solved by [`SpatialCable::solve`] from the last: halved where Newton fails, lengthened by
+    /// half where it succeeds. Returns the Newton iterations; fails where the step falls below
+    /// 1/1024 of the way (a fold of the branch), after 64 steps taken or refused, or on the
+    /// deadline. The cable is left where the last step converged.
+    pub fn carry(&mut self, from: &SpatialPose, to: &SpatialPose) -> Result<usize, CableError> {
+        const MIN_STEP: f64 = 1.0 / 1024.0;
+        let (dp, dr) = from.distance_to(to);
+        if dp <= 1e-9 && dr <= 1e-9 {
+            return self.solve(to);
+        }
+        let (mut s, mut ds, mut iterations) = (0.0_f64, 0.25_f64, 0);
+        // At most this many steps, taken or refused (a way of 1,024 smallest steps is a fold).
+        let mut budget = 64;
+        while s < 1.0 {
+            budget -= 1;
+            if budget == 0 {
+                return Err(CableError::NoConvergence {
+                    iterations,
+                    residual: f64::INFINITY,
+                });
+            }
+            let next = (s + ds).min(1.0);
+            let goal = SpatialPose {
+                position: from.position + (to.position - from.position) * next,
+                rotation: from.rotation.slerp(&to.rotation, next),
+            };
+            let mut trial = self.clone();
+            match trial.solve(&goal) {
+                Ok(it) => {
+                    *self = trial;
+                    iterations += it;
+                    s = next;
+                    ds *= 1.5;
+                }
+                Err(CableError::Rod(RodError::Deadline { t })) => {
+                    return Err(CableError::Rod(RodError::Deadline { t }))
+                }
+                Err(_) if ds > MIN_STEP => ds *= 0.5,
+                Err(e) => return Err(e),
+            }
+        }
+        Ok(iterations)
     }
 
     /// The residual's max norm at `target` (rod lengths, radians).

@@ -49,6 +49,12 @@ pub(crate) struct PlanarReduction {
 }
 
 impl PlanarReduction {
+    /// True when the target lies in Π (to [`PLANE_TOLERANCE`]): the planar rods reach it.
+    pub(crate) fn is_exact_for(&self, target: &SpatialPose) -> bool {
+        let (dp, dr) = target.distance_to(&self.lifted_target());
+        dp <= PLANE_TOLERANCE && dr <= PLANE_TOLERANCE
+    }
+
     /// The planar problem nearest to a 3-D one: Π through e1 and ĝ (or, with ĝ along e1,
     /// through e1 and the target), the target projected on Π (its position, and the angle of
     /// its tangent's projection). None when bending is anisotropic or there is no weight.
@@ -163,7 +169,7 @@ fn lifted_solution(
     target: &SpatialPose,
 ) -> Option<Solution<SpatialParams, SpatialPose>> {
     let mut cable = lifted_cable(rod, reduction, &s.a).ok()?;
-    let polish = carried(&mut cable, &reduction.lifted_target(), target)?;
+    let polish = cable.carry(&reduction.lifted_target(), target).ok()?;
     let stability = cable.stability().ok()?;
     if !stability.stable {
         return None;
@@ -187,42 +193,6 @@ fn lifted_solution(
     );
     out.complete = s.complete;
     Some(out)
-}
-
-/// Smallest step of the continuation in the target, as a share of the way.
-const MIN_TARGET_STEP: f64 = 1.0 / 1024.0;
-
-/// Moves `cable`, in equilibrium on `from`, to an equilibrium on `to` along the straight path
-/// of targets between them (positions on a line, orientations by slerp), each step solved by
-/// the 3-D multiple shooting from the last: halved where Newton fails, lengthened by half
-/// where it succeeds. Returns the Newton iterations; None where the step falls below
-/// [`MIN_TARGET_STEP`] (a fold of the branch on the way) or the deadline passes.
-fn carried(cable: &mut SpatialCable, from: &SpatialPose, to: &SpatialPose) -> Option<usize> {
-    let (dp, dr) = from.distance_to(to);
-    if dp <= PLANE_TOLERANCE && dr <= PLANE_TOLERANCE {
-        return cable.solve(to).ok();
-    }
-    let (mut s, mut ds, mut iterations) = (0.0_f64, 0.25_f64, 0);
-    while s < 1.0 {
-        let next = (s + ds).min(1.0);
-        let goal = SpatialPose {
-            position: from.position + (to.position - from.position) * next,
-            rotation: from.rotation.slerp(&to.rotation, next),
-        };
-        let mut trial = cable.clone();
-        match trial.solve(&goal) {
-            Ok(it) => {
-                *cable = trial;
-                iterations += it;
-                s = next;
-                ds *= 1.5;
-            }
-            Err(CableError::Rod(RodError::Deadline { .. })) => return None,
-            Err(_) if ds > MIN_TARGET_STEP => ds *= 0.5,
-            Err(_) => return None,
-        }
-    }
-    Some(iterations)
 }
 
 /// The planar search's first rod, lifted (module docs); None when it finds none that is

@@ -112,6 +112,14 @@ pub fn evaluate(
         });
     }
     check(a, k)?;
+    let long = g.weight() > crate::planar::heavy::cable_search::LONG_CABLE_WEIGHT;
+    if long {
+        // A long cable a solver returned: from its node states, whatever single shooting from
+        // its f64 `a` would say.
+        if let Some(cable) = super::cable::recall(a, k, g) {
+            return of_cable(&cable, a, k, g);
+        }
+    }
     let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
     let grid: Vec<f64> = (40..=2000).map(|i| f64::from(i) / 2000.0).collect();
     let mut last = initial();
@@ -159,10 +167,9 @@ pub fn evaluate(
         elastic_energy: last[7],
         stability: if degenerate { undecided } else { scan.report() },
     };
-    let long = g.weight() > crate::planar::heavy::cable_search::LONG_CABLE_WEIGHT;
     if long && !(condition <= crate::planar::heavy::MAX_TRUSTED_CONDITION) {
+        // The tip of this f64 `a` is not determined to the accuracy of the verdict.
         e.stability = undecided;
-        return untrusted(a, k, g, e);
     }
     Ok(e)
 }
@@ -171,25 +178,32 @@ fn condition_of(a: &SpatialParams, j: &SpatialJacobian) -> f64 {
     j.abs().row_sum().max() * a.amax().max(1.0)
 }
 
-/// A long cable whose single shooting from an f64 `a` is not trusted: evaluated from its node
-/// states when a 3-D solver returned it, else `single` (single shooting's tip and energy) with
-/// its verdict `uncertain`: the tip of this `a` is not determined to the verdict's accuracy.
-fn untrusted(
+/// The evaluation of a long cable a 3-D solver returned, from its node states. Its J is single
+/// shooting's (the true, ill-conditioned J(1, a); NaN where that integration overflows).
+fn of_cable(
+    cable: &super::cable::SpatialCable,
     a: &SpatialParams,
     k: &Stiffness,
     g: &Gravity3,
-    single: HeavyEvaluation3d,
 ) -> Result<HeavyEvaluation3d, RodError> {
-    let Some(cable) = super::cable::recall(a, k, g) else {
-        return Ok(single);
-    };
+    let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
+    let jacobian = solve(
+        |t, s, ds| rhs::<NV, 6>(&ci, &av, load, t, s, ds, true),
+        0.0,
+        initial(),
+        1.0,
+        &options(a),
+    )
+    .map(|(s, _)| jac(&s))
+    .unwrap_or_else(|_| SpatialJacobian::from_element(f64::NAN));
     let (elastic_energy, energy) = cable.energies()?;
     Ok(HeavyEvaluation3d {
         tip: cable.tip()?,
+        jacobian,
         energy,
         elastic_energy,
         stability: cable.stability()?,
-        ..single
+        condition: condition_of(a, &jacobian),
     })
 }
 

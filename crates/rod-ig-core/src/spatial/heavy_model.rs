@@ -209,25 +209,33 @@ impl InverseGeometry<6> for HeavySpatial {
         if self.gravity.is_weightless() {
             return self.spatial().robust(target, options);
         }
-        // The caller's guess at the full weight, then the planar problem nearest to the target
-        // (exact where the target is planar), then the weightless 3-D rods carried in load.
+        // The caller's guess at the full weight; then the planar rods where they reach the
+        // target exactly (the symmetric targets among them); then, for a long cable, the
+        // planar problem nearest to the target carried to it, and otherwise the weightless
+        // 3-D rods carried in load first (fast where single shooting keeps its digits) and
+        // the nearest planar problem last.
         if let Some(a0) = options.initial_guess {
             if let Ok(s) = cable_search::from_guess((&self.stiffness, &self.gravity), &a0, target) {
                 return Ok(s);
             }
         }
-        if let Some(reduction) = PlanarReduction::nearest(target, &self.stiffness, &self.gravity) {
-            if let Some(s) = cable_search::first(
-                (&self.stiffness, &self.gravity),
-                &reduction,
-                target,
-                options,
-            ) {
+        let rod = (&self.stiffness, &self.gravity);
+        let reduction = PlanarReduction::nearest(target, &self.stiffness, &self.gravity);
+        let exact = reduction.as_ref().is_some_and(|r| r.is_exact_for(target));
+        let planar = |r: &PlanarReduction| cable_search::first(rod, r, target, options);
+        if let Some(r) = reduction.as_ref().filter(|_| exact || self.is_long_cable()) {
+            if let Some(s) = planar(r) {
                 return Ok(s);
             }
         }
         let starts = weightless_starts(self.spatial(), target, options);
-        load::first(&self.weightless(), self, target, options, starts)
+        let carried = load::first(&self.weightless(), self, target, options, starts);
+        match (carried, &reduction) {
+            (Err(f), Some(r)) if !exact && !self.is_long_cable() && !crate::deadline::expired() => {
+                planar(r).ok_or(f)
+            }
+            (other, _) => other,
+        }
     }
 
     fn robust_all(
@@ -238,7 +246,10 @@ impl InverseGeometry<6> for HeavySpatial {
         if self.gravity.is_weightless() {
             return self.spatial().robust_all(target, options);
         }
+        // The nearest planar problem for a long cable; below, only where it is exact (the
+        // weightless rods carried in load are faster there).
         let mut found = PlanarReduction::nearest(target, &self.stiffness, &self.gravity)
+            .filter(|r| self.is_long_cable() || r.is_exact_for(target))
             .map(|r| cable_search::all((&self.stiffness, &self.gravity), &r, target, options))
             .unwrap_or(Found {
                 solutions: Vec::new(),
