@@ -35,6 +35,9 @@
 //!     states integrated from the base, kept when stable by the second variation, loop-free,
 //!     not crossing itself and |tip| <= 0.98), solved from no guess (deadline 2 s; objective
 //!     `first` or `least_energy`); each answer re-checked on target (1e-6) and stable
+//! cargo run --release -p rod-ig-bench --example search_coverage -- long3d N SEED
+//!     the same in 3-D (`families::long_cable_3d`: the planar long cables turned into a random
+//!     plane and carried out of it, stable in 3-D), solved with the default options
 //! ```
 use rod_ig_core::ode::planar_reference;
 use rod_ig_core::planar::{self, ig, PlanarClosedForm};
@@ -56,6 +59,7 @@ fn main() {
         Some("solves") => solves(num(1, 500) as usize),
         Some("heavy") => heavy_coverage(num(1, 3000) as usize, num(2, 41)),
         Some("heavy3d") => heavy_coverage_3d(num(1, 500) as usize, num(2, 43)),
+        Some("long3d") => long_coverage_3d(num(1, 100) as usize, num(2, 53)),
         Some("long") => long_coverage(
             num(1, 200) as usize,
             num(2, 51),
@@ -299,9 +303,8 @@ fn heavy_coverage(n: usize, seed: u64) {
 
 /// Issue 41's success rate of the 3-D robust search with weight (see the module's header).
 fn heavy_coverage_3d(n: usize, seed: u64) {
-    use rod_ig_core::solver;
     use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
-    use rod_ig_core::spatial::{HeavySpatial, SpatialParams, Stiffness};
+    use rod_ig_core::spatial::{SpatialParams, Stiffness};
     let mut r = SplitMix64::new(seed);
     let k = Stiffness::default();
     let mut cases = Vec::new();
@@ -327,6 +330,34 @@ fn heavy_coverage_3d(n: usize, seed: u64) {
             cases.push((a, g, e.tip));
         }
     }
+    solve_and_report_3d(&cases);
+}
+
+/// Issue 51's success rate in 3-D: N targets of stable long cables (`families::long_cable_3d`).
+fn long_coverage_3d(n: usize, seed: u64) {
+    let mut r = SplitMix64::new(seed);
+    let mut cases = Vec::new();
+    while cases.len() < n {
+        cases.extend(rod_ig_bench::families::long_cable_3d(&mut r));
+        eprint!("\rdrawn {}", cases.len());
+    }
+    eprintln!();
+    solve_and_report_3d(&cases);
+}
+
+/// Solves every (a, gravity, target) 3-D case from no guess (default options), re-checks each
+/// answer (on target to 1e-6, stable), prints the misses, the count and the time quantiles.
+fn solve_and_report_3d(
+    cases: &[(
+        rod_ig_core::spatial::SpatialParams,
+        rod_ig_core::spatial::heavy::Gravity3,
+        rod_ig_core::spatial::SpatialPose,
+    )],
+) {
+    use rod_ig_core::solver;
+    use rod_ig_core::spatial::heavy as heavy3;
+    use rod_ig_core::spatial::{HeavySpatial, Stiffness};
+    let k = Stiffness::default();
     let options = solver::SolveOptions::default();
     let (mut solved, mut wrong, mut times) = (0usize, 0usize, Vec::new());
     // ONLY=i,j,…: re-run those cases alone (the indices the misses print).

@@ -4,6 +4,7 @@
 
 use crate::SplitMix64;
 use rod_ig_core::{PlanarParams, PlanarPose};
+use std::f64::consts::PI;
 
 /// ±10^u with u uniform in [lo, hi] and a random sign ([`SplitMix64::signed_pow10`]).
 pub fn signed_pow10(rng: &mut SplitMix64, lo: f64, hi: f64) -> f64 {
@@ -157,4 +158,67 @@ pub fn long_cables(
         out.extend(long_cable(&mut r));
     }
     out
+}
+
+/// A stable 3-D long cable and its tip, or None where the draw is not one (issue 51, item 5):
+/// a planar long cable of [`long_cable`] (w = 10^U(log 200, 4), its node states integrated from
+/// the base, stable, loop-free) posed in a plane turned by U(−π, π) about the base tangent,
+/// then carried by the 3-D multiple shooting out of that plane to a target moved by up to 0.2
+/// in position (|tip| ≤ 0.98) and 0.4 rad in orientation, in random directions; kept when the
+/// 3-D rod reached is stable (`SpatialCable::stability`, out of the plane too).
+#[allow(clippy::type_complexity)]
+pub fn long_cable_3d(
+    r: &mut SplitMix64,
+) -> Option<(
+    rod_ig_core::spatial::SpatialParams,
+    rod_ig_core::spatial::heavy::Gravity3,
+    rod_ig_core::spatial::SpatialPose,
+)> {
+    use nalgebra::{Rotation3, Unit, UnitQuaternion, Vector3};
+    use rod_ig_core::planar::heavy::cable::Cable;
+    use rod_ig_core::spatial::cable::SpatialCable;
+    use rod_ig_core::spatial::heavy::Gravity3;
+    use rod_ig_core::spatial::{SpatialParams, SpatialPose, Stiffness};
+    let unit = |r: &mut SplitMix64| loop {
+        let v = Vector3::new(r.range(-1.0, 1.0), r.range(-1.0, 1.0), r.range(-1.0, 1.0));
+        let n = v.norm();
+        if n > 0.1 && n <= 1.0 {
+            return v / n;
+        }
+    };
+    let (g2, a2, _) = long_cable(r)?;
+    let planar = Cable::from_params(&a2, &g2).ok()?;
+    let turn = Rotation3::from_axis_angle(&Vector3::x_axis(), r.range(-PI, PI));
+    let normal = Unit::new_normalize(turn * Vector3::z());
+    let lift = |n: &[f64; 4]| {
+        (
+            UnitQuaternion::from_axis_angle(&normal, n[2]),
+            turn * Vector3::new(n[0], n[1], 0.0),
+        )
+    };
+    let poses: Vec<_> = planar.nodes().iter().map(lift).collect();
+    let (m, f) = (
+        turn * Vector3::new(0.0, 0.0, a2[0]),
+        turn * Vector3::new(a2[1], a2[2], 0.0),
+    );
+    let a = SpatialParams::new(m.x, m.y, m.z, f.x, f.y, f.z);
+    let gd = turn * Vector3::new(g2.direction()[0], g2.direction()[1], 0.0);
+    let g = Gravity3::new(g2.weight(), [gd.x, gd.y, gd.z]).ok()?;
+    let k = Stiffness::default();
+    let mut cable = SpatialCable::from_poses(&a, &k, &g, planar.mesh().to_vec(), &poses).ok()?;
+    let tip2 = planar.tip().ok()?;
+    let (rotation, position) = lift(&[tip2.x, tip2.y, tip2.theta, 0.0]);
+    let from = SpatialPose { position, rotation };
+    let to = SpatialPose {
+        position: position + unit(r) * r.range(0.0, 0.2),
+        rotation: UnitQuaternion::from_scaled_axis(unit(r) * r.range(0.0, 0.4)) * rotation,
+    };
+    if to.position.norm() > 0.98 {
+        return None;
+    }
+    cable.carry(&from, &to).ok()?;
+    if !cable.stability().ok()?.stable {
+        return None;
+    }
+    Some((cable.params(), g, to))
 }
