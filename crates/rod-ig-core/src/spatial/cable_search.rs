@@ -169,15 +169,32 @@ fn lifted_solution(
     target: &SpatialPose,
 ) -> Option<Solution<SpatialParams, SpatialPose>> {
     let mut cable = lifted_cable(rod, reduction, &s.a).ok()?;
-    let polish = cable.carry(&reduction.lifted_target(), target).ok()?;
-    let stability = cable.stability().ok()?;
+    let polish = cable.carry(&reduction.lifted_target(), target).ok()? as u32;
+    let work = Work {
+        iterations: s.iterations + polish,
+        evaluations: s.evaluations + polish,
+        starts: s.starts,
+    };
+    let mut out = admitted(&cable, target, work).ok()?;
+    out.complete = s.complete;
+    Some(out)
+}
+
+/// A cable solved on `target` as the solvers' answer: admitted by the 3-D stability test
+/// (`Err(None)` where it fails), evaluated, and remembered ([`super::cable::recall`]).
+fn admitted(
+    cable: &SpatialCable,
+    target: &SpatialPose,
+    work: Work,
+) -> Result<Solution<SpatialParams, SpatialPose>, Option<RodError>> {
+    let stability = cable.stability()?;
     if !stability.stable {
-        return None;
+        return Err(None);
     }
-    let tip = cable.tip().ok()?;
-    let (_, energy) = cable.energies().ok()?;
-    super::cable::remember(&cable);
-    let mut out = Solution::new(
+    let tip = cable.tip()?;
+    let (_, energy) = cable.energies()?;
+    super::cable::remember(cable);
+    Ok(Solution::new(
         cable.params(),
         Verified {
             tip,
@@ -185,14 +202,8 @@ fn lifted_solution(
             energy,
             margin: stability.margin,
         },
-        Work {
-            iterations: s.iterations + polish as u32,
-            evaluations: s.evaluations + polish as u32,
-            starts: s.starts,
-        },
-    );
-    out.complete = s.complete;
-    Some(out)
+        work,
+    ))
 }
 
 /// The planar search's first rod, lifted (module docs); None when it finds none that is
@@ -268,34 +279,18 @@ pub(crate) fn from_guess(
         }
         Err(e) => return Err(fail(evaluation(RodError::Overflow(e.to_string())), 0)),
     };
-    let stability = cable
-        .stability()
-        .map_err(|e| fail(evaluation(e), iterations))?;
-    if !stability.stable {
-        return Err(fail(
+    let work = Work {
+        iterations,
+        evaluations: iterations,
+        starts: 1,
+    };
+    admitted(&cable, target, work).map_err(|e| match e {
+        Some(e) => fail(evaluation(e), iterations),
+        None => fail(
             IgError::LeftStableSet {
                 iteration: iterations,
             },
             iterations,
-        ));
-    }
-    let (tip, (_, energy)) = match (cable.tip(), cable.energies()) {
-        (Ok(t), Ok(e)) => (t, e),
-        (Err(e), _) | (_, Err(e)) => return Err(fail(evaluation(e), iterations)),
-    };
-    super::cable::remember(&cable);
-    Ok(Solution::new(
-        cable.params(),
-        Verified {
-            tip,
-            errors: tip.distance_to(target),
-            energy,
-            margin: stability.margin,
-        },
-        Work {
-            iterations,
-            evaluations: iterations,
-            starts: 1,
-        },
-    ))
+        ),
+    })
 }
