@@ -179,3 +179,24 @@ def test_gravity_out_of_the_plane_is_the_3d_rods(cable_3d):
         assert max(abs(p.pose.position.z) for p in shape) > 1e-3  # out of the plane
     finally:
         assert all(r.successful for r in c.set_params(gravity=[0.0, -9.81, 0.0]))
+
+
+@pytest.fixture(scope="module")
+def harness_3d():
+    node, client = h.start_node_and_client(["--ros-args", *HARNESS, "-p", "solve_3d:=true"],
+                                           name="rod_ig_harness_3d_client")
+    yield node, client
+    h.stop_node_and_client(node, client)
+
+
+def test_a_one_metre_harness_in_3d(harness_3d):
+    """solve_3d at w = 2,000 (issue 51, item 5): targets out of the plane of the base and gravity
+    are reached by the 3-D rod (multiple shooting from the nearest planar rod), stable, its path
+    ending on the target; the level target stays the planar rod's (in-plane gravity)."""
+    _, c = harness_3d
+    sol, _ = solve_topic(c, 0.8, 0.0, 0.0)
+    assert sol.success and sol.stable and not sol.spatial, sol.message
+    for (x, y, z, q) in [(0.7, -0.1, 0.15, tilted(0.2, 0.3)), (0.8, 0.0, 0.05, tilted(0.0, 0.0))]:
+        s = h.next_seq()
+        c.pub.publish(c.make_target(x, y, 0.0, s, z=z, q=q))
+        check_heavy_3d(c, s, x, y, z, w=2000.0)
