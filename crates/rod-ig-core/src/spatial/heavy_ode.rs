@@ -5,7 +5,7 @@
 // Index loops mirror the formulas.
 #![allow(clippy::needless_range_loop)]
 
-use super::reduced::{cross, rotmat, rt_mul as rt};
+use super::reduced::{cross, kinematics, rotmat, rt_mul as rt};
 use crate::RodError;
 
 /// Base state: q (w, x, y, z), p, elastic energy, P = ∫p.
@@ -113,15 +113,7 @@ pub(super) fn rhs<const N: usize, const C: usize>(
             a[2] - moment[2] - pxn[2],
         ],
     );
-    let om = [m[0] * ci[0], m[1] * ci[1], m[2] * ci[2]];
-    ds[0] = -0.5 * (x * om[0] + y * om[1] + z * om[2]);
-    ds[1] = 0.5 * (w * om[0] + y * om[2] - z * om[1]);
-    ds[2] = 0.5 * (w * om[1] + z * om[0] - x * om[2]);
-    ds[3] = 0.5 * (w * om[2] + x * om[1] - y * om[0]);
-    ds[4] = r[0][0];
-    ds[5] = r[1][0];
-    ds[6] = r[2][0];
-    ds[7] = 0.5 * (m[0] * om[0] + m[1] * om[1] + m[2] * om[2]);
+    let om = kinematics(ci, [w, x, y, z], &r, m, ds);
     ds[8] = p[0];
     ds[9] = p[1];
     ds[10] = p[2];

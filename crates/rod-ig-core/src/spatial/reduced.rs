@@ -62,6 +62,29 @@ pub(crate) fn rt_mul(r: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
     ]
 }
 
+/// The rod's kinematics shared by every formulation on (q, p, energy): ω = m / c,
+/// q' = ½ q ⊗ (0, ω), p' = R e1 and the elastic energy's rate ½ m · ω, written to `ds[0..8]`.
+/// Returns ω.
+#[inline(always)]
+pub(crate) fn kinematics(
+    ci: &[f64; 3],
+    [w, x, y, z]: [f64; 4],
+    r: &[[f64; 3]; 3],
+    m: [f64; 3],
+    ds: &mut [f64],
+) -> [f64; 3] {
+    let om = [m[0] * ci[0], m[1] * ci[1], m[2] * ci[2]];
+    ds[0] = -0.5 * (x * om[0] + y * om[1] + z * om[2]);
+    ds[1] = 0.5 * (w * om[0] + y * om[2] - z * om[1]);
+    ds[2] = 0.5 * (w * om[1] + z * om[0] - x * om[2]);
+    ds[3] = 0.5 * (w * om[2] + x * om[1] - y * om[0]);
+    ds[4] = r[0][0];
+    ds[5] = r[1][0];
+    ds[6] = r[2][0];
+    ds[7] = 0.5 * (m[0] * om[0] + m[1] * om[1] + m[2] * om[2]);
+    om
+}
+
 /// Right-hand side of the reduced rod (+ variational equations when `VAR`), module docs.
 #[inline(always)]
 pub(crate) fn rhs<const N: usize, const VAR: bool>(
@@ -78,15 +101,7 @@ pub(crate) fn rhs<const N: usize, const VAR: bool>(
     let f = rt_mul(&r, af);
     let pxf = cross(p, af);
     let m = rt_mul(&r, [am[0] - pxf[0], am[1] - pxf[1], am[2] - pxf[2]]);
-    let om = [m[0] * ci[0], m[1] * ci[1], m[2] * ci[2]];
-    ds[0] = -0.5 * (x * om[0] + y * om[1] + z * om[2]);
-    ds[1] = 0.5 * (w * om[0] + y * om[2] - z * om[1]);
-    ds[2] = 0.5 * (w * om[1] + z * om[0] - x * om[2]);
-    ds[3] = 0.5 * (w * om[2] + x * om[1] - y * om[0]);
-    ds[4] = r[0][0];
-    ds[5] = r[1][0];
-    ds[6] = r[2][0];
-    ds[7] = 0.5 * (m[0] * om[0] + m[1] * om[1] + m[2] * om[2]);
+    let om = kinematics(ci, [w, x, y, z], &r, m, ds);
     if !VAR {
         return;
     }
