@@ -27,6 +27,7 @@
 //!   in a-space.
 //! - [`rng`]: a small deterministic generator for reproducible samples.
 //! - [`spatial`]: the 3-D rod by numerical integration, and its inverse geometry.
+//! - [`ends`]: how each end is held (clamped, pinned, free).
 //! - [`wrench`]: the wrenches the rod exerts on its two grippers, as wrist sensors read them.
 #![warn(missing_docs)]
 
@@ -35,6 +36,7 @@ pub mod dd;
 pub mod deadline;
 mod eft;
 pub mod elliptic;
+pub mod ends;
 mod error;
 pub mod ode;
 pub mod plan;

@@ -24,6 +24,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
 use super::Gravity;
+use crate::ends::{EndCondition, HeldEnds};
 use crate::ode::dop853;
 use crate::ode::OdeOptions;
 use crate::{PlanarParams, PlanarPose, RodError};
@@ -182,11 +183,17 @@ pub struct Cable {
     mesh: Vec<f64>,
     /// n(0) = (a4, a5).
     force: [f64; 2],
-    /// (x, y, θ, κ) at t₀ … t_{M−1}; the first is (0, 0, 0, a3).
+    /// (x, y, θ, κ) at t₀ … t_{M−1}; the first is (0, 0, 0, a3) (pinned base: (0, 0, θ₀, 0)).
     nodes: Vec<[f64; 4]>,
     /// Relative tolerance of the segments' integration in the Newton equations: the full
     /// [`SEGMENT_RTOL`], or [`SUBSTEP_RTOL`] on a continuation's intermediate rods.
     rtol: f64,
+    /// How the ends are held: which node-0 component is unknown (κ(0) clamped, θ(0) pinned),
+    /// whether n(0) is (free tip: n(0) = w ĝ) and which tip components are equations.
+    ends: HeldEnds,
+    /// The curvature a pinned or free tip's equation asks, κ(1) = this: 0, except while
+    /// [`Cable::release_into`] lets a clamp's moment go.
+    tip_curvature_goal: f64,
 }
 
 impl Cable {
@@ -194,13 +201,35 @@ impl Cable {
     /// mesh fit for its forces. Exact where single shooting is (w ≲ 300); at larger w it is
     /// a starting guess that [`Cable::solve`] corrects.
     pub fn from_params(a: &PlanarParams, gravity: &Gravity) -> Result<Self, RodError> {
+        Self::held(0.0, a, gravity, HeldEnds::CLAMPED)
+    }
+
+    /// The cable held by `ends` whose base leaves at angle `base_angle` (0 for a clamped base)
+    /// with base wrench `a`, its nodes integrated from the base as [`Cable::from_params`]. A
+    /// pinned base has κ(0) = 0 (a3 is ignored); a free tip has n(0) = w ĝ, so that n(1) = 0
+    /// (a4, a5 are ignored).
+    pub fn held(
+        base_angle: f64,
+        a: &PlanarParams,
+        gravity: &Gravity,
+        ends: HeldEnds,
+    ) -> Result<Self, RodError> {
         RodError::check_finite("a", a.as_slice())?;
+        RodError::check_finite("base_angle", &[base_angle])?;
         let load = gravity.load();
-        let force = [a[1], a[2]];
+        let force = if ends.tip() == EndCondition::Free {
+            load
+        } else {
+            [a[1], a[2]]
+        };
+        let (theta0, kappa0) = match ends.base() {
+            EndCondition::Pinned => (base_angle, 0.0),
+            _ => (base_angle, a[0]),
+        };
         let mesh = uniform_mesh(segments_for(force_max(force, load)));
-        let mut nodes = vec![[0.0, 0.0, 0.0, a[0]]];
+        let mut nodes = vec![[0.0, 0.0, theta0, kappa0]];
         for k in 0..mesh.len() - 2 {
-            let e = integrate_segment::<FULL>(
+            let e = integrate_segment::<STATE>(
                 SEGMENT_RTOL,
                 load,
                 force,
@@ -215,7 +244,86 @@ impl Cable {
             force,
             nodes,
             rtol: SEGMENT_RTOL,
+            ends,
+            tip_curvature_goal: 0.0,
         })
+    }
+
+    /// How the two ends are held.
+    pub fn ends(&self) -> HeldEnds {
+        self.ends
+    }
+
+    /// The rod's angle at the base, θ(0): 0 unless the base is pinned.
+    pub fn base_angle(&self) -> f64 {
+        self.nodes[0][2]
+    }
+
+    /// The same rod with every angle shifted by a whole number of turns so that the base angle
+    /// is in (−π, π] (a pinned base's angle is found modulo 2π).
+    pub fn unwind_base_angle(&mut self) {
+        let shift = self.nodes[0][2] - crate::wrap_angle(self.nodes[0][2]);
+        if shift != 0.0 {
+            for n in &mut self.nodes {
+                n[2] -= shift;
+            }
+        }
+    }
+
+    /// Turns this cable, both ends clamped and on `target`, into the equilibrium held by `ends`
+    /// through the same target: the moments at the ends that become pinned or free are let go
+    /// gradually (a homotopy κ_end = (1 − s) κ_end(clamped), s from 0 to 1, each step corrected
+    /// by Newton; the clamped rod solves the s = 0 equations exactly). Returns the steps.
+    pub fn release_into(&mut self, ends: HeldEnds, target: &PlanarPose) -> Result<u32, CableError> {
+        if ends.tip() == EndCondition::Free {
+            return Err(RodError::OutOfDomain(
+                "a free tip is not reached by releasing a clamp (its force changes too)".into(),
+            )
+            .into());
+        }
+        let base_moment = if ends.base() == EndCondition::Pinned {
+            self.nodes[0][3]
+        } else {
+            0.0
+        };
+        let tip_moment = if ends.tip() == EndCondition::Pinned {
+            self.tip_curvature()?
+        } else {
+            0.0
+        };
+        self.ends = ends;
+        let (mut s, mut ds, mut steps) = (0.0, 1.0, 0u32);
+        while s < 1.0 {
+            if crate::deadline::expired() {
+                return Err(RodError::Deadline { t: s }.into());
+            }
+            let next = (s + ds).min(1.0);
+            let mut trial = self.clone();
+            if ends.base() == EndCondition::Pinned {
+                trial.nodes[0][3] = (1.0 - next) * base_moment;
+            }
+            trial.tip_curvature_goal = (1.0 - next) * tip_moment;
+            steps += 1;
+            match trial.solve(target) {
+                Ok(it) if it <= 10 && trial.close_to(self) => {
+                    *self = trial;
+                    s = next;
+                    ds = (2.0 * ds).min(1.0);
+                }
+                Err(CableError::Rod(RodError::Deadline { t })) => {
+                    return Err(RodError::Deadline { t }.into())
+                }
+                _ if ds > 1.0 / 256.0 => ds *= 0.5,
+                _ => {
+                    return Err(CableError::Lost {
+                        weight: self.gravity.weight(),
+                        target_weight: self.gravity.weight(),
+                        why: format!("the end moments could not be released past s = {s:.4}"),
+                    })
+                }
+            }
+        }
+        Ok(steps)
     }
 
     /// a = (κ(0), n(0)): the base wrench.
@@ -230,7 +338,10 @@ impl Cable {
 
     /// True when `other` is this rod: the same base wrench under the same gravity.
     pub fn same_rod(&self, other: &Cable) -> bool {
-        self.params() == other.params() && self.gravity == other.gravity
+        self.params() == other.params()
+            && self.gravity == other.gravity
+            && self.ends == other.ends
+            && self.base_angle() == other.base_angle()
     }
 
     /// Segments of the mesh.
@@ -271,15 +382,44 @@ impl Cable {
         )
     }
 
+    /// Which component of node 0 is unknown: κ(0) for a clamped base, θ(0) for a pinned one.
+    fn base_unknown(&self) -> usize {
+        match self.ends.base() {
+            EndCondition::Pinned => 2,
+            _ => 3,
+        }
+    }
+
+    /// Unknowns before the interior nodes': node 0's, then n(0) unless the tip is free.
+    fn node_offset(&self) -> usize {
+        if self.ends.tip() == EndCondition::Free {
+            1
+        } else {
+            3
+        }
+    }
+
+    /// The tip components that are equations: (x, y, θ) clamped, (x, y, κ) pinned, κ free.
+    fn tip_equations(&self) -> &'static [usize] {
+        match self.ends.tip() {
+            EndCondition::Clamped => &[0, 1, 2],
+            EndCondition::Pinned => &[0, 1, 3],
+            EndCondition::Free => &[3],
+        }
+    }
+
     fn unknowns(&self) -> DVector<f64> {
         let m = self.segments();
-        let mut z = DVector::zeros(3 + 4 * (m - 1));
-        z[0] = self.nodes[0][3];
-        z[1] = self.force[0];
-        z[2] = self.force[1];
+        let off = self.node_offset();
+        let mut z = DVector::zeros(off + 4 * (m - 1));
+        z[0] = self.nodes[0][self.base_unknown()];
+        if off == 3 {
+            z[1] = self.force[0];
+            z[2] = self.force[1];
+        }
         for k in 1..m {
             for c in 0..4 {
-                z[3 + 4 * (k - 1) + c] = self.nodes[k][c];
+                z[off + 4 * (k - 1) + c] = self.nodes[k][c];
             }
         }
         z
@@ -287,11 +427,15 @@ impl Cable {
 
     fn set_unknowns(&mut self, z: &DVector<f64>) {
         let m = self.segments();
-        self.nodes[0] = [0.0, 0.0, 0.0, z[0]];
-        self.force = [z[1], z[2]];
+        let off = self.node_offset();
+        let b = self.base_unknown();
+        self.nodes[0][b] = z[0];
+        if off == 3 {
+            self.force = [z[1], z[2]];
+        }
         for k in 1..m {
             for c in 0..4 {
-                self.nodes[k][c] = z[3 + 4 * (k - 1) + c];
+                self.nodes[k][c] = z[off + 4 * (k - 1) + c];
             }
         }
     }
@@ -304,8 +448,11 @@ impl Cable {
         jacobian: bool,
     ) -> Result<(DVector<f64>, Option<DMatrix<f64>>), RodError> {
         let m = self.segments();
-        let dim = 3 + 4 * (m - 1);
+        let off = self.node_offset();
+        let dim = off + 4 * (m - 1);
         let load = self.gravity.load();
+        // The variational column of node 0's unknown: ∂/∂κ_k (clamped base) or ∂/∂θ_k.
+        let base_column = if self.base_unknown() == 3 { 1 } else { 0 };
         let mut r = DVector::zeros(dim);
         let mut j = jacobian.then(|| DMatrix::zeros(dim, dim));
         for k in 0..m {
@@ -323,11 +470,13 @@ impl Cable {
                 )?);
             }
             let row = 4 * k;
-            let rows = if k + 1 < m { 4 } else { 3 };
-            let goal: [f64; 4] = if k + 1 < m {
-                self.nodes[k + 1]
+            let (components, goal): (&[usize], [f64; 4]) = if k + 1 < m {
+                (&[0, 1, 2, 3], self.nodes[k + 1])
             } else {
-                [target.x, target.y, target.theta, 0.0]
+                (
+                    self.tip_equations(),
+                    [target.x, target.y, target.theta, self.tip_curvature_goal],
+                )
             };
             // Curvature rows are scaled by 1 + |κ|, so that one tolerance fits every row.
             let scale = |c: usize| {
@@ -337,27 +486,29 @@ impl Cable {
                     1.0
                 }
             };
-            for c in 0..rows {
-                r[row + c] = (e[c] - goal[c]) * scale(c);
+            for (i, &c) in components.iter().enumerate() {
+                r[row + i] = (e[c] - goal[c]) * scale(c);
             }
             let Some(j) = j.as_mut() else { continue };
-            for c in 0..rows {
+            for (i, &c) in components.iter().enumerate() {
                 let sc = scale(c);
                 let col_of = |v: usize| e[STATE + 4 * v + c] * sc;
                 if k == 0 {
-                    j[(row + c, 0)] = col_of(1);
+                    j[(row + i, 0)] = col_of(base_column);
                 } else {
-                    let base = 3 + 4 * (k - 1);
+                    let base = off + 4 * (k - 1);
                     if c < 2 {
-                        j[(row + c, base + c)] = sc; // ∂x/∂x_k, ∂y/∂y_k
+                        j[(row + i, base + c)] = sc; // ∂x/∂x_k, ∂y/∂y_k
                     }
-                    j[(row + c, base + 2)] = col_of(0);
-                    j[(row + c, base + 3)] = col_of(1);
+                    j[(row + i, base + 2)] = col_of(0);
+                    j[(row + i, base + 3)] = col_of(1);
                 }
-                j[(row + c, 1)] = col_of(2);
-                j[(row + c, 2)] = col_of(3);
+                if off == 3 {
+                    j[(row + i, 1)] = col_of(2);
+                    j[(row + i, 2)] = col_of(3);
+                }
                 if k + 1 < m {
-                    j[(row + c, 3 + 4 * k + c)] = -sc;
+                    j[(row + i, off + 4 * k + c)] = -sc;
                 }
             }
         }
@@ -486,8 +637,14 @@ impl Cable {
 
     /// The same cable under another gravity (its state unchanged: a predictor).
     fn with_gravity(&self, gravity: Gravity) -> Self {
+        let force = if self.ends.tip() == EndCondition::Free {
+            gravity.load()
+        } else {
+            self.force
+        };
         Self {
             gravity,
+            force,
             ..self.clone()
         }
     }
@@ -739,6 +896,7 @@ impl Cable {
         let (a, b) = (self.params(), other.params());
         let scale = 1.0 + self.gravity.weight().max(other.gravity.weight());
         (a - b).amax() <= 0.3 * (scale + b.amax())
+            && (self.base_angle() - other.base_angle()).abs() <= 0.5
     }
 
     /// Sign of the determinant of the Newton matrix (changes at a fold).
@@ -889,7 +1047,8 @@ const GRID_PER_ROOT_FORCE: f64 = 24.0;
 const MAX_GRID: usize = 6000;
 
 /// The least eigenvalue μ of the second variation of a heavy rod's energy on the tangent
-/// space of its constraints (both ends clamped, the tip's position held; module docs),
+/// space of its constraints (module docs; at a pinned or free end the variation is free there,
+/// the natural boundary condition v' = 0, and a free tip drops the tip-position constraints),
 /// in continuum units: the rod is stable iff μ > 0.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SecondVariation {
@@ -902,6 +1061,9 @@ pub struct SecondVariation {
     pub index: usize,
     /// Points of the coarse grid (the fine one has twice as many).
     pub grid: usize,
+    /// μ₀ of the straight weightless rod held by the same ends (the margin's unit):
+    /// [`STRAIGHT_ROD_EIGENVALUE`] for both ends clamped.
+    pub straight: f64,
 }
 
 impl SecondVariation {
@@ -915,10 +1077,10 @@ impl SecondVariation {
         self.eigenvalue.abs() <= self.error
     }
 
-    /// μ / μ₀ with μ₀ the straight weightless rod's ([`STRAIGHT_ROD_EIGENVALUE`]): a margin
+    /// μ / μ₀ with μ₀ the straight weightless rod's under the same ends (`straight`): a margin
     /// that is 1 for that rod and does not shrink with w for a hanging cable.
     pub fn normalised(&self) -> f64 {
-        self.eigenvalue / STRAIGHT_ROD_EIGENVALUE
+        self.eigenvalue / self.straight
     }
 
     fn of(cable: &Cable) -> Result<Self, RodError> {
@@ -939,59 +1101,99 @@ impl SecondVariation {
             cos[i] = c;
             tension[i] = n[0] * c + n[1] * s;
         })?;
-        let grid_fine = Grid::new(&sin, &cos, &tension, 1);
-        let grid_coarse = Grid::new(&sin, &cos, &tension, 2);
-        let (mu_f, width_f) = grid_fine.least_eigenvalue();
-        let (mu_c, width_c) = grid_coarse.least_eigenvalue();
-        let eigenvalue = mu_f + (mu_f - mu_c) / 3.0;
-        let error = (mu_f - mu_c).abs() / 3.0 + width_f + width_c + 1e-9 * mu_f.abs();
+        let ends = cable.ends;
+        let (eigenvalue, error, index) =
+            Self::extrapolated(&Grid::new(&sin, &cos, &tension, 1, ends), &{
+                Grid::new(&sin, &cos, &tension, 2, ends)
+            });
         Ok(Self {
             eigenvalue,
             error,
-            index: grid_fine.count_below(0.0),
+            index,
             grid: coarse,
+            straight: Self::straight_rod(ends),
         })
+    }
+
+    /// (μ, its error, the fine grid's index) from a fine grid and one twice as coarse.
+    fn extrapolated(fine: &Grid, coarse: &Grid) -> (f64, f64, usize) {
+        let (mu_f, width_f) = fine.least_eigenvalue();
+        let (mu_c, width_c) = coarse.least_eigenvalue();
+        let eigenvalue = mu_f + (mu_f - mu_c) / 3.0;
+        let error = (mu_f - mu_c).abs() / 3.0 + width_f + width_c + 1e-9 * mu_f.abs();
+        (eigenvalue, error, fine.count_below(0.0))
+    }
+
+    /// μ₀ of the straight weightless rod (θ = 0, no force) held by `ends`: 4ξ² (tan ξ = ξ) when
+    /// both are clamped, else computed on the grid (e.g. (π/2)² for a free tip).
+    pub fn straight_rod(ends: HeldEnds) -> f64 {
+        if ends.both_clamped() {
+            return STRAIGHT_ROD_EIGENVALUE;
+        }
+        let n = 2 * MIN_GRID;
+        let (sin, cos, tension) = (vec![0.0; n + 1], vec![1.0; n + 1], vec![0.0; n + 1]);
+        let fine = Grid::new(&sin, &cos, &tension, 1, ends);
+        let coarse = Grid::new(&sin, &cos, &tension, 2, ends);
+        Self::extrapolated(&fine, &coarse).0
     }
 }
 
-/// The second variation on a uniform grid of interior points (v₀ = v_N = 0): the matrix
-/// A(σ) = K/h + h (diag(c) − σ) with K = tridiag(−1, 2, −1), and the two constraint rows
-/// h sin θ_j, h cos θ_j.
+/// The second variation on a uniform grid (linear elements, lumped masses): the unknowns are
+/// v_j at the interior points, and at a pinned or free end its end point too (mass h/2,
+/// stiffness row 1/h: the natural condition v' = 0 in the weak form). The matrix is
+/// A(σ) = K + M (diag(c) − σ) with K the stiffness (tridiag(−1, 2, −1)/h) and M the masses;
+/// while the tip's position is held, two constraint rows m_j sin θ_j, m_j cos θ_j.
 struct Grid {
     h: f64,
     diag: Vec<f64>,
     sin: Vec<f64>,
     cos: Vec<f64>,
+    mass: Vec<f64>,
+    stiffness: Vec<f64>,
+    constrained: bool,
 }
 
 impl Grid {
-    fn new(sin: &[f64], cos: &[f64], tension: &[f64], stride: usize) -> Self {
+    fn new(sin: &[f64], cos: &[f64], tension: &[f64], stride: usize, ends: HeldEnds) -> Self {
         let n = (sin.len() - 1) / stride;
         let h = 1.0 / n as f64;
-        let pick = |v: &[f64]| (1..n).map(|j| v[j * stride]).collect::<Vec<_>>();
+        let first = usize::from(ends.base() == EndCondition::Clamped);
+        let last = if ends.tip() == EndCondition::Clamped {
+            n - 1
+        } else {
+            n
+        };
+        let pick = |v: &[f64]| (first..=last).map(|j| v[j * stride]).collect::<Vec<_>>();
+        let at_end = |j: usize| j == 0 || j == n;
         Self {
             h,
             diag: pick(tension),
             sin: pick(sin),
             cos: pick(cos),
+            mass: (first..=last)
+                .map(|j| if at_end(j) { 0.5 * h } else { h })
+                .collect(),
+            stiffness: (first..=last)
+                .map(|j| if at_end(j) { 1.0 / h } else { 2.0 / h })
+                .collect(),
+            constrained: ends.tip() != EndCondition::Free,
         }
     }
 
     /// Eigenvalues of the constrained problem below σ: neg(A) + pos(Cᵀ A⁻¹ C) − 2 (the
-    /// inertia of the bordered matrix, Haynsworth; C has rank 2).
+    /// inertia of the bordered matrix, Haynsworth; C has rank 2), neg(A) without constraints.
     fn count_below(&self, sigma: f64) -> usize {
         let n = self.diag.len();
-        let h = self.h;
-        let off = -1.0 / h;
+        let off = -1.0 / self.h;
         // LDLᵀ of the tridiagonal A(σ), and A⁻¹ C by the same factors.
         let mut d = vec![0.0; n];
         let mut l = vec![0.0; n];
         let mut neg = 0usize;
         for j in 0..n {
-            let a = 2.0 / h + h * (self.diag[j] - sigma);
+            let a = self.stiffness[j] + self.mass[j] * (self.diag[j] - sigma);
             let mut dj = if j == 0 { a } else { a - off * off / d[j - 1] };
             if dj == 0.0 {
-                dj = -f64::EPSILON * (2.0 / h);
+                dj = -f64::EPSILON * (2.0 / self.h);
             }
             if j + 1 < n {
                 l[j] = off / dj;
@@ -1000,6 +1202,9 @@ impl Grid {
                 neg += 1;
             }
             d[j] = dj;
+        }
+        if !self.constrained {
+            return neg;
         }
         let solve = |rhs: &dyn Fn(usize) -> f64| {
             let mut y = vec![0.0; n];
@@ -1014,9 +1219,15 @@ impl Grid {
             }
             y
         };
-        let us = solve(&|j| h * self.sin[j]);
-        let uc = solve(&|j| h * self.cos[j]);
-        let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(a, b)| a * h * b).sum::<f64>();
+        let us = solve(&|j| self.mass[j] * self.sin[j]);
+        let uc = solve(&|j| self.mass[j] * self.cos[j]);
+        let dot = |u: &[f64], v: &[f64]| {
+            u.iter()
+                .zip(v)
+                .zip(&self.mass)
+                .map(|((a, b), m)| a * m * b)
+                .sum::<f64>()
+        };
         let s11 = dot(&us, &self.sin);
         let s12 = dot(&uc, &self.sin);
         let s22 = dot(&uc, &self.cos);

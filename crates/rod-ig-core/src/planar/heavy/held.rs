@@ -1,0 +1,471 @@
+//! Equilibria of a planar rod, with or without weight, whose ends are pinned or free
+//! (issue 52; [`crate::ends`]). Solved on the multiple-shooting formulation ([`Cable`]) with
+//! the end conditions as its equations, and judged by the second variation with the natural
+//! boundary conditions ([`SecondVariation`]).
+//!
+//! - **Free tip** (clamped base): n(1) = 0 fixes n(0) = w ĝ, and κ(1) = 0 leaves one equation
+//!   in a3. Since m(0) = w ∫ (r × ĝ) dt and |r(t)| ≤ t, every root has |a3| ≤ w/2: the bracket
+//!   is scanned (single shooting at w ≤ [`SCAN_WEIGHT`], where κ(1) keeps its digits), each
+//!   sign change is bisected and polished by Newton on the nodes, then carried in load to the
+//!   rod's weight when that is larger. Every root found is reported; the stable ones answer.
+//! - **A held tip** (pinned, or clamped with a pinned base): the weightless rods through the
+//!   target, found by the closed forms for base angles (pinned base) and tip angles (pinned
+//!   tip) around the chord, are corrected on the end conditions at w = 0, then carried in load
+//!   to the rod's weight with the tip held; then the same rods' bases turned toward gravity,
+//!   corrected at the full weight directly.
+
+use super::cable::{lift_near, Cable, CableError, FollowLimits, SecondVariation};
+use super::series;
+use super::Gravity;
+use crate::ends::{EndCondition, HeldEnds};
+use crate::planar::ig::SolveOptions;
+use crate::planar::PlanarClosedForm;
+use crate::solver::InverseGeometry;
+use crate::{PlanarParams, PlanarPose, RodError};
+use std::f64::consts::FRAC_PI_4;
+
+/// Up to this weight a free tip's κ(1)(a3) is scanned by single shooting at the rod's weight
+/// (cond J(1) ≲ 1e7); above it the scan runs here and its roots are carried in load.
+pub const SCAN_WEIGHT: f64 = 300.0;
+/// Scan points per unit of w (the oracle's scans resolve every root at 20).
+const SCAN_PER_WEIGHT: f64 = 24.0;
+/// Fewest and most scan points.
+const SCAN_POINTS: (usize, usize) = (400, 9000);
+/// Angles tried around the chord at a pinned end (every π/4).
+const ANGLES: usize = 8;
+/// Time the closed forms' search may spend on one weightless seed.
+const WEIGHTLESS_DEADLINE: std::time::Duration = std::time::Duration::from_millis(5);
+
+/// Why held ends could not be solved.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum HeldError {
+    /// The target does not fit the tip's condition, or cannot be reached.
+    #[error("{field}: {why}")]
+    Target {
+        /// The request field to change.
+        field: &'static str,
+        /// Why.
+        why: String,
+    },
+    /// No stable equilibrium was found.
+    #[error(
+        "no stable equilibrium found with {base} base and {tip} tip ({starts} starts{cut}){last}"
+    )]
+    NotFound {
+        /// Base condition.
+        base: EndCondition,
+        /// Tip condition.
+        tip: EndCondition,
+        /// Starts tried.
+        starts: u32,
+        /// ", cut short by the deadline" when it passed.
+        cut: &'static str,
+        /// The last failure's reason (": …"), if any.
+        last: String,
+    },
+}
+
+/// One equilibrium with held ends.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeldSolution {
+    /// a = (κ(0), n(0)) in the base frame (a3 = 0 for a pinned base; n(0) = w ĝ for a free tip).
+    pub a: PlanarParams,
+    /// The rod's angle at the base θ(0) (0 unless the base is pinned).
+    pub base_angle: f64,
+    /// The tip (x, y, θ), θ unwrapped.
+    pub tip: PlanarPose,
+    /// κ(1) (0 at a pinned or free tip).
+    pub tip_curvature: f64,
+    /// Total energy (elastic + gravitational).
+    pub energy: f64,
+    /// Elastic energy ½∫κ².
+    pub elastic_energy: f64,
+    /// The second variation with the natural boundary conditions.
+    pub stability: SecondVariation,
+    /// Full turns of the tangent.
+    pub turns: u32,
+    /// The centreline crosses itself.
+    pub self_intersects: bool,
+    /// The equilibrium's node states.
+    pub cable: Cable,
+}
+
+/// What a search with held ends found.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct HeldSearch {
+    /// The admitted (stable, within `max_turns`) equilibria, least energy first.
+    pub solutions: Vec<HeldSolution>,
+    /// Every distinct equilibrium found, stable or not, least energy first.
+    pub equilibria: Vec<HeldSolution>,
+    /// Starts tried.
+    pub starts: u32,
+    /// The deadline passed before every start was tried.
+    pub cut_short: bool,
+    /// Why the last start failed, when one did.
+    pub last_failure: Option<String>,
+}
+
+fn finish(mut cable: Cable) -> Result<HeldSolution, RodError> {
+    cable.unwind_base_angle();
+    let tip = cable.tip()?;
+    let (energy, elastic_energy) = cable.energies()?;
+    let shape = cable.shape(super::cable::SHAPE_CHECK_SAMPLES)?;
+    Ok(HeldSolution {
+        a: cable.params(),
+        base_angle: cable.base_angle(),
+        tip,
+        tip_curvature: cable.tip_curvature()?,
+        energy,
+        elastic_energy,
+        stability: cable.second_variation()?,
+        turns: super::cable::turns_of(&shape),
+        self_intersects: super::cable::self_intersects(&shape),
+        cable,
+    })
+}
+
+/// The target as the tip's condition needs it: a pose (clamped), a position (pinned, θ is
+/// ignored), nothing (free).
+fn checked_target(
+    ends: HeldEnds,
+    target: Option<&PlanarPose>,
+) -> Result<Option<PlanarPose>, HeldError> {
+    let refuse = |why: &str| {
+        Err(HeldError::Target {
+            field: "target",
+            why: why.into(),
+        })
+    };
+    match (ends.tip(), target) {
+        (EndCondition::Free, None) => Ok(None),
+        (EndCondition::Free, Some(_)) => {
+            refuse("a free tip has no target: the cable hangs from its base")
+        }
+        (_, None) => refuse("a clamped or pinned tip needs a target"),
+        (tip, Some(t)) => {
+            let theta = if tip == EndCondition::Pinned {
+                0.0
+            } else {
+                t.theta
+            };
+            if !(t.x.is_finite() && t.y.is_finite() && theta.is_finite()) {
+                return refuse("the target must be finite");
+            }
+            let d = t.x.hypot(t.y);
+            if d > 1.0 {
+                return Err(HeldError::Target {
+                    field: "target",
+                    why: format!("unreachable: the tip is {d:.6} from the base, the rod is 1 long"),
+                });
+            }
+            Ok(Some(PlanarPose::new(t.x, t.y, theta)))
+        }
+    }
+}
+
+/// The equilibria of the rod under `gravity` held by `ends`, its tip at `target` (a pose for
+/// a clamped tip; a position for a pinned tip, θ ignored; `None` for a free tip). Stops at
+/// the deadline in force; `options.max_turns` bounds the admitted turns (0: loop-free, and
+/// the centreline must not cross itself).
+pub fn equilibria(
+    ends: HeldEnds,
+    gravity: &Gravity,
+    target: Option<&PlanarPose>,
+    options: &SolveOptions,
+) -> Result<HeldSearch, HeldError> {
+    let target = checked_target(ends, target)?;
+    let _deadline = crate::deadline::scope(options.deadline);
+    let mut search = Search {
+        ends,
+        gravity: *gravity,
+        out: HeldSearch::default(),
+        max_turns: options.max_turns,
+    };
+    match target {
+        None => search.free_tip(),
+        Some(t) => search.held_tip(&t, options),
+    }
+    search.out.cut_short |= crate::deadline::expired();
+    let by_energy = |a: &HeldSolution, b: &HeldSolution| a.energy.total_cmp(&b.energy);
+    search.out.equilibria.sort_by(by_energy);
+    search.out.solutions.sort_by(by_energy);
+    Ok(search.out)
+}
+
+/// The least-energy admitted equilibrium of [`equilibria`], or why there is none.
+pub fn least_energy(
+    ends: HeldEnds,
+    gravity: &Gravity,
+    target: Option<&PlanarPose>,
+    options: &SolveOptions,
+) -> Result<(HeldSolution, HeldSearch), HeldError> {
+    let found = equilibria(ends, gravity, target, options)?;
+    match found.solutions.first() {
+        Some(s) => Ok((s.clone(), found)),
+        None => Err(HeldError::NotFound {
+            base: ends.base(),
+            tip: ends.tip(),
+            starts: found.starts,
+            cut: if found.cut_short {
+                ", cut short by the deadline"
+            } else {
+                ""
+            },
+            last: found
+                .last_failure
+                .map(|w| format!(": {w}"))
+                .unwrap_or_default(),
+        }),
+    }
+}
+
+struct Search {
+    ends: HeldEnds,
+    gravity: Gravity,
+    out: HeldSearch,
+    max_turns: u32,
+}
+
+impl Search {
+    fn admits(&self, s: &HeldSolution) -> bool {
+        s.stability.stable()
+            && s.turns <= self.max_turns
+            && (self.max_turns > 0 || !s.self_intersects)
+    }
+
+    /// Finishes a start's cable and keeps it when it is new.
+    fn keep(&mut self, reached: Result<Cable, CableError>) {
+        self.out.starts += 1;
+        let s = match reached.and_then(|c| finish(c).map_err(CableError::from)) {
+            Ok(s) => s,
+            Err(e) => {
+                self.out.last_failure = Some(e.to_string());
+                return;
+            }
+        };
+        let scale = 1e-6 * (1.0 + s.a.amax());
+        let same = |o: &HeldSolution| {
+            (o.a - s.a).amax() <= scale
+                && crate::wrap_angle(o.base_angle - s.base_angle).abs() <= 1e-6
+        };
+        if self.out.equilibria.iter().any(same) {
+            return;
+        }
+        if self.admits(&s) {
+            self.out.solutions.push(s.clone());
+        } else {
+            self.out.last_failure = Some(format!(
+                "an equilibrium was found but not admitted (stable: {}, turns: {}, crosses \
+                 itself: {})",
+                s.stability.stable(),
+                s.turns,
+                s.self_intersects
+            ));
+        }
+        self.out.equilibria.push(s);
+    }
+
+    /// Free tip: the roots of κ(1)(a3) on |a3| ≤ w/2 (module docs).
+    fn free_tip(&mut self) {
+        let w = self.gravity.weight();
+        let scan = if w > SCAN_WEIGHT {
+            self.gravity
+                .with_weight(SCAN_WEIGHT)
+                .unwrap_or(self.gravity)
+        } else {
+            self.gravity
+        };
+        let dummy = PlanarPose::new(0.0, 0.0, 0.0);
+        for a3 in free_tip_roots(&scan) {
+            if crate::deadline::expired() {
+                return;
+            }
+            let target = self.gravity;
+            let ends = self.ends;
+            self.keep((|| {
+                let mut c = Cable::held(0.0, &PlanarParams::new(a3, 0.0, 0.0), &scan, ends)?;
+                c.solve(&dummy)?;
+                if scan != target {
+                    c.carry_within(&target, &dummy, &FollowLimits::default())?;
+                }
+                Ok(c)
+            })());
+        }
+    }
+
+    /// A held tip (module docs).
+    fn held_tip(&mut self, target: &PlanarPose, options: &SolveOptions) {
+        let weightless = self.gravity.with_weight(0.0).unwrap_or(Gravity::NONE);
+        // The closed forms' atlas, built (once per process) within this request's deadline
+        // rather than in the seeds' short ones.
+        let _ = crate::planar::ig::atlas::get(crate::planar::ig::atlas::Tier::Box);
+        let mut seeds = Vec::new();
+        for (theta0, a) in weightless_seeds(self.ends, target, options) {
+            if crate::deadline::expired() {
+                return;
+            }
+            let Ok(mut c) = Cable::held(theta0, &a, &weightless, HeldEnds::CLAMPED) else {
+                continue;
+            };
+            let Ok(tip) = c.tip() else { continue };
+            // The clamped rod is corrected on its own tip angle (a pinned tip's target has none).
+            let lifted = if self.ends.tip() == EndCondition::Pinned {
+                PlanarPose::new(target.x, target.y, tip.theta)
+            } else {
+                lift_near(target, tip.theta)
+            };
+            if c.solve(&lifted).is_err() || c.release_into(self.ends, &lifted).is_err() {
+                continue;
+            }
+            if !seeds.iter().any(|(s, _): &(Cable, _)| s.close_to(&c)) {
+                seeds.push((c, lifted));
+            }
+        }
+        let limits = FollowLimits {
+            max_theta_spread: std::f64::consts::TAU * (self.max_turns as f64 + 1.5),
+            ..FollowLimits::default()
+        };
+        for (c, lifted) in &seeds {
+            if crate::deadline::expired() {
+                return;
+            }
+            let mut c = c.clone();
+            let g = self.gravity;
+            self.keep(c.carry_within(&g, lifted, &limits).map(|_| c));
+        }
+        // The same rods at the full weight, the load shared by both ends, corrected directly.
+        let l = self.gravity.load();
+        for (c, lifted) in &seeds {
+            if crate::deadline::expired() {
+                return;
+            }
+            let a = c.params();
+            let shared = PlanarParams::new(a[0], a[1] + 0.5 * l[0], a[2] + 0.5 * l[1]);
+            let g = self.gravity;
+            let ends = self.ends;
+            let theta0 = c.base_angle();
+            self.keep((|| {
+                let mut c = Cable::held(theta0, &shared, &g, ends)?;
+                c.solve(lifted)?;
+                Ok(c)
+            })());
+        }
+    }
+}
+
+/// κ(1) of the clamped rod with base moment `a3` and a free tip (n(0) = w ĝ), by single
+/// shooting.
+fn free_tip_curvature(a3: f64, gravity: &Gravity) -> Option<f64> {
+    let l = gravity.load();
+    let a = PlanarParams::new(a3, l[0], l[1]);
+    series::integrate(&gravity.problem(&a), false, |_| true)
+        .ok()
+        .map(|end| end.kappa)
+        .filter(|k| k.is_finite())
+}
+
+/// The roots of κ(1)(a3) on [−w/2, w/2] found by a uniform scan and bisection (w = 0: the
+/// straight rod, a3 = 0).
+pub fn free_tip_roots(gravity: &Gravity) -> Vec<f64> {
+    let w = gravity.weight();
+    if w == 0.0 {
+        return vec![0.0];
+    }
+    let n = ((SCAN_PER_WEIGHT * w) as usize).clamp(SCAN_POINTS.0, SCAN_POINTS.1);
+    let a3_at = |i: usize| -0.5 * w + w * i as f64 / n as f64;
+    let mut roots = Vec::new();
+    let mut prev: Option<(f64, f64)> = None;
+    for i in 0..=n {
+        if crate::deadline::expired() {
+            break;
+        }
+        let a3 = a3_at(i);
+        let Some(k) = free_tip_curvature(a3, gravity) else {
+            prev = None;
+            continue;
+        };
+        if k == 0.0 {
+            roots.push(a3);
+        } else if let Some((a_prev, k_prev)) = prev {
+            if k_prev != 0.0 && k.signum() != k_prev.signum() {
+                if let Some(r) = bisect(a_prev, k_prev, a3, gravity) {
+                    roots.push(r);
+                }
+            }
+        }
+        prev = Some((a3, k));
+    }
+    roots
+}
+
+/// Bisection of κ(1) on [lo, hi] (κ(1)(lo) = `k_lo`, of the other sign at hi).
+fn bisect(mut lo: f64, k_lo: f64, mut hi: f64, gravity: &Gravity) -> Option<f64> {
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        let k = free_tip_curvature(mid, gravity)?;
+        if k.signum() == k_lo.signum() {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// Angles tried at a pinned end: the chord's direction φ plus k π/4; a clamped end's own.
+fn angles(condition: EndCondition, own: f64, chord: f64) -> Vec<f64> {
+    if condition == EndCondition::Clamped {
+        return vec![own];
+    }
+    (0..ANGLES)
+        .map(|k| crate::wrap_angle(chord + FRAC_PI_4 * k as f64))
+        .collect()
+}
+
+/// Weightless rods (base angle, a in the base gripper's frame) through `target` at the tried
+/// angles: the closed forms' stable solutions (`robust_all` and `robust`, each within
+/// [`WEIGHTLESS_DEADLINE`]) in the frame turned by the base angle.
+fn weightless_seeds(
+    ends: HeldEnds,
+    target: &PlanarPose,
+    options: &SolveOptions,
+) -> Vec<(f64, PlanarParams)> {
+    let chord = target.y.atan2(target.x);
+    let opts = SolveOptions {
+        initial_guess: None,
+        deadline: WEIGHTLESS_DEADLINE.min(options.deadline),
+        ..options.clone()
+    };
+    let mut out = Vec::new();
+    for theta0 in angles(ends.base(), 0.0, chord) {
+        for theta1 in angles(ends.tip(), target.theta, chord) {
+            if crate::deadline::expired() {
+                return out;
+            }
+            let (s, c) = theta0.sin_cos();
+            let local = PlanarPose::new(
+                c * target.x + s * target.y,
+                -s * target.x + c * target.y,
+                crate::wrap_angle(theta1 - theta0),
+            );
+            let found = {
+                let _deadline = crate::deadline::scope(opts.deadline);
+                let mut all = PlanarClosedForm.robust_all(&local, &opts).solutions;
+                all.extend(PlanarClosedForm.robust(&local, &opts).ok());
+                all
+            };
+            for sol in found {
+                let a = sol.a;
+                // The force turned back into the base gripper's frame.
+                out.push((
+                    theta0,
+                    PlanarParams::new(a[0], c * a[1] - s * a[2], s * a[1] + c * a[2]),
+                ));
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,218 @@
+//! Pinned and free ends (issue 52, item 1) against the public reference cases
+//! (`ends_public.jsonl`: shooting with DOP853 at rtol 1e-12, refined by multiple shooting;
+//! stability from the discretised energy's reduced Hessian with the same ends, N = 200/400 and
+//! Richardson, cross-checked there by a focal-point count), and against the straight rod's
+//! eigenvalues in closed form.
+
+mod common;
+
+use rod_ig_core::ends::{EndCondition, HeldEnds};
+use rod_ig_core::planar::heavy::cable::SecondVariation;
+use rod_ig_core::planar::heavy::held::{self, HeldError};
+use rod_ig_core::planar::heavy::Gravity;
+use rod_ig_core::planar::ig::SolveOptions;
+use rod_ig_core::PlanarPose;
+use serde_json::Value;
+use std::f64::consts::PI;
+use std::time::Duration;
+
+fn cases() -> Vec<Value> {
+    let text = std::fs::read_to_string(common::oracle_file("ends_public.jsonl")).expect("oracle");
+    common::json_lines(&text).collect()
+}
+
+fn condition(v: &Value) -> EndCondition {
+    v.as_str().expect("name").parse().expect("condition")
+}
+
+fn setup(case: &Value) -> (HeldEnds, Gravity, Option<PlanarPose>) {
+    let ends = HeldEnds::new(
+        condition(&case["base_condition"]),
+        condition(&case["tip_condition"]),
+    )
+    .expect("ends");
+    let g = common::numbers(&case["gravity"]);
+    let gravity = Gravity::new(case["weight"].as_f64().expect("w"), [g[0], g[1]]).expect("g");
+    let target = case["target"]
+        .as_array()
+        .map(|t| PlanarPose::new(t[0].as_f64().expect("x"), t[1].as_f64().expect("y"), 0.0));
+    (ends, gravity, target)
+}
+
+fn options(max_turns: u32) -> SolveOptions {
+    SolveOptions {
+        deadline: Duration::from_secs(20),
+        max_turns,
+        ..SolveOptions::default()
+    }
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * (1.0 + b.abs())
+}
+
+/// Case A (clamped base, free tip): every root of κ(1)(a3) the reference lists, and no other;
+/// each with its energy, its verdict, its Morse index and the least eigenvalue of the second
+/// variation. Tolerances: a3 and energies 1e-9 relative (both sides are solved to residuals
+/// ≤ 1e-12; the roots' κ(1) slope is up to 3e4, so 1e-13 in κ is ~1e-12 in a3); μ 1e-4
+/// relative (two Richardson extrapolations of O(h²) discretisations, N ≥ 400 on each side).
+#[test]
+fn a_free_tip_has_every_equilibrium_of_the_reference_and_their_stability() {
+    for case in cases().iter().filter(|c| c["case"] == "A") {
+        let id = case["id"].as_str().expect("id");
+        let (ends, gravity, target) = setup(case);
+        assert!(target.is_none());
+        let found = held::equilibria(ends, &gravity, None, &options(3)).expect("posed");
+        let roots = case["roots"].as_array().expect("roots");
+        assert_eq!(found.equilibria.len(), roots.len(), "{id}: number of roots");
+        for r in roots {
+            let a = common::numbers(&r["a"]);
+            let s = found
+                .equilibria
+                .iter()
+                .find(|s| close(s.a[0], a[0], 1e-9))
+                .unwrap_or_else(|| panic!("{id}: root a3 = {} not found", a[0]));
+            assert!(
+                close(s.a[1], a[1], 1e-12) && close(s.a[2], a[2], 1e-12),
+                "{id}"
+            );
+            assert!(close(s.energy, r["energy"].as_f64().unwrap(), 1e-9), "{id}");
+            assert!(
+                s.tip_curvature.abs() < 1e-9,
+                "{id}: κ(1) = {}",
+                s.tip_curvature
+            );
+            assert_eq!(s.stability.stable(), r["stable"].as_bool().unwrap(), "{id}");
+            assert_eq!(
+                s.stability.index as u64,
+                r["morse_index"].as_u64().unwrap(),
+                "{id}"
+            );
+            let mu = r["hessian_min_eig_rich"].as_f64().unwrap();
+            assert!(
+                close(s.stability.eigenvalue, mu, 1e-4),
+                "{id}: μ {} vs {mu}",
+                s.stability.eigenvalue
+            );
+        }
+        let least = case["least_energy_known"].as_f64().unwrap();
+        assert!(close(found.solutions[0].energy, least, 1e-9), "{id}");
+        assert!(found.solutions.iter().all(|s| s.stability.stable()));
+    }
+}
+
+/// Cases B (clamped base, pinned tip) and C (both pinned): the least-energy stable
+/// equilibrium is the reference's (a, θ0 and energy to 1e-8 relative: Newton on both sides to
+/// 1e-12 residuals, κ(1) slopes ~1e2), on target with the released moments zero, and its μ
+/// agrees with the reduced Hessian's to 1e-4.
+#[test]
+fn pinned_ends_reach_the_reference_least_energy_rod() {
+    for case in cases().iter().filter(|c| c["case"] != "A") {
+        let id = case["id"].as_str().expect("id");
+        let (ends, gravity, target) = setup(case);
+        let target = target.expect("a target");
+        let (best, found) =
+            held::least_energy(ends, &gravity, Some(&target), &options(0)).expect("solved");
+        let a = common::numbers(&case["a_least_energy_known"]);
+        for i in 0..3 {
+            assert!(
+                close(best.a[i], a[i], 1e-8),
+                "{id}: a {:?} vs {a:?}",
+                best.a
+            );
+        }
+        let theta0 = case
+            .get("theta0_least_energy_known")
+            .and_then(Value::as_f64)
+            .unwrap_or(0.0);
+        assert!(close(best.base_angle, theta0, 1e-8), "{id}: θ0");
+        assert!(close(
+            best.energy,
+            case["least_energy_known"].as_f64().unwrap(),
+            1e-9
+        ));
+        assert!((best.tip.x - target.x).abs() < 1e-10 && (best.tip.y - target.y).abs() < 1e-10);
+        assert!(best.tip_curvature.abs() < 1e-10, "{id}: κ(1)");
+        if ends.base() == EndCondition::Pinned {
+            assert_eq!(best.a[0], 0.0, "{id}: a pinned base has no moment");
+        }
+        let reference = case["equilibria"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| close(e["energy"].as_f64().unwrap(), best.energy, 1e-9))
+            .expect("the reference's least-energy rod");
+        let mu = reference["hessian_min_eig_rich"].as_f64().unwrap();
+        assert!(close(best.stability.eigenvalue, mu, 1e-4), "{id}: μ");
+        // Every stable rod listed is one of the reference's equilibria, stable there too.
+        for s in &found.solutions {
+            let same = case["equilibria"].as_array().unwrap().iter().any(|e| {
+                close(e["energy"].as_f64().unwrap(), s.energy, 1e-8)
+                    && e["stable"].as_bool() == Some(true)
+            });
+            assert!(
+                same,
+                "{id}: a stable rod the reference does not list: {:?}",
+                s.a
+            );
+        }
+    }
+}
+
+/// The straight weightless rod's least eigenvalue with natural conditions, in closed form:
+/// −v'' = μ v with v(0) = 0, v'(1) = 0 (free tip: μ = π²/4); with v'(0) = v'(1) = 0 and
+/// ∫ v = 0 (both pinned, the tip's position held: μ = π²). The grid's Richardson value is
+/// within 1e-6 relative (h² error ~1e-5 at N = 400, cancelled to h⁴).
+#[test]
+fn natural_conditions_give_the_straight_rods_eigenvalues() {
+    use EndCondition::*;
+    let free = SecondVariation::straight_rod(HeldEnds::new(Clamped, Free).unwrap());
+    assert!(close(free, PI * PI / 4.0, 1e-6), "{free}");
+    let pinned = SecondVariation::straight_rod(HeldEnds::new(Pinned, Pinned).unwrap());
+    assert!(close(pinned, PI * PI, 1e-6), "{pinned}");
+}
+
+#[test]
+fn targets_that_do_not_fit_the_tip_are_refused_by_name() {
+    use EndCondition::*;
+    let g = Gravity::new(10.0, [0.0, -1.0]).unwrap();
+    let free = HeldEnds::new(Clamped, Free).unwrap();
+    let pinned = HeldEnds::new(Clamped, Pinned).unwrap();
+    let t = PlanarPose::new(0.5, 0.0, 0.0);
+    let field = |e: HeldError| match e {
+        HeldError::Target { field, why } => format!("{field}: {why}"),
+        other => panic!("{other}"),
+    };
+    let e = held::equilibria(free, &g, Some(&t), &options(0)).unwrap_err();
+    assert!(field(e).contains("free tip has no target"));
+    let e = held::equilibria(pinned, &g, None, &options(0)).unwrap_err();
+    assert!(field(e).contains("needs a target"));
+    let far = PlanarPose::new(1.5, 0.0, 0.0);
+    let e = held::equilibria(pinned, &g, Some(&far), &options(0)).unwrap_err();
+    assert!(field(e).contains("unreachable"));
+    let nan = PlanarPose::new(f64::NAN, 0.0, 0.0);
+    assert!(held::equilibria(pinned, &g, Some(&nan), &options(0)).is_err());
+    assert!(HeldEnds::new(Free, Clamped)
+        .unwrap_err()
+        .to_string()
+        .starts_with("base_condition"));
+    assert!("hinged".parse::<EndCondition>().is_err());
+}
+
+/// A deadline too short for any start ends the search with a failure that says so (never a
+/// panic, never an answer past it).
+#[test]
+fn a_search_cut_by_its_deadline_says_so() {
+    use EndCondition::*;
+    let g = Gravity::new(50.0, [0.0, -1.0]).unwrap();
+    let ends = HeldEnds::new(Pinned, Pinned).unwrap();
+    let t = PlanarPose::new(0.8, 0.0, 0.0);
+    let opts = SolveOptions {
+        deadline: Duration::from_nanos(1),
+        ..SolveOptions::default()
+    };
+    match held::least_energy(ends, &g, Some(&t), &opts) {
+        Err(HeldError::NotFound { cut, .. }) => assert!(cut.contains("deadline")),
+        other => panic!("{other:?}"),
+    }
+}
