@@ -21,6 +21,7 @@ mod answer;
 mod bench;
 mod bench_deadlines;
 mod bench_tails;
+mod held_cmds;
 mod jsonl;
 mod motion_cmds;
 mod planar_cmds;
@@ -68,6 +69,16 @@ enum Command {
     /// "base_wrench" and "tip_wrench" (as `forward`), with weight "turns" (full turns of the
     /// tangent: 0 for a loop-free cable)}. One deadline
     /// holds for the whole line, `all` included.
+    ///
+    /// Ends: "base_condition"? ("clamped" | "pinned") and "tip_condition"? ("clamped" |
+    /// "pinned" | "free"), default "clamped". A pinned tip's target is {"x", "y"}; a free tip
+    /// has no target (the equilibria of the cable hanging from its base). Such a line answers
+    /// the least-energy stable rod found (default deadline 1000 ms) with "a", "base_angle"
+    /// (θ(0): a pinned base's angle), "tip", "stable", "energy", "elastic_energy",
+    /// "stability_margin", "turns", "base_wrench", "tip_wrench", "position_error",
+    /// "base_condition", "tip_condition", "termination", "starts", "complete", "rejected"
+    /// (equilibria found but unstable or looped), "reason" (on failure), "solutions" (with
+    /// all: every stable rod found, least energy first).
     Solve {
         /// Print the solver's events (starts, iterations with residual and step, end) on
         /// stderr as JSON lines.

@@ -792,3 +792,54 @@ fn long_cables_in_3d_are_solved_and_forward3d_says_when_it_cannot_place_a_tip() 
         forward[1].get("condition").is_none() && forward[1].get("stability_uncertain").is_none()
     );
 }
+
+/// Pinned and free ends (issue 52, item 1): a free tip has no target and answers the hanging
+/// cable of least energy with its stable alternatives; pinned ends answer a position target
+/// with the base's angle; the moments at pinned and free ends are zero in the wrenches; the
+/// clamped contract is unchanged when the conditions say "clamped"; refusals name the field.
+#[test]
+fn pinned_and_free_ends_are_solved_and_refusals_name_the_field() {
+    let out = run(
+        &["solve"],
+        concat!(
+            "{\"tip_condition\": \"free\", \"weight\": 36.92695280826509, \"gravity\": [-1, 0], \"all\": true}\n",
+            "{\"target\": {\"x\": 0.8, \"y\": 0}, \"base_condition\": \"pinned\", \"tip_condition\": \"pinned\", \"weight\": 50}\n",
+            "{\"target\": {\"x\": 0.8, \"y\": 0, \"theta\": 0}, \"base_condition\": \"clamped\", \"tip_condition\": \"clamped\"}\n",
+            "{\"target\": {\"x\": 0.8, \"y\": 0, \"theta\": 0.2}, \"tip_condition\": \"pinned\"}\n",
+            "{\"target\": {\"x\": 0.8, \"y\": 0}, \"tip_condition\": \"free\"}\n",
+            "{\"tip_condition\": \"free\", \"base_condition\": \"free\"}\n",
+            "{\"tip_condition\": \"hinged\", \"target\": {\"x\": 0.8, \"y\": 0}}\n",
+        ),
+    );
+    // A cable clamped pointing along gravity's normal, gravity along −x: it hangs to either
+    // side (two mirror rods of energy 4.158152, ends_public A-003); the straight one is unstable.
+    let free = &out[0];
+    assert_eq!(free["success"], true, "{free}");
+    assert!((free["energy"].as_f64().unwrap() - 4.158152069940845).abs() < 1e-8);
+    assert_eq!(free["solutions"].as_array().unwrap().len(), 2, "{free}");
+    assert_eq!(free["rejected"], 1);
+    assert!(free["tip_wrench"]["moment"].as_f64().unwrap().abs() < 1e-9);
+    assert!(free["tip_wrench"]["force"][0].as_f64().unwrap().abs() < 1e-12);
+    // Pinned both ends, held level 0.8 apart: the hanging catenary with bending (C-002).
+    let pinned = &out[1];
+    assert_eq!(pinned["success"], true, "{pinned}");
+    assert!((pinned["base_angle"].as_f64().unwrap() + 0.9202652225760789).abs() < 1e-8);
+    assert!((pinned["energy"].as_f64().unwrap() + 6.24283394420708).abs() < 1e-8);
+    assert_eq!(pinned["a"][0].as_f64().unwrap(), 0.0);
+    assert!(pinned["position_error"].as_f64().unwrap() < 1e-10);
+    assert_eq!(pinned["base_condition"], "pinned");
+    // Explicitly clamped: the paper's answer, with its fields.
+    assert_eq!(out[2]["success"], true);
+    assert!(out[2].get("iterations").is_some() && out[2].get("base_condition").is_none());
+    for (line, field) in [
+        (3, "target"),
+        (4, "target"),
+        (5, "base_condition"),
+        (6, "tip_condition"),
+    ] {
+        let e = out[line]["error"]
+            .as_str()
+            .unwrap_or_else(|| panic!("{}", out[line]));
+        assert!(e.starts_with(field), "{e}");
+    }
+}

@@ -105,6 +105,16 @@ pub struct HeldSearch {
     pub last_failure: Option<String>,
 }
 
+impl HeldSolution {
+    /// The wrenches the rod exerts on its grippers ([`crate::wrench`]): at a pinned end the
+    /// moment is zero, at a free tip the whole wrench.
+    pub fn wrenches(&self) -> crate::wrench::GripperWrenches<crate::wrench::PlanarWrench> {
+        let l = self.cable.gravity().load();
+        let n1 = [self.a[1] - l[0], self.a[2] - l[1]];
+        crate::wrench::planar(&self.a, &self.tip, n1, self.tip_curvature)
+    }
+}
+
 fn finish(mut cable: Cable) -> Result<HeldSolution, RodError> {
     cable.unwind_base_angle();
     let tip = cable.tip()?;
@@ -437,7 +447,7 @@ fn weightless_seeds(
     let opts = SolveOptions {
         initial_guess: None,
         deadline: WEIGHTLESS_DEADLINE.min(options.deadline),
-        ..options.clone()
+        ..*options
     };
     let mut out = Vec::new();
     for theta0 in angles(ends.base(), 0.0, chord) {

@@ -1,0 +1,202 @@
+//! `rod-ig solve` with pinned or free ends (`base_condition`, `tip_condition`): JSON in, JSON
+//! out; the search is `rod_ig_core::planar::heavy::held`.
+
+use crate::jsonl::{self, ObjectiveName};
+use crate::planar_cmds::{gravity_of, MAX_TURNS};
+use rod_ig_core::ends::{EndCondition, HeldEnds};
+use rod_ig_core::planar::heavy::held::{self, HeldSolution};
+use rod_ig_core::planar::ig::SolveOptions;
+use rod_ig_core::wrench::PlanarWrench;
+use rod_ig_core::PlanarPose;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use std::time::{Duration, Instant};
+
+/// Default time budget of a request with held ends (its search tries more starts).
+pub const DEFAULT_HELD_DEADLINE: Duration = Duration::from_millis(1000);
+
+/// The end conditions a request names, when either is not `"clamped"` (`None`: the paper's
+/// rod, answered by the clamped solver exactly as before). Refusals name the field.
+pub fn held_ends_of(request: &Value) -> Result<Option<HeldEnds>, String> {
+    let read = |field: &'static str| -> Result<EndCondition, String> {
+        match request.get(field) {
+            None | Some(Value::Null) => Ok(EndCondition::Clamped),
+            Some(Value::String(s)) => s.parse().map_err(|_| {
+                format!("{field} must be \"clamped\", \"pinned\" or \"free\" (got {s:?})")
+            }),
+            Some(other) => Err(format!(
+                "{field} must be \"clamped\", \"pinned\" or \"free\" (got {other})"
+            )),
+        }
+    };
+    let ends = HeldEnds::new(read("base_condition")?, read("tip_condition")?)
+        .map_err(|e| e.to_string())?;
+    Ok((!ends.both_clamped()).then_some(ends))
+}
+
+/// The target of a held tip: a pose (clamped tip), a position (pinned tip; a theta is
+/// refused), absent for a free tip.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HeldTarget {
+    x: f64,
+    y: f64,
+    theta: Option<f64>,
+}
+
+/// One `solve` request with held ends.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HeldRequest {
+    target: Option<HeldTarget>,
+    #[allow(dead_code)] // read by `held_ends_of`
+    base_condition: Option<Value>,
+    #[allow(dead_code)] // read by `held_ends_of`
+    tip_condition: Option<Value>,
+    /// "least_energy" (the default) or "first": both answer the least-energy rod found.
+    #[allow(dead_code)]
+    objective: Option<ObjectiveName>,
+    #[serde(default)]
+    all: bool,
+    deadline_ms: Option<f64>,
+    weight: Option<f64>,
+    gravity: Option<[f64; 2]>,
+    max_turns: Option<u32>,
+}
+
+/// One rod of a held answer.
+#[derive(Serialize)]
+struct HeldRod {
+    a: [f64; 3],
+    /// θ(0), the rod's angle at a pinned base (0 for a clamped one).
+    base_angle: f64,
+    tip: PlanarPose,
+    stable: bool,
+    energy: f64,
+    elastic_energy: f64,
+    /// μ / μ₀ of the second variation with the natural conditions.
+    stability_margin: f64,
+    turns: u32,
+    base_wrench: PlanarWrench,
+    tip_wrench: PlanarWrench,
+    /// Distance from the tip to the target's position (held tips).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    position_error: Option<f64>,
+}
+
+/// One held answer: the least-energy rod (or why none), and with `all` every stable one.
+#[derive(Serialize)]
+struct HeldAnswer {
+    success: bool,
+    #[serde(flatten)]
+    rod: Option<HeldRod>,
+    base_condition: EndCondition,
+    tip_condition: EndCondition,
+    termination: &'static str,
+    starts: u32,
+    elapsed_ms: f64,
+    complete: bool,
+    /// Equilibria found that are not admitted (unstable, or looped beyond `max_turns`).
+    rejected: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    solutions: Option<Vec<HeldRod>>,
+}
+
+fn rod_of(s: &HeldSolution, target: Option<&PlanarPose>) -> HeldRod {
+    let w = s.wrenches();
+    HeldRod {
+        a: [s.a[0], s.a[1], s.a[2]],
+        base_angle: s.base_angle,
+        tip: s.tip,
+        stable: s.stability.stable(),
+        energy: s.energy,
+        elastic_energy: s.elastic_energy,
+        stability_margin: s.stability.normalised(),
+        turns: s.turns,
+        base_wrench: w.base,
+        tip_wrench: w.tip,
+        position_error: target.map(|t| (s.tip.x - t.x).hypot(s.tip.y - t.y)),
+    }
+}
+
+/// Answers one `solve` line whose ends are `ends` (not both clamped).
+pub fn solve_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
+    let started = Instant::now();
+    let request: HeldRequest = jsonl::parse(line)?;
+    let target = match (ends.tip(), request.target) {
+        (EndCondition::Pinned, Some(HeldTarget { theta: Some(_), .. })) => {
+            return Err(
+                "target: a pinned tip's target is {\"x\", \"y\"} (its angle is free: no theta)"
+                    .into(),
+            )
+        }
+        (EndCondition::Clamped, Some(HeldTarget { theta: None, .. })) => {
+            return Err("target: a clamped tip needs theta".into())
+        }
+        (_, t) => t.map(|t| PlanarPose::new(t.x, t.y, t.theta.unwrap_or(0.0))),
+    };
+    let max_turns = request.max_turns.unwrap_or(0);
+    if max_turns > MAX_TURNS {
+        return Err(format!(
+            "max_turns must be in [0, {MAX_TURNS}] (got {max_turns})"
+        ));
+    }
+    let options = SolveOptions {
+        deadline: match request.deadline_ms {
+            Some(ms) => jsonl::deadline_from_ms(ms)?,
+            None => DEFAULT_HELD_DEADLINE,
+        },
+        max_turns,
+        ..SolveOptions::default()
+    };
+    let g = gravity_of(request.weight, request.gravity)?;
+    let found = held::equilibria(ends, &g, target.as_ref(), &options).map_err(|e| e.to_string())?;
+    let best = found.solutions.first();
+    let reason = match best {
+        Some(_) => None,
+        None => Some(
+            held::HeldError::NotFound {
+                base: ends.base(),
+                tip: ends.tip(),
+                starts: found.starts,
+                cut: if found.cut_short {
+                    ", cut short by the deadline"
+                } else {
+                    ""
+                },
+                last: found
+                    .last_failure
+                    .clone()
+                    .map(|w| format!(": {w}"))
+                    .unwrap_or_default(),
+            }
+            .to_string(),
+        ),
+    };
+    let termination = match (best, found.cut_short) {
+        (Some(_), _) => "converged",
+        (None, true) => "deadline",
+        (None, false) => "no_stable_solution",
+    };
+    jsonl::to_value(&HeldAnswer {
+        success: best.is_some(),
+        rod: best.map(|s| rod_of(s, target.as_ref())),
+        base_condition: ends.base(),
+        tip_condition: ends.tip(),
+        termination,
+        starts: found.starts,
+        elapsed_ms: started.elapsed().as_secs_f64() * 1e3,
+        complete: !found.cut_short,
+        rejected: found.equilibria.len() - found.solutions.len(),
+        reason,
+        solutions: request.all.then(|| {
+            found
+                .solutions
+                .iter()
+                .map(|s| rod_of(s, target.as_ref()))
+                .collect()
+        }),
+    })
+}
