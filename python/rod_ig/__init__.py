@@ -56,6 +56,7 @@ FloatArray = npt.NDArray[np.float64]
 Objective = Literal["first", "least_energy"]
 """The objective of a solve: the first stable rod found, or the least energetic one."""
 Method = Literal["robust", "newton"]
+EndName = Literal["clamped", "pinned", "free"]
 """The solver: the robust search, or the paper's alpha-Newton."""
 
 
@@ -233,6 +234,12 @@ class SolveResult:
     """What the rod found exerts on the base gripper (NaN where the solve failed)."""
     tip_wrench: Wrench | None = None
     """What the rod found exerts on the tip gripper, in the tip frame."""
+    base_angle: FloatArray | None = None
+    """With a pinned or free end (``base_condition``/``tip_condition``): (...) the rod's angle
+    at the base, theta(0) (0 for a clamped base; NaN where the solve failed)."""
+    tip: FloatArray | None = None
+    """With a pinned or free end: (..., 3) the tip pose (x, y, theta) of the rod found (a free
+    or pinned tip's angle is part of the answer)."""
 
 
 def _solve_result(
@@ -332,11 +339,11 @@ def shape(
 
 
 def solve(
-    targets: npt.ArrayLike,
+    targets: npt.ArrayLike | None,
     a0: npt.ArrayLike | None = None,
     objective: Objective | None = None,
     method: Method = "robust",
-    deadline_ms: float = 250.0,
+    deadline_ms: float | None = None,
     tolerance: float | None = None,
     max_iterations: int | None = None,
     alpha: float | None = None,
@@ -345,17 +352,38 @@ def solve(
     weight: npt.ArrayLike | None = None,
     gravity: npt.ArrayLike | None = None,
     max_turns: int = 0,
+    base_condition: EndName = "clamped",
+    tip_condition: EndName = "clamped",
 ) -> SolveResult:
     """Planar inverse geometry: for each target (x, y, theta) of shape (..., 3), a stable rod
     whose tip is there. ``a0`` (broadcast against the targets) starts the search and selects
     the branch; ``objective`` "first" | "least_energy" (default: "least_energy" with
     ``weight``, the hanging cable a user sees, else "first"); ``method`` "robust" | "newton"
-    (the paper's alpha-Newton from ``a0``); ``deadline_ms`` per target; ``tolerance`` on the
-    position (rod lengths) and angle (rad) errors, in [1e-14, 1e-2]; ``max_iterations`` per
-    start; ``all=True`` also lists every distinct stable solution found. ``weight``,
-    ``gravity``: as for ``forward`` (the heavy rod's search: docs/weight.md); above weight 200
-    (long cables, solved by multiple shooting) ``max_turns`` full turns of the tangent are
-    admitted (default 0: loop-free rods that do not cross themselves)."""
+    (the paper's alpha-Newton from ``a0``); ``deadline_ms`` per target (default 250);
+    ``tolerance`` on the position (rod lengths) and angle (rad) errors, in [1e-14, 1e-2];
+    ``max_iterations`` per start; ``all=True`` also lists every distinct stable solution
+    found. ``weight``, ``gravity``: as for ``forward`` (the heavy rod's search:
+    docs/weight.md); above weight 200 (long cables, solved by multiple shooting)
+    ``max_turns`` full turns of the tangent are admitted (default 0: loop-free rods that do
+    not cross themselves).
+
+    ``base_condition`` ("clamped" | "pinned") and ``tip_condition`` ("clamped" | "pinned" |
+    "free"): how each end is held (docs/ends.md). A pinned tip's targets are positions of
+    shape (..., 2); a free tip has none (``targets=None``: the cable hanging from its base,
+    one per weight). Such a solve answers the least-energy stable rod found (default deadline
+    1000 ms) and fills ``base_angle`` (a pinned base's angle); ``a0``, ``method``,
+    ``tolerance``, ``max_iterations`` and ``alpha`` apply to clamped ends only."""
+    if base_condition != "clamped" or tip_condition != "clamped":
+        if a0 is not None or method != "robust" or tolerance is not None:
+            raise ValueError("a0, method and tolerance apply to clamped ends only")
+        if max_iterations is not None or alpha is not None:
+            raise ValueError("max_iterations and alpha apply to clamped ends only")
+        return _solve_held(
+            targets, base_condition, tip_condition, deadline_ms, all, threads,
+            weight, gravity, max_turns,
+        )
+    if targets is None:
+        raise ValueError("targets are required (only a free tip has none)")
     t, _ = _batch("targets", targets, 3)
     arrays = [t]
     if a0 is not None:
@@ -369,7 +397,7 @@ def solve(
         if objective is not None
         else ("least_energy" if weight is not None else "first"),
         method=method,
-        deadline_ms=deadline_ms,
+        deadline_ms=250.0 if deadline_ms is None else deadline_ms,
         tolerance=tolerance,
         max_iterations=None
         if max_iterations is None
@@ -385,6 +413,71 @@ def solve(
     pair = (_wrench(w["base"], batch, 2), _wrench(w["tip"], batch, 2))
     turns = _rod_ig.turns(d["a"], threads=_threads(threads), **kwargs) if heavy else None
     return _solve_result(d, batch, 3, all, pair, turns)
+
+
+def _solve_held(
+    targets: npt.ArrayLike | None,
+    base_condition: str,
+    tip_condition: str,
+    deadline_ms: float | None,
+    all: bool,
+    threads: int | None,
+    weight: npt.ArrayLike | None,
+    gravity: npt.ArrayLike | None,
+    max_turns: int,
+) -> SolveResult:
+    """``solve`` with a pinned or free end (the native ``solve_held``)."""
+    for field, value in (("base_condition", base_condition), ("tip_condition", tip_condition)):
+        if value not in ("clamped", "pinned", "free"):
+            raise ValueError(f'{field} must be "clamped", "pinned" or "free", got {value!r}')
+    width = {"free": 0, "pinned": 2}.get(tip_condition, 3)
+    arrays = []
+    if width > 0 and targets is not None:
+        arrays.append(_batch("targets", targets, width)[0])
+    elif width == 0 and targets is not None:
+        raise ValueError("targets: a free tip has no target (the cable hangs from its base)")
+    heavy = _weight_arrays(weight, gravity)
+    if not arrays and not heavy:
+        heavy = _weight_arrays(0.0, None)
+    flat, batch = _broadcast(*arrays, *heavy)
+    n = int(np.prod(batch, dtype=np.int64))
+    d = _rod_ig.solve_held(
+        n,
+        targets=flat[0] if arrays else None,
+        base_condition=base_condition,
+        tip_condition=tip_condition,
+        all=all,
+        deadline_ms=deadline_ms,
+        max_turns=_integer("max_turns", max_turns, 0, 100),
+        threads=_threads(threads),
+        **_weight_kwargs(flat, len(arrays)),
+    )
+    solutions = None
+    if all:
+        solutions = np.empty(n, dtype=object)
+        for i, s in enumerate(d["solutions"]):
+            solutions[i] = s.reshape(-1, 3)
+        solutions = _shaped(solutions, batch)
+    nan = np.full(n, np.nan)
+    return SolveResult(
+        success=_shaped(d["success"], batch),
+        a=d["a"].reshape(batch + (3,)),
+        termination=_shaped(np.array(d["termination"], dtype=str), batch),
+        reason=_shaped(np.array(d["reason"], dtype=str), batch),
+        iterations=_shaped(np.zeros(n, dtype=np.uint32), batch),
+        margin=_shaped(d["margin"], batch),
+        energy=_shaped(d["energy"], batch),
+        position_error=_shaped(d["position_error"], batch),
+        orientation_error=_shaped(nan, batch),
+        starts=_shaped(d["starts"], batch),
+        complete=_shaped(d["complete"], batch),
+        solutions=solutions,
+        turns=_shaped(d["turns"], batch),
+        base_wrench=_wrench(d["base_wrench"], batch, 2),
+        tip_wrench=_wrench(d["tip_wrench"], batch, 2),
+        base_angle=_shaped(d["base_angle"], batch),
+        tip=d["tip"].reshape(batch + (3,)),
+    )
 
 
 def forward3d(

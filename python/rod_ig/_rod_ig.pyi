@@ -42,6 +42,18 @@ def solve(
     gravity: npt.NDArray[np.float64] | None = None,
     max_turns: int = 0,
 ) -> dict[str, Any]: ...
+def solve_held(
+    n: int,
+    targets: npt.NDArray[np.float64] | None = None,
+    base_condition: str = "clamped",
+    tip_condition: str = "clamped",
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
+    all: bool = False,
+    deadline_ms: float | None = None,
+    max_turns: int = 0,
+    threads: int | None = None,
+) -> dict[str, Any]: ...
 def wrenches(
     a: npt.NDArray[np.float64],
     threads: int | None = None,

@@ -8,8 +8,9 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::exceptions::{PyMemoryError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use rod_ig_core::ends::{EndCondition, HeldEnds};
 use rod_ig_core::plan::{Obstacle, PlanRequest, Planner as CorePlanner};
-use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
+use rod_ig_core::planar::heavy::{self, held, Gravity, HeavyPlanar};
 use rod_ig_core::planar::PlanarClosedForm;
 use rod_ig_core::solver::{self, BranchEvent, BranchFollower, Method, Objective, SolveOptions};
 use rod_ig_core::spatial::heavy::{self as heavy3, Gravity3};
@@ -625,6 +626,275 @@ const MAX_TURNS: u32 = 100;
 const SOLVE_BLOCK: usize = 256;
 
 /// Planar inverse geometry of n targets (x, y, θ) (flattened), optional starts `a0`.
+/// The ends a `solve_held` call names and the width of its targets (0 for a free tip, 2
+/// pinned, 3 clamped), checked against `targets`; refusals name the argument.
+fn held_request(
+    n: usize,
+    t: Option<&[f64]>,
+    base_condition: &str,
+    tip_condition: &str,
+    max_turns: u32,
+) -> PyResult<(HeldEnds, usize)> {
+    let condition = |field: &str, v: &str| {
+        v.parse::<EndCondition>().map_err(|_| {
+            PyValueError::new_err(format!(
+                "{field} must be \"clamped\", \"pinned\" or \"free\", got {v:?}"
+            ))
+        })
+    };
+    let ends = HeldEnds::new(
+        condition("base_condition", base_condition)?,
+        condition("tip_condition", tip_condition)?,
+    )
+    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let width = match ends.tip() {
+        EndCondition::Free => 0,
+        EndCondition::Pinned => 2,
+        EndCondition::Clamped => 3,
+    };
+    match (width, t) {
+        (0, Some(_)) => {
+            return Err(PyValueError::new_err(
+                "targets: a free tip has no target (the cable hangs from its base)",
+            ))
+        }
+        (w, Some(t)) if t.len() != w * n => {
+            return Err(PyValueError::new_err(format!(
+                "targets must have shape (..., {w}) for a {tip_condition} tip"
+            )))
+        }
+        (w, None) if w > 0 => {
+            return Err(PyValueError::new_err(format!(
+                "targets: a {tip_condition} tip needs targets of shape (..., {w})"
+            )))
+        }
+        _ => {}
+    }
+    if max_turns > MAX_TURNS {
+        return Err(PyValueError::new_err(format!(
+            "max_turns must be in [0, {MAX_TURNS}], got {max_turns}"
+        )));
+    }
+    Ok((ends, width))
+}
+
+/// One held-ends answer, flattened for the batch arrays.
+struct HeldRow {
+    found: Result<held::HeldSearch, String>,
+    target: Option<PlanarPose>,
+}
+
+/// Pinned and free ends (issue 52): for each of `n` rods, the least-energy stable
+/// equilibrium held by (`base_condition`, `tip_condition`) through its target (flattened
+/// (n, 2) positions for a pinned tip, (n, 3) poses for a clamped one, none for a free tip),
+/// and with `all` every stable one found. Returns a dict of flat arrays.
+#[pyfunction]
+#[pyo3(signature = (n, targets=None, base_condition="clamped", tip_condition="clamped",
+                    weight=None, gravity=None, all=false, deadline_ms=None, max_turns=0,
+                    threads=None))]
+#[allow(clippy::too_many_arguments)]
+fn solve_held<'py>(
+    py: Python<'py>,
+    n: usize,
+    targets: Option<PyReadonlyArray1<'py, f64>>,
+    base_condition: &str,
+    tip_condition: &str,
+    weight: Option<PyReadonlyArray1<'py, f64>>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
+    all: bool,
+    deadline_ms: Option<f64>,
+    max_turns: u32,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let t = targets.as_ref().map(|t| t.as_slice()).transpose()?;
+    let (ends, width) = held_request(n, t, base_condition, tip_condition, max_turns)?;
+    let gravities = gravities2(n, weight.as_ref(), gravity.as_ref())?;
+    let options = SolveOptions {
+        deadline: match deadline_ms {
+            Some(ms) if ms.is_finite() && ms > 0.0 && ms <= 1e7 => {
+                Duration::from_secs_f64(ms / 1e3)
+            }
+            Some(ms) => {
+                return Err(PyValueError::new_err(format!(
+                    "deadline_ms must be a positive number of milliseconds, got {ms}"
+                )))
+            }
+            None => Duration::from_millis(1000),
+        },
+        max_turns,
+        ..SolveOptions::default()
+    };
+    let target_of = |i: usize| {
+        t.map(|t| match width {
+            2 => PlanarPose::new(t[2 * i], t[2 * i + 1], 0.0),
+            _ => PlanarPose::new(t[3 * i], t[3 * i + 1], t[3 * i + 2]),
+        })
+    };
+    rod_ig_core::planar::ig::warm_up();
+    let mut rows: Vec<Option<HeldRow>> = (0..n).map(|_| None).collect();
+    batch(
+        py,
+        n,
+        thread_count(threads)?,
+        FORWARD_BLOCK,
+        |i| {
+            let g = gravities.as_ref().map_or(Gravity::NONE, |g| g[i]);
+            let target = target_of(i);
+            HeldRow {
+                found: held::equilibria(ends, &g, target.as_ref(), &options)
+                    .map_err(|e| e.to_string()),
+                target,
+            }
+        },
+        |i, r| rows[i] = Some(r),
+    )?;
+    held_dict(py, ends, rows.into_iter().flatten().collect(), all)
+}
+
+/// The columns of [`solve_held`]'s answer, one row per rod (NaN where it failed).
+struct HeldColumns {
+    a: Vec<f64>,
+    tip: Vec<f64>,
+    base_angle: Vec<f64>,
+    energy: Vec<f64>,
+    elastic: Vec<f64>,
+    margin: Vec<f64>,
+    position_error: Vec<f64>,
+    turns: Vec<i64>,
+    base_wrench: Vec<f64>,
+    tip_wrench: Vec<f64>,
+    success: Vec<bool>,
+}
+
+impl HeldColumns {
+    fn new(n: usize) -> Self {
+        let nan = f64::NAN;
+        Self {
+            a: vec![nan; 3 * n],
+            tip: vec![nan; 3 * n],
+            base_angle: vec![nan; n],
+            energy: vec![nan; n],
+            elastic: vec![nan; n],
+            margin: vec![nan; n],
+            position_error: vec![nan; n],
+            turns: vec![-1; n],
+            base_wrench: vec![nan; 3 * n],
+            tip_wrench: vec![nan; 3 * n],
+            success: vec![false; n],
+        }
+    }
+
+    fn set(&mut self, i: usize, s: &held::HeldSolution, target: Option<PlanarPose>) {
+        self.success[i] = true;
+        self.a[3 * i..3 * i + 3].copy_from_slice(s.a.as_slice());
+        self.tip[3 * i..3 * i + 3].copy_from_slice(&[s.tip.x, s.tip.y, s.tip.theta]);
+        self.base_angle[i] = s.base_angle;
+        self.energy[i] = s.energy;
+        self.elastic[i] = s.elastic_energy;
+        self.margin[i] = s.stability.normalised();
+        self.turns[i] = i64::from(s.turns);
+        self.position_error[i] = target.map_or(f64::NAN, |t| (s.tip.x - t.x).hypot(s.tip.y - t.y));
+        let w = s.wrenches();
+        self.base_wrench[3 * i..3 * i + 3].copy_from_slice(&[
+            w.base.force[0],
+            w.base.force[1],
+            w.base.moment,
+        ]);
+        self.tip_wrench[3 * i..3 * i + 3].copy_from_slice(&[
+            w.tip.force[0],
+            w.tip.force[1],
+            w.tip.moment,
+        ]);
+    }
+
+    fn into_dict(self, d: &Bound<'_, PyDict>) -> PyResult<()> {
+        let py = d.py();
+        d.set_item("success", self.success.into_pyarray(py))?;
+        d.set_item("a", f64_out(py, self.a))?;
+        d.set_item("tip", f64_out(py, self.tip))?;
+        d.set_item("base_angle", f64_out(py, self.base_angle))?;
+        d.set_item("energy", f64_out(py, self.energy))?;
+        d.set_item("elastic_energy", f64_out(py, self.elastic))?;
+        d.set_item("margin", f64_out(py, self.margin))?;
+        d.set_item("position_error", f64_out(py, self.position_error))?;
+        d.set_item("turns", self.turns.into_pyarray(py))?;
+        d.set_item("base_wrench", f64_out(py, self.base_wrench))?;
+        d.set_item("tip_wrench", f64_out(py, self.tip_wrench))?;
+        Ok(())
+    }
+}
+
+/// The dict of [`solve_held`]'s arrays.
+fn held_dict<'py>(
+    py: Python<'py>,
+    ends: HeldEnds,
+    rows: Vec<HeldRow>,
+    all: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let n = rows.len();
+    let mut columns = HeldColumns::new(n);
+    let (mut complete, mut starts) = (vec![false; n], vec![0u32; n]);
+    let (mut termination, mut reason) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let solutions = PyList::empty(py);
+    let solution_angles = PyList::empty(py);
+    for (i, row) in rows.iter().enumerate() {
+        let found = match &row.found {
+            Ok(f) => f,
+            Err(e) => {
+                termination.push("invalid_input".to_string());
+                reason.push(e.clone());
+                solutions.append(f64_out(py, Vec::new()))?;
+                solution_angles.append(f64_out(py, Vec::new()))?;
+                continue;
+            }
+        };
+        starts[i] = found.starts;
+        complete[i] = !found.cut_short;
+        if let Some(s) = found.solutions.first() {
+            columns.set(i, s, row.target);
+            termination.push("converged".to_string());
+            reason.push(String::new());
+        } else {
+            let why = if found.cut_short {
+                "deadline"
+            } else {
+                "no_stable_solution"
+            };
+            termination.push(why.into());
+            reason.push(format!(
+                "no stable equilibrium found with {} base and {} tip ({} starts){}",
+                ends.base(),
+                ends.tip(),
+                found.starts,
+                found
+                    .last_failure
+                    .as_ref()
+                    .map(|w| format!(": {w}"))
+                    .unwrap_or_default()
+            ));
+        }
+        if all {
+            let flat: Vec<f64> = found
+                .solutions
+                .iter()
+                .flat_map(|s| s.a.as_slice().to_vec())
+                .collect();
+            solutions.append(f64_out(py, flat))?;
+            let angles = found.solutions.iter().map(|s| s.base_angle).collect();
+            solution_angles.append(f64_out(py, angles))?;
+        }
+    }
+    let d = PyDict::new(py);
+    columns.into_dict(&d)?;
+    d.set_item("starts", starts.into_pyarray(py))?;
+    d.set_item("complete", complete.into_pyarray(py))?;
+    d.set_item("termination", termination)?;
+    d.set_item("reason", reason)?;
+    d.set_item("solutions", solutions)?;
+    d.set_item("solutions_base_angle", solution_angles)?;
+    Ok(d)
+}
+
 #[pyfunction]
 #[pyo3(signature = (targets, a0=None, objective="first", method="robust", deadline_ms=None,
                     tolerance=None, max_iterations=None, alpha=None, all=false, threads=None,
@@ -1160,6 +1430,7 @@ fn _rod_ig(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(is_stable, m)?)?;
     m.add_function(wrap_pyfunction!(shape, m)?)?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;
+    m.add_function(wrap_pyfunction!(solve_held, m)?)?;
     m.add_function(wrap_pyfunction!(forward3d, m)?)?;
     m.add_function(wrap_pyfunction!(solve3d, m)?)?;
     m.add_function(wrap_pyfunction!(wrenches, m)?)?;

@@ -626,3 +626,42 @@ def test_heavy_solves_report_turns() -> None:
     cli = run_cli("solve", [{"target": {"x": 0.6, "y": 0.0, "theta": 0.0}, "weight": 50.0}])[0]
     assert cli["turns"] == 0
     assert rod_ig.solve([0.5, 0.2, 1.0]).turns is None
+
+
+def test_pinned_and_free_ends() -> None:
+    """base_condition / tip_condition (issue 52): a free tip hangs from its base (one cable per
+    weight, the least-energy stable one of ends_public A-003 and A-000), pinned ends answer a
+    position with the base angle (C-002), the released moments are zero; refusals name the
+    field."""
+    free = rod_ig.solve(
+        None,
+        tip_condition="free",
+        weight=[36.92695280826509, 307.54823911836],
+        gravity=[[-1.0, 0.0], [0.0, -1.0]],
+        all=True,
+        deadline_ms=5000,
+    )
+    assert free.success.all()
+    np.testing.assert_allclose(free.energy, [4.158152069940845, -133.55792759178848], rtol=1e-9)
+    assert free.solutions is not None and [len(s) for s in free.solutions] == [2, 2]
+    assert free.tip_wrench is not None
+    np.testing.assert_allclose(free.tip_wrench.moment, 0.0, atol=1e-9)
+    np.testing.assert_allclose(free.tip_wrench.force, 0.0, atol=1e-9)
+    pinned = rod_ig.solve(
+        [0.8, 0.0], base_condition="pinned", tip_condition="pinned", weight=50.0, deadline_ms=5000
+    )
+    assert pinned.success
+    assert pinned.base_angle is not None
+    assert abs(pinned.base_angle + 0.9202652225760789) < 1e-8
+    assert abs(pinned.energy + 6.24283394420708) < 1e-8
+    assert pinned.a[0] == 0.0 and pinned.position_error < 1e-10
+    with pytest.raises(ValueError, match="tip_condition"):
+        rod_ig.solve([0.8, 0.0], tip_condition="hinged")
+    with pytest.raises(ValueError, match="base_condition"):
+        rod_ig.solve(None, base_condition="free", tip_condition="free")
+    with pytest.raises(ValueError, match="targets"):
+        rod_ig.solve([0.8, 0.0], tip_condition="free")
+    with pytest.raises(ValueError, match=r"shape \(\.\.\., 2\)"):
+        rod_ig.solve([0.8, 0.0, 0.0], tip_condition="pinned")
+    with pytest.raises(ValueError, match="clamped ends only"):
+        rod_ig.solve([0.8, 0.0], tip_condition="pinned", a0=[0.0, 1.0, 0.0])

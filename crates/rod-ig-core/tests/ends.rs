@@ -246,3 +246,62 @@ fn a_long_cable_hangs_from_a_level_clamp_up_to_w_1e4() {
         assert!(found.solutions.iter().all(|s| s.stability.stable()));
     }
 }
+
+/// The catenary's parameter u = d / (2 c) for span d of a unit string: sinh u / u = 1 / d.
+fn catenary_u(span: f64) -> f64 {
+    let (mut lo, mut hi) = (1e-9_f64, 20.0_f64);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid.sinh() / mid < 1.0 / span {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// A long cable pinned at both ends tends to the inextensible catenary as w grows (a pinned
+/// end has no moment, so no bending boundary layer there): its base angle to
+/// −atan(sinh u) with a gap shrinking like 1/√w (measured: 0.022 at w = 2,000, 0.011 at 10⁴;
+/// asserted ≤ 1.5/√w and the ratio of the two gaps within 25 % of √5), and its potential
+/// energy per unit weight to the catenary's ∫ y ds (computed here by Simpson's rule on 2·10⁴
+/// intervals; agreement 4e-6 and 5e-7 measured, asserted ≤ 2e-5).
+#[test]
+fn a_long_cable_pinned_at_both_ends_tends_to_the_catenary() {
+    use EndCondition::*;
+    let span = 0.8;
+    let u = catenary_u(span);
+    let c = 0.5 * span / u;
+    let theta_string = -u.sinh().atan();
+    // ∫ y ds with y = c cosh((x − d/2)/c) − c cosh(u), ds = cosh((x − d/2)/c) dx.
+    let n = 20_000;
+    let f = |x: f64| {
+        let z = (x - 0.5 * span) / c;
+        (c * z.cosh() - c * u.cosh()) * z.cosh()
+    };
+    let h = span / n as f64;
+    let potential: f64 = (0..=n)
+        .map(|i| {
+            let weight = if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+            weight * f(i as f64 * h)
+        })
+        .sum::<f64>()
+        * h
+        / 3.0;
+    let ends = HeldEnds::new(Pinned, Pinned).unwrap();
+    let target = PlanarPose::new(span, 0.0, 0.0);
+    let mut gaps = Vec::new();
+    for w in [2_000.0_f64, 10_000.0] {
+        let g = Gravity::new(w, [0.0, -1.0]).unwrap();
+        let (best, _) = held::least_energy(ends, &g, Some(&target), &options(0)).expect("hangs");
+        let per_weight = (best.energy - best.elastic_energy) / w;
+        assert!((per_weight - potential).abs() < 2e-5, "w {w}: {per_weight} vs {potential}");
+        let gap = best.base_angle - theta_string;
+        assert!(gap.abs() <= 1.5 / w.sqrt(), "w {w}: θ0 {} vs {theta_string}", best.base_angle);
+        assert!(best.stability.stable() && best.turns == 0);
+        gaps.push(gap);
+    }
+    let ratio = gaps[0] / gaps[1];
+    assert!((ratio / 5f64.sqrt() - 1.0).abs() < 0.25, "gap ratio {ratio}");
+}

@@ -305,43 +305,31 @@ impl Search {
 
     /// A held tip (module docs).
     fn held_tip(&mut self, target: &PlanarPose, options: &SolveOptions) {
-        let weightless = self.gravity.with_weight(0.0).unwrap_or(Gravity::NONE);
         // The closed forms' atlas, built (once per process) within this request's deadline
         // rather than in the seeds' short ones.
         let _ = crate::planar::ig::atlas::get(crate::planar::ig::atlas::Tier::Box);
-        let mut seeds = Vec::new();
-        for (theta0, a) in weightless_seeds(self.ends, target, options) {
-            if crate::deadline::expired() {
-                return;
-            }
-            let Ok(mut c) = Cable::held(theta0, &a, &weightless, HeldEnds::CLAMPED) else {
-                continue;
-            };
-            let Ok(tip) = c.tip() else { continue };
-            // The clamped rod is corrected on its own tip angle (a pinned tip's target has none).
-            let lifted = if self.ends.tip() == EndCondition::Pinned {
-                PlanarPose::new(target.x, target.y, tip.theta)
-            } else {
-                lift_near(target, tip.theta)
-            };
-            if c.solve(&lifted).is_err() || c.release_into(self.ends, &lifted).is_err() {
-                continue;
-            }
-            if !seeds.iter().any(|(s, _): &(Cable, _)| s.close_to(&c)) {
-                seeds.push((c, lifted));
-            }
-        }
         let limits = FollowLimits {
             max_theta_spread: std::f64::consts::TAU * (self.max_turns as f64 + 1.5),
             ..FollowLimits::default()
         };
-        for (c, lifted) in &seeds {
-            if crate::deadline::expired() {
-                return;
+        let mut seeds: Vec<(Cable, PlanarPose)> = Vec::new();
+        for (theta0, theta1) in angle_pairs(self.ends, target) {
+            for a in weightless_rods(theta0, theta1, target, options) {
+                if crate::deadline::expired() {
+                    return;
+                }
+                let Some(seed) = self.released(theta0, &a, target) else {
+                    continue;
+                };
+                if seeds.iter().any(|(s, _)| s.close_to(&seed.0)) {
+                    continue;
+                }
+                // Carried from w = 0 to the rod's weight with the tip held.
+                let (mut c, lifted) = seed.clone();
+                let g = self.gravity;
+                self.keep(c.carry_within(&g, &lifted, &limits).map(|_| c));
+                seeds.push(seed);
             }
-            let mut c = c.clone();
-            let g = self.gravity;
-            self.keep(c.carry_within(&g, lifted, &limits).map(|_| c));
         }
         // The same rods at the full weight, the load shared by both ends, corrected directly.
         let l = self.gravity.load();
@@ -351,15 +339,35 @@ impl Search {
             }
             let a = c.params();
             let shared = PlanarParams::new(a[0], a[1] + 0.5 * l[0], a[2] + 0.5 * l[1]);
-            let g = self.gravity;
-            let ends = self.ends;
-            let theta0 = c.base_angle();
+            let (g, ends, theta0) = (self.gravity, self.ends, c.base_angle());
             self.keep((|| {
                 let mut c = Cable::held(theta0, &shared, &g, ends)?;
                 c.solve(lifted)?;
                 Ok(c)
             })());
         }
+    }
+
+    /// The weightless clamped rod (base angle `theta0`, base wrench `a`) on target, its
+    /// moments released into this search's ends at w = 0, and the target its tip is held at.
+    fn released(
+        &self,
+        theta0: f64,
+        a: &PlanarParams,
+        target: &PlanarPose,
+    ) -> Option<(Cable, PlanarPose)> {
+        let weightless = self.gravity.with_weight(0.0).unwrap_or(Gravity::NONE);
+        let mut c = Cable::held(theta0, a, &weightless, HeldEnds::CLAMPED).ok()?;
+        let tip = c.tip().ok()?;
+        // The clamped rod is corrected on its own tip angle (a pinned tip's target has none).
+        let lifted = if self.ends.tip() == EndCondition::Pinned {
+            PlanarPose::new(target.x, target.y, tip.theta)
+        } else {
+            lift_near(target, tip.theta)
+        };
+        c.solve(&lifted).ok()?;
+        c.release_into(self.ends, &lifted).ok()?;
+        Some((c, lifted))
     }
 }
 
@@ -425,57 +433,63 @@ fn bisect(mut lo: f64, k_lo: f64, mut hi: f64, gravity: &Gravity) -> Option<f64>
     Some(0.5 * (lo + hi))
 }
 
-/// Angles tried at a pinned end: the chord's direction φ plus k π/4; a clamped end's own.
-fn angles(condition: EndCondition, own: f64, chord: f64) -> Vec<f64> {
-    if condition == EndCondition::Clamped {
-        return vec![own];
+/// The (base, tip) angles of the weightless clamped rods the search starts from, most
+/// promising first: a clamped end keeps its own angle, a pinned end tries the chord's
+/// direction χ plus k π/4; with both ends pinned the symmetric pairs (χ + δ, χ − δ) come first
+/// (the weightless pinned–pinned elastica is symmetric about its chord), the others after.
+fn angle_pairs(ends: HeldEnds, target: &PlanarPose) -> Vec<(f64, f64)> {
+    let chord = target.y.atan2(target.x);
+    let turned = |k: usize| crate::wrap_angle(chord + FRAC_PI_4 * k as f64);
+    let around = |condition: EndCondition, own: f64| -> Vec<f64> {
+        if condition == EndCondition::Clamped {
+            vec![own]
+        } else {
+            (0..ANGLES).map(turned).collect()
+        }
+    };
+    let mut pairs = Vec::new();
+    if ends.base() == EndCondition::Pinned && ends.tip() == EndCondition::Pinned {
+        pairs.extend((0..ANGLES).map(|k| (turned(k), 2.0 * chord - turned(k))));
     }
-    (0..ANGLES)
-        .map(|k| crate::wrap_angle(chord + FRAC_PI_4 * k as f64))
-        .collect()
+    for theta0 in around(ends.base(), 0.0) {
+        for theta1 in around(ends.tip(), target.theta) {
+            if !pairs.contains(&(theta0, theta1)) {
+                pairs.push((theta0, theta1));
+            }
+        }
+    }
+    pairs
 }
 
-/// Weightless rods (base angle, a in the base gripper's frame) through `target` at the tried
-/// angles: the closed forms' stable solutions (`robust_all` and `robust`, each within
-/// [`WEIGHTLESS_DEADLINE`]) in the frame turned by the base angle.
-fn weightless_seeds(
-    ends: HeldEnds,
+/// The weightless rods (a in the base gripper's frame) from the base at angle `theta0` to
+/// `target` at tip angle `theta1`: the closed forms' stable solutions (`robust_all` and
+/// `robust`, within [`WEIGHTLESS_DEADLINE`]) in the frame turned by `theta0`.
+fn weightless_rods(
+    theta0: f64,
+    theta1: f64,
     target: &PlanarPose,
     options: &SolveOptions,
-) -> Vec<(f64, PlanarParams)> {
-    let chord = target.y.atan2(target.x);
+) -> Vec<PlanarParams> {
     let opts = SolveOptions {
         initial_guess: None,
         deadline: WEIGHTLESS_DEADLINE.min(options.deadline),
         ..*options
     };
-    let mut out = Vec::new();
-    for theta0 in angles(ends.base(), 0.0, chord) {
-        for theta1 in angles(ends.tip(), target.theta, chord) {
-            if crate::deadline::expired() {
-                return out;
-            }
-            let (s, c) = theta0.sin_cos();
-            let local = PlanarPose::new(
-                c * target.x + s * target.y,
-                -s * target.x + c * target.y,
-                crate::wrap_angle(theta1 - theta0),
-            );
-            let found = {
-                let _deadline = crate::deadline::scope(opts.deadline);
-                let mut all = PlanarClosedForm.robust_all(&local, &opts).solutions;
-                all.extend(PlanarClosedForm.robust(&local, &opts).ok());
-                all
-            };
-            for sol in found {
-                let a = sol.a;
-                // The force turned back into the base gripper's frame.
-                out.push((
-                    theta0,
-                    PlanarParams::new(a[0], c * a[1] - s * a[2], s * a[1] + c * a[2]),
-                ));
-            }
-        }
-    }
-    out
+    let (s, c) = theta0.sin_cos();
+    let local = PlanarPose::new(
+        c * target.x + s * target.y,
+        -s * target.x + c * target.y,
+        crate::wrap_angle(theta1 - theta0),
+    );
+    let _deadline = crate::deadline::scope(opts.deadline);
+    let mut found = PlanarClosedForm.robust_all(&local, &opts).solutions;
+    found.extend(PlanarClosedForm.robust(&local, &opts).ok());
+    // The force turned back into the base gripper's frame.
+    found
+        .into_iter()
+        .map(|sol| {
+            let a = sol.a;
+            PlanarParams::new(a[0], c * a[1] - s * a[2], s * a[1] + c * a[2])
+        })
+        .collect()
 }
