@@ -283,7 +283,13 @@ fn a_long_cable_pinned_at_both_ends_tends_to_the_catenary() {
     let h = span / n as f64;
     let potential: f64 = (0..=n)
         .map(|i| {
-            let weight = if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 };
+            let weight = if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
             weight * f(i as f64 * h)
         })
         .sum::<f64>()
@@ -296,12 +302,22 @@ fn a_long_cable_pinned_at_both_ends_tends_to_the_catenary() {
         let g = Gravity::new(w, [0.0, -1.0]).unwrap();
         let (best, _) = held::least_energy(ends, &g, Some(&target), &options(0)).expect("hangs");
         let per_weight = (best.energy - best.elastic_energy) / w;
-        assert!((per_weight - potential).abs() < 2e-5, "w {w}: {per_weight} vs {potential}");
+        assert!(
+            (per_weight - potential).abs() < 2e-5,
+            "w {w}: {per_weight} vs {potential}"
+        );
         let gap = best.base_angle - theta_string;
-        assert!(gap.abs() <= 1.5 / w.sqrt(), "w {w}: θ0 {} vs {theta_string}", best.base_angle);
+        assert!(
+            gap.abs() <= 1.5 / w.sqrt(),
+            "w {w}: θ0 {} vs {theta_string}",
+            best.base_angle
+        );
         assert!(best.stability.stable() && best.turns == 0);
         gaps.push(gap);
     }
     let ratio = gaps[0] / gaps[1];
-    assert!((ratio / 5f64.sqrt() - 1.0).abs() < 0.25, "gap ratio {ratio}");
+    assert!(
+        (ratio / 5f64.sqrt() - 1.0).abs() < 0.25,
+        "gap ratio {ratio}"
+    );
 }
