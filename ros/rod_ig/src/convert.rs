@@ -51,6 +51,10 @@ pub enum TargetError {
     /// The weight parameters cannot be used (see [`gravity_of`]).
     #[error("{0}")]
     Weight(String),
+    /// The end-condition parameters cannot be used together, or the target is not planar
+    /// while an end is pinned or free (see [`ends_of`]).
+    #[error("{0}")]
+    Ends(String),
     /// Gravity leaves the rod's plane by more than `planar_tolerance`: the planar rod with
     /// weight hangs in a vertical plane (the 3-D rod's with `solve_3d`).
     #[error("gravity leaves the rod's plane by {tilt:.3e} rad (gravity z = {gz} m/s^2; accepted <= planar_tolerance = {tol} rad): the planar rod with weight hangs in a vertical plane; with solve_3d:=true the 3-D rod with weight serves every target")]
@@ -89,6 +93,7 @@ impl TargetError {
             Self::NonFinite(_)
             | Self::ZeroQuaternion(_)
             | Self::Weight(_)
+            | Self::Ends(_)
             | Self::GravityOutOfPlane { .. } => "invalid_input",
         }
     }
@@ -102,6 +107,22 @@ impl TargetError {
             Self::OffPlane { .. } | Self::Tilted { .. } | Self::GravityOutOfPlane { .. }
         )
     }
+}
+
+/// The end conditions of the parameters `base_condition` and `tip_condition` (a pinned base
+/// with a free tip holds nothing: refused with the reason).
+pub fn ends_of(params: &Params) -> Result<rod_ig_core::ends::HeldEnds, TargetError> {
+    rod_ig_core::ends::HeldEnds::new(params.base_condition, params.tip_condition)
+        .map_err(|e| TargetError::Ends(e.to_string()))
+}
+
+/// A non-planar target (`e`) while an end is pinned or free: refused, since end conditions
+/// other than clamped are planar (the 3-D solver holds both ends clamped).
+pub fn planar_ends_only(e: TargetError, params: &Params) -> TargetError {
+    TargetError::Ends(format!(
+        "{e}; pinned and free ends (base_condition {}, tip_condition {}) are planar",
+        params.base_condition, params.tip_condition
+    ))
 }
 
 /// The rod's weight from the parameters, in the base frame: the dimensionless
@@ -493,6 +514,8 @@ struct ModelParts {
     /// The dimensionless weight and the elastic part of the solution's energy.
     weight: f64,
     elastic_energy: f64,
+    /// θ(0): 0 unless the base is pinned.
+    base_angle: f64,
 }
 
 /// Scales a converged answer to physical units (rod length L, bending stiffness EI).
@@ -548,6 +571,9 @@ fn converged_message<P, X>(
         } else {
             Wrench::default()
         },
+        base_condition: params.base_condition.name().into(),
+        tip_condition: params.tip_condition.name().into(),
+        base_angle: c.base_angle,
     }
 }
 
@@ -594,6 +620,7 @@ pub fn solution_message_3d(
         critical: None,
         weight,
         elastic_energy,
+        base_angle: 0.0,
     };
     converged_message(s, parts, header, params, solve_time)
 }
@@ -609,7 +636,11 @@ pub fn solution_message(
     let (l, ei) = (params.rod_length, params.bending_stiffness);
     let a = [s.a[0], s.a[1], s.a[2]];
     let parts = ModelParts {
-        what: "converged",
+        what: if ends_of(params).is_ok_and(|e| !e.both_clamped()) {
+            "held-ends search converged"
+        } else {
+            "converged"
+        },
         a,
         a_spatial: [0.0; 6],
         spatial: false,
@@ -620,6 +651,7 @@ pub fn solution_message(
         critical: solved.critical.map(|c| planar_to_pose(&c, l)),
         weight: solved.weight,
         elastic_energy: solved.elastic_energy,
+        base_angle: solved.base_angle,
     };
     converged_message(s, parts, header, params, solve_time)
 }
@@ -670,6 +702,9 @@ pub fn failure_message(
         weight: gravity_3d_of(params).map_or(f64::NAN, |g| g.weight()),
         total_energy: nan,
         tip_wrench: Wrench::default(),
+        base_condition: params.base_condition.name().into(),
+        tip_condition: params.tip_condition.name().into(),
+        base_angle: nan,
     }
 }
 
@@ -848,6 +883,7 @@ mod tests {
             weight: 0.0,
             elastic_energy: 1.5,
             tip_wrench: [1.0, -2.0, 0.0, 0.0, 0.0, 0.5],
+            base_angle: 0.0,
         };
         let p = Params {
             rod_length: 0.5,

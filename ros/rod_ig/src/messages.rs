@@ -306,6 +306,13 @@ pub struct RodSolution {
     /// The wrench the rod exerts on the tip gripper (N, N·m), in the tip frame (appended
     /// field; zeros unless `wrench_valid`).
     pub tip_wrench: Wrench,
+    /// How the base was held: "clamped" or "pinned" (appended field).
+    pub base_condition: String,
+    /// How the tip was held: "clamped", "pinned" or "free" (appended field).
+    pub tip_condition: String,
+    /// The rod's angle at the base (rad): 0 for a clamped base, θ(0) for a pinned one; NaN
+    /// when success is false (appended field).
+    pub base_angle: f64,
 }
 impl Message for RodSolution {}
 
@@ -768,6 +775,9 @@ pub(crate) mod tests {
                     z: 1.75,
                 },
             },
+            base_condition: "pinned".into(),
+            tip_condition: "free".into(),
+            base_angle: -0.5,
         }
     }
 

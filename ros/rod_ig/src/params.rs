@@ -6,6 +6,7 @@
 //! applies the parameter sources in order. At run time the same validation
 //! ([`Params::apply`]) guards the ROS parameter services.
 
+use rod_ig_core::ends::EndCondition;
 use std::path::{Path, PathBuf};
 
 use ros2_client::ParameterValue;
@@ -101,6 +102,13 @@ pub struct Params {
     /// `tf_rate` in (0, 1000] Hz: at most how often `tip_frame` is looked up, after TF updates
     /// (default 30).
     pub tf_rate: f64,
+    /// `base_condition`: how the base gripper holds the rod, "clamped" (default) or "pinned"
+    /// (position held, angle free: a hook or a pin joint; docs/ends.md).
+    pub base_condition: EndCondition,
+    /// `tip_condition`: "clamped" (default), "pinned" (the target's position is held, its
+    /// orientation ignored) or "free" (nothing held: the cable hangs from its base, the target
+    /// only asks for the answer).
+    pub tip_condition: EndCondition,
     /// `world_frame`: when set (and `linear_density` > 0), gravity is −9.80665 m/s² along this
     /// TF frame's z, expressed in `base_frame` at each target's stamp (it replaces `gravity`);
     /// default empty: `gravity` as set.
@@ -213,6 +221,8 @@ impl Default for Params {
             tip_frame: String::new(),
             tf_rate: 0.0,
             world_frame: String::new(),
+            base_condition: EndCondition::Clamped,
+            tip_condition: EndCondition::Clamped,
             qos_overrides: QosOverride::for_node(|n| {
                 Ok::<_, std::convert::Infallible>(if n.starts_with('/') {
                     n.to_string()
@@ -341,7 +351,7 @@ const MAX_DEADLINE_MS: f64 = rod_ig_core::planar::ig::MAX_DEADLINE.as_secs_f64()
 const MAX_PATH_SAMPLES: i64 = 100_000;
 
 /// Every parameter of `rod_ig_node` (beside the `qos_overrides` ones), in declaration order.
-const TABLE: [Spec; 21] = [
+const TABLE: [Spec; 23] = [
     Spec {
         name: "rod_length",
         kind: Kind::Double {
@@ -644,7 +654,51 @@ const TABLE: [Spec; 21] = [
             Ok(())
         },
     },
+    Spec {
+        name: "base_condition",
+        kind: Kind::Str,
+        default: DefaultValue::Str("clamped"),
+        description: "How the base gripper holds the rod: clamped (pose) or pinned (position \
+                      only, angle free)",
+        constraints: "clamped or pinned",
+        get: |p| ParameterValue::String(p.base_condition.name().into()),
+        set: |p, v| {
+            p.base_condition = end_condition("base_condition", str_of(v), false)?;
+            Ok(())
+        },
+    },
+    Spec {
+        name: "tip_condition",
+        kind: Kind::Str,
+        default: DefaultValue::Str("clamped"),
+        description: "How the tip gripper holds the rod: clamped (pose), pinned (position only) \
+                      or free (the cable hangs from its base)",
+        constraints: "clamped, pinned or free",
+        get: |p| ParameterValue::String(p.tip_condition.name().into()),
+        set: |p, v| {
+            p.tip_condition = end_condition("tip_condition", str_of(v), true)?;
+            Ok(())
+        },
+    },
 ];
+
+/// An end condition parameter's value ("free" only where `free_allowed`).
+fn end_condition(name: &str, v: &str, free_allowed: bool) -> Result<EndCondition, String> {
+    match v.parse::<EndCondition>() {
+        Ok(EndCondition::Free) if !free_allowed => Err(format!(
+            "{name} cannot be \"free\": the base gripper holds the rod (clamped or pinned)"
+        )),
+        Ok(c) => Ok(c),
+        Err(_) => Err(format!(
+            "{name} must be {}, got {v:?}",
+            if free_allowed {
+                "\"clamped\", \"pinned\" or \"free\""
+            } else {
+                "\"clamped\" or \"pinned\""
+            }
+        )),
+    }
+}
 
 /// The row of parameter `name`.
 fn spec(name: &str) -> Option<&'static Spec> {

@@ -148,6 +148,8 @@ pub fn settings_of(params: &Params) -> SolverSettings {
         // Unusable weight parameters refuse every target (`process`); the settings keep none.
         gravity: crate::convert::gravity_of(params).unwrap_or_default(),
         gravity_3d: crate::convert::gravity_3d_of(params).unwrap_or(Gravity3::NONE),
+        // An unusable pair refuses every target (`process`); the settings keep both clamped.
+        ends: crate::convert::ends_of(params).unwrap_or_default(),
     }
 }
 
@@ -224,7 +226,8 @@ impl Processor {
             marker: None,
         };
         // Gravity out of the rod's plane makes every target the 3-D rod's, as a non-planar one.
-        let planar = crate::convert::gravity_3d_of(params)
+        let planar = crate::convert::ends_of(params)
+            .and_then(|_| crate::convert::gravity_3d_of(params))
             .and_then(|_| crate::convert::gravity_of(params))
             .and_then(|_| target_to_planar(&target.pose, params));
         match planar {
@@ -244,6 +247,9 @@ impl Processor {
             // Non-planar (or under gravity out of the rod's plane) but otherwise valid: the
             // 3-D solver when enabled (the planar initial guess of a service request is
             // embedded as (0, 0, a3, a4, a5, 0)).
+            Err(e) if e.is_non_planar() && !settings.ends.both_clamped() => {
+                rejected(crate::convert::planar_ends_only(e, params))
+            }
             Err(e) if e.is_non_planar() && params.solve_3d => {
                 let spatial = match target_to_spatial(&target.pose, params) {
                     Ok(t) => t,

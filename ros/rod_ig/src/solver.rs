@@ -8,7 +8,8 @@
 //! the solver's normalised units (unit rod length, unit bending stiffness); scaling to metres
 //! happens in [`crate::convert`].
 
-use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
+use rod_ig_core::ends::{EndCondition, HeldEnds};
+use rod_ig_core::planar::heavy::{self, held, Gravity, HeavyPlanar};
 use rod_ig_core::planar::ig::{self, Failure, Solution, SolveOptions, Tracker};
 use rod_ig_core::planar::PlanarClosedForm;
 use rod_ig_core::planar::PlanarRod;
@@ -41,6 +42,10 @@ pub struct SolverSettings {
     /// The same weight for the 3-D rod: gravity's direction in the base frame, which may
     /// leave the rod's plane.
     pub gravity_3d: Gravity3,
+    /// How the two grippers hold the rod (parameters `base_condition`, `tip_condition`):
+    /// both clamped by default; otherwise every planar target is answered by the held-ends
+    /// search (`planar::heavy::held`).
+    pub ends: HeldEnds,
 }
 
 /// A converged solve with its sampled shape, normalised units: the core crate's solution
@@ -63,6 +68,8 @@ pub struct WithShape<S, P> {
     /// (x, y, z) then moment (x, y, z) (`rod_ig_core::wrench`; NaN where it could not be
     /// evaluated).
     pub tip_wrench: [f64; 6],
+    /// The rod's angle at the base θ(0): 0 unless the base is pinned.
+    pub base_angle: f64,
 }
 
 /// The planar tip wrench as [`WithShape::tip_wrench`]: (fx, fy, 0, 0, 0, m).
@@ -323,6 +330,9 @@ impl RodSolver {
         one_off: Option<SolverSettings>,
         samples: usize,
     ) -> Result<Solved, Failed> {
+        if !self.settings.ends.both_clamped() {
+            return solve_held(&one_off.unwrap_or(self.settings), target, samples);
+        }
         if !self.settings.gravity.is_weightless() {
             return self.solve_heavy(target, initial_guess, one_off, samples);
         }
@@ -380,6 +390,83 @@ impl RodSolver {
     }
 }
 
+/// A planar target with pinned or free ends: the least-energy stable rod of the held-ends
+/// search (a pinned tip holds the target's position, a free tip ignores the target), as a
+/// solver `Solution` (iterations 0: a search, not one Newton run) with its shape.
+fn solve_held(s: &SolverSettings, target: &PlanarPose, samples: usize) -> Result<Solved, Failed> {
+    let options = SolveOptions {
+        deadline: s.deadline.max(HELD_MIN_DEADLINE),
+        ..SolveOptions::default()
+    };
+    let tip_target = (s.ends.tip() != EndCondition::Free).then_some(target);
+    let failed = |reason: String, termination: &'static str| Failed {
+        reason,
+        termination,
+        iterations: 0,
+        residual: f64::NAN,
+        last_a: None,
+        last_a_spatial: None,
+        spatial: false,
+        event: "",
+    };
+    let started = std::time::Instant::now();
+    let (best, found) =
+        held::least_energy(s.ends, &s.gravity, tip_target, &options).map_err(|e| {
+            let termination = match &e {
+                held::HeldError::NotFound { cut, .. } if !cut.is_empty() => "deadline",
+                held::HeldError::NotFound { .. } => "no_stable_solution",
+                held::HeldError::Target { .. } => "invalid_input",
+            };
+            failed(e.to_string(), termination)
+        })?;
+    let shape = best.cable.shape(samples).map_err(|e| {
+        failed(
+            format!("cannot evaluate the solution's shape: {e}"),
+            "evaluation_failed",
+        )
+    })?;
+    let position_error = match s.ends.tip() {
+        EndCondition::Free => f64::NAN,
+        _ => (best.tip.x - target.x).hypot(best.tip.y - target.y),
+    };
+    let orientation_error = match s.ends.tip() {
+        EndCondition::Clamped => (best.tip.theta - target.theta).abs(),
+        _ => f64::NAN,
+    };
+    let w = best.wrenches().tip;
+    Ok(WithShape {
+        solution: Solution {
+            a: best.a,
+            tip: best.tip,
+            stable: true,
+            stability_margin: best.stability.normalised(),
+            iterations: 0,
+            position_error,
+            orientation_error,
+            residual: if position_error.is_nan() {
+                0.0
+            } else {
+                position_error
+            },
+            energy: best.energy,
+            evaluations: 0,
+            starts: found.starts,
+            elapsed_us: started.elapsed().as_secs_f64() * 1e6,
+            complete: !found.cut_short,
+        },
+        shape,
+        event: "",
+        critical: None,
+        weight: s.gravity.weight(),
+        elastic_energy: best.elastic_energy,
+        tip_wrench: [w.force[0], w.force[1], 0.0, 0.0, 0.0, w.moment],
+        base_angle: best.base_angle,
+    })
+}
+
+/// Least time a held-ends solve gets (its search tries more starts than a clamped one).
+const HELD_MIN_DEADLINE: std::time::Duration = std::time::Duration::from_millis(1000);
+
 /// A followed move as the node answers it: the solution with its shape (`shape`), the branch
 /// event and, after a snap, the critical gripper pose; or the failure with its event.
 fn followed(
@@ -426,6 +513,7 @@ fn with_heavy_shape(s: &Solution, g: &Gravity, samples: usize) -> Result<Solved,
         weight: g.weight(),
         elastic_energy: elastic,
         tip_wrench: planar_tip_wrench(&s.a, g),
+        base_angle: 0.0,
     })
 }
 
@@ -439,6 +527,7 @@ fn with_shape(s: &Solution, samples: usize) -> Result<Solved, Failed> {
         weight: 0.0,
         elastic_energy: s.energy,
         tip_wrench: planar_tip_wrench(&s.a, &Gravity::NONE),
+        base_angle: 0.0,
     })
 }
 
@@ -484,5 +573,6 @@ fn with_shape_3d(s: &Solution3d, g: &Gravity3, samples: usize) -> Result<Solved3
                 t.moment[2],
             ]
         }),
+        base_angle: 0.0,
     })
 }

@@ -1,0 +1,89 @@
+"""Pinned and free ends in the node (issue 52, item 1): the parameters base_condition and
+tip_condition; RodSolution's appended base_condition, tip_condition and base_angle; a free tip
+hangs from its base whatever the target; refusals name the parameter."""
+import math
+
+import pytest
+
+import rodig_harness as h
+
+# A 1 m cable of 50 g/m, EI = 0.0981 N m^2: w = 0.05 * 9.81 * 1^3 / 0.0981 = 5.
+CABLE = ["-p", "rod_length:=1.0", "-p", "bending_stiffness:=0.0981", "-p", "linear_density:=0.05",
+         "-p", "gravity:=[0.0, -9.81, 0.0]", "-p", "follow_branch:=false"]
+
+
+@pytest.fixture(scope="module")
+def cable():
+    node, client = h.start_node_and_client(["--ros-args", *CABLE, "-p", "tip_condition:=pinned"])
+    yield node, client
+    h.stop_node_and_client(node, client)
+
+
+def solve_topic(c, x, y, yaw):
+    s = h.next_seq()
+    c.pub.publish(c.make_target(x, y, yaw, s))
+    return c.solution_for(s, timeout=10.0), c.path_for(s, timeout=10.0)
+
+
+def test_a_pinned_tip_holds_the_position_and_frees_the_angle(cable):
+    _, c = cable
+    assert c.get_params("base_condition", "tip_condition") == {
+        "base_condition": "clamped", "tip_condition": "pinned"}
+    # The target's yaw is ignored: two yaws, one rod.
+    sol, path = solve_topic(c, 0.6, -0.2, 0.0)
+    other, _ = solve_topic(c, 0.6, -0.2, 1.0)
+    assert sol.success, sol.message
+    assert (sol.base_condition, sol.tip_condition) == ("clamped", "pinned")
+    assert sol.stable and sol.base_angle == 0.0
+    assert sol.position_error < 1e-9 and math.isnan(sol.orientation_error)
+    assert list(other.a) == pytest.approx(list(sol.a), abs=1e-9)
+    assert abs(sol.tip_wrench.torque.z) < 1e-9  # no moment at a pin
+    last = path.poses[-1].pose.position
+    assert math.hypot(last.x - 0.6, last.y + 0.2) < 1e-9
+
+
+def test_pinned_at_both_ends_the_cable_hangs_between_the_pins(cable):
+    _, c = cable
+    assert all(r.successful for r in c.set_params(base_condition="pinned"))
+    try:
+        sol, path = solve_topic(c, 0.8, 0.0, 0.0)
+        assert sol.success, sol.message
+        assert sol.a[0] == 0.0 and sol.base_angle < 0.0  # leaves the base pin downwards
+        first = path.poses[1].pose.position
+        assert first.y < 0.0
+        # Symmetric: the tip leaves at minus the base angle (gravity normal to the chord).
+        assert sol.tip.orientation.z == pytest.approx(math.sin(-sol.base_angle / 2), abs=1e-8)
+    finally:
+        assert all(r.successful for r in c.set_params(base_condition="clamped"))
+
+
+def test_a_free_tip_hangs_from_its_base_whatever_the_target(cable):
+    _, c = cable
+    assert all(r.successful for r in c.set_params(tip_condition="free"))
+    try:
+        sol, path = solve_topic(c, 0.3, 0.3, 0.0)
+        assert sol.success, sol.message
+        assert sol.tip_condition == "free" and math.isnan(sol.position_error)
+        # No force or moment at a free tip; the base carries the whole weight (w = 5).
+        assert abs(sol.tip_wrench.force.x) < 1e-9 and abs(sol.tip_wrench.force.y) < 1e-9
+        assert sol.a[2] == pytest.approx(-5.0, rel=1e-12)
+        assert path.poses[-1].pose.position.y < -0.4  # the cantilever sags (w = 5: y(1) = -0.496)
+    finally:
+        assert all(r.successful for r in c.set_params(tip_condition="pinned"))
+
+
+def test_bad_conditions_are_refused_by_name(cable):
+    _, c = cable
+    results = c.set_params(tip_condition="hinged")
+    assert not results[0].successful and "tip_condition" in results[0].reason
+    results = c.set_params(base_condition="free")
+    assert not results[0].successful and "base_condition" in results[0].reason
+    # A pinned base with a free tip: each value is valid, the pair holds nothing; targets are
+    # refused with the reason.
+    assert all(r.successful for r in c.set_params(base_condition="pinned", tip_condition="free"))
+    try:
+        sol, _ = solve_topic(c, 0.5, 0.0, 0.0)
+        assert not sol.success and "pendulum" in sol.message
+    finally:
+        assert all(r.successful for r in c.set_params(base_condition="clamped",
+                                                      tip_condition="pinned"))
