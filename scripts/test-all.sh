@@ -99,7 +99,7 @@ py_ok=1
 WHEEL="$(ls "$REPO"/target/wheels/rod_ig-*manylinux*.whl 2>/dev/null | head -n 1)"
 [ -n "$WHEEL" ] || py_ok=0
 [ "$py_ok" = 1 ] && env PATH="$NORUST_PATH" "$PYVENV/bin/python" -m pip install --quiet \
-    --disable-pip-version-check pytest hypothesis mypy "dask[array]" matplotlib numpy "$WHEEL" \
+    --disable-pip-version-check pytest hypothesis mypy "dask[array]" matplotlib numpy "cosseratbench==0.3.*" "$WHEEL" \
     >"$LOGS/py-deps.log" 2>&1 || py_ok=0
 if [ "$py_ok" = 1 ]; then
     echo "wheel: $(basename "$WHEEL")"

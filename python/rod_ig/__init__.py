@@ -240,6 +240,9 @@ class SolveResult:
     tip: FloatArray | None = None
     """With a pinned or free end: (..., 3) the tip pose (x, y, theta) of the rod found (a free
     or pinned tip's angle is part of the answer)."""
+    shape: FloatArray | None = None
+    """With a pinned or free end and ``samples``: (..., samples, 3) the rod found, poses
+    (x, y, theta) from base to tip (NaN where the solve failed)."""
 
 
 def _solve_result(
@@ -354,6 +357,8 @@ def solve(
     max_turns: int = 0,
     base_condition: EndName = "clamped",
     tip_condition: EndName = "clamped",
+    tip_load: Sequence[float] | None = None,
+    samples: int = 0,
 ) -> SolveResult:
     """Planar inverse geometry: for each target (x, y, theta) of shape (..., 3), a stable rod
     whose tip is there. ``a0`` (broadcast against the targets) starts the search and selects
@@ -372,7 +377,9 @@ def solve(
     shape (..., 2); a free tip has none (``targets=None``: the cable hanging from its base,
     one per weight). Such a solve answers the least-energy stable rod found (default deadline
     1000 ms) and fills ``base_angle`` (a pinned base's angle); ``a0``, ``method``,
-    ``tolerance``, ``max_iterations`` and ``alpha`` apply to clamped ends only."""
+    ``tolerance``, ``max_iterations`` and ``alpha`` apply to clamped ends only. ``tip_load``
+    (fx, fy): a point force hanging from a free tip (base frame, units of EI/L^2);
+    ``samples`` >= 2 fills ``shape`` with the rod found, base to tip (pinned or free ends)."""
     if base_condition != "clamped" or tip_condition != "clamped":
         if a0 is not None or method != "robust" or tolerance is not None:
             raise ValueError("a0, method and tolerance apply to clamped ends only")
@@ -380,8 +387,10 @@ def solve(
             raise ValueError("max_iterations and alpha apply to clamped ends only")
         return _solve_held(
             targets, base_condition, tip_condition, deadline_ms, all, threads,
-            weight, gravity, max_turns,
+            weight, gravity, max_turns, tip_load, samples,
         )
+    if tip_load is not None or samples:
+        raise ValueError("tip_load and samples apply to pinned or free ends only")
     if targets is None:
         raise ValueError("targets are required (only a free tip has none)")
     t, _ = _batch("targets", targets, 3)
@@ -415,6 +424,14 @@ def solve(
     return _solve_result(d, batch, 3, all, pair, turns)
 
 
+def _tip_load(tip_load: Sequence[float]) -> tuple[float, float]:
+    """A free tip's point force (fx, fy), checked."""
+    load = np.asarray(tip_load, dtype=np.float64)
+    if load.shape != (2,) or not np.isfinite(load).all():
+        raise ValueError(f"tip_load must be two finite numbers (fx, fy), got {tip_load!r}")
+    return float(load[0]), float(load[1])
+
+
 def _solve_held(
     targets: npt.ArrayLike | None,
     base_condition: str,
@@ -425,6 +442,8 @@ def _solve_held(
     weight: npt.ArrayLike | None,
     gravity: npt.ArrayLike | None,
     max_turns: int,
+    tip_load: Sequence[float] | None = None,
+    samples: int = 0,
 ) -> SolveResult:
     """``solve`` with a pinned or free end (the native ``solve_held``)."""
     for field, value in (("base_condition", base_condition), ("tip_condition", tip_condition)):
@@ -450,6 +469,8 @@ def _solve_held(
         deadline_ms=deadline_ms,
         max_turns=_integer("max_turns", max_turns, 0, 100),
         threads=_threads(threads),
+        tip_load=None if tip_load is None else _tip_load(tip_load),
+        samples=_integer("samples", samples, 0, 1_000_000),
         **_weight_kwargs(flat, len(arrays)),
     )
     solutions = None
@@ -477,7 +498,21 @@ def _solve_held(
         tip_wrench=_wrench(d["tip_wrench"], batch, 2),
         base_angle=_shaped(d["base_angle"], batch),
         tip=d["tip"].reshape(batch + (3,)),
+        shape=_held_shapes(d["shapes"], batch, samples),
     )
+
+
+def _held_shapes(
+    rows: list[FloatArray], batch: tuple[int, ...], samples: int
+) -> FloatArray | None:
+    """The rods' shapes (..., samples, 3), NaN where a solve failed; None without samples."""
+    if samples < 2:
+        return None
+    out = np.full((len(rows), samples, 3), np.nan)
+    for i, r in enumerate(rows):
+        if len(r):
+            out[i] = r.reshape(samples, 3)
+    return out.reshape(batch + (samples, 3))
 
 
 def forward3d(

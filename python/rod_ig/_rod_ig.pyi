@@ -53,6 +53,8 @@ def solve_held(
     deadline_ms: float | None = None,
     max_turns: int = 0,
     threads: int | None = None,
+    tip_load: tuple[float, float] | None = None,
+    samples: int = 0,
 ) -> dict[str, Any]: ...
 def wrenches(
     a: npt.NDArray[np.float64],

@@ -682,6 +682,9 @@ fn held_request(
 struct HeldRow {
     found: Result<held::HeldSearch, String>,
     target: Option<PlanarPose>,
+    /// The best rod's shape, `samples` poses (x, y, θ) base to tip (empty when not asked or
+    /// when there is no rod).
+    shape: Vec<f64>,
 }
 
 /// Pinned and free ends (issue 52): for each of `n` rods, the least-energy stable
@@ -691,7 +694,7 @@ struct HeldRow {
 #[pyfunction]
 #[pyo3(signature = (n, targets=None, base_condition="clamped", tip_condition="clamped",
                     weight=None, gravity=None, all=false, deadline_ms=None, max_turns=0,
-                    threads=None))]
+                    threads=None, tip_load=None, samples=0))]
 #[allow(clippy::too_many_arguments)]
 fn solve_held<'py>(
     py: Python<'py>,
@@ -705,8 +708,16 @@ fn solve_held<'py>(
     deadline_ms: Option<f64>,
     max_turns: u32,
     threads: Option<i64>,
+    tip_load: Option<[f64; 2]>,
+    samples: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if samples == 1 || samples > 1_000_000 {
+        return Err(PyValueError::new_err(format!(
+            "samples must be 0 (no shape) or in [2, 1000000], got {samples}"
+        )));
+    }
     let t = targets.as_ref().map(|t| t.as_slice()).transpose()?;
+    let tip_load = tip_load.unwrap_or([0.0; 2]);
     let (ends, width) = held_request(n, t, base_condition, tip_condition, max_turns)?;
     let gravities = gravities2(n, weight.as_ref(), gravity.as_ref())?;
     let options = SolveOptions {
@@ -740,10 +751,22 @@ fn solve_held<'py>(
         |i| {
             let g = gravities.as_ref().map_or(Gravity::NONE, |g| g[i]);
             let target = target_of(i);
+            let found =
+                held::equilibria_with_tip_load(ends, &g, tip_load, target.as_ref(), &options)
+                    .map_err(|e| e.to_string());
+            let shape = match (&found, samples) {
+                (Ok(f), 2..) => f
+                    .solutions
+                    .first()
+                    .and_then(|s| s.cable.shape(samples).ok())
+                    .map(|p| p.iter().flat_map(|q| [q.x, q.y, q.theta]).collect())
+                    .unwrap_or_default(),
+                _ => Vec::new(),
+            };
             HeldRow {
-                found: held::equilibria(ends, &g, target.as_ref(), &options)
-                    .map_err(|e| e.to_string()),
+                found,
                 target,
+                shape,
             }
         },
         |i, r| rows[i] = Some(r),
@@ -837,7 +860,9 @@ fn held_dict<'py>(
     let (mut termination, mut reason) = (Vec::with_capacity(n), Vec::with_capacity(n));
     let solutions = PyList::empty(py);
     let solution_angles = PyList::empty(py);
+    let shapes = PyList::empty(py);
     for (i, row) in rows.iter().enumerate() {
+        shapes.append(f64_out(py, row.shape.clone()))?;
         let found = match &row.found {
             Ok(f) => f,
             Err(e) => {
@@ -861,6 +886,7 @@ fn held_dict<'py>(
                 "no_stable_solution"
             };
             termination.push(why.into());
+            reason.push(held::not_found(ends, found).to_string());
             reason.push(format!(
                 "no stable equilibrium found with {} base and {} tip ({} starts){}",
                 ends.base(),
@@ -892,6 +918,7 @@ fn held_dict<'py>(
     d.set_item("reason", reason)?;
     d.set_item("solutions", solutions)?;
     d.set_item("solutions_base_angle", solution_angles)?;
+    d.set_item("shapes", shapes)?;
     Ok(d)
 }
 

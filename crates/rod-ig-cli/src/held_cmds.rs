@@ -15,6 +15,16 @@ use std::time::{Duration, Instant};
 /// Default time budget of a request with held ends (its search tries more starts).
 pub const DEFAULT_HELD_DEADLINE: Duration = Duration::from_millis(1000);
 
+/// Answers one `solve` line: with a pinned or free end here, else the clamped solver
+/// ([`crate::planar_cmds::solve_line`], `verbose`: its events on stderr).
+pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
+    let value: Value = jsonl::parse(line)?;
+    match held_ends_of(&value)? {
+        Some(ends) => solve_held(line, ends),
+        None => crate::planar_cmds::solve_line(line, verbose),
+    }
+}
+
 /// The end conditions a request names, when either is not `"clamped"` (`None`: the paper's
 /// rod, answered by the clamped solver exactly as before). Refusals name the field.
 pub fn held_ends_of(request: &Value) -> Result<Option<HeldEnds>, String> {
@@ -62,6 +72,8 @@ struct HeldRequest {
     weight: Option<f64>,
     gravity: Option<[f64; 2]>,
     max_turns: Option<u32>,
+    /// A point force at a free tip, base frame (units of EI/L²).
+    tip_load: Option<[f64; 2]>,
 }
 
 /// One rod of a held answer.
@@ -152,29 +164,13 @@ pub fn solve_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
         ..SolveOptions::default()
     };
     let g = gravity_of(request.weight, request.gravity)?;
-    let found = held::equilibria(ends, &g, target.as_ref(), &options).map_err(|e| e.to_string())?;
+    let tip_load = request.tip_load.unwrap_or([0.0; 2]);
+    let found = held::equilibria_with_tip_load(ends, &g, tip_load, target.as_ref(), &options)
+        .map_err(|e| e.to_string())?;
     let best = found.solutions.first();
-    let reason = match best {
-        Some(_) => None,
-        None => Some(
-            held::HeldError::NotFound {
-                base: ends.base(),
-                tip: ends.tip(),
-                starts: found.starts,
-                cut: if found.cut_short {
-                    ", cut short by the deadline"
-                } else {
-                    ""
-                },
-                last: found
-                    .last_failure
-                    .clone()
-                    .map(|w| format!(": {w}"))
-                    .unwrap_or_default(),
-            }
-            .to_string(),
-        ),
-    };
+    let reason = best
+        .is_none()
+        .then(|| held::not_found(ends, &found).to_string());
     let termination = match (best, found.cut_short) {
         (Some(_), _) => "converged",
         (None, true) => "deadline",

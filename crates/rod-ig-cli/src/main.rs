@@ -72,7 +72,8 @@ enum Command {
     ///
     /// Ends: "base_condition"? ("clamped" | "pinned") and "tip_condition"? ("clamped" |
     /// "pinned" | "free"), default "clamped". A pinned tip's target is {"x", "y"}; a free tip
-    /// has no target (the equilibria of the cable hanging from its base). Such a line answers
+    /// has no target (the equilibria of the cable hanging from its base; "tip_load"?: [fx, fy],
+    /// a point force hanging from it, base frame, EI/L²). Such a line answers
     /// the least-energy stable rod found (default deadline 1000 ms) with "a", "base_angle"
     /// (θ(0): a pinned base's angle), "tip", "stable", "energy", "elastic_energy",
     /// "stability_margin", "turns", "base_wrench", "tip_wrench", "position_error",
@@ -394,7 +395,7 @@ fn main() -> ExitCode {
         }
         Command::Solve { verbose } => {
             warm_up();
-            jsonl::run(stdin, stdout, |line| planar_cmds::solve_line(line, verbose))
+            jsonl::run(stdin, stdout, |line| held_cmds::solve_line(line, verbose))
                 .map_err(|e| e.to_string())
         }
         Command::Forward3d => {

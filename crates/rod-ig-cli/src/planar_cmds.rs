@@ -117,19 +117,15 @@ struct SolveRequest {
     /// Most full turns of the tangent an answer may make (default 0: loop-free). Applied by
     /// the long-cable search (weight > 200).
     max_turns: Option<u32>,
-    /// "clamped" (the default) here; "pinned" or "free" go to `held_cmds`.
-    #[allow(dead_code)] // read by `held_cmds::held_ends_of`
+    /// "clamped" (the default) here; `held_cmds::solve_line` answers "pinned" and "free".
+    #[allow(dead_code)] // read by `held_cmds::solve_line`
     base_condition: Option<Value>,
-    #[allow(dead_code)] // read by `held_cmds::held_ends_of`
+    #[allow(dead_code)] // read by `held_cmds::solve_line`
     tip_condition: Option<Value>,
 }
 
 /// Answers one `solve` line (`verbose`: the solver's events on stderr).
 pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
-    let value: Value = jsonl::parse(line)?;
-    if let Some(ends) = crate::held_cmds::held_ends_of(&value)? {
-        return crate::held_cmds::solve_held(line, ends);
-    }
     let request: SolveRequest = jsonl::parse(line)?;
     let knobs = Knobs {
         method: request.method,

@@ -321,3 +321,34 @@ fn a_long_cable_pinned_at_both_ends_tends_to_the_catenary() {
         "gap ratio {ratio}"
     );
 }
+
+/// A weightless cantilever with a point load at its free tip (`equilibria_with_tip_load`):
+/// for P L²/EI = 1 the large-deflection elastica's tip sits at (0.94356, −0.30172)
+/// (Bisshopp & Drucker 1945, Q. Appl. Math. 3, table 1: δ_v/L = 0.30172, δ_h/L = 0.05644),
+/// and by the weightless closed form's moment balance κ(1) = a3 + a4 y(1) − a5 x(1) = 0
+/// (checked to 1e-9 on the closed form, independent of the shooting that found it). A load on
+/// a held tip is refused by name.
+#[test]
+fn a_cantilever_with_a_tip_load_matches_the_large_deflection_elastica() {
+    use EndCondition::*;
+    let ends = HeldEnds::new(Clamped, Free).unwrap();
+    let (best, _) =
+        held::least_energy_with_tip_load(ends, &Gravity::NONE, [0.0, -1.0], None, &options(0))
+            .expect("a cantilever");
+    assert!((best.tip.x - 0.94356).abs() < 2e-5, "{:?}", best.tip);
+    assert!((best.tip.y + 0.30172).abs() < 2e-5, "{:?}", best.tip);
+    let tip = rod_ig_core::planar::tip(&best.a).unwrap();
+    let k1 = best.a[0] + best.a[1] * tip.y - best.a[2] * tip.x;
+    assert!(k1.abs() < 1e-9, "κ(1) = {k1}");
+    let pinned = HeldEnds::new(Clamped, Pinned).unwrap();
+    let t = PlanarPose::new(0.5, 0.0, 0.0);
+    let e =
+        held::equilibria_with_tip_load(pinned, &Gravity::NONE, [0.0, -1.0], Some(&t), &options(0));
+    assert!(matches!(
+        e,
+        Err(HeldError::Target {
+            field: "tip_load",
+            ..
+        })
+    ));
+}

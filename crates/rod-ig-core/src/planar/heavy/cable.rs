@@ -194,6 +194,9 @@ pub struct Cable {
     /// The curvature a pinned or free tip's equation asks, κ(1) = this: 0, except while
     /// [`Cable::release_into`] lets a clamp's moment go.
     tip_curvature_goal: f64,
+    /// A point force applied at a free tip (base frame; zero: nothing hangs from it): then
+    /// n(1) = this and n(0) = w ĝ + this.
+    tip_load: [f64; 2],
 }
 
 impl Cable {
@@ -246,7 +249,29 @@ impl Cable {
             rtol: SEGMENT_RTOL,
             ends,
             tip_curvature_goal: 0.0,
+            tip_load: [0.0; 2],
         })
+    }
+
+    /// The same free-tip cable with the point force `load` (base frame, unit rod's units)
+    /// applied at its tip: n(0) = w ĝ + load. Refused unless the tip is free (a held tip's
+    /// gripper takes any load).
+    pub fn with_tip_load(mut self, load: [f64; 2]) -> Result<Self, RodError> {
+        RodError::check_finite("tip_load", &load)?;
+        if self.ends.tip() != EndCondition::Free {
+            return Err(RodError::OutOfDomain(
+                "a tip load needs a free tip (a held tip's gripper takes it)".into(),
+            ));
+        }
+        let l = self.gravity.load();
+        self.tip_load = load;
+        self.force = [l[0] + load[0], l[1] + load[1]];
+        Ok(self)
+    }
+
+    /// The point force applied at a free tip (zero otherwise).
+    pub fn tip_load(&self) -> [f64; 2] {
+        self.tip_load
     }
 
     /// How the two ends are held.
@@ -638,7 +663,8 @@ impl Cable {
     /// The same cable under another gravity (its state unchanged: a predictor).
     fn with_gravity(&self, gravity: Gravity) -> Self {
         let force = if self.ends.tip() == EndCondition::Free {
-            gravity.load()
+            let l = gravity.load();
+            [l[0] + self.tip_load[0], l[1] + self.tip_load[1]]
         } else {
             self.force
         };

@@ -76,7 +76,7 @@ pub struct HeldSolution {
     pub tip: PlanarPose,
     /// κ(1) (0 at a pinned or free tip).
     pub tip_curvature: f64,
-    /// Total energy (elastic + gravitational).
+    /// Total energy (elastic + gravitational, and a free tip's load potential −P · r(1)).
     pub energy: f64,
     /// Elastic energy ½∫κ².
     pub elastic_energy: f64,
@@ -107,7 +107,7 @@ pub struct HeldSearch {
 
 impl HeldSolution {
     /// The wrenches the rod exerts on its grippers ([`crate::wrench`]): at a pinned end the
-    /// moment is zero, at a free tip the whole wrench.
+    /// moment is zero, at a free tip the whole wrench (minus a tip load, if any).
     pub fn wrenches(&self) -> crate::wrench::GripperWrenches<crate::wrench::PlanarWrench> {
         let l = self.cable.gravity().load();
         let n1 = [self.a[1] - l[0], self.a[2] - l[1]];
@@ -119,6 +119,9 @@ fn finish(mut cable: Cable) -> Result<HeldSolution, RodError> {
     cable.unwind_base_angle();
     let tip = cable.tip()?;
     let (energy, elastic_energy) = cable.energies()?;
+    // A tip load's potential: −P · r(1).
+    let load = cable.tip_load();
+    let energy = energy - (load[0] * tip.x + load[1] * tip.y);
     let shape = cable.shape(super::cable::SHAPE_CHECK_SAMPLES)?;
     Ok(HeldSolution {
         a: cable.params(),
@@ -183,11 +186,43 @@ pub fn equilibria(
     target: Option<&PlanarPose>,
     options: &SolveOptions,
 ) -> Result<HeldSearch, HeldError> {
+    equilibria_with_tip_load(ends, gravity, [0.0; 2], target, options)
+}
+
+/// [`equilibria`] with a point force `tip_load` (base frame, units of EI/L²) applied at a free
+/// tip: a weight hanging from the cable's end, a cantilever's tip load. Refused for a held tip
+/// (its gripper takes any load).
+pub fn equilibria_with_tip_load(
+    ends: HeldEnds,
+    gravity: &Gravity,
+    tip_load: [f64; 2],
+    target: Option<&PlanarPose>,
+    options: &SolveOptions,
+) -> Result<HeldSearch, HeldError> {
     let target = checked_target(ends, target)?;
+    if tip_load != [0.0; 2] && ends.tip() != EndCondition::Free {
+        return Err(HeldError::Target {
+            field: "tip_load",
+            why: "a tip load needs a free tip (a held tip's gripper takes it)".into(),
+        });
+    }
+    if !(tip_load
+        .iter()
+        .all(|v| v.is_finite() && v.abs() <= super::MAX_PARAM))
+    {
+        return Err(HeldError::Target {
+            field: "tip_load",
+            why: format!(
+                "each component must be finite, |f| <= {:e}",
+                super::MAX_PARAM
+            ),
+        });
+    }
     let _deadline = crate::deadline::scope(options.deadline);
     let mut search = Search {
         ends,
         gravity: *gravity,
+        tip_load,
         out: HeldSearch::default(),
         max_turns: options.max_turns,
     };
@@ -209,29 +244,48 @@ pub fn least_energy(
     target: Option<&PlanarPose>,
     options: &SolveOptions,
 ) -> Result<(HeldSolution, HeldSearch), HeldError> {
-    let found = equilibria(ends, gravity, target, options)?;
+    least_energy_with_tip_load(ends, gravity, [0.0; 2], target, options)
+}
+
+/// [`least_energy`] with a point force at a free tip ([`equilibria_with_tip_load`]).
+pub fn least_energy_with_tip_load(
+    ends: HeldEnds,
+    gravity: &Gravity,
+    tip_load: [f64; 2],
+    target: Option<&PlanarPose>,
+    options: &SolveOptions,
+) -> Result<(HeldSolution, HeldSearch), HeldError> {
+    let found = equilibria_with_tip_load(ends, gravity, tip_load, target, options)?;
     match found.solutions.first() {
         Some(s) => Ok((s.clone(), found)),
-        None => Err(HeldError::NotFound {
-            base: ends.base(),
-            tip: ends.tip(),
-            starts: found.starts,
-            cut: if found.cut_short {
-                ", cut short by the deadline"
-            } else {
-                ""
-            },
-            last: found
-                .last_failure
-                .map(|w| format!(": {w}"))
-                .unwrap_or_default(),
-        }),
+        None => Err(not_found(ends, &found)),
+    }
+}
+
+/// Why a search found no admitted equilibrium.
+pub fn not_found(ends: HeldEnds, found: &HeldSearch) -> HeldError {
+    HeldError::NotFound {
+        base: ends.base(),
+        tip: ends.tip(),
+        starts: found.starts,
+        cut: if found.cut_short {
+            ", cut short by the deadline"
+        } else {
+            ""
+        },
+        last: found
+            .last_failure
+            .as_ref()
+            .map(|w| format!(": {w}"))
+            .unwrap_or_default(),
     }
 }
 
 struct Search {
     ends: HeldEnds,
     gravity: Gravity,
+    /// The point force at a free tip (zero otherwise).
+    tip_load: [f64; 2],
     out: HeldSearch,
     max_turns: u32,
 }
@@ -275,7 +329,7 @@ impl Search {
         self.out.equilibria.push(s);
     }
 
-    /// Free tip: the roots of κ(1)(a3) on |a3| ≤ w/2 (module docs).
+    /// Free tip: the roots of κ(1)(a3) on |a3| ≤ w/2 + |P| (module docs).
     fn free_tip(&mut self) {
         let w = self.gravity.weight();
         let scan = if w > SCAN_WEIGHT {
@@ -286,14 +340,16 @@ impl Search {
             self.gravity
         };
         let dummy = PlanarPose::new(0.0, 0.0, 0.0);
-        for a3 in free_tip_roots(&scan) {
+        let load = self.tip_load;
+        for a3 in free_tip_roots(&scan, load) {
             if crate::deadline::expired() {
                 return;
             }
             let target = self.gravity;
             let ends = self.ends;
             self.keep((|| {
-                let mut c = Cable::held(0.0, &PlanarParams::new(a3, 0.0, 0.0), &scan, ends)?;
+                let c = Cable::held(0.0, &PlanarParams::new(a3, 0.0, 0.0), &scan, ends)?;
+                let mut c = c.with_tip_load(load)?;
                 c.solve(&dummy)?;
                 if scan != target {
                     c.carry_within(&target, &dummy, &FollowLimits::default())?;
@@ -371,26 +427,29 @@ impl Search {
     }
 }
 
-/// κ(1) of the clamped rod with base moment `a3` and a free tip (n(0) = w ĝ), by single
-/// shooting.
-fn free_tip_curvature(a3: f64, gravity: &Gravity) -> Option<f64> {
+/// κ(1) of the clamped rod with base moment `a3` and a free tip carrying `load`
+/// (n(0) = w ĝ + load), by single shooting.
+fn free_tip_curvature(a3: f64, gravity: &Gravity, load: [f64; 2]) -> Option<f64> {
     let l = gravity.load();
-    let a = PlanarParams::new(a3, l[0], l[1]);
+    let a = PlanarParams::new(a3, l[0] + load[0], l[1] + load[1]);
     series::integrate(&gravity.problem(&a), false, |_| true)
         .ok()
         .map(|end| end.kappa)
         .filter(|k| k.is_finite())
 }
 
-/// The roots of κ(1)(a3) on [−w/2, w/2] found by a uniform scan and bisection (w = 0: the
-/// straight rod, a3 = 0).
-pub fn free_tip_roots(gravity: &Gravity) -> Vec<f64> {
+/// The roots of κ(1)(a3) of a free tip carrying `load` on |a3| ≤ w/2 + |load| (the moment
+/// balance about the base: |r(t)| ≤ t), found by a uniform scan and bisection (no weight and
+/// no load: the straight rod, a3 = 0).
+pub fn free_tip_roots(gravity: &Gravity, load: [f64; 2]) -> Vec<f64> {
     let w = gravity.weight();
-    if w == 0.0 {
+    let bound = 0.5 * w + load[0].hypot(load[1]);
+    if bound == 0.0 {
         return vec![0.0];
     }
-    let n = ((SCAN_PER_WEIGHT * w) as usize).clamp(SCAN_POINTS.0, SCAN_POINTS.1);
-    let a3_at = |i: usize| -0.5 * w + w * i as f64 / n as f64;
+    let n = ((SCAN_PER_WEIGHT * 2.0 * bound) as usize).clamp(SCAN_POINTS.0, SCAN_POINTS.1);
+    let a3_at = |i: usize| -bound + 2.0 * bound * i as f64 / n as f64;
+    let curvature = |a3: f64| free_tip_curvature(a3, gravity, load);
     let mut roots = Vec::new();
     let mut prev: Option<(f64, f64)> = None;
     for i in 0..=n {
@@ -398,7 +457,7 @@ pub fn free_tip_roots(gravity: &Gravity) -> Vec<f64> {
             break;
         }
         let a3 = a3_at(i);
-        let Some(k) = free_tip_curvature(a3, gravity) else {
+        let Some(k) = curvature(a3) else {
             prev = None;
             continue;
         };
@@ -406,7 +465,7 @@ pub fn free_tip_roots(gravity: &Gravity) -> Vec<f64> {
             roots.push(a3);
         } else if let Some((a_prev, k_prev)) = prev {
             if k_prev != 0.0 && k.signum() != k_prev.signum() {
-                if let Some(r) = bisect(a_prev, k_prev, a3, gravity) {
+                if let Some(r) = bisect(a_prev, k_prev, a3, &curvature) {
                     roots.push(r);
                 }
             }
@@ -417,13 +476,18 @@ pub fn free_tip_roots(gravity: &Gravity) -> Vec<f64> {
 }
 
 /// Bisection of κ(1) on [lo, hi] (κ(1)(lo) = `k_lo`, of the other sign at hi).
-fn bisect(mut lo: f64, k_lo: f64, mut hi: f64, gravity: &Gravity) -> Option<f64> {
+fn bisect(
+    mut lo: f64,
+    k_lo: f64,
+    mut hi: f64,
+    curvature: &impl Fn(f64) -> Option<f64>,
+) -> Option<f64> {
     for _ in 0..80 {
         let mid = 0.5 * (lo + hi);
         if mid <= lo || mid >= hi {
             break;
         }
-        let k = free_tip_curvature(mid, gravity)?;
+        let k = curvature(mid)?;
         if k.signum() == k_lo.signum() {
             lo = mid;
         } else {
