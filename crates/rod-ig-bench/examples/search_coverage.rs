@@ -35,6 +35,13 @@
 //!     states integrated from the base, kept when stable by the second variation, loop-free,
 //!     not crossing itself and |tip| <= 0.98), solved from no guess (deadline 2 s; objective
 //!     `first` or `least_energy`); each answer re-checked on target (1e-6) and stable
+//! cargo run --release -p rod-ig-bench --example search_coverage -- pinned N SEED
+//!     issue 52's held ends: N stable, loop-free equilibria with a pinned tip (clamped or
+//!     pinned base; w = 10^U(-1, log 300), gravity along -y for half), drawn as a free tip
+//!     carrying a log-scale force (clamped base: every root of κ(1)(a3)) or as a scan of the
+//!     base angle for κ(1) = 0 (pinned base, a3 = 0) -- not the search's route -- and each
+//!     solved from its tip's position by `held::least_energy` (deadline 2 s); prints the
+//!     misses, the answers of more energy than the drawn rod, the count and the times
 //! cargo run --release -p rod-ig-bench --example search_coverage -- long3d N SEED
 //!     the same in 3-D (`families::long_cable_3d`: the planar long cables turned into a random
 //!     plane and carried out of it, stable in 3-D), solved with the default options
@@ -60,6 +67,7 @@ fn main() {
         Some("heavy") => heavy_coverage(num(1, 3000) as usize, num(2, 41)),
         Some("heavy3d") => heavy_coverage_3d(num(1, 500) as usize, num(2, 43)),
         Some("long3d") => long_coverage_3d(num(1, 100) as usize, num(2, 53)),
+        Some("pinned") => pinned_coverage(num(1, 200) as usize, num(2, 52)),
         Some("long") => long_coverage(
             num(1, 200) as usize,
             num(2, 51),
@@ -487,6 +495,152 @@ fn solve_and_report(
         q(0.5),
         q(0.9),
         q(0.99),
+        q(1.0)
+    );
+}
+
+/// Draws stable loop-free equilibria with a pinned tip (module docs, `pinned`).
+fn pinned_cases(
+    n: usize,
+    seed: u64,
+) -> Vec<(
+    rod_ig_core::ends::HeldEnds,
+    rod_ig_core::planar::heavy::held::HeldSolution,
+)> {
+    use rod_ig_core::ends::{EndCondition::*, HeldEnds};
+    use rod_ig_core::planar::heavy::{cable::Cable, held, Gravity};
+    let mut r = SplitMix64::new(seed);
+    let mut out = Vec::new();
+    let dummy = PlanarPose::new(0.0, 0.0, 0.0);
+    while out.len() < n {
+        let w = 10f64.powf(r.range(-1.0, 300f64.log10()));
+        let psi = if r.uniform() < 0.5 {
+            -PI / 2.0
+        } else {
+            r.range(-PI, PI)
+        };
+        let g = Gravity::new(w, [psi.cos(), psi.sin()]).expect("gravity");
+        let pinned_base = r.uniform() < 0.5;
+        let (mag, dir) = (
+            10f64.powf(r.range(-1.0, (50.0 + w).log10())),
+            r.range(-PI, PI),
+        );
+        let force = [mag * dir.cos(), mag * dir.sin()];
+        let ends = HeldEnds::new(if pinned_base { Pinned } else { Clamped }, Pinned).expect("ends");
+        // (base angle, a) of the drawn equilibria.
+        let mut drawn: Vec<(f64, PlanarParams)> = Vec::new();
+        if pinned_base {
+            let k1 = |t0: f64| {
+                Cable::held(t0, &PlanarParams::new(0.0, force[0], force[1]), &g, ends)
+                    .and_then(|c| c.tip_curvature())
+                    .ok()
+            };
+            let m = 720;
+            let mut prev: Option<(f64, f64)> = None;
+            for i in 0..=m {
+                let t0 = -PI + 2.0 * PI * i as f64 / m as f64;
+                let Some(k) = k1(t0) else { continue };
+                if let Some((tp, kp)) = prev {
+                    if kp.signum() != k.signum() {
+                        let (mut lo, mut hi) = (tp, t0);
+                        for _ in 0..60 {
+                            let mid = 0.5 * (lo + hi);
+                            match k1(mid) {
+                                Some(km) if km.signum() == kp.signum() => lo = mid,
+                                Some(_) => hi = mid,
+                                None => break,
+                            }
+                        }
+                        drawn.push((0.5 * (lo + hi), PlanarParams::new(0.0, force[0], force[1])));
+                    }
+                }
+                prev = Some((t0, k));
+            }
+        } else {
+            let l = g.load();
+            let tip_load = [force[0] - l[0], force[1] - l[1]];
+            for a3 in held::free_tip_roots(&g, tip_load) {
+                drawn.push((0.0, PlanarParams::new(a3, force[0], force[1])));
+            }
+        }
+        for (t0, a) in drawn {
+            let Ok(mut c) = Cable::held(t0, &a, &g, ends) else {
+                continue;
+            };
+            let Ok(tip) = c.tip() else { continue };
+            // Polish κ(1) = 0 at this tip position (the cable's own Newton).
+            let target = PlanarPose::new(tip.x, tip.y, 0.0);
+            if c.solve(&target).is_err() {
+                continue;
+            }
+            let Ok(s) = held::HeldSolution::of(c) else {
+                continue;
+            };
+            if s.stability.stable()
+                && s.turns == 0
+                && !s.self_intersects
+                && s.tip.x.hypot(s.tip.y) <= 0.98
+                && out.len() < n
+            {
+                out.push((ends, s));
+            }
+        }
+        let _ = dummy;
+        eprint!("\rdrawn {}", out.len());
+    }
+    eprintln!();
+    out
+}
+
+fn pinned_coverage(n: usize, seed: u64) {
+    use rod_ig_core::planar::heavy::held;
+    let cases = pinned_cases(n, seed);
+    let options = ig::SolveOptions {
+        deadline: Duration::from_secs(2),
+        ..ig::SolveOptions::default()
+    };
+    let (mut solved, mut worse, mut times) = (0usize, 0usize, Vec::new());
+    for (ends, drawn) in &cases {
+        let g = *drawn.cable.gravity();
+        let target = PlanarPose::new(drawn.tip.x, drawn.tip.y, 0.0);
+        let t0 = Instant::now();
+        let result = held::least_energy(*ends, &g, Some(&target), &options);
+        times.push(t0.elapsed().as_secs_f64() * 1e3);
+        match result {
+            Ok((s, _)) if (s.tip.x - target.x).hypot(s.tip.y - target.y) <= 1e-9 => {
+                solved += 1;
+                if s.energy > drawn.energy + 1e-9 * (1.0 + drawn.energy.abs()) {
+                    worse += 1;
+                    println!(
+                        "worse {:?} w {:.4e} g {:?} target {:.9},{:.9} drawn E {:.9} a {:?} θ0 {:.9}; answer E {:.9}",
+                        ends, g.weight(), g.direction(), target.x, target.y, drawn.energy,
+                        drawn.a.as_slice(), drawn.base_angle, s.energy
+                    );
+                }
+            }
+            other => println!(
+                "miss {:?} w {:.4e} g {:?} target {:.9},{:.9} a {:?} θ0 {:.9}: {}",
+                ends,
+                g.weight(),
+                g.direction(),
+                target.x,
+                target.y,
+                drawn.a.as_slice(),
+                drawn.base_angle,
+                other
+                    .err()
+                    .map_or("off target".to_string(), |e| e.to_string())
+            ),
+        }
+    }
+    times.sort_by(f64::total_cmp);
+    let q = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
+    println!(
+        "{solved} of {} solved ({:.2} %), {worse} of more energy than the drawn rod; ms median {:.1}, p90 {:.1}, max {:.1}",
+        cases.len(),
+        100.0 * solved as f64 / cases.len().max(1) as f64,
+        q(0.5),
+        q(0.9),
         q(1.0)
     );
 }

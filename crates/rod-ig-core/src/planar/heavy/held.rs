@@ -115,26 +115,31 @@ impl HeldSolution {
     }
 }
 
-fn finish(mut cable: Cable) -> Result<HeldSolution, RodError> {
-    cable.unwind_base_angle();
-    let tip = cable.tip()?;
-    let (energy, elastic_energy) = cable.energies()?;
-    // A tip load's potential: −P · r(1).
-    let load = cable.tip_load();
-    let energy = energy - (load[0] * tip.x + load[1] * tip.y);
-    let shape = cable.shape(super::cable::SHAPE_CHECK_SAMPLES)?;
-    Ok(HeldSolution {
-        a: cable.params(),
-        base_angle: cable.base_angle(),
-        tip,
-        tip_curvature: cable.tip_curvature()?,
-        energy,
-        elastic_energy,
-        stability: cable.second_variation()?,
-        turns: super::cable::turns_of(&shape),
-        self_intersects: super::cable::self_intersects(&shape),
-        cable,
-    })
+impl HeldSolution {
+    /// The equilibrium `cable` (solved on its end conditions) with its energies (a free
+    /// tip's load potential included), stability, turns and crossings; a pinned base's angle
+    /// unwound into (−π, π].
+    pub fn of(mut cable: Cable) -> Result<Self, RodError> {
+        cable.unwind_base_angle();
+        let tip = cable.tip()?;
+        let (energy, elastic_energy) = cable.energies()?;
+        // A tip load's potential: −P · r(1).
+        let load = cable.tip_load();
+        let energy = energy - (load[0] * tip.x + load[1] * tip.y);
+        let shape = cable.shape(super::cable::SHAPE_CHECK_SAMPLES)?;
+        Ok(HeldSolution {
+            a: cable.params(),
+            base_angle: cable.base_angle(),
+            tip,
+            tip_curvature: cable.tip_curvature()?,
+            energy,
+            elastic_energy,
+            stability: cable.second_variation()?,
+            turns: super::cable::turns_of(&shape),
+            self_intersects: super::cable::self_intersects(&shape),
+            cable,
+        })
+    }
 }
 
 /// The target as the tip's condition needs it: a pose (clamped), a position (pinned, θ is
@@ -244,18 +249,11 @@ pub fn least_energy(
     target: Option<&PlanarPose>,
     options: &SolveOptions,
 ) -> Result<(HeldSolution, HeldSearch), HeldError> {
-    least_energy_with_tip_load(ends, gravity, [0.0; 2], target, options)
+    best_of(ends, equilibria(ends, gravity, target, options)?)
 }
 
-/// [`least_energy`] with a point force at a free tip ([`equilibria_with_tip_load`]).
-pub fn least_energy_with_tip_load(
-    ends: HeldEnds,
-    gravity: &Gravity,
-    tip_load: [f64; 2],
-    target: Option<&PlanarPose>,
-    options: &SolveOptions,
-) -> Result<(HeldSolution, HeldSearch), HeldError> {
-    let found = equilibria_with_tip_load(ends, gravity, tip_load, target, options)?;
+/// The least-energy admitted equilibrium a search `found` (with `ends`), or why there is none.
+pub fn best_of(ends: HeldEnds, found: HeldSearch) -> Result<(HeldSolution, HeldSearch), HeldError> {
     match found.solutions.first() {
         Some(s) => Ok((s.clone(), found)),
         None => Err(not_found(ends, &found)),
@@ -300,7 +298,7 @@ impl Search {
     /// Finishes a start's cable and keeps it when it is new.
     fn keep(&mut self, reached: Result<Cable, CableError>) {
         self.out.starts += 1;
-        let s = match reached.and_then(|c| finish(c).map_err(CableError::from)) {
+        let s = match reached.and_then(|c| HeldSolution::of(c).map_err(CableError::from)) {
             Ok(s) => s,
             Err(e) => {
                 self.out.last_failure = Some(e.to_string());
@@ -368,6 +366,7 @@ impl Search {
             max_theta_spread: std::f64::consts::TAU * (self.max_turns as f64 + 1.5),
             ..FollowLimits::default()
         };
+        self.heavy_starts(target, false);
         let mut seeds: Vec<(Cable, PlanarPose)> = Vec::new();
         for (theta0, theta1) in angle_pairs(self.ends, target) {
             for a in weightless_rods(theta0, theta1, target, options) {
@@ -402,6 +401,11 @@ impl Search {
                 Ok(c)
             })());
         }
+        // Nothing yet: the heavy search again, each angle pair with its share of the time left
+        // (nearly taut rods under tension need more than the first pass's budget).
+        if self.out.solutions.is_empty() {
+            self.heavy_starts(target, true);
+        }
     }
 
     /// The weightless clamped rod (base angle `theta0`, base wrench `a`) on target, its
@@ -413,7 +417,13 @@ impl Search {
         target: &PlanarPose,
     ) -> Option<(Cable, PlanarPose)> {
         let weightless = self.gravity.with_weight(0.0).unwrap_or(Gravity::NONE);
-        let mut c = Cable::held(theta0, a, &weightless, HeldEnds::CLAMPED).ok()?;
+        let c = Cable::held(theta0, a, &weightless, HeldEnds::CLAMPED).ok()?;
+        self.release(c, target)
+    }
+
+    /// The clamped cable `c` corrected on target (at its own tip angle where the tip is
+    /// pinned), its moments released into this search's ends; and the target its tip is held at.
+    fn release(&self, mut c: Cable, target: &PlanarPose) -> Option<(Cable, PlanarPose)> {
         let tip = c.tip().ok()?;
         // The clamped rod is corrected on its own tip angle (a pinned tip's target has none).
         let lifted = if self.ends.tip() == EndCondition::Pinned {
@@ -425,7 +435,71 @@ impl Search {
         c.release_into(self.ends, &lifted).ok()?;
         Some((c, lifted))
     }
+
+    /// The first stage with weight (and, `patient`, the last where nothing was found, each
+    /// pair with its share of the time left): at each (base, tip) angle pair the heavy clamped search
+    /// (in the frame turned by the base angle, gravity turned back) at the rod's own weight,
+    /// its moments released at that weight. A long cable (w > 200) is taken only with an
+    /// unturned base, from the node states its search remembered.
+    fn heavy_starts(&mut self, target: &PlanarPose, patient: bool) {
+        if self.gravity.is_weightless() {
+            return;
+        }
+        let pairs = angle_pairs(self.ends, target);
+        let count = pairs.len();
+        let w = self.gravity.weight();
+        let long = w > super::cable_search::LONG_CABLE_WEIGHT;
+        let dir = self.gravity.direction();
+        for (i, (theta0, theta1)) in pairs.into_iter().enumerate() {
+            if crate::deadline::expired() {
+                return;
+            }
+            if long && theta0 != 0.0 {
+                continue;
+            }
+            // The patient pass: this pair's share of the time left, at most 1/4 of it.
+            let _share = patient
+                .then(|| crate::deadline::share_of_remaining(1.0 / (count - i).max(4) as f64));
+            let (s, c) = theta0.sin_cos();
+            let Ok(local_g) = Gravity::new(w, [c * dir[0] + s * dir[1], -s * dir[0] + c * dir[1]])
+            else {
+                continue;
+            };
+            let local = PlanarPose::new(
+                c * target.x + s * target.y,
+                -s * target.x + c * target.y,
+                crate::wrap_angle(theta1 - theta0),
+            );
+            let opts = SolveOptions {
+                deadline: match (patient, long) {
+                    (true, _) => crate::planar::ig::MAX_DEADLINE,
+                    (false, true) => HEAVY_DEADLINE * 10,
+                    (false, false) => HEAVY_DEADLINE,
+                },
+                objective: crate::solver::Objective::FirstFound,
+                ..SolveOptions::default()
+            };
+            let Ok(sol) = crate::solver::solve(&super::HeavyPlanar::new(local_g), &local, &opts)
+            else {
+                continue;
+            };
+            let a = sol.a;
+            let cable = if long {
+                super::cable_search::recall(&a, &local_g)
+            } else {
+                let turned = PlanarParams::new(a[0], c * a[1] - s * a[2], s * a[1] + c * a[2]);
+                Cable::held(theta0, &turned, &self.gravity, HeldEnds::CLAMPED).ok()
+            };
+            match cable.and_then(|cable| self.release(cable, target)) {
+                Some((released, _)) => self.keep(Ok(released)),
+                None => self.out.starts += 1,
+            }
+        }
+    }
 }
+
+/// Time the heavy clamped search may spend at one angle pair (ten times that for a long cable).
+const HEAVY_DEADLINE: std::time::Duration = std::time::Duration::from_millis(20);
 
 /// κ(1) of the clamped rod with base moment `a3` and a free tip carrying `load`
 /// (n(0) = w ĝ + load), by single shooting.
@@ -499,8 +573,9 @@ fn bisect(
 
 /// The (base, tip) angles of the weightless clamped rods the search starts from, most
 /// promising first: a clamped end keeps its own angle, a pinned end tries the chord's
-/// direction χ plus k π/4; with both ends pinned the symmetric pairs (χ + δ, χ − δ) come first
-/// (the weightless pinned–pinned elastica is symmetric about its chord), the others after.
+/// direction χ plus k π/4; first come the angles symmetric about the chord (θ0 + θ1 = 2χ: with
+/// both ends pinned every such pair, as the weightless pinned–pinned elastica is symmetric
+/// about its chord; with one end pinned the arc of a circle, the nearly taut rod's).
 fn angle_pairs(ends: HeldEnds, target: &PlanarPose) -> Vec<(f64, f64)> {
     let chord = target.y.atan2(target.x);
     let turned = |k: usize| crate::wrap_angle(chord + FRAC_PI_4 * k as f64);
@@ -512,8 +587,16 @@ fn angle_pairs(ends: HeldEnds, target: &PlanarPose) -> Vec<(f64, f64)> {
         }
     };
     let mut pairs = Vec::new();
-    if ends.base() == EndCondition::Pinned && ends.tip() == EndCondition::Pinned {
-        pairs.extend((0..ANGLES).map(|k| (turned(k), 2.0 * chord - turned(k))));
+    match (ends.base(), ends.tip()) {
+        (EndCondition::Pinned, EndCondition::Pinned) => {
+            pairs.extend((0..ANGLES).map(|k| (turned(k), 2.0 * chord - turned(k))));
+        }
+        // The arc of a circle through the target: the nearly taut rod's tip angle.
+        (EndCondition::Clamped, EndCondition::Pinned) => pairs.push((0.0, 2.0 * chord)),
+        (EndCondition::Pinned, EndCondition::Clamped) => {
+            pairs.push((2.0 * chord - target.theta, target.theta))
+        }
+        _ => {}
     }
     for theta0 in around(ends.base(), 0.0) {
         for theta1 in around(ends.tip(), target.theta) {
