@@ -411,15 +411,10 @@ fn solve_and_report_3d(
             a.as_slice()
         );
     }
-    times.sort_by(f64::total_cmp);
-    let q = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
     println!(
-        "{solved} of {tried} solved ({:.2} %), {wrong} wrong; µs median {:.0}, p90 {:.0}, p99 {:.0}, max {:.0}",
+        "{solved} of {tried} solved ({:.2} %), {wrong} wrong; µs {}",
         100.0 * solved as f64 / tried.max(1) as f64,
-        q(0.5),
-        q(0.9),
-        q(0.99),
-        q(1.0)
+        quantiles(&mut times)
     );
 }
 
@@ -486,16 +481,11 @@ fn solve_and_report(
             a[2]
         );
     }
-    times.sort_by(f64::total_cmp);
-    let q = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
     println!(
-        "{solved} of {} solved ({:.2} %), {wrong} wrong; ms median {:.2}, p90 {:.2}, p99 {:.2}, max {:.2}",
+        "{solved} of {} solved ({:.2} %), {wrong} wrong; ms {}",
         cases.len(),
         100.0 * solved as f64 / cases.len().max(1) as f64,
-        q(0.5),
-        q(0.9),
-        q(0.99),
-        q(1.0)
+        quantiles(&mut times)
     );
 }
 
@@ -633,14 +623,26 @@ fn pinned_coverage(n: usize, seed: u64) {
             ),
         }
     }
-    times.sort_by(f64::total_cmp);
-    let q = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
     println!(
-        "{solved} of {} solved ({:.2} %), {worse} of more energy than the drawn rod; ms median {:.1}, p90 {:.1}, max {:.1}",
+        "{solved} of {} solved ({:.2} %), {worse} of more energy than the drawn rod; ms {}",
         cases.len(),
         100.0 * solved as f64 / cases.len().max(1) as f64,
+        quantiles(&mut times)
+    );
+}
+
+/// "median m, p90 a, p99 b, max c" of `times` (sorted here), to three significant digits.
+fn quantiles(times: &mut [f64]) -> String {
+    if times.is_empty() {
+        return "(none)".into();
+    }
+    times.sort_by(f64::total_cmp);
+    let q = |p: f64| times[((times.len() - 1) as f64 * p) as usize];
+    format!(
+        "median {:.3}, p90 {:.3}, p99 {:.3}, max {:.3}",
         q(0.5),
         q(0.9),
+        q(0.99),
         q(1.0)
-    );
+    )
 }
