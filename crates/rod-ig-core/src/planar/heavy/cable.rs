@@ -253,6 +253,46 @@ impl Cable {
         })
     }
 
+    /// A clamped cable with base force `force` whose node states are a guessed shape:
+    /// `angle_of(t)` = (θ, κ) at t, positions integrated from the angle (Simpson, `steps` per
+    /// segment). Not an equilibrium: a start for [`Cable::solve`]
+    /// ([`super::catenary::seed`]).
+    pub(crate) fn from_states(
+        gravity: &Gravity,
+        force: [f64; 2],
+        angle_of: impl Fn(f64) -> (f64, f64),
+        steps: usize,
+    ) -> Result<Self, RodError> {
+        RodError::check_finite("force", &force)?;
+        let mesh = uniform_mesh(segments_for(force_max(force, gravity.load())));
+        let mut nodes = Vec::with_capacity(mesh.len() - 1);
+        let (mut x, mut y) = (0.0, 0.0);
+        for k in 0..mesh.len() - 1 {
+            let (theta, kappa) = angle_of(mesh[k]);
+            RodError::check_finite("the seed's state", &[theta, kappa, x, y])?;
+            nodes.push([x, y, if k == 0 { 0.0 } else { theta }, kappa]);
+            let h = (mesh[k + 1] - mesh[k]) / steps as f64;
+            for i in 0..steps {
+                let t = mesh[k] + i as f64 * h;
+                for (weight, s) in [(1.0, t), (4.0, t + 0.5 * h), (1.0, t + h)] {
+                    let theta = angle_of(s).0;
+                    x += weight * h / 6.0 * theta.cos();
+                    y += weight * h / 6.0 * theta.sin();
+                }
+            }
+        }
+        Ok(Self {
+            gravity: *gravity,
+            mesh,
+            force,
+            nodes,
+            rtol: SEGMENT_RTOL,
+            ends: HeldEnds::CLAMPED,
+            tip_curvature_goal: 0.0,
+            tip_load: [0.0; 2],
+        })
+    }
+
     /// The same free-tip cable with the point force `load` (base frame, unit rod's units)
     /// applied at its tip: n(0) = w ĝ + load. Refused unless the tip is free (a held tip's
     /// gripper takes any load).

@@ -3,7 +3,8 @@
 //! the target, and which answers it admits.
 //!
 //! Starts, in order: the caller's guess (corrected where it is, then moved to the target);
-//! every stable weightless rod through the target (the closed forms' search, loop-free ones
+//! the catenary through the grippers with a tension layer at each clamp ([`super::catenary`]),
+//! corrected by Newton at the full weight; every stable weightless rod through the target (the closed forms' search, loop-free ones
 //! first, least energy under the weight to first order first), each carried from w = 0 to the rod's weight with the gripper
 //! fixed; the same rods with the load shared by both grippers, a + (0, w ĝ/2), moved from
 //! where they end to the target at the full weight; then the stable rods the single-shooting
@@ -291,7 +292,11 @@ pub fn search(
     };
     // 1. The caller's guess.
     if let Some(a0) = options.initial_guess {
-        s.start(|s| from_guess(&a0, s.gravity, s.target, &s.limits));
+        s.start(|s| from_guess(&a0, s.gravity, s.target, s.admission));
+    }
+    // 1b. The catenary through the grippers with its tension layers, at the full weight.
+    if !s.done() {
+        s.start(|s| catenary_seeded(s.gravity, s.target));
     }
     // 2. and 3. The weightless rods through the target: carried in load, then shared-load
     // seeds moved to the target.
@@ -408,6 +413,18 @@ fn carried(
     Ok((c, it + steps))
 }
 
+/// The catenary seed ([`super::catenary`]) corrected on the target by Newton at the full
+/// weight.
+fn catenary_seeded(gravity: &Gravity, target: &PlanarPose) -> Result<(Cable, u32), CableError> {
+    let Some((mut c, lifted)) = super::catenary::seed(target, gravity)? else {
+        return Err(CableError::Rod(RodError::OutOfDomain(
+            "no catenary through the target (a vertical or taut chord)".into(),
+        )));
+    };
+    let it = c.solve(&lifted)?;
+    Ok((c, it as u32))
+}
+
 /// The rod a + (0, w ĝ / 2) at the full weight (each gripper holding half of it), moved from
 /// where it ends to `target`.
 fn seed_moved(
@@ -431,7 +448,7 @@ pub fn newton(
     options: &SolveOptions,
 ) -> Result<Solution<PlanarParams, PlanarPose>, Failure<PlanarParams>> {
     let admission = Admission::of(options);
-    let reached = from_guess(a0, gravity, target, &limits_of(admission));
+    let reached = from_guess(a0, gravity, target, admission);
     one_start_outcome(
         reached,
         target,
@@ -495,28 +512,53 @@ fn moved(
 }
 
 /// The caller's guess: a rod a solver returned is moved from where it is to the target along
-/// its branch; another `a0` is integrated to its cable, corrected on target where it is, else
-/// moved there.
+/// its branch. Another `a0` is tried three ways, and the first rod `admission` admits is
+/// returned (else the last one reached, for the caller to reject with its reason): the cable
+/// `a0` integrates to, corrected on the target where it is; the perfect cable under a0's force
+/// with its clamp layers (at large w the integrated cable has lost its digits), corrected; the
+/// integrated cable moved to the target.
 fn from_guess(
     a0: &PlanarParams,
     gravity: &Gravity,
     target: &PlanarPose,
-    limits: &FollowLimits,
+    admission: Admission,
 ) -> Result<(Cable, u32), CableError> {
+    let limits = limits_of(admission);
     // A rod a solver returned: its node states, moved to the target (tracking).
     if let Some(mut c) = recall(a0, gravity) {
-        let steps = c.move_within(target, limits)?;
+        let steps = c.move_within(target, &limits)?;
         return Ok((c, steps));
     }
-    let c = Cable::from_params(a0, gravity)?;
-    let lifted = lift_near(target, c.tip()?.theta);
-    let mut direct = c.clone();
-    if let Ok(it) = direct.solve(&lifted) {
-        return Ok((direct, it as u32));
+    let integrated = Cable::from_params(a0, gravity)?;
+    let lifted = lift_near(target, integrated.tip()?.theta);
+    let direct = || {
+        let mut c = integrated.clone();
+        c.solve(&lifted).map(|it| (c, it as u32))
+    };
+    let force_seeded = || match super::catenary::seed_with_force([a0[1], a0[2]], target, gravity)? {
+        Some((mut c, lifted)) => c.solve(&lifted).map(|it| (c, it as u32)),
+        None => Err(CableError::Singular),
+    };
+    let moved = || {
+        let mut c = integrated.clone();
+        c.move_within(target, &limits).map(|steps| (c, steps))
+    };
+    let tries: [&dyn Fn() -> Result<(Cable, u32), CableError>; 3] =
+        [&direct, &force_seeded, &moved];
+    let mut last = Err(CableError::Singular);
+    for attempt in tries {
+        let reached = attempt();
+        if let Ok((c, _)) = &reached {
+            let admitted = finish(c.clone(), 0).is_ok_and(|s| admission.admits(&s));
+            if admitted {
+                return reached;
+            }
+        }
+        if reached.is_ok() || last.is_err() {
+            last = reached;
+        }
     }
-    let mut moved = c;
-    let steps = moved.move_within(target, limits)?;
-    Ok((moved, steps))
+    last
 }
 
 /// Cables the solvers returned, remembered so that the shape, energy and stability of an
