@@ -59,7 +59,7 @@ def rod_solution():
         spatial=True, a_spatial=[0.5, -0.25, 1.5, -2.25, 3.125, 0.75],
         event="snap", critical_pose=pose(2), weight=15.1, total_energy=3.25,
         tip_wrench=Wrench(force=Vector3(x=-0.5, y=0.25, z=0.0), torque=Vector3(x=0.0, y=0.0, z=1.75)),
-        base_condition="pinned", tip_condition="free", base_angle=-0.5)
+        base_condition="pinned", tip_condition="free", base_angle=-0.5, turns=2)
 
 
 def request():

@@ -107,13 +107,14 @@ def harness():
 
 def test_a_one_metre_harness_hangs_and_follows_the_gripper(harness):
     """w = 2,000 held level 0.8 m apart: the hanging, loop-free cable (each gripper holds half of
-    the weight: a5 = -w/2), its path below the grippers with the reference sag 0.2676 m; the
+    the weight: a5 = -w/2; turns 0), its path below the grippers with the reference sag 0.2676 m; the
     next target starts from the rod just returned (its node states) and is solved too."""
     _, c = harness
     sol, path = solve_topic(c, 0.8, 0.0, 0.0)
     assert sol.success, sol.message
     assert sol.stable and math.isclose(sol.weight, 2000.0, rel_tol=1e-9)
     assert abs(sol.a[2] + 1000.0) < 1e-6
+    assert sol.turns == 0  # loop-free (RodSolution.turns, appended)
     ys = [p.pose.position.y for p in path.poses]
     assert max(ys) <= 1e-9 and abs(-min(ys) - 0.2676) < 5e-3  # 100 path samples: the sag to 5 mm
     last = path.poses[-1].pose.position

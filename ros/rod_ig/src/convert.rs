@@ -516,6 +516,8 @@ struct ModelParts {
     elastic_energy: f64,
     /// θ(0): 0 unless the base is pinned.
     base_angle: f64,
+    /// Full turns of the planar tangent along the shape (0 in 3-D).
+    turns: u32,
 }
 
 /// Scales a converged answer to physical units (rod length L, bending stiffness EI).
@@ -574,6 +576,7 @@ fn converged_message<P, X>(
         base_condition: params.base_condition.name().into(),
         tip_condition: params.tip_condition.name().into(),
         base_angle: c.base_angle,
+        turns: c.turns,
     }
 }
 
@@ -621,6 +624,7 @@ pub fn solution_message_3d(
         weight,
         elastic_energy,
         base_angle: 0.0,
+        turns: 0,
     };
     converged_message(s, parts, header, params, solve_time)
 }
@@ -652,6 +656,7 @@ pub fn solution_message(
         weight: solved.weight,
         elastic_energy: solved.elastic_energy,
         base_angle: solved.base_angle,
+        turns: rod_ig_core::planar::heavy::cable::turns_of(&solved.shape),
     };
     converged_message(s, parts, header, params, solve_time)
 }
@@ -705,6 +710,7 @@ pub fn failure_message(
         base_condition: params.base_condition.name().into(),
         tip_condition: params.tip_condition.name().into(),
         base_angle: nan,
+        turns: 0,
     }
 }
 
@@ -906,6 +912,18 @@ mod tests {
         let m0 = solution_message(&s, &Header::default(), &p0, 1e-4);
         assert!(!m0.wrench_valid && m0.elastic_energy_joules.is_nan());
         assert_eq!(m0.base_wrench, Wrench::default());
+        // `turns` counts the tangent's full turns along the shape: 0 → 4.5π is two.
+        assert_eq!(m.turns, 0);
+        let coiled = Solved {
+            shape: (0..=90)
+                .map(|i| PlanarPose::new(0.0, 0.0, i as f64 * 0.05 * PI))
+                .collect(),
+            ..s.clone()
+        };
+        assert_eq!(
+            solution_message(&coiled, &Header::default(), &p, 1e-4).turns,
+            2
+        );
     }
 
     #[test]

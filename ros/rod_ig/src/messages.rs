@@ -313,6 +313,9 @@ pub struct RodSolution {
     /// The rod's angle at the base (rad): 0 for a clamped base, θ(0) for a pinned one; NaN
     /// when success is false (appended field).
     pub base_angle: f64,
+    /// Full turns of the planar rod's tangent along its path (0: loop-free); 0 for the 3-D
+    /// solver and on failure (appended field).
+    pub turns: u32,
 }
 impl Message for RodSolution {}
 
@@ -778,6 +781,7 @@ pub(crate) mod tests {
             base_condition: "pinned".into(),
             tip_condition: "free".into(),
             base_angle: -0.5,
+            turns: 2,
         }
     }
 
