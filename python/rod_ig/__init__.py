@@ -181,6 +181,10 @@ class ForwardResult:
     """What the rod exerts on the base gripper, in the base frame (:class:`Wrench`)."""
     tip_wrench: Wrench | None = None
     """What the rod exerts on the tip gripper, in the tip frame (:class:`Wrench`)."""
+    condition: FloatArray | None = None
+    """(...): ||J(1)||_inf * max(1, ||a||_inf): the tip of an f64 ``a`` is uncertain by about
+    this times 1.1e-16. Above 1e9 (long cables, w > 200) ``uncertain`` is True unless ``a`` is
+    a solver's answer, evaluated from its node states (docs/weight.md)."""
 
 
 @dataclass(frozen=True)
@@ -200,6 +204,11 @@ class Forward3dResult:
     """What the rod exerts on the base gripper, in the base frame (:class:`Wrench`)."""
     tip_wrench: Wrench | None = None
     """What the rod exerts on the tip gripper, in the tip frame (:class:`Wrench`)."""
+    uncertain: BoolArray | None = None
+    """(...): the stability verdict is undecided (margin within its error, or the tip of this
+    f64 ``a`` not determined: ``condition`` > 1e9); ``stable`` is then False."""
+    condition: FloatArray | None = None
+    """(...): ||J(1)||_inf * max(1, ||a||_inf), as :class:`ForwardResult`'s."""
 
 
 @dataclass(frozen=True)
@@ -304,6 +313,7 @@ def forward(
         elastic_energy=_shaped(d["elastic_energy"], shape),
         base_wrench=_wrench(d["base_wrench"], shape, 2),
         tip_wrench=_wrench(d["tip_wrench"], shape, 2),
+        condition=_shaped(d["condition"], shape),
     )
 
 
@@ -539,6 +549,8 @@ def forward3d(
         energy=d["energy"].reshape(batch),
         base_wrench=_wrench(d["base_wrench"], batch, 3),
         tip_wrench=_wrench(d["tip_wrench"], batch, 3),
+        uncertain=d["uncertain"].reshape(batch),
+        condition=d["condition"].reshape(batch),
     )
 
 

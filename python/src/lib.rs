@@ -178,8 +178,8 @@ fn buffer<T: Clone>(rows: usize, per_row: usize, fill: T) -> PyResult<Vec<T>> {
 }
 
 /// Planar forward map of n rods `a` (flattened (n, 3)): tip (x, y, θ unwrapped), J (rows x, y,
-/// θ; columns a3, a4, a5), stable, margin, uncertain, energy. A rod that cannot be evaluated
-/// gets NaN, stable False, uncertain True.
+/// θ; columns a3, a4, a5), stable, margin, uncertain, condition, energy. A rod that cannot be
+/// evaluated gets NaN, stable False, uncertain True.
 #[pyfunction]
 #[pyo3(signature = (a, threads=None, weight=None, gravity=None))]
 fn forward<'py>(
@@ -200,6 +200,7 @@ fn forward<'py>(
     let mut margin = buffer(n, 1, f64::NAN)?;
     let mut uncertain = buffer(n, 1, true)?;
     let mut energy = buffer(n, 1, f64::NAN)?;
+    let mut cond = buffer(n, 1, f64::NAN)?;
     let (mut base_w, mut tip_w) = (buffer(n, 3, f64::NAN)?, buffer(n, 3, f64::NAN)?);
     batch(
         py,
@@ -231,11 +232,13 @@ fn forward<'py>(
                 margin[i] = e.stability.margin;
                 uncertain[i] = e.stability.uncertain;
                 energy[i] = e.energy;
+                cond[i] = e.condition;
             }
         },
     )?;
     let d = PyDict::new(py);
     d.set_item("tip", f64_out(py, tip))?;
+    d.set_item("condition", f64_out(py, cond))?;
     d.set_item("jacobian", f64_out(py, jac))?;
     d.set_item("stable", stable.into_pyarray(py))?;
     d.set_item("margin", f64_out(py, margin))?;
@@ -1081,7 +1084,8 @@ fn gravities3(
 }
 
 /// 3-D forward map of n rods `a` (flattened (n, 6)): position, quaternion (x, y, z, w),
-/// J (6×6, body twists, rows ω1 ω2 ω3 v1 v2 v3), stable, margin, energy.
+/// J (6×6, body twists, rows ω1 ω2 ω3 v1 v2 v3), stable, margin, uncertain, condition,
+/// energy.
 #[pyfunction]
 #[pyo3(signature = (a, stiffness=(1.0, 1.0, 1.0), threads=None, weight=None, gravity=None))]
 fn forward3d<'py>(
@@ -1104,6 +1108,7 @@ fn forward3d<'py>(
     let mut stable = buffer(n, 1, false)?;
     let mut margin = buffer(n, 1, f64::NAN)?;
     let mut energy = buffer(n, 1, f64::NAN)?;
+    let (mut uncertain, mut cond) = (buffer(n, 1, true)?, buffer(n, 1, f64::NAN)?);
     let (mut base_w, mut tip_w) = (buffer(n, 6, f64::NAN)?, buffer(n, 6, f64::NAN)?);
     batch(
         py,
@@ -1116,17 +1121,19 @@ fn forward3d<'py>(
             match &g {
                 Some(g) => heavy3::evaluate(&ai, &k, &g[i]).ok().map(|e| {
                     let w = heavy3::wrenches(&ai, &k, &g[i]).ok();
-                    (e.tip, e.jacobian, e.stability, e.energy, w)
+                    (e.tip, e.jacobian, e.stability, e.energy, w, e.condition)
                 }),
                 // Without weight the world wrench is conserved: the tip's follows from the tip.
                 None => spatial::evaluate(&ai, &k, &opts).ok().map(|e| {
                     let w = Some(wrench::spatial(&ai, &e.tip, af, am));
-                    (e.tip, e.jacobian, e.stability, e.energy, w)
+                    let condition = heavy3::condition_of(&ai, &e.jacobian);
+                    (e.tip, e.jacobian, e.stability, e.energy, w, condition)
                 }),
             }
         },
         |i, e| {
-            let e = e.map(|(tip, jacobian, stability, energy, w)| {
+            let e = e.map(|(tip, jacobian, stability, energy, w, condition)| {
+                cond[i] = condition;
                 if let Some([b, t]) = w.as_ref().map(spatial_rows) {
                     base_w[6 * i..6 * i + 6].copy_from_slice(&b);
                     tip_w[6 * i..6 * i + 6].copy_from_slice(&t);
@@ -1149,12 +1156,15 @@ fn forward3d<'py>(
                 }
                 stable[i] = e.stability.stable;
                 margin[i] = e.stability.margin;
+                uncertain[i] = e.stability.uncertain;
                 energy[i] = e.energy;
             }
         },
     )?;
     let d = PyDict::new(py);
     d.set_item("position", f64_out(py, position))?;
+    d.set_item("uncertain", uncertain.into_pyarray(py))?;
+    d.set_item("condition", f64_out(py, cond))?;
     d.set_item("quaternion", f64_out(py, quaternion))?;
     d.set_item("jacobian", f64_out(py, jac))?;
     d.set_item("stable", stable.into_pyarray(py))?;

@@ -432,6 +432,28 @@ def test_a_one_metre_cable_hangs_and_matches_the_long_cable_reference() -> None:
         rod_ig.solve([0.8, 0.0, 0.0], weight=2000.0, max_turns=1000)
 
 
+def test_forward_says_when_an_f64_a_does_not_determine_its_tip() -> None:
+    """Issue 51 item 1: at w = 8,000 (a public long cable), an ``a`` one ulp from the reference's
+    has a condition figure beyond 1e9 and an undecided verdict, planar and 3-D, never a
+    confident answer; a gently bent weightless rod is well conditioned and decided."""
+    line = json.loads((REPO / "data" / "oracle" / "long_cables_public.jsonl").read_text().splitlines()[2])
+    assert line["weight"] == 8000.0
+    a = np.array(line["a"], dtype=float)
+    a[1] = np.nextafter(a[1], np.inf)
+    r = rod_ig.forward(a, weight=8000.0)
+    assert r.condition is not None and float(r.condition) > 1e9
+    assert bool(r.uncertain) and not bool(r.stable)
+    # The same rod in 3-D (its plane x-z, gravity -z): a = (0, a3, 0, a4, 0, a5) in the
+    # 3-D rod's components (a2 bends about e2 as the planar a3 does; forces along e1, e3).
+    a3 = np.array([0.0, -a[0], 0.0, a[1], 0.0, a[2]])
+    r3 = rod_ig.forward3d(a3, weight=8000.0, gravity=[0.0, 0.0, -1.0])
+    assert r3.condition is not None and r3.uncertain is not None
+    assert float(r3.condition) > 1e9 and bool(r3.uncertain) and not bool(r3.stable)
+    gentle = rod_ig.forward3d([0.0, 0.5, 0.0, 0.0, 0.0, 0.0])
+    assert gentle.condition is not None and gentle.uncertain is not None
+    assert float(gentle.condition) < 1e3 and not bool(gentle.uncertain) and bool(gentle.stable)
+
+
 def test_weight_in_3d_matches_the_public_cases_and_solves() -> None:
     lines = (REPO / "data" / "oracle" / "gravity_public.jsonl").read_text().splitlines()
     cases = [c for c in map(json.loads, lines) if c["kind"] == "3d" and c["stiffness"] == [1.0, 1.0, 1.0]]

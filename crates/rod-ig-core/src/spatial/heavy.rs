@@ -174,7 +174,9 @@ pub fn evaluate(
     Ok(e)
 }
 
-fn condition_of(a: &SpatialParams, j: &SpatialJacobian) -> f64 {
+/// The condition figure of an evaluation, ‖J(1)‖∞ · max(1, ‖a‖∞): the tip of an f64 `a` is
+/// uncertain by about this × 1.1e-16 ([`HeavyEvaluation3d::condition`]).
+pub fn condition_of(a: &SpatialParams, j: &SpatialJacobian) -> f64 {
     j.abs().row_sum().max() * a.amax().max(1.0)
 }
 
