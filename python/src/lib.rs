@@ -1083,6 +1083,37 @@ fn gravities3(
     gravities(n, weight, gravity, [0.0, 0.0, -1.0], Gravity3::new)
 }
 
+/// One 3-D rod's forward map (with weight `g`, else weightless): tip, J, stability, energy,
+/// wrenches, condition figure.
+#[allow(clippy::type_complexity)]
+fn evaluate3d(
+    a: &rod_ig_core::spatial::SpatialParams,
+    k: &Stiffness,
+    g: Option<&Gravity3>,
+    opts: &StabilityOptions,
+) -> Option<(
+    SpatialPose,
+    nalgebra::Matrix6<f64>,
+    rod_ig_core::StabilityReport,
+    f64,
+    Option<rod_ig_core::wrench::GripperWrenches<rod_ig_core::wrench::SpatialWrench>>,
+    f64,
+)> {
+    let (am, af) = (a.fixed_rows::<3>(0).into(), a.fixed_rows::<3>(3).into());
+    match g {
+        Some(g) => heavy3::evaluate(a, k, g).ok().map(|e| {
+            let w = heavy3::wrenches(a, k, g).ok();
+            (e.tip, e.jacobian, e.stability, e.energy, w, e.condition)
+        }),
+        // Without weight the world wrench is conserved: the tip's follows from the tip.
+        None => spatial::evaluate(a, k, opts).ok().map(|e| {
+            let w = Some(wrench::spatial(a, &e.tip, af, am));
+            let condition = heavy3::condition_of(a, &e.jacobian);
+            (e.tip, e.jacobian, e.stability, e.energy, w, condition)
+        }),
+    }
+}
+
 /// 3-D forward map of n rods `a` (flattened (n, 6)): position, quaternion (x, y, z, w),
 /// J (6×6, body twists, rows ω1 ω2 ω3 v1 v2 v3), stable, margin, uncertain, condition,
 /// energy.
@@ -1117,19 +1148,7 @@ fn forward3d<'py>(
         SOLVE_BLOCK,
         |i| {
             let ai = Vector6::from_column_slice(&a[6 * i..6 * i + 6]);
-            let (am, af) = (ai.fixed_rows::<3>(0).into(), ai.fixed_rows::<3>(3).into());
-            match &g {
-                Some(g) => heavy3::evaluate(&ai, &k, &g[i]).ok().map(|e| {
-                    let w = heavy3::wrenches(&ai, &k, &g[i]).ok();
-                    (e.tip, e.jacobian, e.stability, e.energy, w, e.condition)
-                }),
-                // Without weight the world wrench is conserved: the tip's follows from the tip.
-                None => spatial::evaluate(&ai, &k, &opts).ok().map(|e| {
-                    let w = Some(wrench::spatial(&ai, &e.tip, af, am));
-                    let condition = heavy3::condition_of(&ai, &e.jacobian);
-                    (e.tip, e.jacobian, e.stability, e.energy, w, condition)
-                }),
-            }
+            evaluate3d(&ai, &k, g.as_ref().map(|g| &g[i]), &opts)
         },
         |i, e| {
             let e = e.map(|(tip, jacobian, stability, energy, w, condition)| {

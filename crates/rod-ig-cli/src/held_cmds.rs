@@ -25,6 +25,91 @@ pub fn solve_line(line: &str, verbose: bool) -> Result<Value, String> {
     }
 }
 
+/// Answers one `forward` line: with a pinned or free end here ([`forward_held`]), else the
+/// clamped rod's ([`crate::planar_cmds::forward_line`]).
+pub fn forward_line(line: &str) -> Result<Value, String> {
+    let value: Value = jsonl::parse(line)?;
+    match held_ends_of(&value)? {
+        Some(ends) => forward_held(line, ends),
+        None => crate::planar_cmds::forward_line(line),
+    }
+}
+
+/// One `forward` request with held ends.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HeldForwardRequest {
+    /// (a3, a4, a5): a3 = 0 for a pinned base; (a4, a5) = w ĝ + tip_load for a free tip.
+    a: [f64; 3],
+    /// θ(0) of a pinned base (default 0).
+    base_angle: Option<f64>,
+    #[allow(dead_code)] // read by `held_ends_of`
+    base_condition: Option<Value>,
+    #[allow(dead_code)] // read by `held_ends_of`
+    tip_condition: Option<Value>,
+    weight: Option<f64>,
+    gravity: Option<[f64; 2]>,
+    tip_load: Option<[f64; 2]>,
+}
+
+/// One `forward` answer with held ends: the clamped answer's fields, the margin and verdict
+/// those of the second variation with the natural conditions.
+#[derive(Serialize)]
+struct HeldForwardAnswer {
+    tip: PlanarPose,
+    /// Rows x, y, θ; columns a3 (θ(0) for a pinned base), a4, a5.
+    jacobian: [[f64; 3]; 3],
+    stable: bool,
+    energy: f64,
+    elastic_energy: f64,
+    /// μ / μ₀ of the second variation with the natural conditions.
+    stability_margin: f64,
+    stability_uncertain: bool,
+    /// ‖J‖∞ · max(1, ‖a‖∞) (with weight above 200 and beyond 1e9: uncertain).
+    condition: f64,
+    base_angle: f64,
+    turns: u32,
+    self_intersects: bool,
+    base_wrench: PlanarWrench,
+    tip_wrench: PlanarWrench,
+    base_condition: EndCondition,
+    tip_condition: EndCondition,
+}
+
+/// Answers one `forward` line whose ends are `ends` (not both clamped).
+pub fn forward_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
+    let request: HeldForwardRequest = jsonl::parse(line)?;
+    let g = gravity_of(request.weight, request.gravity)?;
+    let a = rod_ig_core::PlanarParams::from(request.a);
+    let e = held::evaluate(
+        request.base_angle.unwrap_or(0.0),
+        &a,
+        &g,
+        ends,
+        request.tip_load.unwrap_or([0.0; 2]),
+    )
+    .map_err(|e| e.to_string())?;
+    let s = &e.solution;
+    let w = s.wrenches();
+    jsonl::to_value(&HeldForwardAnswer {
+        tip: s.tip,
+        jacobian: std::array::from_fn(|r| std::array::from_fn(|c| e.jacobian[(r, c)])),
+        stable: e.stable(),
+        energy: s.energy,
+        elastic_energy: s.elastic_energy,
+        stability_margin: s.stability.normalised(),
+        stability_uncertain: e.uncertain(),
+        condition: e.condition,
+        base_angle: s.base_angle,
+        turns: s.turns,
+        self_intersects: s.self_intersects,
+        base_wrench: w.base,
+        tip_wrench: w.tip,
+        base_condition: ends.base(),
+        tip_condition: ends.tip(),
+    })
+}
+
 /// The end conditions a request names, when either is not `"clamped"` (`None`: the paper's
 /// rod, answered by the clamped solver exactly as before). Refusals name the field.
 pub fn held_ends_of(request: &Value) -> Result<Option<HeldEnds>, String> {
@@ -195,4 +280,80 @@ pub fn solve_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
                 .collect()
         }),
     })
+}
+
+/// A rod held by pinned or free ends, sampled for `rod-ig shape`.
+pub struct HeldShape {
+    /// Its base wrench (a3 = 0 at a pinned base).
+    pub a: [f64; 3],
+    /// θ(0).
+    pub base_angle: f64,
+    /// `samples` poses from base to tip.
+    pub poses: Vec<PlanarPose>,
+    /// Stable with the natural conditions (and decided).
+    pub stable: bool,
+    /// Total energy.
+    pub energy: f64,
+}
+
+/// How `rod-ig shape` draws rods held by pinned or free ends.
+pub struct HeldShapeRequest<'a> {
+    /// The ends (not both clamped).
+    pub ends: HeldEnds,
+    /// Rods by their base wrench (`--a`), each leaving the base at `base_angle`.
+    pub params: &'a [[f64; 3]],
+    /// θ(0) of the `--a` rods (pinned base).
+    pub base_angle: f64,
+    /// A free tip's point load.
+    pub tip_load: [f64; 2],
+    /// `--target`: every stable equilibrium held through it (a free tip: the rod hanging from
+    /// its base, any target ignored).
+    pub target: Option<PlanarPose>,
+    /// Samples per rod.
+    pub samples: usize,
+}
+
+/// The rods of `request` under `g`, each sampled (the held forward map for `--a` rods, the
+/// held-ends search's stable equilibria for `--target`).
+pub fn held_shapes(
+    request: &HeldShapeRequest,
+    g: &rod_ig_core::planar::heavy::Gravity,
+) -> Result<Vec<HeldShape>, String> {
+    crate::planar_cmds::check_samples(request.samples)?;
+    let shaped = |s: &HeldSolution, stable: bool| -> Result<HeldShape, String> {
+        Ok(HeldShape {
+            a: [s.a[0], s.a[1], s.a[2]],
+            base_angle: s.base_angle,
+            poses: s.cable.shape(request.samples).map_err(|e| e.to_string())?,
+            stable,
+            energy: s.energy,
+        })
+    };
+    let mut out = Vec::new();
+    for a in request.params {
+        let a = rod_ig_core::PlanarParams::from(*a);
+        let e = held::evaluate(request.base_angle, &a, g, request.ends, request.tip_load)
+            .map_err(|e| e.to_string())?;
+        out.push(shaped(&e.solution, e.stable())?);
+    }
+    let free = request.ends.tip() == EndCondition::Free;
+    if request.target.is_some() || (free && request.params.is_empty()) {
+        let options = SolveOptions {
+            deadline: DEFAULT_HELD_DEADLINE,
+            ..SolveOptions::default()
+        };
+        let target = request.target.filter(|_| !free);
+        let found = held::equilibria_with_tip_load(
+            request.ends,
+            g,
+            request.tip_load,
+            target.as_ref(),
+            &options,
+        )
+        .map_err(|e| e.to_string())?;
+        for s in &found.solutions {
+            out.push(shaped(s, true)?);
+        }
+    }
+    Ok(out)
 }

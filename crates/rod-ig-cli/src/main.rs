@@ -54,7 +54,11 @@ enum Command {
     /// "moment"}: what the rod exerts on each gripper, in that gripper's frame, as a wrist
     /// force-torque sensor reads it); with weight also "elastic_energy", "tip_force" and
     /// "condition" (the tip's sensitivity to rounding a: above weight 200 and 1e9 the verdict
-    /// is uncertain)}. theta is unwrapped (∫κ). A line that cannot be parsed or evaluated gets
+    /// is uncertain)}. theta is unwrapped (∫κ). "base_condition" ("clamped" | "pinned") and
+    /// "tip_condition" ("clamped" | "pinned" | "free"): a pinned base takes "base_angle" and
+    /// a3 = 0, a free tip (a4, a5) = w ĝ + "tip_load"; the verdict is the second variation's
+    /// with the natural conditions, and the answer adds "base_angle", "turns",
+    /// "self_intersects" (docs/ends.md). A line that cannot be parsed or evaluated gets
     /// {"error": "why"}; the stream goes on.
     Forward,
     /// Inverse geometry. Reads JSON lines {"target": {"x", "y", "theta"}, "a0"?: [..],
@@ -154,6 +158,19 @@ enum Command {
         /// Direction of gravity "gx,gy" in the base frame (default 0,-1).
         #[arg(long, allow_hyphen_values = true, default_value = "0,-1")]
         gravity: String,
+        /// How the base is held: clamped (default) or pinned (docs/ends.md).
+        #[arg(long, default_value = "clamped")]
+        base_condition: String,
+        /// How the tip is held: clamped (default), pinned or free (a free tip draws the rods
+        /// hanging from the base when no --a is given).
+        #[arg(long, default_value = "clamped")]
+        tip_condition: String,
+        /// θ(0) of the --a rods at a pinned base (rad).
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+        base_angle: f64,
+        /// A point force "fx,fy" at a free tip (base frame, units of EI/L²).
+        #[arg(long, allow_hyphen_values = true)]
+        tip_load: Option<String>,
     },
     /// Measures every speed figure in one run: forward map, J, stability, shape against the
     /// paper's RK4 baseline (dt = 1e-4); the paper's Table 1 protocol for Newton; the robust
@@ -235,6 +252,123 @@ struct ShapeRequest<'a> {
     target: Option<&'a str>,
     samples: usize,
     gravity: Gravity,
+}
+
+/// `rod-ig shape`'s end-condition flags.
+struct HeldFlags<'a> {
+    base_condition: &'a str,
+    tip_condition: &'a str,
+    base_angle: f64,
+    tip_load: Option<&'a str>,
+}
+
+impl HeldFlags<'_> {
+    /// The ends the flags name, `None` when both are clamped (the paper's rod).
+    fn ends(&self) -> Result<Option<rod_ig_core::ends::HeldEnds>, String> {
+        let request = serde_json::json!({
+            "base_condition": self.base_condition,
+            "tip_condition": self.tip_condition,
+        });
+        held_cmds::held_ends_of(&request).map_err(|e| format!("--{}", e.replacen('_', "-", 1)))
+    }
+
+    /// `--tip-load "fx,fy"` (default none).
+    fn parsed_tip_load(&self) -> Result<[f64; 2], String> {
+        let Some(t) = self.tip_load else {
+            return Ok([0.0; 2]);
+        };
+        t.split_once(',')
+            .and_then(|(a, b)| Some([a.trim().parse().ok()?, b.trim().parse().ok()?]))
+            .ok_or_else(|| format!("--tip-load must be \"fx,fy\" (got {t:?})"))
+    }
+}
+
+/// `rod-ig shape` with pinned or free ends: the held forward map's rods (--a) or the held
+/// search's stable equilibria (--target; a free tip: the rods hanging from the base).
+fn held_shape_command(
+    request: ShapeRequest,
+    ends: rod_ig_core::ends::HeldEnds,
+    flags: &HeldFlags,
+    format: Option<Format>,
+    output: Option<&PathBuf>,
+) -> Result<(), String> {
+    let params = request
+        .params
+        .iter()
+        .map(|t| parse_triple(t, "--a"))
+        .collect::<Result<Vec<_>, _>>()?;
+    let target = match request.target {
+        Some(t) => {
+            let [x, y, theta] = parse_triple(t, "--target")?;
+            Some(rod_ig_core::PlanarPose::new(x, y, theta))
+        }
+        None => None,
+    };
+    let tip_load = flags.parsed_tip_load()?;
+    let held = held_cmds::HeldShapeRequest {
+        ends,
+        params: &params,
+        base_angle: flags.base_angle,
+        tip_load,
+        target,
+        samples: request.samples,
+    };
+    let rods = held_cmds::held_shapes(&held, &request.gravity)?;
+    if rods.is_empty() {
+        return Err("give --a a3,a4,a5 (repeatable) or --target x,y,theta".to_string());
+    }
+    let svg = match format {
+        Some(f) => f == Format::Svg,
+        None => output.is_some_and(|p| p.extension().is_some_and(|e| e == "svg")),
+    };
+    let text = held_shape_text(rods, ends, svg);
+    match output {
+        Some(path) => std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display())),
+        None => io::stdout()
+            .lock()
+            .write_all(text.as_bytes())
+            .map_err(|e| e.to_string()),
+    }
+}
+
+/// Held rods as an SVG picture, or as JSON lines {"a", "base_angle", "stable", "poses"}.
+fn held_shape_text(
+    rods: Vec<held_cmds::HeldShape>,
+    ends: rod_ig_core::ends::HeldEnds,
+    svg: bool,
+) -> String {
+    if svg {
+        let drawn: Vec<_> = rods
+            .into_iter()
+            .map(|r| svg::DrawnRod {
+                label: format!(
+                    "{} base, {} tip: a = ({:.3}, {:.3}, {:.3}), base angle {:.3}   energy {:.3}   {}",
+                    ends.base().name(),
+                    ends.tip().name(),
+                    r.a[0],
+                    r.a[1],
+                    r.a[2],
+                    r.base_angle,
+                    r.energy,
+                    if r.stable { "stable" } else { "unstable (dashed)" }
+                ),
+                dashed: !r.stable,
+                poses: r.poses,
+                muted: false,
+            })
+            .collect();
+        svg::draw(&drawn, "rod-ig: rods held by pinned or free ends")
+    } else {
+        let mut text = String::new();
+        for r in rods {
+            let line = serde_json::json!({
+                "a": r.a, "base_angle": r.base_angle, "stable": r.stable, "poses": r.poses,
+            });
+            text.push_str(&line.to_string());
+            text.push('\n');
+        }
+        text
+    }
 }
 
 fn shape_command(
@@ -391,7 +525,7 @@ fn main() -> ExitCode {
     let stdout = io::stdout().lock();
     let result = match cli.command {
         Command::Forward => {
-            jsonl::run(stdin, stdout, planar_cmds::forward_line).map_err(|e| e.to_string())
+            jsonl::run(stdin, stdout, held_cmds::forward_line).map_err(|e| e.to_string())
         }
         Command::Solve { verbose } => {
             warm_up();
@@ -415,6 +549,10 @@ fn main() -> ExitCode {
             output,
             weight,
             gravity,
+            base_condition,
+            tip_condition,
+            base_angle,
+            tip_load,
         } => parse_gravity(weight, &gravity).and_then(|gravity| {
             let request = ShapeRequest {
                 params: &params,
@@ -422,7 +560,16 @@ fn main() -> ExitCode {
                 samples,
                 gravity,
             };
-            shape_command(request, format, output.as_ref())
+            let held = HeldFlags {
+                base_condition: &base_condition,
+                tip_condition: &tip_condition,
+                base_angle,
+                tip_load: tip_load.as_deref(),
+            };
+            match held.ends()? {
+                Some(ends) => held_shape_command(request, ends, &held, format, output.as_ref()),
+                None => shape_command(request, format, output.as_ref()),
+            }
         }),
         Command::Bench {
             quick,

@@ -20,6 +20,11 @@ struct ForwardRequest {
     weight: Option<f64>,
     /// Direction of gravity in the base frame (default [0, -1]).
     gravity: Option<[f64; 2]>,
+    /// "clamped" (the default) here; `held_cmds::forward_line` answers "pinned" and "free".
+    #[allow(dead_code)] // read by `held_cmds::forward_line`
+    base_condition: Option<Value>,
+    #[allow(dead_code)] // read by `held_cmds::forward_line`
+    tip_condition: Option<Value>,
 }
 
 /// The gravity of a request: `weight` (default 0) along `gravity` (default −y, normalised).

@@ -843,3 +843,125 @@ fn pinned_and_free_ends_are_solved_and_refusals_name_the_field() {
         assert!(e.starts_with(field), "{e}");
     }
 }
+
+/// `forward` with held ends (issue 52, item 1): the rods `solve` returns, given back as `a`
+/// (and `base_angle`), reproduce their tips and verdicts with the natural conditions; an
+/// explicit "clamped" is the paper's forward; refusals name the field.
+#[test]
+fn forward_with_held_ends_reproduces_the_solved_rods() {
+    let solved = run(
+        &["solve"],
+        concat!(
+            "{\"tip_condition\": \"free\", \"weight\": 36.92695280826509, \"gravity\": [-1, 0]}\n",
+            "{\"target\": {\"x\": 0.8, \"y\": 0}, \"base_condition\": \"pinned\", \"tip_condition\": \"pinned\", \"weight\": 50}\n",
+        ),
+    );
+    let lines: Vec<String> = solved
+        .iter()
+        .zip([
+            "\"tip_condition\": \"free\", \"weight\": 36.92695280826509, \"gravity\": [-1, 0]",
+            "\"base_condition\": \"pinned\", \"tip_condition\": \"pinned\", \"weight\": 50",
+        ])
+        .map(|(s, ends)| {
+            assert_eq!(s["success"], true, "{s}");
+            format!(
+                "{{\"a\": {}, \"base_angle\": {}, {ends}}}",
+                s["a"], s["base_angle"]
+            )
+        })
+        .chain([
+            "{\"a\": [1, 2, 3], \"base_condition\": \"clamped\"}".to_string(),
+            "{\"a\": [1, 0, 0], \"base_condition\": \"pinned\", \"tip_condition\": \"pinned\"}"
+                .to_string(),
+            "{\"a\": [1, 0, 0], \"tip_condition\": \"free\", \"weight\": 5}".to_string(),
+            "{\"a\": [1, 0, 0], \"tip_condition\": \"pivot\"}".to_string(),
+        ])
+        .collect();
+    let out = run(&["forward"], &(lines.join("\n") + "\n"));
+    for (f, s) in out.iter().zip(&solved) {
+        for c in ["x", "y"] {
+            let d = f["tip"][c].as_f64().unwrap() - s["tip"][c].as_f64().unwrap();
+            assert!(d.abs() < 1e-9, "{f} vs {s}");
+        }
+        assert_eq!(f["stable"], true, "{f}");
+        assert_eq!(f["turns"], 0);
+        assert!((f["energy"].as_f64().unwrap() - s["energy"].as_f64().unwrap()).abs() < 1e-8);
+    }
+    assert_eq!(out[1]["base_condition"], "pinned");
+    assert!(out[1]["tip_wrench"]["moment"].as_f64().unwrap().abs() < 1e-8);
+    // Explicitly clamped: the paper's forward, without the held answer's fields.
+    assert!(out[2].get("jacobian").is_some() && out[2].get("base_condition").is_none());
+    for (line, field) in [(3, "a"), (4, "a"), (5, "tip_condition")] {
+        let e = out[line]["error"]
+            .as_str()
+            .unwrap_or_else(|| panic!("{}", out[line]));
+        assert!(e.starts_with(field), "{e}");
+    }
+}
+
+/// `shape` with held ends (issue 52, item 1): a free tip without --a draws every stable rod
+/// hanging from the clamp (at w = 300, ends_public A: two mirror rods, each ending straight
+/// down, κ(1) = 0 so the last samples are collinear); a pinned base's --a rod starts at its
+/// base angle; a pinned base with a moment and an unknown condition are refused by flag.
+#[test]
+fn shape_draws_rods_held_by_pinned_and_free_ends() {
+    let out = run(
+        &[
+            "shape",
+            "--tip-condition",
+            "free",
+            "--weight",
+            "300",
+            "--samples",
+            "201",
+        ],
+        "",
+    );
+    assert_eq!(out.len(), 2, "{out:?}");
+    for rod in &out {
+        assert_eq!(rod["stable"], true);
+        let poses = rod["poses"].as_array().unwrap();
+        let theta = poses.last().unwrap()["theta"].as_f64().unwrap();
+        assert!(
+            (rod_ig_core::wrap_angle(theta) + std::f64::consts::FRAC_PI_2).abs() < 1e-3,
+            "{theta}"
+        );
+    }
+    let pinned = run(
+        &[
+            "shape",
+            "--base-condition",
+            "pinned",
+            "--tip-condition",
+            "pinned",
+            "--a",
+            "0,5,-2",
+            "--base-angle",
+            "0.3",
+            "--samples",
+            "3",
+        ],
+        "",
+    );
+    assert_eq!(pinned[0]["poses"][0]["theta"], 0.3);
+    for (args, flag) in [
+        (
+            vec!["shape", "--base-condition", "pinned", "--a", "1,2,3"],
+            "a:",
+        ),
+        (
+            vec!["shape", "--base-condition", "hinge", "--a", "0,2,3"],
+            "--base-condition",
+        ),
+    ] {
+        let bad = Command::new(env!("CARGO_BIN_EXE_rod-ig"))
+            .args(&args)
+            .output()
+            .unwrap();
+        assert!(!bad.status.success());
+        assert!(
+            String::from_utf8_lossy(&bad.stderr).contains(flag),
+            "{args:?}"
+        );
+    }
+}

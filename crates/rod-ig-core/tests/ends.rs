@@ -353,3 +353,84 @@ fn a_cantilever_with_a_tip_load_matches_the_large_deflection_elastica() {
         })
     ));
 }
+
+/// The forward map with held ends (`held::evaluate`, what `rod-ig forward` answers) against
+/// the references: (1) every free-tip root of the public cases, given its a, is an equilibrium
+/// with κ(1) = 0 (to 1e-9), the reference's energy (1e-9) and verdict; (2) a weightless rod
+/// leaving a pinned base at angle φ is the closed form's clamped rod with the base force turned
+/// by −φ, turned by φ (tip to 1e-10: two independent evaluations); (3) its J's first column is
+/// ∂tip/∂φ (central differences, 1e-6); (4) a moment at a pinned base, a force at a free tip
+/// other than w ĝ + load, a base angle at a clamped base are refused by field.
+#[test]
+fn the_forward_map_with_held_ends_matches_the_references() {
+    for case in cases().iter().filter(|c| c["case"] == "A") {
+        let (ends, gravity, _) = setup(case);
+        for r in case["roots"].as_array().expect("roots") {
+            let a = common::numbers(&r["a"]);
+            let a = rod_ig_core::PlanarParams::new(a[0], a[1], a[2]);
+            let e = held::evaluate(0.0, &a, &gravity, ends, [0.0; 2]).expect("evaluates");
+            // An f64 a reproduces its rod to about condition × ε (single shooting from the
+            // base), and κ, θ's derivative, one factor √w more (the boundary layer's scale).
+            let tol = 1e-9_f64.max(1e-14 * e.condition * (1.0 + gravity.weight().sqrt()));
+            assert!(
+                e.solution.tip_curvature.abs() < tol,
+                "{a:?}: κ(1) {} condition {:e}",
+                e.solution.tip_curvature,
+                e.condition
+            );
+            assert!(close(
+                e.solution.energy,
+                r["energy"].as_f64().unwrap(),
+                1e-9
+            ));
+            assert_eq!(e.stable(), r["stable"].as_bool().unwrap(), "{a:?}");
+        }
+    }
+    let pinned = HeldEnds::new(EndCondition::Pinned, EndCondition::Pinned).unwrap();
+    for (phi, f) in [(0.3, [5.0, -2.0]), (-1.2, [-3.0, 8.0]), (2.5, [0.5, 0.0])] {
+        let a = rod_ig_core::PlanarParams::new(0.0, f[0], f[1]);
+        let e = held::evaluate(phi, &a, &Gravity::NONE, pinned, [0.0; 2]).expect("evaluates");
+        let (s, c) = f64::sin_cos(phi);
+        let turned = rod_ig_core::PlanarParams::new(0.0, c * f[0] + s * f[1], -s * f[0] + c * f[1]);
+        let t = rod_ig_core::planar::tip(&turned).expect("closed form");
+        let (x, y) = (c * t.x - s * t.y, s * t.x + c * t.y);
+        let tip = e.solution.tip;
+        assert!(
+            (tip.x - x)
+                .abs()
+                .max((tip.y - y).abs())
+                .max((tip.theta - t.theta - phi).abs())
+                < 1e-10,
+            "φ {phi}: {tip:?} vs ({x}, {y}, {})",
+            t.theta + phi
+        );
+        let h = 1e-6;
+        let at = |p: f64| {
+            held::evaluate(p, &a, &Gravity::NONE, pinned, [0.0; 2])
+                .expect("evaluates")
+                .solution
+                .tip
+        };
+        let (up, down) = (at(phi + h), at(phi - h));
+        let fd = [
+            (up.x - down.x) / (2.0 * h),
+            (up.y - down.y) / (2.0 * h),
+            (up.theta - down.theta) / (2.0 * h),
+        ];
+        for (r, f) in fd.iter().enumerate() {
+            assert!((e.jacobian[(r, 0)] - f).abs() < 1e-6 * (1.0 + f.abs()));
+        }
+    }
+    let refused = |phi: f64, a: [f64; 3], ends: HeldEnds, field: &str| {
+        let g = Gravity::new(10.0, [0.0, -1.0]).unwrap();
+        let a = rod_ig_core::PlanarParams::new(a[0], a[1], a[2]);
+        match held::evaluate(phi, &a, &g, ends, [0.0; 2]) {
+            Err(HeldError::Target { field: f, .. }) => assert_eq!(f, field),
+            other => panic!("expected a refusal of {field}, got {other:?}"),
+        }
+    };
+    refused(0.0, [1.0, 0.0, 0.0], pinned, "a");
+    let free = HeldEnds::new(EndCondition::Clamped, EndCondition::Free).unwrap();
+    refused(0.0, [1.0, 0.0, -5.0], free, "a");
+    refused(0.4, [1.0, 0.0, -10.0], free, "base_angle");
+}

@@ -644,11 +644,12 @@ impl Cable {
 
     /// J(1, a) = ∂(x, y, θ)(1)/∂(a3, a4, a5), rows x, y, θ: the segments' transition matrices
     /// multiplied along the rod (each accurate; the product is the true, ill-conditioned J).
+    /// With a pinned base the first column is ∂/∂θ(0) (its κ(0) is 0).
     pub fn jacobian(&self) -> Result<crate::PlanarJacobian, RodError> {
         let load = self.gravity.load();
         // d[r][c] = ∂(x, y, θ, κ)_r / ∂a_c at the current node.
         let mut d = [[0.0; 3]; 4];
-        d[3][0] = 1.0;
+        d[self.base_unknown()][0] = 1.0;
         for k in 0..self.segments() {
             let e = integrate_segment::<FULL>(
                 SEGMENT_RTOL,

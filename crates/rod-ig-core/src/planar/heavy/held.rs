@@ -142,6 +142,98 @@ impl HeldSolution {
     }
 }
 
+/// The forward map of a rod held by `ends` (no search): the cable leaving the base at
+/// `base_angle` with base wrench `a`, integrated from the base ([`Cable::held`]), a free tip
+/// carrying `tip_load`. What it reports: [`HeldSolution`] (tip, energies, the second
+/// variation with the natural conditions, turns, wrenches), J(1) = ∂(x, y, θ)(1)/∂(base
+/// unknown, a4, a5) (first column ∂/∂a3 for a clamped base, ∂/∂θ(0) for a pinned one) and the
+/// condition figure ‖J‖∞ · max(1, ‖a‖∞). Refused with the field named: a moment at a pinned
+/// base (a3 ≠ 0), and for a free tip a base force other than w ĝ + `tip_load` (a free tip
+/// holds no force: the rod's force is its weight and the load).
+pub fn evaluate(
+    base_angle: f64,
+    a: &PlanarParams,
+    gravity: &Gravity,
+    ends: HeldEnds,
+    tip_load: [f64; 2],
+) -> Result<HeldEvaluation, HeldError> {
+    let field = |field: &'static str, why: String| HeldError::Target { field, why };
+    if ends.base() == EndCondition::Pinned && a[0] != 0.0 {
+        return Err(field(
+            "a",
+            format!("a pinned base holds no moment: a3 must be 0 (got {})", a[0]),
+        ));
+    }
+    if ends.base() == EndCondition::Clamped && base_angle != 0.0 {
+        return Err(field(
+            "base_angle",
+            "a clamped base leaves along the base frame's x axis: base_angle must be 0".into(),
+        ));
+    }
+    if ends.tip() == EndCondition::Free {
+        let l = gravity.load();
+        let need = [l[0] + tip_load[0], l[1] + tip_load[1]];
+        let off = (a[1] - need[0]).abs().max((a[2] - need[1]).abs());
+        if !(off <= 1e-9 * (1.0 + need[0].abs().max(need[1].abs()))) {
+            return Err(field(
+                "a",
+                format!(
+                    "a free tip holds no force: (a4, a5) must be w ĝ + tip_load = ({}, {}) (got ({}, {}))",
+                    need[0], need[1], a[1], a[2]
+                ),
+            ));
+        }
+    } else if tip_load != [0.0; 2] {
+        return Err(field(
+            "tip_load",
+            "a tip load needs a free tip (a held tip's gripper takes it)".into(),
+        ));
+    }
+    let rod = |e: RodError| field("a", e.to_string());
+    let mut cable = Cable::held(base_angle, a, gravity, ends).map_err(rod)?;
+    if ends.tip() == EndCondition::Free {
+        cable = cable.with_tip_load(tip_load).map_err(rod)?;
+    }
+    let jacobian = cable.jacobian().map_err(rod)?;
+    let condition = jacobian.abs().row_sum().max() * a.amax().max(1.0);
+    let solution = HeldSolution::of(cable).map_err(rod)?;
+    Ok(HeldEvaluation {
+        solution,
+        jacobian,
+        condition,
+    })
+}
+
+/// What [`evaluate`] reports of a held rod.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HeldEvaluation {
+    /// The rod, its energies, stability (natural conditions), turns and node states.
+    pub solution: HeldSolution,
+    /// J(1) = ∂(x, y, θ)(1)/∂(a3 or θ(0), a4, a5), rows x, y, θ.
+    pub jacobian: crate::PlanarJacobian,
+    /// ‖J‖∞ · max(1, ‖a‖∞): the tip of an f64 `a` is uncertain by about this × 1.1e-16; above
+    /// [`super::MAX_TRUSTED_CONDITION`] the verdict should not be trusted
+    /// ([`HeldEvaluation::uncertain`]).
+    pub condition: f64,
+}
+
+impl HeldEvaluation {
+    /// The verdict is undecided: μ within its error, or, for a long cable (w above
+    /// [`super::cable_search::LONG_CABLE_WEIGHT`]), the tip of this f64 `a` not determined by
+    /// integration from the base (`condition` beyond [`super::MAX_TRUSTED_CONDITION`]), as
+    /// [`super::evaluate`] says of a clamped rod.
+    pub fn uncertain(&self) -> bool {
+        let long = self.solution.cable.gravity().weight() > super::cable_search::LONG_CABLE_WEIGHT;
+        self.solution.stability.uncertain()
+            || (long && !(self.condition <= super::MAX_TRUSTED_CONDITION))
+    }
+
+    /// Stable with the natural conditions, and decided.
+    pub fn stable(&self) -> bool {
+        self.solution.stability.stable() && !self.uncertain()
+    }
+}
+
 /// The target as the tip's condition needs it: a pose (clamped), a position (pinned, θ is
 /// ignored), nothing (free).
 fn checked_target(
