@@ -222,48 +222,73 @@ fn rod_of(s: &HeldSolution, target: Option<&PlanarPose>) -> HeldRod {
 pub fn solve_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
     let started = Instant::now();
     let request: HeldRequest = jsonl::parse(line)?;
-    let target = match (ends.tip(), request.target) {
-        (EndCondition::Pinned, Some(HeldTarget { theta: Some(_), .. })) => {
-            return Err(
-                "target: a pinned tip's target is {\"x\", \"y\"} (its angle is free: no theta)"
-                    .into(),
-            )
-        }
+    let target = target_of(ends, request.target)?;
+    let options = options_of(request.deadline_ms, request.max_turns)?;
+    let g = gravity_of(request.weight, request.gravity)?;
+    let tip_load = request.tip_load.unwrap_or([0.0; 2]);
+    let found = held::equilibria_with_tip_load(ends, &g, tip_load, target.as_ref(), &options)
+        .map_err(|e| e.to_string())?;
+    jsonl::to_value(&answer_of(
+        ends,
+        &found,
+        target.as_ref(),
+        request.all,
+        started,
+    ))
+}
+
+/// The target a request gives for a tip held by `ends` (refusals name the field).
+fn target_of(ends: HeldEnds, target: Option<HeldTarget>) -> Result<Option<PlanarPose>, String> {
+    match (ends.tip(), target) {
+        (EndCondition::Pinned, Some(HeldTarget { theta: Some(_), .. })) => Err(
+            "target: a pinned tip's target is {\"x\", \"y\"} (its angle is free: no theta)".into(),
+        ),
         (EndCondition::Clamped, Some(HeldTarget { theta: None, .. })) => {
-            return Err("target: a clamped tip needs theta".into())
+            Err("target: a clamped tip needs theta".into())
         }
-        (_, t) => t.map(|t| PlanarPose::new(t.x, t.y, t.theta.unwrap_or(0.0))),
-    };
-    let max_turns = request.max_turns.unwrap_or(0);
+        (_, t) => Ok(t.map(|t| PlanarPose::new(t.x, t.y, t.theta.unwrap_or(0.0)))),
+    }
+}
+
+/// The options of a held request: `deadline_ms` (default [`DEFAULT_HELD_DEADLINE`]) and
+/// `max_turns` (default 0).
+fn options_of(deadline_ms: Option<f64>, max_turns: Option<u32>) -> Result<SolveOptions, String> {
+    let max_turns = max_turns.unwrap_or(0);
     if max_turns > MAX_TURNS {
         return Err(format!(
             "max_turns must be in [0, {MAX_TURNS}] (got {max_turns})"
         ));
     }
-    let options = SolveOptions {
-        deadline: match request.deadline_ms {
+    Ok(SolveOptions {
+        deadline: match deadline_ms {
             Some(ms) => jsonl::deadline_from_ms(ms)?,
             None => DEFAULT_HELD_DEADLINE,
         },
         max_turns,
         ..SolveOptions::default()
-    };
-    let g = gravity_of(request.weight, request.gravity)?;
-    let tip_load = request.tip_load.unwrap_or([0.0; 2]);
-    let found = held::equilibria_with_tip_load(ends, &g, tip_load, target.as_ref(), &options)
-        .map_err(|e| e.to_string())?;
+    })
+}
+
+/// The answer to a held search that `found` what it found.
+fn answer_of(
+    ends: HeldEnds,
+    found: &held::HeldSearch,
+    target: Option<&PlanarPose>,
+    all: bool,
+    started: Instant,
+) -> HeldAnswer {
     let best = found.solutions.first();
     let reason = best
         .is_none()
-        .then(|| held::not_found(ends, &found).to_string());
+        .then(|| held::not_found(ends, found).to_string());
     let termination = match (best, found.cut_short) {
         (Some(_), _) => "converged",
         (None, true) => "deadline",
         (None, false) => "no_stable_solution",
     };
-    jsonl::to_value(&HeldAnswer {
+    HeldAnswer {
         success: best.is_some(),
-        rod: best.map(|s| rod_of(s, target.as_ref())),
+        rod: best.map(|s| rod_of(s, target)),
         base_condition: ends.base(),
         tip_condition: ends.tip(),
         termination,
@@ -272,14 +297,97 @@ pub fn solve_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
         complete: !found.cut_short,
         rejected: found.equilibria.len() - found.solutions.len(),
         reason,
-        solutions: request.all.then(|| {
-            found
-                .solutions
-                .iter()
-                .map(|s| rod_of(s, target.as_ref()))
-                .collect()
-        }),
-    })
+        solutions: all.then(|| found.solutions.iter().map(|s| rod_of(s, target)).collect()),
+    }
+}
+
+/// A `track` stream whose grippers hold the rod by pinned or free ends: the ends of its first
+/// line, the stream's gravity and the rod held.
+#[derive(Default)]
+pub struct HeldTrack {
+    ends: Option<HeldEnds>,
+    gravity: Option<rod_ig_core::planar::heavy::Gravity>,
+    held: Option<HeldSolution>,
+}
+
+/// One `track` line with held ends: the same fields as `solve`'s, `weight` and `gravity`
+/// carried over from the lines before.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HeldTrackRequest {
+    target: Option<HeldTarget>,
+    #[allow(dead_code)] // read by `held_ends_of`
+    base_condition: Option<Value>,
+    #[allow(dead_code)] // read by `held_ends_of`
+    tip_condition: Option<Value>,
+    deadline_ms: Option<f64>,
+    weight: Option<f64>,
+    gravity: Option<[f64; 2]>,
+    max_turns: Option<u32>,
+}
+
+impl HeldTrack {
+    /// Answers one `track` line held by `ends`: the rod held moved along its branch to the
+    /// line's target (and gravity) with the event "none"; where its branch ends, a fresh search
+    /// and the event "snap"; where none is found, "lost" (success false). The first line
+    /// solves afresh; every line must name the first line's ends.
+    pub fn line(&mut self, line: &str, ends: HeldEnds) -> Result<Value, String> {
+        let started = Instant::now();
+        if let Some(first) = self.ends.filter(|e| *e != ends) {
+            let field = if first.base() != ends.base() {
+                "base_condition"
+            } else {
+                "tip_condition"
+            };
+            return Err(format!(
+                "{field}: a track stream keeps the ends of its first line ({} base, {} tip)",
+                first.base().name(),
+                first.tip().name()
+            ));
+        }
+        let request: HeldTrackRequest = jsonl::parse(line)?;
+        let target = target_of(ends, request.target)?;
+        let options = options_of(request.deadline_ms, request.max_turns)?;
+        let previous = self.gravity.unwrap_or_default();
+        let g = rod_ig_core::planar::heavy::Gravity::new(
+            request.weight.unwrap_or(previous.weight()),
+            request.gravity.unwrap_or(previous.direction()),
+        )
+        .map_err(|e| e.to_string())?;
+        self.ends = Some(ends);
+        self.gravity = Some(g);
+        let followed = self
+            .held
+            .as_ref()
+            .map(|h| held::follow(h, &g, target.as_ref(), &options));
+        let (event, found) = match followed {
+            Some(Ok(s)) => {
+                let found = held::HeldSearch {
+                    solutions: vec![s.clone()],
+                    equilibria: vec![s],
+                    starts: 1,
+                    ..Default::default()
+                };
+                ("none", found)
+            }
+            other => {
+                let found = held::equilibria(ends, &g, target.as_ref(), &options)
+                    .map_err(|e| e.to_string())?;
+                let event = match (&other, found.solutions.is_empty()) {
+                    (None, _) => "none",
+                    (Some(_), false) => "snap",
+                    (Some(_), true) => "lost",
+                };
+                (event, found)
+            }
+        };
+        self.held = found.solutions.first().cloned();
+        let mut value = jsonl::to_value(&answer_of(ends, &found, target.as_ref(), false, started))?;
+        if let Some(map) = value.as_object_mut() {
+            map.insert("event".into(), event.into());
+        }
+        Ok(value)
+    }
 }
 
 /// A rod held by pinned or free ends, sampled for `rod-ig shape`.

@@ -117,7 +117,9 @@ enum Command {
     /// "progress" (the fraction of the move done: 1 when the target was reached), "held_a"
     /// (the rod held after the line: on a deadline the last equilibrium reached, kept for the
     /// next line) and, after a snap, "critical": {"x", "y", "theta"} (where the branch
-    /// folded), "critical_a" and "energy_released".
+    /// folded), "critical_a" and "energy_released". Lines with "base_condition" or
+    /// "tip_condition" pinned or free (every line, the same ends) move a rod held by those
+    /// ends and answer as `solve` does with them, plus "event" (docs/ends.md).
     Track {
         /// Draw the sequence of rods (snaps marked) into this SVG file at the end.
         #[arg(long)]

@@ -29,6 +29,11 @@ struct TrackRequest {
     weight: Option<f64>,
     /// Direction of gravity from this line on (default: the stream's, at first [0, -1]).
     gravity: Option<[f64; 2]>,
+    /// "clamped" (the default) here; pinned and free ends go to `held_cmds::HeldTrack`.
+    #[allow(dead_code)] // read by `held_cmds::held_ends_of`
+    base_condition: Option<Value>,
+    #[allow(dead_code)] // read by `held_cmds::held_ends_of`
+    tip_condition: Option<Value>,
 }
 
 /// The branch follower of a stream: the weightless closed forms until a line gives weight.
@@ -133,6 +138,8 @@ pub const MAX_DRAWN_RODS: usize = 1000;
 #[derive(Default)]
 pub struct Tracking {
     follower: Option<Follower>,
+    /// The stream's rod when its lines hold it by pinned or free ends.
+    held: crate::held_cmds::HeldTrack,
     /// The stream's gravity (a line with `weight` or `gravity` changes it for the next lines).
     gravity: Gravity,
     /// Whether rods are kept for a picture (`--svg`).
@@ -254,6 +261,10 @@ fn change_gravity(
 impl Tracking {
     /// Answers one `track` line.
     pub fn line(&mut self, line: &str) -> Result<Value, String> {
+        let value: Value = jsonl::parse(line)?;
+        if let Some(ends) = crate::held_cmds::held_ends_of(&value)? {
+            return self.held.line(line, ends);
+        }
         let request: TrackRequest = jsonl::parse(line)?;
         let mut options = SolveOptions::default();
         jsonl::apply_newton_knobs(

@@ -965,3 +965,63 @@ fn shape_draws_rods_held_by_pinned_and_free_ends() {
         );
     }
 }
+
+/// `track` with held ends (issue 52, item 1): a cable pinned at both ends, 0.8 apart at
+/// w = 50 (ends_public C-002's rod), follows its tip gripper over 10 steps and a weight ramp
+/// to 2,000 with the event "none", each rod on target with zero end moments; the ramp ends on
+/// the rod a fresh `solve` finds there (the same base angle to 1e-8); a free tip follows
+/// gravity turning; a line naming other ends is refused by field.
+#[test]
+fn track_follows_rods_held_by_pinned_and_free_ends() {
+    let ends = "\"base_condition\": \"pinned\", \"tip_condition\": \"pinned\"";
+    let mut lines = vec![format!(
+        "{{\"target\": {{\"x\": 0.8, \"y\": 0}}, {ends}, \"weight\": 50}}"
+    )];
+    for i in 1..=10 {
+        let (x, y) = (0.8 - 0.01 * i as f64, 0.01 * i as f64);
+        lines.push(format!(
+            "{{\"target\": {{\"x\": {x}, \"y\": {y}}}, {ends}}}"
+        ));
+    }
+    for w in [300.0, 1000.0, 2000.0] {
+        lines.push(format!(
+            "{{\"target\": {{\"x\": 0.7, \"y\": 0.1}}, {ends}, \"weight\": {w}}}"
+        ));
+    }
+    lines.push("{\"tip_condition\": \"free\"}".into());
+    let out = run(&["track"], &(lines.join("\n") + "\n"));
+    assert_eq!(out.len(), 15);
+    assert!((out[0]["base_angle"].as_f64().unwrap() + 0.9202652225760789).abs() < 1e-8);
+    for (i, v) in out[..14].iter().enumerate() {
+        assert_eq!(v["success"], true, "line {i}: {v}");
+        assert_eq!(v["event"], "none", "line {i}: {v}");
+        assert!(
+            v["position_error"].as_f64().unwrap() < 1e-9,
+            "line {i}: {v}"
+        );
+        assert!(v["base_wrench"]["moment"].as_f64().unwrap().abs() < 1e-8);
+        assert!(v["tip_wrench"]["moment"].as_f64().unwrap().abs() < 1e-8);
+    }
+    let fresh = run(
+        &["solve"],
+        &format!("{{\"target\": {{\"x\": 0.7, \"y\": 0.1}}, {ends}, \"weight\": 2000, \"deadline_ms\": 5000}}\n"),
+    );
+    let d = out[13]["base_angle"].as_f64().unwrap() - fresh[0]["base_angle"].as_f64().unwrap();
+    assert!(d.abs() < 1e-8, "{} vs {}", out[13], fresh[0]);
+    assert!(out[14]["error"]
+        .as_str()
+        .unwrap()
+        .starts_with("base_condition"));
+    let free = run(
+        &["track"],
+        "{\"tip_condition\": \"free\", \"weight\": 100}\n{\"tip_condition\": \"free\", \"gravity\": [0.3, -1]}\n",
+    );
+    for v in &free {
+        assert_eq!(v["success"], true, "{v}");
+        assert_eq!(v["event"], "none", "{v}");
+        assert!(
+            v["tip_wrench"]["force"][0].as_f64().unwrap().abs() < 1e-9,
+            "{v}"
+        );
+    }
+}

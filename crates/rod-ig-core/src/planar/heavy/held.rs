@@ -47,6 +47,13 @@ pub enum HeldError {
         /// Why.
         why: String,
     },
+    /// A followed rod left its branch: the continuation failed, or the rod it reached is not
+    /// admitted (unstable, coiled).
+    #[error("the held rod was lost on the way: {why}")]
+    Lost {
+        /// What stopped it.
+        why: String,
+    },
     /// No stable equilibrium was found.
     #[error(
         "no stable equilibrium found with {base} base and {tip} tip ({starts} starts{cut}){last}"
@@ -332,6 +339,62 @@ pub fn equilibria_with_tip_load(
     search.out.equilibria.sort_by(by_energy);
     search.out.solutions.sort_by(by_energy);
     Ok(search.out)
+}
+
+/// Quasi-static motion with held ends: the rod `from` carried to `gravity` with its gripper
+/// where it is, then moved along its branch to `target` (a clamped tip's pose, a pinned tip's
+/// position; `None` for a free tip, which only follows gravity), by continuation on its node
+/// states ([`Cable::carry_within`], [`Cable::move_within`]) within `options.deadline`. The rod
+/// reached must be admitted as the search's answers are (stable with the natural conditions,
+/// at most `options.max_turns` turns, loop-free without crossing); otherwise, or where the
+/// continuation stops (a fold), [`HeldError::Lost`] says why.
+pub fn follow(
+    from: &HeldSolution,
+    gravity: &Gravity,
+    target: Option<&PlanarPose>,
+    options: &SolveOptions,
+) -> Result<HeldSolution, HeldError> {
+    let ends = from.cable.ends();
+    let target = checked_target(ends, target)?;
+    let _deadline = crate::deadline::scope(options.deadline);
+    let lost = |e: CableError| HeldError::Lost { why: e.to_string() };
+    let limits = FollowLimits {
+        max_theta_spread: std::f64::consts::TAU * (options.max_turns as f64 + 1.5),
+        ..FollowLimits::default()
+    };
+    let mut cable = from.cable.clone();
+    let tip = from.tip;
+    // A pinned tip's θ is free: the goal pose keeps the rod's own (no equation asks it).
+    let goal = |t: Option<PlanarPose>, theta: f64| match (ends.tip(), t) {
+        (EndCondition::Clamped, Some(t)) => lift_near(&t, theta),
+        (_, Some(t)) => PlanarPose::new(t.x, t.y, theta),
+        (_, None) => PlanarPose::new(tip.x, tip.y, theta),
+    };
+    if cable.gravity() != gravity {
+        cable
+            .carry_within(gravity, &goal(None, tip.theta), &limits)
+            .map_err(lost)?;
+    }
+    if target.is_some() {
+        let theta = cable.tip().map_err(|e| lost(e.into()))?.theta;
+        cable
+            .move_within(&goal(target, theta), &limits)
+            .map_err(lost)?;
+    }
+    let reached = HeldSolution::of(cable).map_err(|e| lost(e.into()))?;
+    let admitted = reached.stability.stable()
+        && reached.turns <= options.max_turns
+        && (options.max_turns > 0 || !reached.self_intersects);
+    if !admitted {
+        return Err(HeldError::Lost {
+            why: format!(
+                "the rod reached is not admitted (stable: {}, turns: {})",
+                reached.stability.stable(),
+                reached.turns
+            ),
+        });
+    }
+    Ok(reached)
 }
 
 /// The least-energy admitted equilibrium of [`equilibria`], or why there is none.
