@@ -537,10 +537,15 @@ fn main() -> ExitCode {
         Command::Forward3d => {
             jsonl::run(stdin, stdout, spatial_cmds::forward3d_line).map_err(|e| e.to_string())
         }
-        Command::Solve3d { verbose } => jsonl::run(stdin, stdout, |line| {
-            spatial_cmds::solve3d_line(line, verbose)
-        })
-        .map_err(|e| e.to_string()),
+        Command::Solve3d { verbose } => {
+            // A rod with weight starts from the planar rods (their atlas, built outside the
+            // first line's deadline as for `solve`).
+            warm_up();
+            jsonl::run(stdin, stdout, |line| {
+                spatial_cmds::solve3d_line(line, verbose)
+            })
+            .map_err(|e| e.to_string())
+        }
         Command::Track { svg } => track(stdin, stdout, svg.as_deref()),
         Command::Plan { svg } => plan(stdin, stdout, svg.as_deref()),
         Command::Shape {
