@@ -416,6 +416,8 @@ fn solve_held(s: &SolverSettings, target: &PlanarPose, samples: usize) -> Result
                 held::HeldError::NotFound { cut, .. } if !cut.is_empty() => "deadline",
                 held::HeldError::NotFound { .. } => "no_stable_solution",
                 held::HeldError::Target { .. } => "invalid_input",
+                // Only `held::follow` loses a rod; a search answers NotFound.
+                held::HeldError::Lost { .. } => "no_stable_solution",
             };
             failed(e.to_string(), termination)
         })?;

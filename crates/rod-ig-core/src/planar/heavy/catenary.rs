@@ -174,7 +174,7 @@ impl SeedShape {
 
 /// The cable, both ends clamped, whose node states are the catenary through `target` with its
 /// two tension layers (module docs), and the target lifted to the seed's tip angle; `None`
-/// when there is no such catenary (module docs, [`Catenary::through`]).
+/// when there is no such catenary (the chord is not shorter than the cable, or vertical).
 pub fn seed(
     target: &PlanarPose,
     gravity: &Gravity,
