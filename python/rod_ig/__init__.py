@@ -185,6 +185,10 @@ class ForwardResult:
     """(...): ||J(1)||_inf * max(1, ||a||_inf): the tip of an f64 ``a`` is uncertain by about
     this times 1.1e-16. Above 1e9 (long cables, w > 200) ``uncertain`` is True unless ``a`` is
     a solver's answer, evaluated from its node states (docs/weight.md)."""
+    base_angle: FloatArray | None = None
+    """(...): with pinned or free ends, the rod's angle at the base (0 unless pinned)."""
+    turns: FloatArray | None = None
+    """(...): with pinned or free ends, full turns of the tangent along the rod."""
 
 
 @dataclass(frozen=True)
@@ -292,6 +296,10 @@ def forward(
     threads: int | None = None,
     weight: npt.ArrayLike | None = None,
     gravity: npt.ArrayLike | None = None,
+    base_condition: EndName = "clamped",
+    tip_condition: EndName = "clamped",
+    base_angle: npt.ArrayLike = 0.0,
+    tip_load: tuple[float, float] | None = None,
 ) -> ForwardResult:
     """Planar forward map of rods ``a`` of shape (..., 3) = (a3, a4, a5): tip pose, J(1, a),
     stability verdict and margin, energy (closed forms, paper section 2). A rod that cannot be
@@ -299,7 +307,17 @@ def forward(
 
     ``weight`` (dimensionless w = rho g A L^3 / EI, in [0, 1e4]) and ``gravity`` (its direction in
     the base frame, (..., 2), default (0, -1)) broadcast against the batch: the rod with weight
-    (docs/weight.md)."""
+    (docs/weight.md).
+
+    With a pinned or free end (``base_condition`` "clamped" | "pinned", ``tip_condition``
+    "clamped" | "pinned" | "free"; docs/ends.md) the rod leaves its base at ``base_angle`` (a
+    pinned base's a3 must be 0; a free tip's (a4, a5) must be w g + ``tip_load``): the verdict
+    and margin are the second variation's with the natural conditions, J's first column is
+    d/d base_angle at a pinned base, and ``base_angle`` and ``turns`` are filled. A rod the
+    conditions refuse raises ValueError naming the argument."""
+    if base_condition != "clamped" or tip_condition != "clamped":
+        return _forward_held(a, weight, gravity, base_condition, tip_condition, base_angle,
+                             tip_load)
     arr, _ = _batch("a", a, 3)
     flat, shape = _broadcast(arr, *_weight_arrays(weight, gravity))
     d = _rod_ig.forward(flat[0], threads=_threads(threads), **_weight_kwargs(flat, 1))
@@ -314,6 +332,38 @@ def forward(
         base_wrench=_wrench(d["base_wrench"], shape, 2),
         tip_wrench=_wrench(d["tip_wrench"], shape, 2),
         condition=_shaped(d["condition"], shape),
+    )
+
+
+def _forward_held(
+    a: npt.ArrayLike,
+    weight: npt.ArrayLike | None,
+    gravity: npt.ArrayLike | None,
+    base_condition: str,
+    tip_condition: str,
+    base_angle: npt.ArrayLike,
+    tip_load: tuple[float, float] | None,
+) -> ForwardResult:
+    """:func:`forward` with pinned or free ends (``_rod_ig.forward_held``)."""
+    arr, _ = _batch("a", a, 3)
+    angle = np.asarray(base_angle, dtype=np.float64)
+    flat, shape = _broadcast(arr, angle[..., None], *_weight_arrays(weight, gravity))
+    load = None if tip_load is None else (float(tip_load[0]), float(tip_load[1]))
+    d = _rod_ig.forward_held(flat[0], np.ascontiguousarray(flat[1].reshape(-1)), base_condition,
+                             tip_condition, tip_load=load, **_weight_kwargs(flat, 2))
+    return ForwardResult(
+        tip=d["tip"].reshape(shape + (3,)),
+        jacobian=d["jacobian"].reshape(shape + (3, 3)),
+        stable=_shaped(d["stable"], shape),
+        margin=_shaped(d["margin"], shape),
+        uncertain=_shaped(d["uncertain"], shape),
+        energy=_shaped(d["energy"], shape),
+        elastic_energy=_shaped(d["elastic_energy"], shape),
+        base_wrench=_wrench(d["base_wrench"], shape, 2),
+        tip_wrench=_wrench(d["tip_wrench"], shape, 2),
+        condition=_shaped(d["condition"], shape),
+        base_angle=_shaped(d["base_angle"], shape),
+        turns=_shaped(d["turns"], shape),
     )
 
 

@@ -14,6 +14,15 @@ def forward(
     weight: npt.NDArray[np.float64] | None = None,
     gravity: npt.NDArray[np.float64] | None = None,
 ) -> dict[str, Any]: ...
+def forward_held(
+    a: npt.NDArray[np.float64],
+    base_angle: npt.NDArray[np.float64],
+    base_condition: str,
+    tip_condition: str,
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
+    tip_load: tuple[float, float] | None = None,
+) -> dict[str, Any]: ...
 def is_stable(
     a: npt.NDArray[np.float64],
     threads: int | None = None,

@@ -638,18 +638,7 @@ fn held_request(
     tip_condition: &str,
     max_turns: u32,
 ) -> PyResult<(HeldEnds, usize)> {
-    let condition = |field: &str, v: &str| {
-        v.parse::<EndCondition>().map_err(|_| {
-            PyValueError::new_err(format!(
-                "{field} must be \"clamped\", \"pinned\" or \"free\", got {v:?}"
-            ))
-        })
-    };
-    let ends = HeldEnds::new(
-        condition("base_condition", base_condition)?,
-        condition("tip_condition", tip_condition)?,
-    )
-    .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let ends = ends_of(base_condition, tip_condition)?;
     let width = match ends.tip() {
         EndCondition::Free => 0,
         EndCondition::Pinned => 2,
@@ -679,6 +668,90 @@ fn held_request(
         )));
     }
     Ok((ends, width))
+}
+
+/// The ends named by `base_condition` and `tip_condition` (refusals name the argument).
+fn ends_of(base_condition: &str, tip_condition: &str) -> PyResult<HeldEnds> {
+    let condition = |field: &str, v: &str| {
+        v.parse::<EndCondition>().map_err(|_| {
+            PyValueError::new_err(format!(
+                "{field} must be \"clamped\", \"pinned\" or \"free\", got {v:?}"
+            ))
+        })
+    };
+    HeldEnds::new(
+        condition("base_condition", base_condition)?,
+        condition("tip_condition", tip_condition)?,
+    )
+    .map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// The forward map of n rods `a` (flattened (n, 3)) held by (`base_condition`,
+/// `tip_condition`), each leaving its base at `base_angle[i]` (`held::evaluate`): the keys of
+/// [`forward`] (margin: μ/μ₀ of the second variation with the natural conditions; J's first
+/// column ∂/∂θ(0) at a pinned base) plus `base_angle` and `turns`. A rod the conditions refuse
+/// (a moment at a pinned base, a force at a free tip other than w ĝ + `tip_load`) raises
+/// ValueError naming the argument.
+#[pyfunction]
+#[pyo3(signature = (a, base_angle, base_condition, tip_condition, weight=None, gravity=None,
+                    tip_load=None))]
+#[allow(clippy::too_many_arguments)]
+fn forward_held<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    base_angle: PyReadonlyArray1<'py, f64>,
+    base_condition: &str,
+    tip_condition: &str,
+    weight: Option<PyReadonlyArray1<'py, f64>>,
+    gravity: Option<PyReadonlyArray1<'py, f64>>,
+    tip_load: Option<(f64, f64)>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (a, angles) = (a.as_slice()?, base_angle.as_slice()?);
+    let n = a.len() / 3;
+    let ends = ends_of(base_condition, tip_condition)?;
+    let g = gravities2(n, weight.as_ref(), gravity.as_ref())?;
+    let load = tip_load.map_or([0.0; 2], |(x, y)| [x, y]);
+    let mut out: [Vec<f64>; 10] = std::array::from_fn(|_| Vec::with_capacity(n));
+    let (mut stable, mut uncertain) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for i in 0..n {
+        let gi = g.as_ref().map_or(Gravity::NONE, |g| g[i]);
+        let e = held::evaluate(angles[i], &planar_params(a, i), &gi, ends, load)
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let s = &e.solution;
+        let w = s.wrenches();
+        let [b, t] = planar_rows(&w);
+        out[0].extend([s.tip.x, s.tip.y, s.tip.theta]);
+        out[1].extend(e.jacobian.transpose().iter());
+        out[2].push(s.stability.normalised());
+        out[3].push(s.energy);
+        out[4].push(s.elastic_energy);
+        out[5].extend(b);
+        out[6].extend(t);
+        out[7].push(e.condition);
+        out[8].push(s.base_angle);
+        out[9].push(s.turns as f64);
+        stable.push(e.stable());
+        uncertain.push(e.uncertain());
+    }
+    let d = PyDict::new(py);
+    let [tip, jac, margin, energy, elastic, base_w, tip_w, cond, angle, turns] = out;
+    for (key, v) in [
+        ("tip", tip),
+        ("jacobian", jac),
+        ("margin", margin),
+        ("energy", energy),
+        ("elastic_energy", elastic),
+        ("base_wrench", base_w),
+        ("tip_wrench", tip_w),
+        ("condition", cond),
+        ("base_angle", angle),
+        ("turns", turns),
+    ] {
+        d.set_item(key, f64_out(py, v))?;
+    }
+    d.set_item("stable", stable.into_pyarray(py))?;
+    d.set_item("uncertain", uncertain.into_pyarray(py))?;
+    Ok(d)
 }
 
 /// One held-ends answer, flattened for the batch arrays.
@@ -1483,6 +1556,7 @@ fn warm_up(py: Python<'_>) -> usize {
 #[pymodule]
 fn _rod_ig(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(forward, m)?)?;
+    m.add_function(wrap_pyfunction!(forward_held, m)?)?;
     m.add_function(wrap_pyfunction!(is_stable, m)?)?;
     m.add_function(wrap_pyfunction!(shape, m)?)?;
     m.add_function(wrap_pyfunction!(solve, m)?)?;

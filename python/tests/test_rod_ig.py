@@ -687,3 +687,39 @@ def test_pinned_and_free_ends() -> None:
         rod_ig.solve([0.8, 0.0, 0.0], tip_condition="pinned")
     with pytest.raises(ValueError, match="clamped ends only"):
         rod_ig.solve([0.8, 0.0], tip_condition="pinned", a0=[0.0, 1.0, 0.0])
+
+
+def test_forward_with_held_ends_gives_back_the_solved_rods() -> None:
+    """forward(..., base_condition=, tip_condition=, base_angle=) (issue 52): the rods solve
+    returns with pinned or free ends, given back as a (and their base angle), reproduce their
+    tips (1e-9), energies (1e-8) and verdicts with the natural conditions, loop-free; a
+    weightless rod from a pinned base is the closed form's clamped rod turned by its base angle;
+    refusals name the argument."""
+    free = rod_ig.solve(None, tip_condition="free", weight=300.0, gravity=[0.0, -1.0],
+                        deadline_ms=5000)
+    pinned = rod_ig.solve([0.8, 0.0], base_condition="pinned", tip_condition="pinned",
+                          weight=50.0, deadline_ms=5000)
+    for s, w, base, tip in ((free, 300.0, "clamped", "free"), (pinned, 50.0, "pinned", "pinned")):
+        assert s.base_angle is not None and s.tip is not None
+        f = rod_ig.forward(s.a, weight=w, base_condition=base, tip_condition=tip,
+                           base_angle=s.base_angle)
+        assert f.turns is not None and f.base_angle is not None
+        np.testing.assert_allclose(f.tip[:2], s.tip[:2], atol=1e-9)
+        assert abs(float(f.energy) - float(s.energy)) < 1e-8
+        assert bool(f.stable) and float(f.turns) == 0.0
+    phi = np.array([0.3, -1.2])
+    forces = np.array([[5.0, -2.0], [-3.0, 8.0]])
+    a = np.column_stack([np.zeros(2), forces])
+    held = rod_ig.forward(a, base_condition="pinned", tip_condition="pinned", base_angle=phi)
+    c, s_ = np.cos(phi), np.sin(phi)
+    turned = np.column_stack([np.zeros(2), c * forces[:, 0] + s_ * forces[:, 1],
+                              -s_ * forces[:, 0] + c * forces[:, 1]])
+    clamped = rod_ig.forward(turned)
+    x = c * clamped.tip[:, 0] - s_ * clamped.tip[:, 1]
+    y = s_ * clamped.tip[:, 0] + c * clamped.tip[:, 1]
+    np.testing.assert_allclose(held.tip[:, 0], x, atol=1e-10)
+    np.testing.assert_allclose(held.tip[:, 1], y, atol=1e-10)
+    with pytest.raises(ValueError, match="a pinned base holds no moment"):
+        rod_ig.forward([1.0, 0.0, 0.0], base_condition="pinned", tip_condition="pinned")
+    with pytest.raises(ValueError, match="base_condition"):
+        rod_ig.forward([0.0, 0.0, 0.0], base_condition="hinged")
