@@ -92,3 +92,21 @@ def test_bad_conditions_are_refused_by_name(cable):
         c.pub.publish(c.make_target(0.5, 0.0, 0.0, s))
         sol = c.solution_for(s, timeout=10.0)
         assert not sol.success and "pendulum" in sol.message
+
+
+def test_a_held_rod_follows_its_gripper(cable):
+    """With held ends the next target moves the rod held along its branch (held::follow): with
+    follow_branch the event is "none", the rod on target, its base angle a step away from the
+    last one's; the first target after a change of ends is a fresh search."""
+    _, c = cable
+    with params_set(c, base_condition="pinned", follow_branch=True):
+        first, _ = solve_topic(c, 0.8, 0.0, 0.0)
+        assert first.success, first.message
+        for i in range(1, 4):
+            sol, path = solve_topic(c, 0.8 - 0.02 * i, 0.02 * i, 0.0)
+            assert sol.success, sol.message
+            assert sol.event == "none", sol.event
+            assert sol.position_error < 1e-9 and sol.stable
+            assert abs(sol.base_angle - first.base_angle) < 0.2
+            last = path.poses[-1].pose.position
+            assert math.hypot(last.x - (0.8 - 0.02 * i), last.y - 0.02 * i) < 1e-9

@@ -191,6 +191,9 @@ pub struct RodSolver {
     last_heavy: Option<PlanarParams>,
     /// Previous 3-D solution: the warm start of the next 3-D target.
     last_3d: Option<SpatialParams>,
+    /// Previous rod held by pinned or free ends: the next target moves it along its branch
+    /// (`held::follow`) before any fresh search.
+    last_held: Option<held::HeldSolution>,
 }
 
 impl RodSolver {
@@ -206,6 +209,7 @@ impl RodSolver {
             ),
             last_heavy: None,
             last_3d: None,
+            last_held: None,
         }
     }
 
@@ -278,6 +282,7 @@ impl RodSolver {
         );
         self.last_heavy = None;
         self.last_3d = None;
+        self.last_held = None;
     }
 
     /// Solves the 3-D inverse geometry for `target` (normalised) with the 3-D solver and
@@ -331,7 +336,17 @@ impl RodSolver {
         samples: usize,
     ) -> Result<Solved, Failed> {
         if !self.settings.ends.both_clamped() {
-            return solve_held(&one_off.unwrap_or(self.settings), target, samples);
+            return match one_off {
+                Some(s) => solve_held(&s, None, target, samples).map(|(solved, _)| solved),
+                None => {
+                    let previous = self.last_held.take();
+                    let held = solve_held(&self.settings, previous.as_ref(), target, samples);
+                    held.map(|(solved, rod)| {
+                        self.last_held = Some(rod);
+                        solved
+                    })
+                }
+            };
         }
         if !self.settings.gravity.is_weightless() {
             return self.solve_heavy(target, initial_guess, one_off, samples);
@@ -390,28 +405,60 @@ impl RodSolver {
     }
 }
 
-/// A planar target with pinned or free ends: the least-energy stable rod of the held-ends
-/// search (a pinned tip holds the target's position, a free tip ignores the target), as a
-/// solver `Solution` (iterations 0: a search, not one Newton run) with its shape.
-fn solve_held(s: &SolverSettings, target: &PlanarPose, samples: usize) -> Result<Solved, Failed> {
+/// A planar target with pinned or free ends: the rod `previous` (held by the same ends) moved
+/// along its branch to the target (`held::follow`, event "none" when following the branch),
+/// else the least-energy stable rod of the held-ends search (a pinned tip holds the target's
+/// position, a free tip ignores the target; event "snap" when a followed rod's branch ended),
+/// as a solver `Solution` (iterations 0: a search, not one Newton run) with its shape, and the
+/// rod itself (the next target's `previous`).
+fn solve_held(
+    s: &SolverSettings,
+    previous: Option<&held::HeldSolution>,
+    target: &PlanarPose,
+    samples: usize,
+) -> Result<(Solved, held::HeldSolution), Failed> {
     let options = SolveOptions {
         deadline: s.deadline.max(HELD_MIN_DEADLINE),
         ..SolveOptions::default()
     };
     let tip_target = (s.ends.tip() != EndCondition::Free).then_some(target);
-    let failed = |reason: String, termination: &'static str| Failed {
-        reason,
-        termination,
-        iterations: 0,
-        residual: f64::NAN,
-        last_a: None,
-        last_a_spatial: None,
-        spatial: false,
-        event: "",
+    let previous = previous.filter(|p| p.cable.ends() == s.ends);
+    if let Some(p) = previous {
+        let started = std::time::Instant::now();
+        let follow_options = SolveOptions {
+            deadline: s.deadline,
+            ..SolveOptions::default()
+        };
+        if let Ok(rod) = held::follow(p, &s.gravity, tip_target, &follow_options) {
+            // One rod followed, not a search: `complete` is false.
+            let found = held::HeldSearch {
+                starts: 1,
+                cut_short: true,
+                ..Default::default()
+            };
+            let event = if s.follow_branch { "none" } else { "" };
+            return held_solved(s, rod, &found, target, samples, started, event);
+        }
+    }
+    let event = match (previous, s.follow_branch) {
+        (Some(_), true) => "snap",
+        _ => "",
     };
+    solve_held_afresh(s, &options, tip_target, target, samples, event)
+}
+
+/// The held-ends search for `target` ([`solve_held`] without a rod to follow).
+fn solve_held_afresh(
+    s: &SolverSettings,
+    options: &SolveOptions,
+    tip_target: Option<&PlanarPose>,
+    target: &PlanarPose,
+    samples: usize,
+    event: &'static str,
+) -> Result<(Solved, held::HeldSolution), Failed> {
     let started = std::time::Instant::now();
     let (best, found) =
-        held::least_energy(s.ends, &s.gravity, tip_target, &options).map_err(|e| {
+        held::least_energy(s.ends, &s.gravity, tip_target, options).map_err(|e| {
             let termination = match &e {
                 held::HeldError::NotFound { cut, .. } if !cut.is_empty() => "deadline",
                 held::HeldError::NotFound { .. } => "no_stable_solution",
@@ -419,10 +466,26 @@ fn solve_held(s: &SolverSettings, target: &PlanarPose, samples: usize) -> Result
                 // Only `held::follow` loses a rod; a search answers NotFound.
                 held::HeldError::Lost { .. } => "no_stable_solution",
             };
-            failed(e.to_string(), termination)
+            Failed {
+                event: if event == "snap" { "lost" } else { "" },
+                ..held_failure(e.to_string(), termination)
+            }
         })?;
+    held_solved(s, best, &found, target, samples, started, event)
+}
+
+/// The node's answer for the held rod `best` that a search (or a follow) `found`.
+fn held_solved(
+    s: &SolverSettings,
+    best: held::HeldSolution,
+    found: &held::HeldSearch,
+    target: &PlanarPose,
+    samples: usize,
+    started: std::time::Instant,
+    event: &'static str,
+) -> Result<(Solved, held::HeldSolution), Failed> {
     let shape = best.cable.shape(samples).map_err(|e| {
-        failed(
+        held_failure(
             format!("cannot evaluate the solution's shape: {e}"),
             "evaluation_failed",
         )
@@ -436,7 +499,7 @@ fn solve_held(s: &SolverSettings, target: &PlanarPose, samples: usize) -> Result
         _ => f64::NAN,
     };
     let w = best.wrenches().tip;
-    Ok(WithShape {
+    let solved = WithShape {
         solution: Solution {
             a: best.a,
             tip: best.tip,
@@ -457,13 +520,28 @@ fn solve_held(s: &SolverSettings, target: &PlanarPose, samples: usize) -> Result
             complete: !found.cut_short,
         },
         shape,
-        event: "",
+        event,
         critical: None,
         weight: s.gravity.weight(),
         elastic_energy: best.elastic_energy,
         tip_wrench: [w.force[0], w.force[1], 0.0, 0.0, 0.0, w.moment],
         base_angle: best.base_angle,
-    })
+    };
+    Ok((solved, best))
+}
+
+/// A held-ends solve that failed, and why.
+fn held_failure(reason: String, termination: &'static str) -> Failed {
+    Failed {
+        reason,
+        termination,
+        iterations: 0,
+        residual: f64::NAN,
+        last_a: None,
+        last_a_spatial: None,
+        spatial: false,
+        event: "",
+    }
 }
 
 /// Least time a held-ends solve gets (its search tries more starts than a clamped one).
