@@ -321,6 +321,13 @@ def forward(
     arr, _ = _batch("a", a, 3)
     flat, shape = _broadcast(arr, *_weight_arrays(weight, gravity))
     d = _rod_ig.forward(flat[0], threads=_threads(threads), **_weight_kwargs(flat, 1))
+    return _forward_result(d, shape)
+
+
+def _forward_result(d: dict[str, Any], shape: tuple[int, ...]) -> ForwardResult:
+    """A :class:`ForwardResult` from the native arrays ``d`` (``base_angle`` and ``turns`` when
+    the rod was held by pinned or free ends)."""
+    held = "base_angle" in d
     return ForwardResult(
         tip=d["tip"].reshape(shape + (3,)),
         jacobian=d["jacobian"].reshape(shape + (3, 3)),
@@ -332,6 +339,8 @@ def forward(
         base_wrench=_wrench(d["base_wrench"], shape, 2),
         tip_wrench=_wrench(d["tip_wrench"], shape, 2),
         condition=_shaped(d["condition"], shape),
+        base_angle=_shaped(d["base_angle"], shape) if held else None,
+        turns=_shaped(d["turns"], shape) if held else None,
     )
 
 
@@ -351,20 +360,7 @@ def _forward_held(
     load = None if tip_load is None else (float(tip_load[0]), float(tip_load[1]))
     d = _rod_ig.forward_held(flat[0], np.ascontiguousarray(flat[1].reshape(-1)), base_condition,
                              tip_condition, tip_load=load, **_weight_kwargs(flat, 2))
-    return ForwardResult(
-        tip=d["tip"].reshape(shape + (3,)),
-        jacobian=d["jacobian"].reshape(shape + (3, 3)),
-        stable=_shaped(d["stable"], shape),
-        margin=_shaped(d["margin"], shape),
-        uncertain=_shaped(d["uncertain"], shape),
-        energy=_shaped(d["energy"], shape),
-        elastic_energy=_shaped(d["elastic_energy"], shape),
-        base_wrench=_wrench(d["base_wrench"], shape, 2),
-        tip_wrench=_wrench(d["tip_wrench"], shape, 2),
-        condition=_shaped(d["condition"], shape),
-        base_angle=_shaped(d["base_angle"], shape),
-        turns=_shaped(d["turns"], shape),
-    )
+    return _forward_result(d, shape)
 
 
 def is_stable(

@@ -241,7 +241,19 @@ impl Cable {
             )?;
             nodes.push([e[0], e[1], e[2], e[3]]);
         }
-        Ok(Self {
+        Ok(Self::assembled(gravity, mesh, force, nodes, ends))
+    }
+
+    /// The cable of these parts at the full integration tolerance, its tip asked no curvature
+    /// and carrying no load.
+    fn assembled(
+        gravity: &Gravity,
+        mesh: Vec<f64>,
+        force: [f64; 2],
+        nodes: Vec<[f64; 4]>,
+        ends: HeldEnds,
+    ) -> Self {
+        Self {
             gravity: *gravity,
             mesh,
             force,
@@ -250,7 +262,7 @@ impl Cable {
             ends,
             tip_curvature_goal: 0.0,
             tip_load: [0.0; 2],
-        })
+        }
     }
 
     /// A clamped cable with base force `force` whose node states are a guessed shape:
@@ -281,16 +293,13 @@ impl Cable {
                 }
             }
         }
-        Ok(Self {
-            gravity: *gravity,
+        Ok(Self::assembled(
+            gravity,
             mesh,
             force,
             nodes,
-            rtol: SEGMENT_RTOL,
-            ends: HeldEnds::CLAMPED,
-            tip_curvature_goal: 0.0,
-            tip_load: [0.0; 2],
-        })
+            HeldEnds::CLAMPED,
+        ))
     }
 
     /// The same free-tip cable with the point force `load` (base frame, unit rod's units)
