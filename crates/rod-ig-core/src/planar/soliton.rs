@@ -58,8 +58,8 @@ const MIN_FORCE: f64 = 1.0;
 /// Largest √R: beyond ln(f64::MAX) J overflows (as for every f64 evaluation under tension).
 const MAX_ROOT_FORCE: f64 = 709.0;
 
-/// Smallest |A|, |B| taken: above the subnormal range (where ln|A| loses digits).
-const MIN_AMPLITUDE: f64 = 1e-300;
+/// Smallest |A|, |B| taken: the smallest normal f64 (below, ln|A| of a subnormal loses digits).
+const MIN_AMPLITUDE: f64 = f64::MIN_POSITIVE;
 
 /// Largest cancellation (|ψ(0)| + |a3|/√R)/|2A| (or B) taken: A and B carry a relative
 /// rounding of a few ε times this, which moves the solitons by as much (in units of 1/√R).
