@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Send one tip-gripper pose to rod_ig_node and print what comes back.
 
-    source scripts/env.sh                      # rclpy + rod_ig_msgs (after scripts/setup-env.sh)
+    source scripts/setup/env.sh                      # rclpy + rod_ig_msgs (after scripts/setup/setup-env.sh)
     python examples/send_target.py 0.5 0.2 1.0 # x (m), y (m), yaw (rad) in the base frame
 """
 import math

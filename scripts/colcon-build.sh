@@ -5,9 +5,9 @@
 # `ros2 run rod_ig rod_ig_node` then finds install/rod_ig/lib/rod_ig/rod_ig_node.
 #
 # On a machine with ROS 2 installed, the same is: clone into <ws>/src, run
-# scripts/patch-deps.sh once, `pip install colcon-ros-cargo cargo-ament-build` (or
+# scripts/setup/patch-deps.sh once, `pip install colcon-ros-cargo cargo-ament-build` (or
 # `cargo install cargo-ament-build`), then `colcon build` in <ws>. Here, without a system
-# ROS, the venv of scripts/setup-env.sh serves as the ROS prefix.
+# ROS, the venv of scripts/setup/setup-env.sh serves as the ROS prefix.
 #
 # Usage: scripts/colcon-build.sh [WORKSPACE]   (default: build/colcon-ws; the repository is
 # linked in as WORKSPACE/src/rod-ig). Takes ~3 min on 2 cores (colcon builds the crates in
@@ -17,8 +17,8 @@ REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 WS="${1:-$REPO/build/colcon-ws}"
 VENV="${ROD_IG_VENV:-$REPO/.venv}"
 
-bash "$REPO/scripts/patch-deps.sh"
-bash "$REPO/scripts/setup-env.sh"
+bash "$REPO/scripts/setup/patch-deps.sh"
+bash "$REPO/scripts/setup/setup-env.sh"
 COLCON_PACKAGES=(colcon-core colcon-ros colcon-cmake colcon-cargo colcon-ros-cargo
                  colcon-recursive-crawl colcon-library-path colcon-package-selection
                  colcon-parallel-executor colcon-output colcon-package-information

@@ -6,14 +6,14 @@
 # ROS_DOMAIN_ID (default 0), ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST or ROS_LOCALHOST_ONLY=1
 # (loopback only), RUST_LOG (console log filter). Stop with Ctrl-C (SIGINT) or SIGTERM.
 # With ROD_IG_SETUP_CLIENT=1 it also prepares the rclpy venv and rod_ig_msgs for clients
-# (scripts/setup-env.sh; then `source scripts/env.sh` in the client's shell).
+# (scripts/setup/setup-env.sh; then `source scripts/setup/env.sh` in the client's shell).
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$REPO"
 if [ "${ROD_IG_SETUP_CLIENT:-0}" = 1 ]; then
-    bash "$REPO/scripts/setup-env.sh"
+    bash "$REPO/scripts/setup/setup-env.sh"
 fi
-bash "$REPO/scripts/patch-deps.sh"
+bash "$REPO/scripts/setup/patch-deps.sh"
 cargo build --release --manifest-path "$REPO/ros/rod_ig/Cargo.toml" --bins >&2
 BIN="${CARGO_TARGET_DIR:-$REPO/target}/release/rod_ig_node"
 export ROS_DISTRO="${ROS_DISTRO:-kilted}"

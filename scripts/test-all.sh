@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Everything from scratch on a fresh Debian 12 machine with Rust and CPython 3.11, idempotent:
 #   1. Python headers if missing (apt: python3-dev), the venv with ROS 2 Kilted wheels, and the
-#      interface package rod_ig_msgs (scripts/setup-env.sh);
+#      interface package rod_ig_msgs (scripts/setup/setup-env.sh);
 #   2. lint of the three Cargo workspaces (crates, ros/rod_ig, python): `cargo fmt --check`,
 #      `cargo clippy --all-targets -- -D warnings`, `RUSTDOCFLAGS="-D warnings" cargo doc`;
 #   3. `cargo test` of the crates and of the node (unit, integration and doc-tests, the seeded
@@ -24,12 +24,12 @@ mkdir -p "$LOGS"
 status=0
 
 echo "== patching dependencies (patches/*.patch onto the crates.io releases)"
-bash "$REPO/scripts/patch-deps.sh" || { echo "patch-deps.sh failed"; exit 1; }
+bash "$REPO/scripts/setup/patch-deps.sh" || { echo "patch-deps.sh failed"; exit 1; }
 
 echo "== setting up the Python/ROS environment"
-bash "$REPO/scripts/setup-env.sh" || { echo "setup-env.sh failed"; exit 1; }
-# shellcheck source=scripts/env.sh
-source "$REPO/scripts/env.sh"
+bash "$REPO/scripts/setup/setup-env.sh" || { echo "setup-env.sh failed"; exit 1; }
+# shellcheck source=scripts/setup/env.sh
+source "$REPO/scripts/setup/env.sh"
 export ROS_DISTRO="${ROS_DISTRO:-kilted}"
 
 # Three Cargo workspaces: the crates (root), the node (its own, with the patched DDS crates)
@@ -54,14 +54,14 @@ lint node "${NODE[@]}"
 lint python "${PYPKG[@]}"
 # The layering (no module imports one that imports it back) and no function over 80 lines.
 for src in crates/rod-ig-core/src crates/rod-ig-cli/src ros/rod_ig/src; do
-    python3 scripts/import_cycles.py "$src" --depth 3 >>"$LOGS/layering.log" || { echo "import cycle in $src (see $LOGS/layering.log)"; status=1; }
+    python3 scripts/checks/import_cycles.py "$src" --depth 3 >>"$LOGS/layering.log" || { echo "import cycle in $src (see $LOGS/layering.log)"; status=1; }
 done
-python3 scripts/long_functions.py crates/*/src ros/rod_ig/src python/src >>"$LOGS/layering.log" \
+python3 scripts/checks/long_functions.py crates/*/src ros/rod_ig/src python/src >>"$LOGS/layering.log" \
     || { echo "functions over 80 lines (see $LOGS/layering.log)"; status=1; }
 # Issue 44's measure of the planar evaluation's path (recorded, not yet a gate: docs/design.md).
 { echo "data-flow walk of planar::evaluate's a (by name; by type):"
-  python3 scripts/dataflow_walk.py crates/rod-ig-core/src planar/mod.rs evaluate a | tail -1
-  python3 scripts/dataflow_walk.py crates/rod-ig-core/src planar/mod.rs evaluate a --typed | tail -1; } >>"$LOGS/layering.log" || true
+  python3 scripts/checks/dataflow_walk.py crates/rod-ig-core/src planar/mod.rs evaluate a | tail -1
+  python3 scripts/checks/dataflow_walk.py crates/rod-ig-core/src planar/mod.rs evaluate a --typed | tail -1; } >>"$LOGS/layering.log" || true
 
 echo "== cargo test: the crates, then the node (release profile: shares the build with the node under test)"
 { cargo test --release --workspace --no-fail-fast 2>&1; cargo test --release "${NODE[@]}" --no-fail-fast 2>&1; } \

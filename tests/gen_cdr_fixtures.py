@@ -6,7 +6,7 @@ CDR leaves the content of alignment padding unspecified and Fast CDR does not cl
 bytes carry leftover memory there), so this script walks each message's type description to
 find the padding bytes and writes them as zeros; every data byte is rclpy's own.
 
-Run once (fixtures are committed):  source scripts/env.sh && python tests/gen_cdr_fixtures.py
+Run once (fixtures are committed):  source scripts/setup/env.sh && python tests/gen_cdr_fixtures.py
 """
 import importlib
 import re

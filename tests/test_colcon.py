@@ -63,7 +63,8 @@ def test_installed_node_serves_the_example_client(workspace):
 def test_the_package_installs_its_launch_files_and_parameters(workspace):
     """`ros2 launch rod_ig rod_ig.launch.py` finds its files in share/rod_ig (issue 43, item 7).
     launch_ros has no wheel, so the launch files are checked by parsing them: each starts the
-    node as a ROS package's executable, Node(package='rod_ig', executable='rod_ig_node')."""
+    node as a ROS package's executable, Node(package='rod_ig', executable='rod_ig_node'), and
+    they are the repository's only launch files (issue 53, item 5: one source)."""
     import ast
 
     share = ws_share = workspace[0] / "install" / "rod_ig" / "share" / "rod_ig"
@@ -75,13 +76,23 @@ def test_the_package_installs_its_launch_files_and_parameters(workspace):
         nodes = [c for c in ast.walk(tree)
                  if isinstance(c, ast.Call) and getattr(c.func, "id", "") == "Node"]
         assert nodes, f"{launch}: no launch_ros Node"
+        started = set()
         for call in nodes:
             kw = {k.arg: k.value for k in call.keywords}
-            assert ast.literal_eval(kw["package"]) == "rod_ig", launch
-            assert ast.literal_eval(kw["executable"]) == "rod_ig_node", launch
+            started.add((ast.literal_eval(kw["package"]), ast.literal_eval(kw["executable"])))
+        # The node, and RViz on request (rod_ig.launch.py's rviz:=true): nothing else.
+        assert ("rod_ig", "rod_ig_node") in started, launch
+        assert started <= {("rod_ig", "rod_ig_node"), ("rviz2", "rviz2")}, (launch, started)
         names = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
         assert "ExecuteProcess" not in names and "generate_launch_description" in {
             f.name for f in tree.body if isinstance(f, ast.FunctionDef)}, launch
+    sources = []
+    for root, dirs, files in os.walk(h.REPO):
+        dirs[:] = [d for d in dirs if d not in {"target", "build", "install", ".git", ".venv"}]
+        sources += [str(Path(root, f).relative_to(h.REPO)) for f in files if f.endswith(".launch.py")]
+    sources.sort()
+    assert sources == ["ros/rod_ig/launch/rod_ig.launch.py",
+                       "ros/rod_ig/launch/two_arms.launch.py"], sources
 
 
 def test_the_installed_parameters_apply_in_a_namespace_without_warnings(workspace):

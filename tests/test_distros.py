@@ -1,5 +1,5 @@
 """Jazzy beside Kilted (issue 43, item 5): one node binary serves a Jazzy rclpy client (rclpy
-7.1.6 from the ros-jazzy wheels, in build/jazzy-venv made by scripts/setup-env.sh) with no
+7.1.6 from the ros-jazzy wheels, in build/jazzy-venv made by scripts/setup/setup-env.sh) with no
 ERROR in its log under ROS_DISTRO=jazzy: Jazzy and Kilted share the wire format (the 24-byte
 Gid from Iron on; patches/ros2-client-0.12.1-distro-wire-compat.patch)."""
 import os
@@ -14,7 +14,7 @@ JAZZY = Path(os.environ.get("ROD_IG_JAZZY_VENV", REPO / "build" / "jazzy-venv"))
 
 def test_a_jazzy_client_is_served_without_error():
     python = JAZZY / "bin" / "python3"
-    assert python.exists(), f"no Jazzy venv at {JAZZY}: run scripts/setup-env.sh"
+    assert python.exists(), f"no Jazzy venv at {JAZZY}: run scripts/setup/setup-env.sh"
     domain = h.free_domain()
     node = h.NodeProcess(domain, [], env={"ROS_DISTRO": "jazzy"})
     try:

@@ -2,7 +2,7 @@
 
 The node's outputs reach an rclpy (Fast DDS) client whole and fast, its memory stays bounded,
 and a small service call is answered while a large one or a long plan is still in flight.
-The figures themselves (medians and worst of several runs) are in tests/latency_bench.py
+The figures themselves (medians and worst of several runs) are in crates/rod-ig-bench/ros/latency_bench.py
 (`--large`); these tests check behaviour, with bounds far above the measured figures (10-100x)
 so that a loaded CI machine does not fail them, yet far below what the node did before the
 fixes (40-60 s for 100,000 poses, small calls queued behind large ones for that long)."""

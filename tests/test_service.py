@@ -14,7 +14,7 @@ POS_TOL = 1e-5
 ANG_TOL = 1e-5
 # A short path keeps the many-call tests fast (full-size replies: test_service_full_path).
 SMALL = 8
-LOOPBACK_PROFILE = h.REPO / "launch_notes" / "fastdds_loopback_client.xml"
+LOOPBACK_PROFILE = h.REPO / "ros" / "rod_ig" / "config" / "fastdds_loopback_client.xml"
 
 
 def check_response(r, target, samples):
@@ -107,7 +107,7 @@ def test_service_full_path(node_and_client, samples):
 
 def test_service_full_path_loopback_client():
     """A Fast DDS client that advertises only its loopback locator
-    (launch_notes/fastdds_loopback_client.xml, the workaround before the DATA_FRAG patch) gets
+    (ros/rod_ig/config/fastdds_loopback_client.xml, the workaround before the DATA_FRAG patch) gets
     the full-size response (100 poses, ~9 kB) too, as one unfragmented DATA. Runs the client in its own process, since
     Fast DDS reads the profile file once per process."""
     domain = h.free_domain()

@@ -450,7 +450,7 @@ pub fn weight(quick: bool) {
 }
 
 /// Long cables (issue 51, item 7): the level cable at w = 2,000 (0.8 apart) against scipy's
-/// `solve_bvp` continuation (`scripts/level_cable_bvp.py`, run by the Python of `ROD_IG_PYTHON`,
+/// `solve_bvp` continuation (`crates/rod-ig-bench/peers/level_cable_bvp.py`, run by the Python of `ROD_IG_PYTHON`,
 /// else `.venv/bin/python`, else `python3`), both timed in this run; then the robust solve's
 /// median over targets of stable loop-free long cables (w ∈ [200, 10⁴]).
 fn long_cables(quick: bool) {
@@ -526,7 +526,7 @@ fn long_cables(quick: bool) {
     );
 }
 
-/// Runs `scripts/level_cable_bvp.py 2000 0.8 TOL` and returns its JSON line.
+/// Runs `crates/rod-ig-bench/peers/level_cable_bvp.py 2000 0.8 TOL` and returns its JSON line.
 fn scipy_level_cable(tol: &str) -> Result<serde_json::Value, String> {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let python = std::env::var("ROD_IG_PYTHON").unwrap_or_else(|_| {
@@ -538,7 +538,7 @@ fn scipy_level_cable(tol: &str) -> Result<serde_json::Value, String> {
         }
     });
     let out = std::process::Command::new(&python)
-        .arg(root.join("scripts/level_cable_bvp.py"))
+        .arg(root.join("crates/rod-ig-bench/peers/level_cable_bvp.py"))
         .args(["2000", "0.8", tol])
         .output()
         .map_err(|e| format!("{python}: {e}"))?;

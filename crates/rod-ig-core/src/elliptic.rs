@@ -581,7 +581,7 @@ fn estrin13(c: &[f64; 13], t: f64) -> f64 {
 }
 
 /// K(m) and q = 2D/K − 1 (D = (K − E)/m) in f64 from the polynomial pieces of
-/// `complete_tables` (scripts/gen_elliptic_complete.py): two independent polynomials, and a
+/// `complete_tables` (scripts/references/gen_elliptic_complete.py): two independent polynomials, and a
 /// logarithm for m > 0.7, where the AGM takes five to eight dependent square roots and
 /// divisions. For m < 0.7, K and q/m in m (q keeps its relative accuracy as m → 0); for
 /// m1 = 1 − m ≤ 0.3, K = A ℓ + B and D = P ℓ + R with ℓ = ln(16/m1) and A, B, P, R analytic in

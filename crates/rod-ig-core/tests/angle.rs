@@ -1,4 +1,4 @@
-//! `wrap_angle` against 80-digit reductions (scripts/gen_angle_tables.py, mpmath): 423 angles
+//! `wrap_angle` against 80-digit reductions (scripts/references/gen_angle_tables.py, mpmath): 423 angles
 //! from 1e-3 to f64::MAX, both signs, exact multiples of 2π rounded to f64 and integers near
 //! 2⁵³. Tolerance: 1 ulp of the result (the reduction is correctly rounded up to the last bit
 //! of a double-double product), and the result lies in (−π, π].

@@ -94,7 +94,7 @@ fn shape_draws_a_compressed_rod_beyond_the_series_reach_as_forward_answers_it() 
 
 #[test]
 fn barely_bent_rods_under_tension_beyond_f64_are_refused_not_answered_wrong() {
-    // The exact pendulum (scripts/gen_tension_truth.py's `pendulum_tip` at 500 digits): x and
+    // The exact pendulum (scripts/references/gen_tension_truth.py's `pendulum_tip` at 500 digits): x and
     // θ at the tip. Forward answered x = 0.922, θ = 20π and x = 0.932, θ = −8π.
     let cases = [
         (

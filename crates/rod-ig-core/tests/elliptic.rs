@@ -1,4 +1,4 @@
-//! Elliptic functions against mpmath (80 digits; `scripts/gen_elliptic_fixtures.py`), and
+//! Elliptic functions against mpmath (80 digits; `scripts/references/gen_elliptic_fixtures.py`), and
 //! identities as property tests.
 //!
 //! Fixture parameters go down to m1 = 1e-25 (m passed as fl(1 − m1) = 1) and up from

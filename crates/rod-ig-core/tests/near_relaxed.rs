@@ -251,7 +251,7 @@ fn unrepresentable_force_is_a_clear_error() {
     }
     // Near the straight equilibrium under √F = 707 (refused before issue 53: the double-double
     // series would need thousands of steps) the separatrix limit answers: 13 loops, against
-    // the exact pendulum (`scripts/gen_tension_truth.py`, 300 digits) x = 0.9264608947565991,
+    // the exact pendulum (`scripts/references/gen_tension_truth.py`, 300 digits) x = 0.9264608947565991,
     // y = 3.157447665242754e-13, θ = 81.68140899357161 (26π), energy 36769.55262170047.
     let e = planar::evaluate(&p(1e-8, 5e5, 0.0)).expect("answered");
     let exact = [0.9264608947565991, 3.157447665242754e-13, 81.68140899357161];

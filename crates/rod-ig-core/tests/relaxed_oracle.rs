@@ -48,7 +48,7 @@ struct Stats {
     errors: Vec<String>,
 }
 
-/// High-precision references (mpmath, 40 digits; scripts/gen_relaxed_truth.py) for the
+/// High-precision references (mpmath, 40 digits; scripts/references/gen_relaxed_truth.py) for the
 /// strong-axial block, keyed by line: there the oracle's own f64 integration is off by up to
 /// 1e-5 in the tip and 100 % in J (rounding made during the loop grows like e^{√a4 (1 − t)}).
 /// Every line has a tip; the lines where we disagree with the oracle's J, energy or verdict

@@ -1,6 +1,6 @@
 //! Forward map, J, energy and stability near the separatrix and under strong axial force,
 //! against a rigorous 320-bit reference: `data/separatrix_truth.jsonl`, written by
-//! `scripts/gen_separatrix_truth.py` (Taylor integration in arb ball arithmetic, python-flint:
+//! `scripts/references/gen_separatrix_truth.py` (Taylor integration in arb ball arithmetic, python-flint:
 //! every reference number carries a proven bound on its rounding, recorded as `radius`).
 //!
 //! The sample (seeded): moments and transverse forces from 1e-14 to 1, axial forces from 1 to
@@ -58,7 +58,7 @@ fn separatrix_rods_match_the_rigorous_reference_or_are_refused() {
 /// on the rod; with it, before its stability pass: 15 uncertain).
 const MAX_EXTREME_UNCERTAIN_SHARE: f64 = 0.01;
 
-/// Issue 23's independent sample (`scripts/gen_separatrix_truth.py --extreme`): axial force
+/// Issue 23's independent sample (`scripts/references/gen_separatrix_truth.py --extreme`): axial force
 /// 1e3..1e4 of either sign, moment and transverse force 1e-14..1e-6 with exact zeros, and the
 /// rod the issue quotes. Before, the double-double scan called 30 of 1,429 such rods (stable,
 /// det_min 3..250) "unstable" with a certain verdict, its rounding bound blind to the e^{√‖F‖ t}
@@ -131,7 +131,7 @@ fn stability_alone_is_never_wrong_on_the_references() {
 /// The 110 rods of a seeded tiny-bending sample (a4 ±1e2..1e4, a3 and a5 ±1e-14..1e-6 with
 /// exact zeros; `extended_pass_agrees_with_the_series_scan`'s) whose f64 norm-wise scan is
 /// uncertain and that the second pass on the closed form in double-double decides, against
-/// their 320-bit verdicts (`scripts/gen_separatrix_truth.py --verdicts`; 100 stable, 10
+/// their 320-bit verdicts (`scripts/references/gen_separatrix_truth.py --verdicts`; 100 stable, 10
 /// unstable, all clear): every verdict right and certain, stable margins within 5e-2 of the
 /// reference's (measured 2.2e-2). The double-double series scan left 18 of them uncertain.
 #[test]
@@ -315,7 +315,7 @@ fn check_reference(text: &str) -> ReferenceReport {
     }
 }
 
-/// Rods of issue 9's strong-force family, against `scripts/gen_separatrix_truth.py`'s reference
+/// Rods of issue 9's strong-force family, against `scripts/references/gen_separatrix_truth.py`'s reference
 /// (run on these two a): either right or refused, never wrong. The first, a tension of 8158
 /// with a moment of 5e-12, came back as success with θ off by 0.034 rad, J off by 100 % and the
 /// verdict "unstable" (margin -1.7e28; it is stable, det_min 127); the second took 25 ms on the
@@ -359,7 +359,7 @@ fn strong_tension_with_tiny_bending_is_right_or_refused() {
     }
 }
 
-/// Tension beyond the double-double series' reach (`scripts/gen_separatrix_truth.py --strong`:
+/// Tension beyond the double-double series' reach (`scripts/references/gen_separatrix_truth.py --strong`:
 /// 48 rods, √‖F‖ 101..470, moment and transverse force 1e-14..1e-3 with exact zeros, each at
 /// up to 880 bits): every answer right, none refused, at most 5 % uncertain. Measured: tips
 /// within 1.4e-14, J 1.2e-10, energies 7.5e-15, every verdict given right, 1 uncertain (its

@@ -5,7 +5,7 @@
 //! straight equilibrium, then loops where ln(8√a4/|a3|)/√a4 < 1: the regime where a wrong tip
 //! slipped between a refusal and the series (θ = −6π for 2π at a = (1e-100, 240000, 0)).
 //!
-//! The reference is the exact pendulum (`scripts/gen_tension_truth.py`: Jacobi functions at
+//! The reference is the exact pendulum (`scripts/references/gen_tension_truth.py`: Jacobi functions at
 //! the complementary parameter m1 passed exactly, mpmath at 80 + 1.5·log10(1/m1) digits, J by
 //! central differences; cross-checked against a Taylor integration of the ODE). Every rod is
 //! answered within the tolerances (tip 1e-9 absolute, J 1e-6 relative (Frobenius),

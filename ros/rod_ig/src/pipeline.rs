@@ -19,7 +19,7 @@ use crate::solver::{spatial_of_planar, Failed, PlanarParams, RodSolver, SolverSe
 
 /// What one target produces. `path` and `marker` are `None` when `solution.success` is false:
 /// a failed solve has no shape worth drawing, and subscribers of /rod/path keep the last
-/// valid shape (the choice documented in `launch_notes/README.md`).
+/// valid shape (the choice documented in `ros/rod_ig/README.md`).
 #[derive(Clone, Debug)]
 pub struct Outcome {
     /// Always present.

@@ -57,7 +57,7 @@ pub(crate) use taylor::{
 /// separatrix (the steps scale like √‖F‖: ≈ 20 ms at √‖F‖ = 100, the top of issue 9's
 /// strong-force family a4 ≤ 1e4). Beyond [`SERIES_DD_MAX_ROOT_F`] its g(t) is not certified
 /// to the scan's 1e-3, but the sign is robust: its verdicts matched the rigorous 320-bit
-/// reference on all 720 separatrix rods of scripts/gen_separatrix_truth.py's samples (√‖F‖ up
+/// reference on all 720 separatrix rods of scripts/references/gen_separatrix_truth.py's samples (√‖F‖ up
 /// to 100), where its tips and J were off by up to 0.25 and 100 %.
 pub(crate) const STABILITY_DD_MAX_ROOT_F: f64 = 120.0;
 

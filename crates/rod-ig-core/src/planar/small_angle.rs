@@ -486,7 +486,7 @@ pub(crate) fn effective_angle(a3: f64, a4: f64, a5: f64) -> f64 {
 /// Largest tension a4 of the expansion: √a4 = 350, where its x row's ∫S1² ≈ e^{2√a4}/(8a4^{3/2})
 /// still fits in f64 (it overflows past √a4 ≈ 354). The truncation constants were measured
 /// up to √a4 = 27 against the series, and up to 350 against the exact pendulum
-/// (`scripts/gen_tension_truth.py`, `tests/tension.rs`: barely bent rods under tension and
+/// (`scripts/references/gen_tension_truth.py`, `tests/tension.rs`: barely bent rods under tension and
 /// rods at the expansion's edge, Θ from 1e-7 to 1e-2).
 const MAX_TENSION: f64 = 122_500.0;
 

@@ -16,7 +16,7 @@ pub(super) const DEEP_SEPARATRIX_M1: f64 = 1e-200;
 pub(crate) const SEPARATRIX_M1: f64 = 1e-7;
 /// Near the separatrix (m1 < [`SEPARATRIX_M1`]) the relative J error of the closed form is
 /// estimated as ε·s(ρ)·(1/m + this/√m1). Measured against the rigorous 320-bit reference
-/// (scripts/gen_separatrix_truth.py, 940 rods with m1 from 1e-30 to 1e-7 and ρ from 0.1 to
+/// (scripts/references/gen_separatrix_truth.py, 940 rods with m1 from 1e-30 to 1e-7 and ρ from 0.1 to
 /// 100) and the double-double series (18,000 rods, ρ ≤ 12): error·√m1/(ε·s(ρ)) ≤ 0.42 (ρ ≤ 12)
 /// and ≤ 0.71 (ρ ≥ 28); this is that, ×3.
 pub(crate) const SEPARATRIX_J_ULPS: f64 = 2.0;

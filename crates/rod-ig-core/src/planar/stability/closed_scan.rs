@@ -87,7 +87,7 @@ pub(crate) fn series_report_after_closed(
 /// The stability of a rod by the separatrix under a strong force. There the closed form's
 /// J(t) entries far below ‖J‖ (the x row while the rod lingers by the straight equilibrium)
 /// are not accurate relative to themselves: with entry-wise error bounds two verdicts in 720
-/// were wrong on the rigorous reference (scripts/gen_separatrix_truth.py). The scan bounds
+/// were wrong on the rigorous reference (scripts/references/gen_separatrix_truth.py). The scan bounds
 /// every entry norm-wise and hands what it cannot decide to a second pass in double-double,
 /// then to the double-double series.
 pub(crate) fn precise_scan(

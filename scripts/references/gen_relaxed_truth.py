@@ -12,7 +12,7 @@ crates/rod-ig-core/tests/data/relaxed_truth.jsonl with, per line:
 {"line", "a", "tip": [theta, x, y], "energy", "jac": rows θ, x, y, "det_min", "stable"}
 where det_min = min over grid t ≥ 0.05 of det J(t)/(t⁹(a3²/8640 + a5²t²/33600)) and stable means
 det J(t) > 0 at every grid point of (0, 1] (grid: the integration steps).
-Run: python3 scripts/gen_relaxed_truth.py [first last]   (needs mpmath; ≈ 1 min per rod, the
+Run: python3 scripts/references/gen_relaxed_truth.py [first last]   (needs mpmath; ≈ 1 min per rod, the
 J columns cost six more integrations). The committed file holds the tip for all 100 lines and
 the full record for the 17 lines where the f64 oracle's J, energy or verdict disagrees with
 ours; regenerating the whole range writes full records everywhere (the test accepts both).
@@ -87,7 +87,7 @@ def reference(a):
 
 
 def main():
-    root = pathlib.Path(__file__).resolve().parent.parent
+    root = pathlib.Path(__file__).resolve().parents[2]
     oracle = root.parent / "shared" / "oracle" / "relaxed_public.jsonl"
     lines = oracle.read_text().splitlines()
     out = root / "crates" / "rod-ig-core" / "tests" / "data" / "relaxed_truth.jsonl"

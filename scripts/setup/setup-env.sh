@@ -10,10 +10,10 @@
 #   ROD_IG_VENV    venv directory            (default: <repo>/.venv)
 #   ROD_IG_BUILD   build directory            (default: <repo>/build)
 #   PYTHON         interpreter for the venv   (default: python3; CPython 3.11 needed by the wheels)
-# Afterwards: `source scripts/env.sh` puts rclpy and rod_ig_msgs on the paths.
+# Afterwards: `source scripts/setup/env.sh` puts rclpy and rod_ig_msgs on the paths.
 set -euo pipefail
 
-REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 VENV="${ROD_IG_VENV:-$REPO/.venv}"
 BUILD="${ROD_IG_BUILD:-$REPO/build}"
 PYTHON="${PYTHON:-python3}"

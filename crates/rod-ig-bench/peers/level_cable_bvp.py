@@ -7,7 +7,7 @@ n(t) = n(0) - w t g (the model of docs/weight.md). The hanging rod is reached by
 in w from the weightless rod that sags (a sine-shaped first guess), each solve started from the
 previous one, as a user of scipy would. Prints one JSON line: seconds, sag, a, nodes, status.
 
-    python3 scripts/level_cable_bvp.py [W] [D] [TOL]
+    python3 crates/rod-ig-bench/peers/level_cable_bvp.py [W] [D] [TOL]
 """
 import json
 import sys

@@ -4,7 +4,7 @@
 //! (fixed LCG seed) from the public oracle box a3 ∈ [−10, 10], a4, a5 ∈ [−100, 100], so the
 //! reported time is per call, averaged over the cases of the box.
 //!
-//! Run: `cargo bench -p rod-ig-core --bench planar -- --quick` (or `--measurement-time 2`).
+//! Run: `cargo bench -p rod-ig-bench --bench planar -- --quick` (or `--measurement-time 2`).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use rod_ig_core::planar::{self, PlanarRod};

@@ -5,10 +5,10 @@
 # own runner; prints its result lines (error metrics, wall time). docs/cosseratbench.md has the
 # table of one run. Takes ~5 minutes on two cores.
 #
-# Usage: scripts/cosseratbench-compare.sh [OUT_DIR]   (default: build/cosseratbench)
+# Usage: crates/rod-ig-bench/peers/cosseratbench-compare.sh [OUT_DIR]   (default: build/cosseratbench)
 # Env:   COSSERATBENCH_VENV  venv to create or reuse (default: build/cosseratbench-venv)
 set -euo pipefail
-REPO="$(cd "$(dirname "$0")/.." && pwd)"
+REPO="$(cd "$(dirname "$0")/../../.." && pwd)"
 OUT="${1:-$REPO/build/cosseratbench}"
 VENV="${COSSERATBENCH_VENV:-$REPO/build/cosseratbench-venv}"
 [ -x "$VENV/bin/python" ] || python3 -m venv "$VENV"

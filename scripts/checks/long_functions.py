@@ -3,7 +3,7 @@
 outside tests and coefficient tables (a `const`/`static` array is not a function; a function
 that is one, such as a Runge–Kutta method's stages, says so on the line above its `fn`).
 
-Usage: scripts/long_functions.py [--limit N] DIR...   Exit status 1 when one is found.
+Usage: scripts/checks/long_functions.py [--limit N] DIR...   Exit status 1 when one is found.
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ doc links, are ignored; test modules count: a test is code too). Modules nested 
 (`a` and `a::b`) do not count as a cycle between parent and child only when the child is the
 one using the parent's items. Exit status 1 when a cycle exists.
 
-Usage: scripts/import_cycles.py CRATE_SRC_DIR [--depth N]   (N: module depth kept, default 2)
+Usage: scripts/checks/import_cycles.py CRATE_SRC_DIR [--depth N]   (N: module depth kept, default 2)
 """
 
 from __future__ import annotations

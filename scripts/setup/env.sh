@@ -1,6 +1,6 @@
 # Source me (bash): puts the venv's rclpy and the built rod_ig_msgs on the paths.
-# Needs scripts/setup-env.sh to have run. Honours ROD_IG_VENV and ROD_IG_BUILD like it.
-_rod_ig_repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+# Needs scripts/setup/setup-env.sh to have run. Honours ROD_IG_VENV and ROD_IG_BUILD like it.
+_rod_ig_repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 _rod_ig_venv="${ROD_IG_VENV:-$_rod_ig_repo/.venv}"
 _rod_ig_prefix="${ROD_IG_BUILD:-$_rod_ig_repo/build}/rod_ig_msgs/install"
 # tf2_msgs' TFMessage, built for the test clients (tests/interfaces/tf2_msgs).

@@ -18,7 +18,7 @@ Writes crates/rod-ig-core/tests/data/separatrix_truth.jsonl, one line per rod:
  "stable": true | false | null (null: some det J ball contains 0), "det_min" (min over grid
  t ≥ 0.05 of det J(t)/(t⁹(a3²/8640 + a5²t²/33600)), "first_conjugate" (first grid t with
  det J ≤ 0, or null)}.
-Run: python3 scripts/gen_separatrix_truth.py [N=600]   (needs python-flint; ≈ 1 s per rod, two
+Run: python3 scripts/references/gen_separatrix_truth.py [N=600]   (needs python-flint; ≈ 1 s per rod, two
 processes); `--extreme [N=160]` writes separatrix_truth_extreme.jsonl instead, issue 23's
 tiny-bending sample; `--strong [N=48]` writes separatrix_truth_strong.jsonl, tension beyond the
 double-double series' reach (√‖F‖ 100..500) at up to ~925 bits; `--edge [N=16]`
@@ -252,7 +252,7 @@ if __name__ == "__main__":
     name = ("separatrix_truth_extreme.jsonl" if extreme else
             "separatrix_truth_strong.jsonl" if strong else
             "separatrix_truth_edge.jsonl" if edge else "separatrix_truth.jsonl")
-    path = pathlib.Path(__file__).resolve().parent.parent / "crates/rod-ig-core/tests/data" / name
+    path = pathlib.Path(__file__).resolve().parents[2] / "crates/rod-ig-core/tests/data" / name
     with Pool(2) as pool:
         if strong:
             rows = pool.map(reference_strong, sample_strong(n), chunksize=1)

@@ -17,9 +17,9 @@ message; rclpy's own conversion to Python objects is timed apart, on the same by
 same sizes as /rod/solve replies (whole call, conversion included), and a 5-pose call made
 while a 100,000-pose call from another process is in flight. Medians and worst of --runs.
 
-Usage (after scripts/setup-env.sh and `source scripts/env.sh`):
-    python tests/latency_bench.py [--n 1200] [--rounds 3] [--samples 100] [--warmup 100]
-    python tests/latency_bench.py --large [--runs 8]
+Usage (after scripts/setup/setup-env.sh and `source scripts/setup/env.sh`):
+    python crates/rod-ig-bench/ros/latency_bench.py [--n 1200] [--rounds 3] [--samples 100] [--warmup 100]
+    python crates/rod-ig-bench/ros/latency_bench.py --large [--runs 8]
 """
 import argparse
 import statistics
@@ -28,7 +28,7 @@ import threading
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "tests"))  # rodig_harness
 import rodig_harness as h  # noqa: E402
 
 

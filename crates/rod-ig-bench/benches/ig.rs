@@ -6,14 +6,12 @@
 //! is per solve. The atlas is built before measuring. The `ig::bench` functions (used by
 //! `rod-ig bench`) report success rates and medians; this harness gives criterion's statistics.
 //!
-//! Run: `cargo bench -p rod-ig-core --bench ig -- --quick`.
+//! Run: `cargo bench -p rod-ig-bench --bench ig -- --quick`.
 
-#[path = "../tests/workloads/mod.rs"]
-mod workloads;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use rod_ig_core::planar::ig::{self, Method, SolveOptions, Tracker};
 use rod_ig_core::PlanarParams;
-use workloads::planar::{self as planar_workloads, ParamBox};
+use rod_ig_bench::planar::{self as planar_workloads, ParamBox};
 
 fn bench(c: &mut Criterion) {
     let _ = ig::warm_up();

@@ -1,6 +1,6 @@
 """rod_ig's speed goals, measured in one run (issue 22): a one-thread batch `forward` per rod
 against the Rust call it wraps (goal <= 1.2x + 50 ns), and all cores against one thread (goal
->= 0.8 x cores). Medians of several rounds on the paper's box; run `python python/benches/forward.py`."""
+>= 0.8 x cores). Medians of several rounds on the paper's box; run `python crates/rod-ig-bench/python/forward.py`."""
 
 from __future__ import annotations
 

@@ -9,7 +9,7 @@ Outputs (JSON lines):
   tests/data/elliptic_jacobi.jsonl     u, m, m1, sn, cn, dn, am (continuous), e_am = E(am u|m)
   tests/data/elliptic_integrals.jsonl  phi, m, m1, F, E, D = (F - E)/m, K, Ec (complete)
 
-Usage: python3 scripts/gen_elliptic_fixtures.py   (from the repository root; needs mpmath)
+Usage: python3 scripts/references/gen_elliptic_fixtures.py   (from the repository root; needs mpmath)
 """
 import json
 import os
@@ -18,7 +18,7 @@ import mpmath as mp
 
 mp.mp.dps = 80
 HERE = os.path.dirname(os.path.abspath(__file__))
-OUT = os.path.join(HERE, "..", "crates", "rod-ig-core", "tests", "data")
+OUT = os.path.join(HERE, "..", "..", "crates", "rod-ig-core", "tests", "data")
 
 
 def params():

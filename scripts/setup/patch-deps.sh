@@ -11,7 +11,7 @@
 # when done (a stamp holds the patches' checksums). Needs curl (or the crate in cargo's cache),
 # sha256sum, tar, and patch or git.
 set -euo pipefail
-REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 OUT="$REPO/build/patched"
 mkdir -p "$OUT"
 # build/ holds Cargo packages (the patched crates) and rod_ig_msgs' build: not for colcon.
