@@ -9,9 +9,9 @@
 //! Run: `cargo bench -p rod-ig-bench --bench ig -- --quick`.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use rod_ig_bench::planar::{self as planar_workloads, ParamBox};
 use rod_ig_core::planar::ig::{self, Method, SolveOptions, Tracker};
 use rod_ig_core::PlanarParams;
-use rod_ig_bench::planar::{self as planar_workloads, ParamBox};
 
 fn bench(c: &mut Criterion) {
     let _ = ig::warm_up();

@@ -2,11 +2,11 @@
 //! stability, and the robust 3-D solve (goal median ≤ 1 ms, ≥ 99 % success).
 
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, Criterion};
+use rod_ig_bench::spatial::random_targets;
+use rod_ig_core::rng::SplitMix64;
 use rod_ig_core::solver::{self, SolveOptions};
 use rod_ig_core::spatial::Spatial;
 use rod_ig_core::spatial::{self, SpatialParams, StabilityOptions, Stiffness};
-use rod_ig_bench::spatial::random_targets;
-use rod_ig_core::rng::SplitMix64;
 
 fn params(n: usize) -> Vec<SpatialParams> {
     let mut rng = SplitMix64::new(17);

@@ -11,7 +11,10 @@ mod det_fields;
 mod estimates;
 mod theorems;
 pub(crate) use det_fields::DetFrame;
-pub(crate) use estimates::*;
+pub(crate) use estimates::{
+    SeriesNeed, CLOSED_J_REL, CLOSED_J_TOLERANCE, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F,
+};
+use estimates::{DEEP_SEPARATRIX_M1, MAX_PHASE};
 
 /// Which closed form applies (decided on f64 values).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,7 +1,26 @@
 //! Stability scans on the closed form (docs/math.md §5), with the short series, the small-m
 //! scan and the margin certification where its own error estimate fails.
 
-use super::*;
+use super::scan::{sample_times, scan, value_only, Probe, Scan};
+use super::series::{
+    certified_verdict, normalisation_scaled, normalised_det_of, normalised_det_series,
+    scaled_jacobian, scaled_series_jacobian, series_after_small_angle,
+};
+use super::small_angle_scan::{
+    small_angle_prefix, small_angle_report, SMALL_ANGLE_MAX_TRUNCATION, SMALL_ANGLE_TRUNCATION_C,
+};
+use super::{
+    straight_report, verdict, COARSE_AMPLIFIED, COARSE_ENTRY_REL, SERIES_ENTRY_REL, SERIES_SPACING,
+    SIGMA_RAY, T_MARGIN, T_MIN,
+};
+use crate::dd::DualDd;
+use crate::planar::closed::{Case, Closed, DetFrame, SeriesNeed};
+use crate::planar::small_angle;
+use crate::planar::taylor::{CoarseDual3, Gradient, TaylorRod};
+use crate::planar_det_leading_term as normalisation;
+use crate::scalar::Dual3;
+use crate::types::{det3, det_and_error, det_and_error_by_column};
+use crate::{PlanarParams, RodError, StabilityReport, StabilityVerdict};
 
 /// Stability on the closed form (docs/math.md §5), with the series where the closed form's own
 /// error estimate fails.

@@ -5,8 +5,14 @@
 //! entries reach 1e300 where the normalisation a3²t⁹/8640 underflows); else the closed form's
 //! scans (the lattice's det J cancels by its solitons, beyond a bound it could prove).
 
-use super::*;
+use super::scan::{scan, value_only};
+use super::series::certified_verdict;
+use super::small_angle_scan::small_angle_report;
+use super::{with_theorem, SERIES_SPACING, T_MARGIN};
 use crate::planar::soliton::Lattice;
+use crate::scalar::Dual3;
+use crate::types::det_and_error;
+use crate::{PlanarParams, RodError, StabilityReport, StabilityVerdict};
 
 /// Relative error of the lattice's J entries: its neglected terms O(ρ²) ≤ 1e-14 and the
 /// rounding of a few dozen operations (measured ≤ 4e-13 against the exact pendulum,

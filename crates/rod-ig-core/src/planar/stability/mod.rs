@@ -1,13 +1,7 @@
 //! Fast stability test on the closed form (docs/math.md §5).
 
-use super::closed::{Case, Closed, DetFrame, SeriesNeed};
-use super::small_angle;
-use super::taylor::{CoarseDual3, Gradient, TaylorRod};
-use crate::dd::DualDd;
-use crate::planar_det_leading_term as normalisation;
-use crate::scalar::Dual3;
-use crate::types::{det3, det_and_error, det_and_error_by_column};
-use crate::{PlanarParams, RodError, StabilityReport, StabilityVerdict};
+use crate::{StabilityReport, StabilityVerdict};
+use scan::Scan;
 
 mod closed_scan;
 mod lattice_scan;
@@ -17,11 +11,13 @@ mod small_angle_scan;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use closed_scan::*;
+pub(crate) use closed_scan::{
+    closed_report, precise_scan, series_report_after_closed, stability_of, stability_of_with,
+    verdict_of,
+};
 pub(crate) use lattice_scan::lattice_report;
-use scan::*;
-pub(crate) use series::*;
-pub(crate) use small_angle_scan::*;
+pub(crate) use series::{series_after_small_angle, stability_of_dense_series};
+pub(crate) use small_angle_scan::small_angle_report;
 
 /// Below this t the closed-form det J is dominated by rounding; it is positive there by its
 /// leading term (docs/math.md §5).

@@ -1,7 +1,8 @@
 //! The one scan of g(t) = det J(t)/leading term, written once over a probe: sampling on a
 //! wavelength grid, the first sign change located to 1e-7, local minima refined for the margin.
 
-use super::*;
+use super::T_MARGIN;
+use crate::RodError;
 
 /// What a scan of g found.
 #[derive(Clone, Copy, Debug)]

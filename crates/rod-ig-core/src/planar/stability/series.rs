@@ -1,7 +1,18 @@
 //! Stability scans on the Taylor series: near-relaxed rods, and the double-double series where
 //! the closed form's error estimate fails.
 
-use super::*;
+use super::closed_scan::normalised_det;
+use super::scan::{sample_times, scan, value_only, Probe, Scan};
+use super::{
+    straight_report, verdict, SERIES_ENTRY_REL, SERIES_SLOPED_MAX_SPACING, SERIES_SPACING,
+    SERIES_T_MIN, SIGMA_RAY,
+};
+use crate::planar::closed::Closed;
+use crate::planar::taylor::{Gradient, TaylorRod};
+use crate::planar_det_leading_term as normalisation;
+use crate::scalar::Dual3;
+use crate::types::{det3, det_and_error};
+use crate::{PlanarParams, RodError, StabilityReport};
 
 /// The series scan on the rod's dense dual-number series, for a caller that has already
 /// asked [`small_angle_report`].

@@ -1,7 +1,11 @@
 //! The stability of nearly straight rods by the small-angle expansion's det J (its own scan
 //! spacing, truncation and rounding bounds).
 
-use super::*;
+use super::scan::{scan, Probe};
+use super::series::certified_verdict;
+use super::SERIES_T_MIN;
+use crate::planar::small_angle;
+use crate::{PlanarParams, RodError, StabilityReport};
 
 /// Grid spacing of the small-angle scan ([`small_angle_report`]) in periods 2π/max(σ, √|a4|),
 /// and its cap. Its samples carry g₀′ ([`small_angle::normalised_det_sloped`]): on 16,280

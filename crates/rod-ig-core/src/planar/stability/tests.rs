@@ -1,9 +1,27 @@
 //! Tests of the stability scans.
 
-use super::*;
-use crate::rng::SplitMix64;
-
+use super::closed_scan::{
+    closed_scan, normalised_det, normalised_det_extended, normalised_det_sloped, plain_closed_scan,
+    small_m_scan, unstable_at_the_end, verdict_of, CLOSED_G_ERROR, COLUMN_WISE_MAX_M,
+    SHORT_SERIES_REACH,
+};
+use super::scan::{find_root, refine_min, Probe, ROOT_TOL};
+use super::series::{
+    normalised_det_series, normalised_det_series_amplified, scaled_series_jacobian, scan_series,
+    series_after_small_angle, whole_series_scan,
+};
+use super::small_angle_scan::{
+    small_angle_prefix, small_angle_report, SMALL_ANGLE_PREFIX_REACH, SMALL_ANGLE_ROUNDING,
+    SMALL_ANGLE_TRUNCATION_C,
+};
+use super::{COARSE_AMPLIFIED, COARSE_ENTRY_REL, SERIES_SPACING, T_MARGIN};
+use crate::planar::closed::{Case, Closed};
+use crate::planar::small_angle;
 use crate::planar::small_angle::tests::nearly_straight_sample;
+use crate::planar::taylor::{CoarseDual3, TaylorRod};
+use crate::rng::SplitMix64;
+use crate::scalar::Dual3;
+use crate::{PlanarParams, StabilityVerdict};
 
 /// A rod for the slope tests: the paper's box, log-scale magnitudes with exact zeros,
 /// looped rods and near-circles under a small force.
