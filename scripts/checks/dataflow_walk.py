@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Follows one parameter through the code, from its function's imports and calls (issue 44).
 
-    python3 scripts/checks/dataflow_walk.py crates/rod-ig-core/src planar/mod.rs evaluate a [--trace] [--typed]
+    python3 scripts/checks/dataflow_walk.py crates/rod-ig-core/src planar/entry.rs evaluate a [--trace] [--typed]
 
 The walk starts in the named function with the named parameter tracked. In a function's body a
 tracked value is any tracked parameter, `self` when the function was reached as a method of a

@@ -963,3 +963,18 @@ impl<T: Real> Closed<T> {
         ([x, y, half_theta * (2.0 * eps)], kappa)
     }
 }
+
+/// The refusal of a closed form whose intermediate quantities exceed f64.
+pub(crate) fn overflow() -> crate::RodError {
+    crate::RodError::Overflow("closed form of the planar rod: parameters too large for f64".into())
+}
+
+/// The closed form in dual numbers seeded with the identity on a (so that it carries J); None
+/// where an intermediate quantity overflows.
+pub(crate) fn seeded_closed(a: &crate::PlanarParams) -> Option<Closed<crate::scalar::Dual3>> {
+    Closed::new(
+        crate::scalar::Dual3::variable(a[0], 0),
+        crate::scalar::Dual3::variable(a[1], 1),
+        crate::scalar::Dual3::variable(a[2], 2),
+    )
+}

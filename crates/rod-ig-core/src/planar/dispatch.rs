@@ -23,13 +23,17 @@
 //! [`FullEvaluation`] has J at t = 1 only): the next row is asked.
 
 use super::closed::Closed;
+
 use super::formulation::{
     Answer, ClosedForm, ClosedScan, Formulation, FullEvaluation, IllConditioned, Need, Precision,
     Rod, SeparatrixLimit, Series, SmallAngle,
 };
-use super::{curvature_scale, evaluate, Evaluation, PlanarRod};
+use crate::planar::entry::{evaluate, Evaluation};
+use crate::planar::shape::PlanarRod;
+use crate::planar::taylor::curvature_scale;
 use crate::scalar::Dual3;
 use crate::StabilityVerdict;
+
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 
 /// Rods with ρ = max(|a3|, √‖(a4, a5)‖) up to this value are evaluated by the Taylor series

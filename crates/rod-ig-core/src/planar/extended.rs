@@ -161,7 +161,7 @@ mod tests {
             worst_energy = worst_energy.max(off / bound);
             let Some((tip, j, energy)) = tip_jacobian_energy(a) else {
                 let root_f = a[1].hypot(a[2]).sqrt();
-                let ill = super::super::seeded_closed(a).is_some_and(|c| {
+                let ill = crate::planar::closed::seeded_closed(a).is_some_and(|c| {
                     c.needs_series() == super::super::closed::SeriesNeed::IllConditioned
                 });
                 assert!(
@@ -219,7 +219,7 @@ mod tests {
             };
             let a = PlanarParams::new(a3, r.signed_pow10(-2.0, 2.85), a5);
             let Some(e) = energy(&a) else { continue };
-            let reference = super::super::series_dd::<true>(&a, false, 27.0)
+            let reference = crate::planar::taylor::series_dd::<true>(&a, false, 27.0)
                 .expect("series")
                 .energy()
                 .value();

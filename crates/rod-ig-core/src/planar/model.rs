@@ -59,7 +59,7 @@ pub(crate) enum Precision {
 impl Precision {
     /// The precision iterations from `a0` need (`planar::needs_precise_iterations`).
     pub(crate) fn for_start(a0: &PlanarParams) -> Self {
-        if crate::planar::needs_precise_iterations(a0) {
+        if crate::planar::entry::needs_precise_iterations(a0) {
             Self::Precise
         } else {
             Self::Fast
@@ -74,13 +74,15 @@ pub(crate) fn tip_and_jacobian_for_iteration(
     a: &PlanarParams,
     precision: Precision,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-    crate::planar::tip_and_jacobian_for_iteration(a, precision == Precision::Precise)
+    crate::planar::entry::tip_and_jacobian_for_iteration(a, precision == Precision::Precise)
 }
 
 /// Υ(a), J(1, a), energy and the stability test at full accuracy from one precomputation.
 #[inline]
-pub(crate) fn evaluate_precise(a: &PlanarParams) -> Result<crate::planar::Evaluation, RodError> {
-    super::evaluate(a)
+pub(crate) fn evaluate_precise(
+    a: &PlanarParams,
+) -> Result<crate::planar::entry::Evaluation, RodError> {
+    crate::planar::entry::evaluate(a)
 }
 
 /// Elastic energy ½∫κ² from the tip, by the identity of docs/math.md §1:
@@ -216,22 +218,22 @@ impl RodModel<3> for PlanarClosedForm {
     }
 
     fn tip(&self, a: &Vector3<f64>) -> Result<PlanarPose, RodError> {
-        crate::planar::tip(a)
+        crate::planar::entry::tip(a)
     }
 
     fn tip_and_jacobian(&self, a: &Vector3<f64>) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-        crate::planar::tip_and_jacobian(a)
+        crate::planar::entry::tip_and_jacobian(a)
     }
 
     fn tip_and_jacobian_for_substep(
         &self,
         a: &Vector3<f64>,
     ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-        crate::planar::tip_and_jacobian_for_substep(a)
+        crate::planar::entry::tip_and_jacobian_for_substep(a)
     }
 
     fn evaluate(&self, a: &Vector3<f64>) -> Result<ModelEvaluation<3, PlanarPose>, RodError> {
-        crate::planar::evaluate(a)
+        crate::planar::entry::evaluate(a)
     }
 
     fn evaluate_iterate(
@@ -243,11 +245,11 @@ impl RodModel<3> for PlanarClosedForm {
     }
 
     fn stability(&self, a: &Vector3<f64>) -> Result<StabilityReport, RodError> {
-        crate::planar::stability(a)
+        crate::planar::entry::stability(a)
     }
 
     fn energy(&self, a: &Vector3<f64>) -> Result<f64, RodError> {
-        crate::planar::energy(a)
+        crate::planar::entry::energy(a)
     }
 
     planar_geometry!();

@@ -1,6 +1,13 @@
 //! The shape of a planar rod: [`PlanarRod`], the rod ready to be sampled along its length.
 
-use super::*;
+use super::{dispatch, small_angle};
+use crate::planar::closed::{overflow, Case, Closed};
+use crate::planar::dispatch::{
+    beyond_ordinary_force, domain_evaluation, overflow_force, LN_F64_MAX,
+};
+use crate::planar::formulation::closed_energy;
+use crate::planar::taylor::{series_f64, TaylorRod};
+use crate::{PlanarParams, PlanarPose, RodError};
 
 /// A planar rod ready to be sampled: the closed form with everything that depends on a only
 /// precomputed (case, m, m1 = 1 − m, r, phase φ, the Landen sequence and the values at Γ0 = φ;
@@ -63,7 +70,7 @@ pub(crate) fn series_backend(a: &PlanarParams) -> Result<Backend, RodError> {
 
 impl PlanarRod {
     /// Precomputes the rod for a. Errors: [`RodError::NonFinite`] if a component of a is NaN
-    /// or ±∞; every refusal of [`evaluate`] (one domain: beyond ‖(a4, a5)‖ = 625 the full
+    /// or ±∞; every refusal of [`evaluate`](crate::planar::evaluate) (one domain: beyond ‖(a4, a5)‖ = 625 the full
     /// evaluation runs first, and its tip is the shape's); [`RodError::Overflow`] where the
     /// shape cannot be represented in f64 (its series beyond √‖(a4, a5)‖ = ln(f64::MAX), the
     /// one kind of rod forward answers and the shape does not: `tests/domain.rs`).
@@ -170,7 +177,7 @@ impl PlanarRod {
 
     /// Elastic energy ½∫₀¹κ² = λ2/2 − a4 x(1) − a5 y(1), λ2 = a3² + 2a4 (docs/math.md §1), or
     /// integrated along the series where that identity cancels (see `closed_energy`).
-    /// May be +∞ when a3² overflows (the free function [`energy`] reports that as an error).
+    /// May be +∞ when a3² overflows (the free function [`energy`](crate::planar::energy) reports that as an error).
     pub fn energy(&self) -> f64 {
         match &self.backend {
             Backend::Closed(c) => closed_energy(c, &self.a, &self.tip).unwrap_or(f64::INFINITY),

@@ -26,6 +26,7 @@
 use crate::eft::{two_prod, two_sum};
 use crate::scalar::Dual3;
 use crate::RodError;
+
 use crate::{PlanarJacobian, PlanarParams, PlanarPose};
 
 /// Highest Taylor order per step. The terms decay like (h/R)ᵏ with R the radius of convergence
@@ -848,8 +849,8 @@ pub(crate) fn series_dd<const TIGHT: bool>(
     max_root_f: f64,
 ) -> Result<TaylorRod<DualF64x2<TIGHT>>, RodError> {
     let root_f = a[1].hypot(a[2]).sqrt();
-    if root_f > super::LN_F64_MAX {
-        return Err(super::overflow_force());
+    if root_f > crate::planar::dispatch::LN_F64_MAX {
+        return Err(crate::planar::dispatch::overflow_force());
     }
     if root_f > max_root_f {
         return Err(RodError::OutOfDomain(format!(
@@ -878,7 +879,7 @@ pub(crate) fn pose_jac_from<T: Gradient>(
         x.1[0], x.1[1], x.1[2], y.1[0], y.1[1], y.1[2], th.1[0], th.1[1], th.1[2],
     );
     if !(pose.is_finite() && j.iter().all(|v| v.is_finite())) {
-        return Err(super::overflow());
+        return Err(crate::planar::closed::overflow());
     }
     Ok((pose, j))
 }
@@ -892,7 +893,15 @@ pub(crate) fn series_pose_and_jac(
         return pose_jac_from(series_dual(a, false)?.tip());
     }
     let rod = series_dual(a, true)?;
-    pose_jac_from(rod.pose(t.max(0.0)).ok_or_else(super::overflow)?)
+    pose_jac_from(
+        rod.pose(t.max(0.0))
+            .ok_or_else(crate::planar::closed::overflow)?,
+    )
+}
+
+/// ρ = max(|a3|, √‖(a4, a5)‖): the rod's curvature scale (its Taylor terms grow like ρᵏ/k!).
+pub(crate) fn curvature_scale(a: &PlanarParams) -> f64 {
+    a[0].abs().max(crate::scalar::fast_hypot(a[1], a[2]).sqrt())
 }
 
 #[cfg(test)]

@@ -4,16 +4,19 @@
 use super::super::closed::{Case, Closed, SeriesNeed, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F};
 use super::super::shape::Backend;
 use super::super::taylor::Gradient;
-use super::super::PlanarRod;
-use super::super::{
-    extended, overflow, series_dd, series_dual, series_f64, small_angle, stability,
-};
+use crate::planar::shape::PlanarRod;
+
+use super::super::{extended, small_angle, stability};
+use crate::planar::closed::overflow;
+use crate::planar::taylor::{series_dd, series_dual, series_f64};
+
 use super::{
     full_accuracy, with_theorem, Answer, Evaluation, Formulation, Need, Precision, Rod,
     SERIES_F64_TIP_MAX_ROOT_F,
 };
 use crate::scalar::{Dual3, Real};
 use crate::StabilityVerdict;
+
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 
 /// The closed form of the rod, built by the dispatcher: in f64 for the tip and the energy, in
@@ -104,7 +107,7 @@ impl Formulation for ClosedForm<'_, Dual3> {
     ) -> Answer<(PlanarPose, PlanarJacobian)> {
         let within = self.need_at(t) == Need::Closed
             || (precision == Precision::Substep && self.c.accurate_within(SUBSTEP_J_TOLERANCE));
-        within.then(|| super::super::pose_jac_from(self.c.pose(t)))
+        within.then(|| crate::planar::taylor::pose_jac_from(self.c.pose(t)))
     }
     /// The verdict where a theorem, the sign of det J(1) or the scan from the theorem's
     /// conjugate-free time decides ([`stability::verdict_of`]); the stability rows elsewhere.
@@ -234,7 +237,7 @@ pub(crate) fn closed_energy<T: Real>(
 /// verdict of the scans alone. By the separatrix, where the identity cancels, the energy and
 /// det J(t) come from one dense series.
 fn evaluate_closed(c: &Closed<Dual3>, a: &PlanarParams) -> Result<Evaluation, RodError> {
-    let (tip, jacobian) = super::super::pose_jac_from(c.pose(1.0))?;
+    let (tip, jacobian) = crate::planar::taylor::pose_jac_from(c.pose(1.0))?;
     let near_separatrix = c.m1 < SEPARATRIX_M1
         && !c.needs_precise_series()
         && energy_by_identity(c, a, &tip)?.is_none();

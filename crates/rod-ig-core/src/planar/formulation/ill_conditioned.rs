@@ -3,9 +3,15 @@
 
 use super::super::closed::{Closed, SERIES_DD_MAX_ROOT_F};
 use super::super::taylor::Gradient;
-use super::super::PlanarRod;
-use super::super::{extended, overflow, pose_jac_from, seeded_closed, series_dd, series_dual};
-use super::super::{stability, STABILITY_DD_MAX_ROOT_F};
+use crate::planar::shape::PlanarRod;
+
+use super::super::extended;
+use crate::planar::closed::{overflow, seeded_closed};
+use crate::planar::taylor::{pose_jac_from, series_dd, series_dual};
+
+use super::super::stability;
+use crate::planar::stability::STABILITY_DD_MAX_ROOT_F;
+
 use super::closed_form::{energy_by_identity, energy_from_tip, ENERGY_REL_TOLERANCE};
 use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Formulation, Need};
 use super::{Precision, Rod, SERIES_F64_TIP_MAX_ROOT_F};

@@ -15,11 +15,14 @@
 //! | [`Series`] | `series` | gently bent rods (ρ ≤ 0.25), closed forms that overflow, closed-form J that cancels |
 
 use super::closed::Case;
+
 use super::closed::{Closed, SeriesNeed, CLOSED_J_TOLERANCE};
 use super::shape::{case_without_closed, series_backend, Backend};
-use super::{Evaluation, PlanarRod};
+use crate::planar::entry::Evaluation;
+use crate::planar::shape::PlanarRod;
 use crate::scalar::Dual3;
 use crate::StabilityVerdict;
+
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 
 mod closed_form;
@@ -217,7 +220,7 @@ pub(crate) fn finite_tip([x, y, th]: [f64; 3]) -> Result<PlanarPose, RodError> {
     if tip.is_finite() {
         Ok(tip)
     } else {
-        Err(super::overflow())
+        Err(crate::planar::closed::overflow())
     }
 }
 

@@ -3,9 +3,13 @@
 
 use super::super::soliton::{self, Lattice};
 use super::super::taylor::pose_jac_from;
-use super::super::{shape::case_without_closed, shape::Backend, stability, PlanarRod};
+
+use super::super::{shape::case_without_closed, shape::Backend, stability};
+use crate::planar::shape::PlanarRod;
+
 use super::{finite_tip, full_accuracy, Answer, Evaluation, Formulation, Precision};
 use crate::scalar::Dual3;
+
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 
 /// The rod in the separatrix limit: asked before the closed form, whose phase is lost there
@@ -41,7 +45,7 @@ impl<'a> SeparatrixLimit<'a> {
     }
 
     fn pose_and_jacobian_at(&self, t: f64) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-        let lattice = self.dual().ok_or_else(super::super::overflow)?;
+        let lattice = self.dual().ok_or_else(crate::planar::closed::overflow)?;
         pose_jac_from(lattice.pose(t.clamp(0.0, 1.0)))
     }
 
@@ -50,12 +54,12 @@ impl<'a> SeparatrixLimit<'a> {
         if e.is_finite() {
             Ok(e)
         } else {
-            Err(super::super::overflow())
+            Err(crate::planar::closed::overflow())
         }
     }
 
     fn report(&self) -> Result<StabilityReport, RodError> {
-        stability::lattice_report(self.a).unwrap_or_else(|| Err(super::super::overflow()))
+        stability::lattice_report(self.a).unwrap_or_else(|| Err(crate::planar::closed::overflow()))
     }
 }
 

@@ -3,11 +3,15 @@
 
 use super::super::closed::Closed;
 use super::super::shape::Backend;
-use super::super::PlanarRod;
-use super::super::{pose_jac_from, series_dual, series_f64, series_pose_and_jac, stability};
+use crate::planar::shape::PlanarRod;
+
+use super::super::stability;
+use crate::planar::taylor::{pose_jac_from, series_dual, series_f64, series_pose_and_jac};
+
 use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Formulation};
 use super::{Precision, Rod};
 use crate::StabilityVerdict;
+
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 
 /// The Taylor series of the rod in f64 (dual numbers for J): the last row of the table, it
@@ -30,7 +34,7 @@ impl Formulation for Series<'_> {
             if e.is_finite() {
                 Ok(e)
             } else {
-                Err(super::super::overflow())
+                Err(crate::planar::closed::overflow())
             }
         }))
     }
@@ -48,9 +52,12 @@ impl Formulation for Series<'_> {
     /// The dense f64 series (or the expansion where the series cannot run).
     fn shape(&self) -> Answer<PlanarRod> {
         let a = self.0.a;
-        Some(self.0.series_shape(|backend| match backend {
-            Backend::Series(r) => Ok(r.tip()),
-            _ => super::super::small_angle::checked_tip(a).ok_or_else(super::super::overflow),
+        Some(self.0.series_shape(|backend| {
+            match backend {
+                Backend::Series(r) => Ok(r.tip()),
+                _ => super::super::small_angle::checked_tip(a)
+                    .ok_or_else(crate::planar::closed::overflow),
+            }
         }))
     }
     /// With the theorem of the rod's closed form where one was built, else of its f64 one.

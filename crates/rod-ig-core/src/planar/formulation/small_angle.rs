@@ -2,7 +2,10 @@
 //! formulation: nearly straight rods, where their a-priori bounds hold.
 
 use super::super::shape::Backend;
-use super::super::{small_angle, stability, PlanarRod};
+
+use super::super::{small_angle, stability};
+use crate::planar::shape::PlanarRod;
+
 use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Formulation, Need};
 use super::{Precision, Rod};
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
@@ -40,7 +43,8 @@ impl Formulation for SmallAngle<'_> {
     /// nearly straight rod under compression).
     fn shape(&self) -> Answer<PlanarRod> {
         let a = self.0.a;
-        let beyond_series = crate::scalar::fast_hypot(a[1], a[2]).sqrt() > super::super::LN_F64_MAX;
+        let beyond_series =
+            crate::scalar::fast_hypot(a[1], a[2]).sqrt() > crate::planar::dispatch::LN_F64_MAX;
         if self.0.need == Need::Closed || !beyond_series {
             return None;
         }

@@ -19,7 +19,8 @@
 use super::cable::{lift_near, Cable, CableError, FollowLimits, SecondVariation};
 use super::Gravity;
 use crate::planar::ig::SolveOptions;
-use crate::planar::PlanarClosedForm;
+use crate::planar::model::PlanarClosedForm;
+
 use crate::solver::{
     Failure, IgError, InverseGeometry, Objective, RodModel, Solution, Verified, Work,
 };
@@ -375,7 +376,7 @@ fn weightless_rods(
     let mut keyed: Vec<(bool, f64, PlanarParams)> = sols
         .into_iter()
         .filter_map(|s| {
-            let shape = crate::planar::PlanarRod::new(&s.a)
+            let shape = crate::planar::shape::PlanarRod::new(&s.a)
                 .ok()?
                 .shape(super::cable::SHAPE_CHECK_SAMPLES);
             let coiled =

@@ -15,12 +15,13 @@
 //!   corrected at the full weight directly.
 
 use super::cable::{lift_near, Cable, CableError, FollowLimits, SecondVariation};
-use super::series;
-use super::Gravity;
+use super::{series, Gravity};
+
 use crate::ends::{EndCondition, HeldEnds};
 use crate::planar::ig::SolveOptions;
-use crate::planar::PlanarClosedForm;
+use crate::planar::model::PlanarClosedForm;
 use crate::solver::InverseGeometry;
+
 use crate::{PlanarParams, PlanarPose, RodError};
 use std::f64::consts::FRAC_PI_4;
 

@@ -230,10 +230,10 @@ fn jacobian_of(s: &series::State) -> PlanarJacobian {
     j
 }
 
-/// Tip pose q(1) of the heavy rod (w = 0: [`crate::planar::tip`]).
+/// Tip pose q(1) of the heavy rod (w = 0: [`crate::planar::entry::tip`]).
 pub fn tip(a: &PlanarParams, g: &Gravity) -> Result<PlanarPose, RodError> {
     if g.is_weightless() {
-        return crate::planar::tip(a);
+        return crate::planar::entry::tip(a);
     }
     check_params(a)?;
     if let Some(c) = recalled(a, g) {
@@ -243,13 +243,13 @@ pub fn tip(a: &PlanarParams, g: &Gravity) -> Result<PlanarPose, RodError> {
     Ok(PlanarPose::new(end.x, end.y, end.theta))
 }
 
-/// Tip pose q(1) and J(1, a) (w = 0: [`crate::planar::tip_and_jacobian`]).
+/// Tip pose q(1) and J(1, a) (w = 0: [`crate::planar::entry::tip_and_jacobian`]).
 pub fn tip_and_jacobian(
     a: &PlanarParams,
     g: &Gravity,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     if g.is_weightless() {
-        return crate::planar::tip_and_jacobian(a);
+        return crate::planar::entry::tip_and_jacobian(a);
     }
     check_params(a)?;
     if let Some(c) = recalled(a, g) {
@@ -259,14 +259,14 @@ pub fn tip_and_jacobian(
     Ok((PlanarPose::new(end.x, end.y, end.theta), jacobian_of(&end)))
 }
 
-/// Pose q(t) and J(t, a) for t ∈ [0, 1] (w = 0: [`crate::planar::pose_and_jacobian`]).
+/// Pose q(t) and J(t, a) for t ∈ [0, 1] (w = 0: [`crate::planar::entry::pose_and_jacobian`]).
 pub fn pose_and_jacobian(
     a: &PlanarParams,
     g: &Gravity,
     t: f64,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     if g.is_weightless() {
-        return crate::planar::pose_and_jacobian(a, t);
+        return crate::planar::entry::pose_and_jacobian(a, t);
     }
     check_params(a)?;
     RodError::check_finite("t", &[t])?;
@@ -287,11 +287,11 @@ pub fn pose_and_jacobian(
 }
 
 /// `samples` poses at t_i = i/(samples − 1), base to tip (w = 0:
-/// [`crate::planar::PlanarRod::shape`]). One integration; each pose is a Horner evaluation of
+/// [`crate::planar::shape::PlanarRod::shape`]). One integration; each pose is a Horner evaluation of
 /// the step's polynomials.
 pub fn shape(a: &PlanarParams, g: &Gravity, samples: usize) -> Result<Vec<PlanarPose>, RodError> {
     if g.is_weightless() {
-        return Ok(crate::planar::PlanarRod::new(a)?.shape(samples));
+        return Ok(crate::planar::shape::PlanarRod::new(a)?.shape(samples));
     }
     check_params(a)?;
     if let Some(c) = recalled(a, g) {
@@ -330,7 +330,7 @@ pub fn wrenches(
     g: &Gravity,
 ) -> Result<crate::wrench::GripperWrenches<crate::wrench::PlanarWrench>, RodError> {
     let (tip, kappa) = if g.is_weightless() {
-        let tip = crate::planar::tip(a)?;
+        let tip = crate::planar::entry::tip(a)?;
         (tip, crate::wrench::weightless_tip_curvature(a, &tip))
     } else {
         check_params(a)?;
@@ -349,10 +349,10 @@ pub fn stability(a: &PlanarParams, g: &Gravity) -> Result<StabilityReport, RodEr
     Ok(evaluate(a, g)?.stability)
 }
 
-/// (total, elastic) energy (w = 0: both [`crate::planar::energy`]).
+/// (total, elastic) energy (w = 0: both [`crate::planar::entry::energy`]).
 pub fn energy(a: &PlanarParams, g: &Gravity) -> Result<(f64, f64), RodError> {
     if g.is_weightless() {
-        let e = crate::planar::energy(a)?;
+        let e = crate::planar::entry::energy(a)?;
         return Ok((e, e));
     }
     check_params(a)?;
@@ -363,7 +363,7 @@ pub fn energy(a: &PlanarParams, g: &Gravity) -> Result<(f64, f64), RodError> {
     Ok((end.elastic + g.weight * end.potential, end.elastic))
 }
 
-/// Tip, J(1, a), energies and stability in one integration (w = 0: [`crate::planar::evaluate`]).
+/// Tip, J(1, a), energies and stability in one integration (w = 0: [`crate::planar::entry::evaluate`]).
 ///
 /// ```
 /// use rod_ig_core::planar::heavy::{self, Gravity};
@@ -377,7 +377,7 @@ pub fn energy(a: &PlanarParams, g: &Gravity) -> Result<(f64, f64), RodError> {
 /// ```
 pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyEvaluation, RodError> {
     if g.is_weightless() {
-        let e = crate::planar::evaluate(a)?;
+        let e = crate::planar::entry::evaluate(a)?;
         return Ok(HeavyEvaluation {
             tip: e.tip,
             jacobian: e.jacobian,

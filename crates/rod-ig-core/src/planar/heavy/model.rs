@@ -8,7 +8,8 @@
 use super::cable_search::{self, Admission, LONG_CABLE_WEIGHT};
 use super::{Gravity, HeavyEvaluation};
 use crate::planar::ig::SolveOptions;
-use crate::planar::PlanarClosedForm;
+use crate::planar::model::PlanarClosedForm;
+
 use crate::solver::load::{self, LoadedModel};
 use crate::solver::{
     Failure, Found, IgError, InverseGeometry, ModelEvaluation, Objective, RodModel, Solution,

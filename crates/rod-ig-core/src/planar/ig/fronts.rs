@@ -106,7 +106,7 @@ mod tests {
             PlanarParams::new(-3.25e-6, 152.0, 0.00366),
             PlanarParams::new(1.67e-5, 187.0, -3.45e-5),
         ] {
-            let b = crate::planar::tip(&a).unwrap();
+            let b = crate::planar::entry::tip(&a).unwrap();
             let s = starts(&b, 4);
             assert!(
                 s.iter().any(|g| {

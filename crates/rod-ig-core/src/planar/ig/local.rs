@@ -16,8 +16,8 @@
 
 use super::newton::{eval, eval_residual, Eval};
 use super::scan;
-use crate::planar::model::solve3;
-use crate::planar::model::Precision;
+use crate::planar::model::{solve3, Precision};
+
 use crate::solver::globalised::{self, Iterate, Problem, Settings};
 use crate::solver::{emit, Event, IgError};
 use crate::{PlanarParams, PlanarPose};
@@ -315,10 +315,10 @@ mod tests {
                 rng.range(-60.0, 60.0),
                 rng.range(-60.0, 60.0),
             );
-            let Ok(tip) = crate::planar::tip(&a) else {
+            let Ok(tip) = crate::planar::entry::tip(&a) else {
                 continue;
             };
-            if !crate::planar::stability(&a).is_ok_and(|s| s.stable) {
+            if !crate::planar::entry::stability(&a).is_ok_and(|s| s.stable) {
                 continue;
             }
             let a0 = a + PlanarParams::new(1e-3, -1e-3, 1e-3);

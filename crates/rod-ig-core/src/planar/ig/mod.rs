@@ -34,7 +34,7 @@ mod scan;
 mod straight;
 mod tracker;
 
-use crate::planar::{PlanarClosedForm, PlanarReference};
+use crate::planar::model::{PlanarClosedForm, PlanarReference};
 use crate::solver::{Found, InverseGeometry};
 use crate::{PlanarParams, PlanarPose};
 

@@ -6,6 +6,7 @@
 use super::Solution;
 use crate::planar::model;
 use crate::planar::model::Precision;
+
 use crate::solver::{Verified, Work};
 use crate::{PlanarJacobian, PlanarParams, PlanarPose};
 use nalgebra::Vector3;
@@ -53,7 +54,7 @@ pub(crate) fn eval_residual(
     jac: &PlanarJacobian,
     target: &PlanarPose,
 ) -> Option<Eval> {
-    eval_from((crate::planar::tip_by_closed_form(a)?, *jac), target)
+    eval_from((crate::planar::entry::tip_by_closed_form(a)?, *jac), target)
 }
 
 fn eval_from((tip, jac): (PlanarPose, PlanarJacobian), target: &PlanarPose) -> Option<Eval> {
@@ -85,7 +86,7 @@ pub(crate) fn make_solution(
     // (integrated where needed) when there is one.
     let energy = e
         .energy
-        .or_else(|| crate::planar::energy(a).ok())
+        .or_else(|| crate::planar::entry::energy(a).ok())
         .unwrap_or_else(|| model::energy_from_tip(a, &e.tip));
     let verified = Verified {
         tip: e.tip,

@@ -13,6 +13,7 @@ use super::{
     SolveOptions,
 };
 use crate::planar::model;
+
 use crate::solver::{emit, Event, Searched, Termination};
 use crate::{PlanarParams, PlanarPose};
 
@@ -180,7 +181,7 @@ impl ModelStarts {
         while self.served_straight < MODEL_STARTS {
             let a = self.straight.next()?;
             self.served_straight += 1;
-            if crate::planar::needs_precise_iterations(&a) {
+            if crate::planar::entry::needs_precise_iterations(&a) {
                 self.late.push_back(a);
             } else {
                 return Some(a);
@@ -528,7 +529,7 @@ fn by_continuation(
             a0_norm: a0.norm(),
         });
         let mut work = crate::solver::Work::default();
-        let model = crate::planar::PlanarClosedForm;
+        let model = crate::planar::model::PlanarClosedForm;
         let end = crate::solver::branch_to(model, options, BRANCH_STEPS, &a0, target, &mut work);
         counts.iterations += work.iterations;
         counts.evaluations += work.evaluations;

@@ -18,6 +18,7 @@
 //! cancel terms of size e^{2k}.
 
 use crate::planar::small_angle;
+
 use crate::{wrap_angle, PlanarParams, PlanarPose};
 use std::sync::OnceLock;
 
@@ -285,7 +286,7 @@ mod tests {
             PlanarParams::new(0.1, -5.0, 0.1),
             PlanarParams::new(0.3, -20.0, 1.0),
         ] {
-            let b = crate::planar::tip(&a).unwrap();
+            let b = crate::planar::entry::tip(&a).unwrap();
             let s = starts(&b, 4);
             // One start within ~25 % of a (small-angle model).
             assert!(
@@ -352,7 +353,7 @@ mod tests {
             PlanarParams::new(0.05, 0.3, -0.02),
             PlanarParams::new(0.1, -5.0, 0.1),
         ] {
-            let b = crate::planar::tip(&a).unwrap();
+            let b = crate::planar::entry::tip(&a).unwrap();
             let s = starts(&b, 8);
             assert!(s.iter().all(|g| g[1] < 100.0), "{a:?}: {s:?}");
         }
@@ -371,7 +372,7 @@ mod tests {
             PlanarParams::new(0.0, 0.0, 1e-2),
             PlanarParams::new(0.05, 0.3, -0.02),
         ] {
-            let b = crate::planar::tip(&a).unwrap();
+            let b = crate::planar::entry::tip(&a).unwrap();
             let s = starts(&b, 4);
             let g = s.first().unwrap_or_else(|| panic!("{a:?}: no start"));
             assert!((g[1] - a[1]).abs() < 0.05, "{a:?}: {g:?}");

@@ -14,11 +14,14 @@ use super::{
     SIGMA_RAY, T_MARGIN, T_MIN,
 };
 use crate::dd::DualDd;
+
 use crate::planar::closed::{Case, Closed, DetFrame, SeriesNeed};
 use crate::planar::small_angle;
+
 use crate::planar::taylor::{CoarseDual3, Gradient, TaylorRod};
 use crate::planar_det_leading_term as normalisation;
 use crate::scalar::Dual3;
+
 use crate::types::{det3, det_and_error, det_and_error_by_column};
 use crate::{PlanarParams, RodError, StabilityReport, StabilityVerdict};
 
@@ -140,7 +143,7 @@ pub(crate) fn precise_scan(
     // Beyond the double-double series' reach the verdict stays uncertain (with the second
     // pass's margin), rather than refusing a rod whose forward map is certified.
     if let Some(report) = undecided {
-        if a[1].hypot(a[2]).sqrt() > crate::planar::STABILITY_DD_MAX_ROOT_F {
+        if a[1].hypot(a[2]).sqrt() > crate::planar::stability::STABILITY_DD_MAX_ROOT_F {
             return Ok(report);
         }
     }
@@ -169,10 +172,10 @@ const SERIES_RADIANS_PER_STEP: f64 = 4.0;
 /// Whether the f64 series would spend its whole step budget before the tip: its steps are
 /// ≈ 1/ρ long, so a rod of curvature scale ρ needs ≈ ρ/1.9 of them. Where a theorem decides the
 /// verdict (circles, case II) such a rod keeps the closed scan's report, its margin uncertain,
-/// instead of failing after ~0.1 s of integration ([`crate::planar::curvature_scale`]).
+/// instead of failing after ~0.1 s of integration ([`crate::planar::taylor::curvature_scale`]).
 pub(super) fn series_out_of_reach(a: &PlanarParams) -> bool {
-    crate::planar::curvature_scale(a)
-        > SERIES_RADIANS_PER_STEP * crate::planar::SERIES_MAX_STEPS as f64
+    crate::planar::taylor::curvature_scale(a)
+        > SERIES_RADIANS_PER_STEP * crate::planar::taylor::SERIES_MAX_STEPS as f64
 }
 
 /// Farthest t to which [`small_m_scan`] builds its certifying series: beyond, the whole-rod
@@ -226,7 +229,7 @@ pub(super) fn small_m_scan(
         Dual3::variable(a[1], 1),
         Dual3::variable(a5, 2),
         t_end,
-        crate::planar::SERIES_MAX_STEPS,
+        crate::planar::taylor::SERIES_MAX_STEPS,
         true,
     ) else {
         return Ok(None);
@@ -796,7 +799,7 @@ pub(super) fn unstable_at_the_end(c: &Closed<Dual3>, a: &PlanarParams) -> bool {
     g < -END_UNSTABLE_BOUNDS * bound
 }
 
-/// The verdict alone on the closed form ([`crate::planar::stability_verdict`]), None where the
+/// The verdict alone on the closed form ([`crate::planar::entry::stability_verdict`]), None where the
 /// caller must run the full test. In order:
 /// 1. a theorem ([`Closed::theorem_verdict`]: no conjugate point before the first inflection,
 ///    one by the third; [`with_theorem`] gives every report that verdict);

@@ -57,6 +57,14 @@ const COARSE_AMPLIFIED: f64 = 2e-13;
 /// underflow.
 const SIGMA_RAY: f64 = 1e-60;
 
+/// Largest √‖F‖ for which the stability scan runs on the double-double series near the
+/// separatrix (the steps scale like √‖F‖: ≈ 20 ms at √‖F‖ = 100, the top of issue 9's
+/// strong-force family a4 ≤ 1e4). Beyond [`crate::planar::closed::SERIES_DD_MAX_ROOT_F`] its g(t) is not certified
+/// to the scan's 1e-3, but the sign is robust: its verdicts matched the rigorous 320-bit
+/// reference on all 720 separatrix rods of scripts/references/gen_separatrix_truth.py's samples (√‖F‖ up
+/// to 100), where its tips and J were off by up to 0.25 and 100 %.
+pub(crate) const STABILITY_DD_MAX_ROOT_F: f64 = 120.0;
+
 /// The straight rod a3 = a5 = 0: J's x row vanishes (∂x/∂a ≡ 0: an inextensible straight rod
 /// stays straight to first order), so det J ≡ 0 on (0, 1]. The test "det J > 0 on (0, 1]"
 /// neither passes nor fails: the rod is a singular point of the a-chart, on the boundary of

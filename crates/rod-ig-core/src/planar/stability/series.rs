@@ -2,15 +2,18 @@
 //! the closed form's error estimate fails.
 
 use super::closed_scan::normalised_det;
+
 use super::scan::{sample_times, scan, value_only, Probe, Scan};
 use super::{
     straight_report, verdict, SERIES_ENTRY_REL, SERIES_SLOPED_MAX_SPACING, SERIES_SPACING,
     SERIES_T_MIN, SIGMA_RAY,
 };
 use crate::planar::closed::Closed;
+
 use crate::planar::taylor::{Gradient, TaylorRod};
 use crate::planar_det_leading_term as normalisation;
 use crate::scalar::Dual3;
+
 use crate::types::{det3, det_and_error};
 use crate::{PlanarParams, RodError, StabilityReport};
 
@@ -57,12 +60,15 @@ pub(super) fn whole_series_scan(
     let b = PlanarParams::new(a3, a4, a5);
     // Without the closed form's wavelength, the rod's own scale: κ varies on 1/ρ, so g on
     // about 2π/ρ (the same quarter-wavelength rule as the closed-form scan).
-    let wavelength =
-        wavelength.unwrap_or_else(|| std::f64::consts::TAU / crate::planar::curvature_scale(a));
+    let wavelength = wavelength
+        .unwrap_or_else(|| std::f64::consts::TAU / crate::planar::taylor::curvature_scale(a));
     let spacing = (0.25 * wavelength).clamp(1e-3, SERIES_SPACING);
     if let Some(closed) = precise {
-        let rod =
-            crate::planar::series_dd::<false>(&b, true, crate::planar::STABILITY_DD_MAX_ROOT_F)?;
+        let rod = crate::planar::taylor::series_dd::<false>(
+            &b,
+            true,
+            crate::planar::stability::STABILITY_DD_MAX_ROOT_F,
+        )?;
         let cross = CrossCheck {
             root_f: a[1].hypot(a[2]).sqrt(),
             closed: (!on_ray).then_some(closed),
@@ -73,7 +79,7 @@ pub(super) fn whole_series_scan(
     match rod {
         Some(r) if !on_ray => scan_series(r, (a3, a5), spacing, None),
         _ => scan_series(
-            &crate::planar::series_dual(&b, true)?,
+            &crate::planar::taylor::series_dual(&b, true)?,
             (a3, a5),
             spacing,
             None,
@@ -101,8 +107,8 @@ pub(super) struct CrossCheck<'a> {
 /// cross-check tolerances (`CROSS_CHECK_TIP`, `CROSS_CHECK_J`).
 pub(super) fn forward_maps_agree<T: Gradient>(closed: &Closed<Dual3>, rod: &TaylorRod<T>) -> bool {
     let (Ok((tip_c, j_c)), Ok((tip_s, j_s))) = (
-        crate::planar::pose_jac_from(closed.pose(1.0)),
-        crate::planar::pose_jac_from(rod.tip()),
+        crate::planar::taylor::pose_jac_from(closed.pose(1.0)),
+        crate::planar::taylor::pose_jac_from(rod.tip()),
     ) else {
         return false;
     };
@@ -110,8 +116,8 @@ pub(super) fn forward_maps_agree<T: Gradient>(closed: &Closed<Dual3>, rod: &Tayl
         .abs()
         .max((tip_c.y - tip_s.y).abs())
         .max((tip_c.theta - tip_s.theta).abs());
-    dtip <= crate::planar::CROSS_CHECK_TIP
-        && (j_c - j_s).norm() <= crate::planar::CROSS_CHECK_J * j_s.norm()
+    dtip <= crate::planar::formulation::CROSS_CHECK_TIP
+        && (j_c - j_s).norm() <= crate::planar::formulation::CROSS_CHECK_J * j_s.norm()
 }
 
 /// Largest relative disagreement between the double-double series' g and the closed form's

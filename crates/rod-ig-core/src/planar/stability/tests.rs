@@ -18,9 +18,11 @@ use super::{COARSE_AMPLIFIED, COARSE_ENTRY_REL, SERIES_SPACING, T_MARGIN};
 use crate::planar::closed::{Case, Closed};
 use crate::planar::small_angle;
 use crate::planar::small_angle::tests::nearly_straight_sample;
+
 use crate::planar::taylor::{CoarseDual3, TaylorRod};
 use crate::rng::SplitMix64;
 use crate::scalar::Dual3;
+
 use crate::{PlanarParams, StabilityVerdict};
 
 /// A rod for the slope tests: the paper's box, log-scale magnitudes with exact zeros,
@@ -187,7 +189,7 @@ fn margin_matches_a_dense_scan() {
     let (mut compared, mut worst) = (0usize, 0.0f64);
     for i in 0..1200 {
         let a = slope_test_rod(&mut r, i);
-        let Ok(rod) = crate::planar::series_dual(&a, true) else {
+        let Ok(rod) = crate::planar::taylor::series_dual(&a, true) else {
             continue;
         };
         let mut dense = f64::INFINITY;
@@ -200,7 +202,7 @@ fn margin_matches_a_dense_scan() {
             );
             dense = dense.min(v);
         }
-        let report = crate::planar::stability(&a).expect("a rod of the box");
+        let report = crate::planar::entry::stability(&a).expect("a rod of the box");
         let dev = (report.margin - dense).abs() / dense.abs().max(1e-3);
         assert!(
             dev <= 0.02,
@@ -232,7 +234,7 @@ fn slope_is_the_derivative_of_g() {
     let (mut compared, mut worst) = ([0usize; 3], 0.0f64);
     for i in 0..2000 {
         let a = slope_test_rod(&mut r, i);
-        let Some(c) = crate::planar::seeded_closed(&a) else {
+        let Some(c) = crate::planar::closed::seeded_closed(&a) else {
             continue;
         };
         let case = match c.case {
@@ -282,7 +284,7 @@ fn small_angle_agrees_with_the_series() {
             continue;
         };
         let (a3, a4, a5) = (a[0], a[1], a[2]);
-        let Ok(rod) = crate::planar::series_dual(&a, true) else {
+        let Ok(rod) = crate::planar::taylor::series_dual(&a, true) else {
             continue;
         };
         let theta = small_angle::max_angle(a3, a4, a5);
@@ -342,7 +344,7 @@ fn small_angle_prefix_agrees_with_the_series() {
             Dual3::variable(a4, 1),
             Dual3::variable(a5, 2),
             t_end,
-            crate::planar::SERIES_MAX_STEPS,
+            crate::planar::taylor::SERIES_MAX_STEPS,
             true,
         ) else {
             continue;
@@ -403,7 +405,7 @@ fn extended_pass_agrees_with_the_series_scan() {
             r.signed_pow10(-14.0, -6.0)
         };
         let a = PlanarParams::new(a3, r.signed_pow10(2.0, 4.0), a5);
-        let Some(c) = crate::planar::seeded_closed(&a) else {
+        let Some(c) = crate::planar::closed::seeded_closed(&a) else {
             continue;
         };
         if !c.needs_precise_series() || small_angle_report(&a).expect("finite").is_some() {
@@ -478,7 +480,7 @@ fn small_angle_report_matches_the_series_scan() {
         if a[1] > 289.0 {
             continue;
         }
-        let Ok(rod) = crate::planar::series_dual(&a, true) else {
+        let Ok(rod) = crate::planar::taylor::series_dual(&a, true) else {
             continue;
         };
         n += 1;
@@ -486,7 +488,7 @@ fn small_angle_report_matches_the_series_scan() {
             continue;
         };
         answered += 1;
-        let wavelength = std::f64::consts::TAU / crate::planar::curvature_scale(&a);
+        let wavelength = std::f64::consts::TAU / crate::planar::taylor::curvature_scale(&a);
         let spacing = (0.25 * wavelength).clamp(1e-3, SERIES_SPACING);
         let slow = scan_series(&rod, (a[0], a[2]), spacing, None).unwrap();
         assert!(!slow.uncertain, "{a:?}: {slow:?}");
@@ -613,7 +615,7 @@ fn conjugate_points_respect_the_theorem() {
             }
         }
         if reference.margin.abs() > 1e-3 && !reference.uncertain {
-            let ours = crate::planar::stability(&a).expect("answered");
+            let ours = crate::planar::entry::stability(&a).expect("answered");
             assert_eq!(
                 ours.stable, reference.stable,
                 "{a:?}: {ours:?} / {reference:?}"
@@ -651,10 +653,10 @@ fn verdict_alone_agrees_with_the_full_test_and_the_reference() {
                 None => continue,
             }
         };
-        let full = crate::planar::stability(&a).map(|s| s.verdict());
-        let alone = crate::planar::stability_verdict(&a);
+        let full = crate::planar::entry::stability(&a).map(|s| s.verdict());
+        let alone = crate::planar::entry::stability_verdict(&a);
         assert_eq!(alone, full, "{a:?}");
-        let Some(c) = crate::planar::seeded_closed(&a) else {
+        let Some(c) = crate::planar::closed::seeded_closed(&a) else {
             continue;
         };
         let shortcut = verdict_of(&c, &a).expect("finite");
@@ -709,7 +711,7 @@ fn closed_g_within_its_bound() {
         } else {
             theorem_sample(&mut r, i)
         };
-        let Some(c) = crate::planar::seeded_closed(&a) else {
+        let Some(c) = crate::planar::closed::seeded_closed(&a) else {
             continue;
         };
         if !plain_closed_scan(&c, &a) {
@@ -766,7 +768,7 @@ fn small_m_scan_agrees_with_the_series_scan() {
             r.signed_pow10(-8.0, 1.0)
         };
         let a = PlanarParams::new(a3, a4, a5);
-        let Some(c) = crate::planar::seeded_closed(&a) else {
+        let Some(c) = crate::planar::closed::seeded_closed(&a) else {
             continue;
         };
         if !c.det_needs_series() || c.needs_precise_series() {
