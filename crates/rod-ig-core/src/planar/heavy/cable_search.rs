@@ -104,6 +104,11 @@ impl Admission {
     }
 }
 
+/// [`finish`] of a rod reached in `iterations`, as a search's error.
+fn finished((cable, iterations): (Cable, u32)) -> Result<CableSolution, CableError> {
+    finish(cable, iterations).map_err(CableError::from)
+}
+
 fn finish(cable: Cable, iterations: u32) -> Result<CableSolution, RodError> {
     let tip = cable.tip()?;
     let (energy, elastic_energy) = cable.energies()?;
@@ -145,9 +150,14 @@ impl Searcher<'_> {
 
     /// Runs one start (with half of the time left) and admits its rod, if any.
     fn start(&mut self, run: impl FnOnce(&Self) -> Result<(Cable, u32), CableError>) {
+        self.start_finished(|s| run(s).and_then(finished));
+    }
+
+    /// [`Self::start`] for a run that finishes its rod itself ([`from_guess`]).
+    fn start_finished(&mut self, run: impl FnOnce(&Self) -> Result<CableSolution, CableError>) {
         self.out.starts += 1;
         let _share = crate::deadline::share_of_remaining(START_SHARE);
-        let r = run(self).and_then(|(c, it)| finish(c, it).map_err(CableError::from));
+        let r = run(self);
         let out = &mut self.out;
         match r {
             Ok(s) if self.admission.admits(&s) => {
@@ -293,7 +303,7 @@ pub fn search(
     };
     // 1. The caller's guess.
     if let Some(a0) = options.initial_guess {
-        s.start(|s| from_guess(&a0, s.gravity, s.target, s.admission));
+        s.start_finished(|s| from_guess(&a0, s.gravity, s.target, s.admission));
     }
     // 1b. The catenary through the grippers with its tension layers, at the full weight.
     if !s.done() {
@@ -463,7 +473,7 @@ pub fn newton(
 /// remembered when `accepted`, else the failure with `rejected` (or the error) as its last
 /// start's reason.
 fn one_start_outcome(
-    reached: Result<(Cable, u32), CableError>,
+    reached: Result<CableSolution, CableError>,
     target: &PlanarPose,
     admission: Admission,
     accepted: impl Fn(&CableSolution) -> bool,
@@ -473,7 +483,7 @@ fn one_start_outcome(
         starts: 1,
         ..CableSearch::default()
     };
-    match reached.and_then(|(c, it)| finish(c, it).map_err(CableError::from)) {
+    match reached {
         Ok(s) if accepted(&s) => {
             remember(&s.cable);
             out.solutions.push(s);
@@ -523,12 +533,12 @@ fn from_guess(
     gravity: &Gravity,
     target: &PlanarPose,
     admission: Admission,
-) -> Result<(Cable, u32), CableError> {
+) -> Result<CableSolution, CableError> {
     let limits = limits_of(admission);
     // A rod a solver returned: its node states, moved to the target (tracking).
     if let Some(mut c) = recall(a0, gravity) {
         let steps = c.move_within(target, &limits)?;
-        return Ok((c, steps));
+        return finished((c, steps));
     }
     let integrated = Cable::from_params(a0, gravity)?;
     let lifted = lift_near(target, integrated.tip()?.theta);
@@ -548,12 +558,10 @@ fn from_guess(
         [&direct, &force_seeded, &moved];
     let mut last = Err(CableError::Singular);
     for attempt in tries {
-        let reached = attempt();
-        if let Ok((c, _)) = &reached {
-            let admitted = finish(c.clone(), 0).is_ok_and(|s| admission.admits(&s));
-            if admitted {
-                return reached;
-            }
+        // Each rod reached is finished once: its verdict decides, and the caller keeps it.
+        let reached = attempt().and_then(finished);
+        if reached.as_ref().is_ok_and(|s| admission.admits(s)) {
+            return reached;
         }
         if reached.is_ok() || last.is_err() {
             last = reached;
@@ -696,7 +704,7 @@ pub fn carry(
         Some(mut c) => {
             let lifted = lift_near(gripper, c.tip().map(|t| t.theta).unwrap_or(gripper.theta));
             c.carry_within(to, &lifted, &limits_of(admission))
-                .map(|steps| (c, steps))
+                .and_then(|steps| finished((c, steps)))
         }
     };
     one_start_outcome(
