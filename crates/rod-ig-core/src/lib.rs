@@ -52,7 +52,7 @@ pub mod wrench;
 pub use error::RodError;
 pub use types::{
     planar_det_leading_term, wrap_angle, PlanarJacobian, PlanarParams, PlanarPose, StabilityReport,
-    StabilityVerdict, STABILITY_T_MIN,
+    StabilityVerdict, STABILITY_MARGIN_T_MIN, STABILITY_T_MIN,
 };
 
 // The README's Rust example is compiled and run as a doc-test.

@@ -112,6 +112,12 @@ pub use crate::angle::wrap_angle;
 /// stability test (closed form, series, RK4 scan, 3-D grid) starts here.
 pub const STABILITY_T_MIN: f64 = 0.02;
 
+/// Smallest t entering the normalised stability margin `det_min` = min over t ∈ [this, 1] of
+/// g(t) (docs/math.md §5): below it g's normalisation t⁹(…) is too small for its value to mean
+/// much. One value for every rod: the planar closed forms and series, the rod with weight, the
+/// 3-D rod and the references.
+pub const STABILITY_MARGIN_T_MIN: f64 = 0.05;
+
 /// The leading small-t term of det J(t, a) for the planar rod, t⁹ (a3²/8640 + a5² t²/33600)
 /// (docs/math.md §5): the normalisation of the stability margin g(t) = det J(t) / this, written
 /// once for the closed form's test and the reference integrator's.

@@ -28,8 +28,8 @@ pub const STABILITY_ATOL: f64 = 1e-30;
 /// Smallest t at which the fixed-step [`rk4_stability`] tests det J (docs/math.md §5: absolute
 /// rounding swamps det J below t ≈ 0.02).
 pub const RK4_STABILITY_T_MIN: f64 = crate::STABILITY_T_MIN;
-/// Smallest t entering the normalised margin `det_min` (docs/math.md §5).
-pub const MARGIN_T_MIN: f64 = 0.05;
+/// Smallest t entering the normalised margin `det_min` ([`crate::STABILITY_MARGIN_T_MIN`]).
+pub const MARGIN_T_MIN: f64 = crate::STABILITY_MARGIN_T_MIN;
 
 /// Planar rod right-hand side (eq. 2.9 + kinematics) on s = (μ3, μ4, μ5, θ, x, y).
 #[inline(always)]

@@ -24,8 +24,8 @@ use crate::{RodError, StabilityReport};
 pub const STABILITY_T_MIN: f64 = crate::STABILITY_T_MIN;
 /// Number of intervals of the rule's grid on [0, 1].
 pub const GRID_N: u32 = 2000;
-/// Smallest t entering the normalised margin.
-pub const MARGIN_T_MIN: f64 = 0.05;
+/// Smallest t entering the normalised margin ([`crate::STABILITY_MARGIN_T_MIN`]).
+pub const MARGIN_T_MIN: f64 = crate::STABILITY_MARGIN_T_MIN;
 const GRID_START: u32 = 40; // 0.02 · 2000
 
 /// Integration and scan settings of the stability test.

@@ -18,8 +18,8 @@ const N: usize = ORDER + 1;
 /// oscillates at most once or twice, so 16 samples bracket every dip the grid of the
 /// reference (2,000 points) would see.
 const SAMPLES: usize = 16;
-/// Smallest t of the margin (docs/math.md §5).
-pub(crate) const MARGIN_T_MIN: f64 = 0.05;
+/// Smallest t of the margin ([`crate::STABILITY_MARGIN_T_MIN`]).
+pub(crate) const MARGIN_T_MIN: f64 = crate::STABILITY_MARGIN_T_MIN;
 /// Relative error of an entry of J per integration step, measured against DOP853 at rtol
 /// 1e-13 (worst 3e-14 over the tests' families) with a factor 10 of headroom.
 const J_REL_PER_STEP: f64 = 3e-13;

@@ -22,8 +22,8 @@ pub(crate) use small_angle_scan::small_angle_report;
 /// Below this t the closed-form det J is dominated by rounding; it is positive there by its
 /// leading term (docs/math.md §5).
 const T_MIN: f64 = crate::STABILITY_T_MIN;
-/// Smallest t entering the margin `det_min` (docs/math.md §5).
-const T_MARGIN: f64 = 0.05;
+/// Smallest t entering the margin `det_min` ([`crate::STABILITY_MARGIN_T_MIN`]).
+const T_MARGIN: f64 = crate::STABILITY_MARGIN_T_MIN;
 /// First t of the scan on the Taylor series. Its J entries are accurate relative to
 /// themselves, so det J ≈ t⁹·(…) is resolved down to small t (the cofactor terms are O(t⁸) and
 /// cancel to O(t⁹): a 1/t loss, 100× here).
