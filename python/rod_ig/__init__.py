@@ -20,6 +20,7 @@ True
 
 from __future__ import annotations
 
+import math
 import threading
 from dataclasses import dataclass
 from typing import Any, Literal, Sequence
@@ -708,6 +709,10 @@ class MoveResult:
     critical_a: FloatArray | None = None
     energy_released: float | None = None
     reason: str | None = None
+    base_angle: float | None = None
+    """With held ends: the rod's angle at the base (0 unless the base is pinned)."""
+    turns: int | None = None
+    """With held ends: full turns of the tangent (-1 without a rod)."""
 
 
 class Tracker:
@@ -727,8 +732,17 @@ class Tracker:
         tolerance: float | None = None,
         weight: float = 0.0,
         gravity: Sequence[float] = (0.0, -1.0),
+        base_condition: str = "clamped",
+        tip_condition: str = "clamped",
+        tip_load: Sequence[float] | None = None,
+        max_turns: int = 0,
     ) -> None:
-        """``weight`` and ``gravity`` (2 components): the rod with weight (docs/weight.md)."""
+        """``weight`` and ``gravity`` (2 components): the rod with weight (docs/weight.md).
+        ``base_condition`` / ``tip_condition`` ("clamped", "pinned" or "free"), ``tip_load`` and
+        ``max_turns``: a rod held by other ends (docs/ends.md), which follows its branch with
+        the multiple-shooting cable: targets are (x, y, theta) for a clamped tip, (x, y) for a
+        pinned one, ``None`` for a free one; ``a0`` and ``tolerance`` apply to clamped ends
+        only."""
         start = None if a0 is None else [float(v) for v in _batch("a0", a0, 3)[0].reshape(3)]
         g = _batch("gravity", gravity, 2)[0].reshape(2)
         self._settings: dict[str, Any] = dict(
@@ -737,30 +751,84 @@ class Tracker:
             weight=float(weight),
             gravity=(float(g[0]), float(g[1])),
         )
+        self._held_settings: dict[str, Any] | None = None
+        if (base_condition, tip_condition) != ("clamped", "clamped") or tip_load is not None:
+            if a0 is not None or tolerance is not None:
+                raise ValueError("a0 and tolerance apply to clamped ends only")
+            self._held_settings = dict(
+                base_condition=base_condition,
+                tip_condition=tip_condition,
+                deadline_ms=deadline_ms,
+                weight=float(weight),
+                gravity=(float(g[0]), float(g[1])),
+                max_turns=_integer("max_turns", max_turns, 0, 100),
+                tip_load=None if tip_load is None else _tip_load(tip_load),
+            )
         self._lock = threading.Lock()
-        self._inner = _rod_ig.Tracker(a0=start, **self._settings)
+        self._inner: Any = self._native(start)
 
-    def move(self, target: npt.ArrayLike) -> MoveResult:
-        """Moves the tip gripper to ``target`` (x, y, theta) and returns the rod it holds."""
+    def _native(self, start: list[float] | None) -> Any:
+        if self._held_settings is not None:
+            return _rod_ig.HeldTracker(**self._held_settings)
+        return _rod_ig.Tracker(a0=start, **self._settings)
+
+    def move(self, target: npt.ArrayLike | None = None) -> MoveResult:
+        """Moves the tip gripper to ``target`` (x, y, theta; (x, y) for a pinned tip, ``None``
+        for a free one) and returns the rod it holds."""
+        if self._held_settings is not None:
+            return self._move_held(target)
+        if target is None:
+            raise ValueError("target: a clamped tip needs (x, y, theta)")
         t = [float(v) for v in _batch("target", target, 3)[0].reshape(3)]
         with self._lock:
             return MoveResult(**self._inner.move(t))
 
+    def _move_held(self, target: npt.ArrayLike | None) -> MoveResult:
+        t = None if target is None else [float(v) for v in np.asarray(target, dtype=np.float64).ravel()]
+        with self._lock:
+            d = self._inner.move(t)
+        tip = d["tip"].reshape(3)
+        orientation_error = math.nan
+        if t is not None and len(t) == 3 and d["success"][0]:
+            orientation_error = abs(math.remainder(float(tip[2]) - t[2], math.tau))
+        reason = str(d["reason"][0])
+        return MoveResult(
+            success=bool(d["success"][0]),
+            a=d["a"].reshape(3),
+            termination=str(d["termination"][0]),
+            iterations=0,
+            margin=float(d["margin"][0]),
+            energy=float(d["energy"][0]),
+            position_error=float(d["position_error"][0]),
+            orientation_error=orientation_error,
+            event=str(d["event"]),
+            reason=reason or None,
+            base_angle=float(d["base_angle"][0]),
+            turns=int(d["turns"][0]),
+        )
+
     @property
     def rod(self) -> FloatArray | None:
-        """The rod held now (a3, a4, a5), None before the first move or after a loss."""
+        """The rod held now (a3, a4, a5), None before the first move or after a loss (with
+        held ends: (a3, a4, a5, base angle))."""
         with self._lock:
             r = self._inner.rod
         return None if r is None else np.array(r)
 
     def __getstate__(self) -> dict[str, Any]:
-        held = self.rod
-        return {"settings": self._settings, "rod": None if held is None else held.tolist()}
+        # A held rod's node states stay in this process: its copy searches afresh.
+        held = None if self._held_settings is not None else self.rod
+        return {
+            "settings": self._settings,
+            "held_settings": self._held_settings,
+            "rod": None if held is None else held.tolist(),
+        }
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self._settings = state["settings"]
+        self._held_settings = state.get("held_settings")
         self._lock = threading.Lock()
-        self._inner = _rod_ig.Tracker(a0=state["rod"], **self._settings)
+        self._inner = self._native(state["rod"])
 
 
 @dataclass(frozen=True)

@@ -122,6 +122,21 @@ class Tracker:
     @property
     def rod(self) -> list[float] | None: ...
 
+class HeldTracker:
+    def __init__(
+        self,
+        base_condition: str,
+        tip_condition: str,
+        deadline_ms: float | None = None,
+        weight: float = 0.0,
+        gravity: tuple[float, float] = (0.0, -1.0),
+        max_turns: int = 0,
+        tip_load: tuple[float, float] | None = None,
+    ) -> None: ...
+    def move(self, target: list[float] | None = None) -> dict[str, Any]: ...
+    @property
+    def rod(self) -> list[float] | None: ...
+
 class Planner:
     def __init__(self) -> None: ...
     def plan(

@@ -639,11 +639,7 @@ fn held_request(
     max_turns: u32,
 ) -> PyResult<(HeldEnds, usize)> {
     let ends = ends_of(base_condition, tip_condition)?;
-    let width = match ends.tip() {
-        EndCondition::Free => 0,
-        EndCondition::Pinned => 2,
-        EndCondition::Clamped => 3,
-    };
+    let width = tip_width(ends);
     match (width, t) {
         (0, Some(_)) => {
             return Err(PyValueError::new_err(
@@ -668,6 +664,15 @@ fn held_request(
         )));
     }
     Ok((ends, width))
+}
+
+/// Components of a target for the tip `ends` hold: 0 free, 2 pinned (x, y), 3 clamped.
+fn tip_width(ends: HeldEnds) -> usize {
+    match ends.tip() {
+        EndCondition::Free => 0,
+        EndCondition::Pinned => 2,
+        EndCondition::Clamped => 3,
+    }
 }
 
 /// The ends named by `base_condition` and `tip_condition` (refusals name the argument).
@@ -796,21 +801,7 @@ fn solve_held<'py>(
     let tip_load = tip_load.unwrap_or([0.0; 2]);
     let (ends, width) = held_request(n, t, base_condition, tip_condition, max_turns)?;
     let gravities = gravities2(n, weight.as_ref(), gravity.as_ref())?;
-    let options = SolveOptions {
-        deadline: match deadline_ms {
-            Some(ms) if ms.is_finite() && ms > 0.0 && ms <= 1e7 => {
-                Duration::from_secs_f64(ms / 1e3)
-            }
-            Some(ms) => {
-                return Err(PyValueError::new_err(format!(
-                    "deadline_ms must be a positive number of milliseconds, got {ms}"
-                )))
-            }
-            None => Duration::from_millis(1000),
-        },
-        max_turns,
-        ..SolveOptions::default()
-    };
+    let options = held_options(deadline_ms, max_turns)?;
     let target_of = |i: usize| {
         t.map(|t| match width {
             2 => PlanarPose::new(t[2 * i], t[2 * i + 1], 0.0),
@@ -848,6 +839,132 @@ fn solve_held<'py>(
         |i, r| rows[i] = Some(r),
     )?;
     held_dict(py, ends, rows.into_iter().flatten().collect(), all)
+}
+
+/// The options of a held-ends search: `deadline_ms` (default 1 s) and `max_turns`.
+fn held_options(deadline_ms: Option<f64>, max_turns: u32) -> PyResult<planar::ig::SolveOptions> {
+    let deadline = match deadline_ms {
+        Some(ms) if ms.is_finite() && ms > 0.0 && ms <= 1e7 => Duration::from_secs_f64(ms / 1e3),
+        Some(ms) => {
+            return Err(PyValueError::new_err(format!(
+                "deadline_ms must be a positive number of milliseconds, got {ms}"
+            )))
+        }
+        None => Duration::from_millis(1000),
+    };
+    Ok(planar::ig::SolveOptions {
+        deadline,
+        max_turns,
+        ..planar::ig::SolveOptions::default()
+    })
+}
+
+/// Quasi-static motion of a rod held by pinned or free ends (`held::step`): the rod follows
+/// its branch as the tip gripper moves (event "none"), is searched afresh where the branch
+/// ends ("snap"), or is lost ("lost").
+#[pyclass(module = "rod_ig._rod_ig")]
+struct HeldTracker {
+    ends: HeldEnds,
+    width: usize,
+    gravity: Gravity,
+    tip_load: [f64; 2],
+    options: planar::ig::SolveOptions,
+    held: Option<held::HeldSolution>,
+}
+
+#[pymethods]
+impl HeldTracker {
+    #[new]
+    #[pyo3(signature = (base_condition, tip_condition, deadline_ms=None, weight=0.0,
+                        gravity=(0.0, -1.0), max_turns=0, tip_load=None))]
+    fn new(
+        base_condition: &str,
+        tip_condition: &str,
+        deadline_ms: Option<f64>,
+        weight: f64,
+        gravity: (f64, f64),
+        max_turns: u32,
+        tip_load: Option<[f64; 2]>,
+    ) -> PyResult<Self> {
+        let ends = ends_of(base_condition, tip_condition)?;
+        if max_turns > MAX_TURNS {
+            return Err(PyValueError::new_err(format!(
+                "max_turns must be in [0, {MAX_TURNS}], got {max_turns}"
+            )));
+        }
+        let width = tip_width(ends);
+        let gravity = Gravity::new(weight, [gravity.0, gravity.1])
+            .map_err(|e| PyValueError::new_err(format!("weight/gravity: {e}")))?;
+        rod_ig_core::planar::ig::warm_up();
+        Ok(HeldTracker {
+            ends,
+            width,
+            gravity,
+            tip_load: tip_load.unwrap_or([0.0; 2]),
+            options: held_options(deadline_ms, max_turns)?,
+            held: None,
+        })
+    }
+
+    /// Moves the tip gripper to `target` ((x, y, θ) clamped, (x, y) pinned, None free); the
+    /// keys of `solve_held` for one rod plus `event`.
+    #[pyo3(name = "move", signature = (target=None))]
+    fn move_to<'py>(
+        &mut self,
+        py: Python<'py>,
+        target: Option<Vec<f64>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let tip = self.ends.tip();
+        let pose = match (self.width, target) {
+            (0, None) => None,
+            (0, Some(_)) => {
+                return Err(PyValueError::new_err(
+                    "target: a free tip has no target (the cable hangs from its base)",
+                ))
+            }
+            (2, Some(t)) if t.len() == 2 => Some(PlanarPose::new(t[0], t[1], 0.0)),
+            (3, Some(t)) if t.len() == 3 => Some(PlanarPose::new(t[0], t[1], t[2])),
+            (w, _) => {
+                return Err(PyValueError::new_err(format!(
+                    "target must have {w} components for a {tip} tip"
+                )))
+            }
+        };
+        if pose.is_some_and(|p| !p.is_finite()) {
+            return Err(PyValueError::new_err("target must be finite"));
+        }
+        let (ends, g, load, o) = (self.ends, self.gravity, self.tip_load, self.options);
+        let held = self.held.take();
+        let stepped = py.detach(|| held::step(held.as_ref(), ends, &g, load, pose.as_ref(), &o));
+        let (event, found) = match stepped {
+            Ok((event, found)) => (event, Ok(found)),
+            Err(e @ held::HeldError::Target { .. }) => {
+                self.held = held;
+                return Err(PyValueError::new_err(e.to_string()));
+            }
+            Err(e) => (held::HeldEvent::Lost, Err(e.to_string())),
+        };
+        self.held = found
+            .as_ref()
+            .ok()
+            .and_then(|f| f.solutions.first().cloned());
+        let row = HeldRow {
+            found,
+            target: pose,
+            shape: Vec::new(),
+        };
+        let d = held_dict(py, ends, vec![row], false)?;
+        d.set_item("event", event.as_str())?;
+        Ok(d)
+    }
+
+    /// The rod held now, (a3, a4, a5, base angle), or None.
+    #[getter]
+    fn rod(&self) -> Option<[f64; 4]> {
+        self.held
+            .as_ref()
+            .map(|h| [h.a[0], h.a[1], h.a[2], h.base_angle])
+    }
 }
 
 /// The columns of [`solve_held`]'s answer, one row per rod (NaN where it failed).
@@ -963,17 +1080,6 @@ fn held_dict<'py>(
             };
             termination.push(why.into());
             reason.push(held::not_found(ends, found).to_string());
-            reason.push(format!(
-                "no stable equilibrium found with {} base and {} tip ({} starts){}",
-                ends.base(),
-                ends.tip(),
-                found.starts,
-                found
-                    .last_failure
-                    .as_ref()
-                    .map(|w| format!(": {w}"))
-                    .unwrap_or_default()
-            ));
         }
         if all {
             let flat: Vec<f64> = found
@@ -1569,6 +1675,7 @@ fn _rod_ig(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(warm_up, m)?)?;
     m.add_function(wrap_pyfunction!(_time_evaluate, m)?)?;
     m.add_class::<Tracker>()?;
+    m.add_class::<HeldTracker>()?;
     m.add_class::<Planner>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

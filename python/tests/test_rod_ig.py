@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import pickle
 import signal
 import subprocess
 import sys
@@ -687,6 +688,67 @@ def test_pinned_and_free_ends() -> None:
         rod_ig.solve([0.8, 0.0, 0.0], tip_condition="pinned")
     with pytest.raises(ValueError, match="clamped ends only"):
         rod_ig.solve([0.8, 0.0], tip_condition="pinned", a0=[0.0, 1.0, 0.0])
+
+
+def test_a_tracker_with_held_ends_follows_its_gripper() -> None:
+    """Tracker with pinned or free ends (issue 52, held-ends motion in Python): a pinned-pinned
+    cable at w = 50 follows its gripper along five steps on its branch (event none, on target
+    to 1e-9, the least-energy rod a fresh solve finds at each step); a free tip hangs as
+    ``solve`` says; targets of the wrong width and clamped-only arguments raise ValueError."""
+    t = rod_ig.Tracker(base_condition="pinned", tip_condition="pinned", weight=50.0, deadline_ms=5000)
+    for x in np.linspace(0.8, 0.7, 5):
+        m = t.move([x, 0.05])
+        assert m.success and m.event == "none", m
+        assert m.position_error < 1e-9 and m.a[0] == 0.0 and m.turns == 0
+        fresh = rod_ig.solve(
+            [x, 0.05], base_condition="pinned", tip_condition="pinned", weight=50.0, deadline_ms=5000
+        )
+        assert abs(m.energy - float(fresh.energy)) < 1e-8 * max(1.0, abs(m.energy))
+        assert fresh.base_angle is not None and m.base_angle is not None
+        assert abs(m.base_angle - float(fresh.base_angle)) < 1e-8
+    held = t.rod
+    assert held is not None and held.shape == (4,)
+    copy = pickle.loads(pickle.dumps(t))
+    again = copy.move([0.7, 0.05])
+    assert again.success and abs(again.energy - m.energy) < 1e-8 * max(1.0, abs(m.energy))
+
+    hanging = rod_ig.Tracker(tip_condition="free", weight=307.54823911836, deadline_ms=5000).move()
+    free = rod_ig.solve(None, tip_condition="free", weight=307.54823911836, deadline_ms=5000)
+    assert hanging.success and hanging.event == "none"
+    assert abs(hanging.energy - float(free.energy)) < 1e-9 * abs(hanging.energy)
+    with pytest.raises(ValueError, match="2 components"):
+        t.move([0.7, 0.0, 0.0])
+    with pytest.raises(ValueError, match="free tip has no target"):
+        rod_ig.Tracker(tip_condition="free").move([0.5, 0.0])
+    with pytest.raises(ValueError, match="clamped ends only"):
+        rod_ig.Tracker(a0=[1.0, 0.0, 0.0], tip_condition="pinned")
+    with pytest.raises(ValueError, match="tip_condition"):
+        rod_ig.Tracker(tip_condition="hinged")
+
+
+def test_a_failed_held_solve_in_a_batch_keeps_its_reason_in_place() -> None:
+    """Each row of a batched held solve has one reason: a failed row once pushed two, so the
+    reasons no longer matched their rows."""
+    r = rod_ig.solve(
+        [[1.5, 0.0], [0.8, 0.0], [2.0, 0.0]],
+        base_condition="pinned",
+        tip_condition="pinned",
+        weight=50.0,
+        deadline_ms=5000,
+    )
+    assert r.success.tolist() == [False, True, False]
+    assert r.reason.shape == (3,) and r.reason[1] == ""
+    assert "unreachable" in r.reason[0] and "unreachable" in r.reason[2]
+    # Searches that find nothing (cut at once by the deadline): one reason each.
+    cut = rod_ig.solve(
+        [[0.8, 0.0], [0.7, 0.1], [0.6, -0.1]],
+        base_condition="pinned",
+        tip_condition="pinned",
+        weight=50.0,
+        deadline_ms=1e-6,
+    )
+    assert not cut.success.any() and cut.reason.shape == (3,)
+    assert all("no stable equilibrium" in why for why in cut.reason), cut.reason
 
 
 def test_forward_with_held_ends_gives_back_the_solved_rods() -> None:

@@ -356,35 +356,19 @@ impl HeldTrack {
         .map_err(|e| e.to_string())?;
         self.ends = Some(ends);
         self.gravity = Some(g);
-        let followed = self
-            .held
-            .as_ref()
-            .map(|h| held::follow(h, &g, target.as_ref(), &options));
-        let (event, found) = match followed {
-            Some(Ok(s)) => {
-                let found = held::HeldSearch {
-                    solutions: vec![s.clone()],
-                    equilibria: vec![s],
-                    starts: 1,
-                    ..Default::default()
-                };
-                ("none", found)
-            }
-            other => {
-                let found = held::equilibria(ends, &g, target.as_ref(), &options)
-                    .map_err(|e| e.to_string())?;
-                let event = match (&other, found.solutions.is_empty()) {
-                    (None, _) => "none",
-                    (Some(_), false) => "snap",
-                    (Some(_), true) => "lost",
-                };
-                (event, found)
-            }
-        };
+        let (event, found) = held::step(
+            self.held.as_ref(),
+            ends,
+            &g,
+            [0.0; 2],
+            target.as_ref(),
+            &options,
+        )
+        .map_err(|e| e.to_string())?;
         self.held = found.solutions.first().cloned();
         let mut value = jsonl::to_value(&answer_of(ends, &found, target.as_ref(), false, started))?;
         if let Some(map) = value.as_object_mut() {
-            map.insert("event".into(), event.into());
+            map.insert("event".into(), event.as_str().into());
         }
         Ok(value)
     }

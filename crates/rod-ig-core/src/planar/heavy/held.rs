@@ -398,6 +398,60 @@ pub fn follow(
     Ok(reached)
 }
 
+/// What happened to a held rod in one step of a motion ([`step`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HeldEvent {
+    /// It followed its branch (or, at the first step, was found afresh).
+    None,
+    /// Its branch ended: a fresh search found another admitted equilibrium.
+    Snap,
+    /// Its branch ended and no admitted equilibrium was found.
+    Lost,
+}
+
+impl HeldEvent {
+    /// "none", "snap" or "lost": the name the CLI, Python and the node report.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            HeldEvent::None => "none",
+            HeldEvent::Snap => "snap",
+            HeldEvent::Lost => "lost",
+        }
+    }
+}
+
+/// One step of a quasi-static motion of a rod held by `ends` (`tip_load` at a free tip): the
+/// rod `held` now (None at the first step or after a loss) is followed along its branch to
+/// `gravity` and `target` ([`follow`], event none); where that fails, or at the first step,
+/// the equilibria are searched afresh, least energy first (event snap after a failed follow,
+/// lost when none is admitted). The rod held next is the search's first solution.
+pub fn step(
+    held: Option<&HeldSolution>,
+    ends: HeldEnds,
+    gravity: &Gravity,
+    tip_load: [f64; 2],
+    target: Option<&PlanarPose>,
+    options: &SolveOptions,
+) -> Result<(HeldEvent, HeldSearch), HeldError> {
+    let followed = held.map(|h| follow(h, gravity, target, options));
+    if let Some(Ok(s)) = followed {
+        let found = HeldSearch {
+            solutions: vec![s.clone()],
+            equilibria: vec![s],
+            starts: 1,
+            ..HeldSearch::default()
+        };
+        return Ok((HeldEvent::None, found));
+    }
+    let found = equilibria_with_tip_load(ends, gravity, tip_load, target, options)?;
+    let event = match (followed.is_some(), found.solutions.is_empty()) {
+        (false, _) => HeldEvent::None,
+        (true, false) => HeldEvent::Snap,
+        (true, true) => HeldEvent::Lost,
+    };
+    Ok((event, found))
+}
+
 /// The least-energy admitted equilibrium of [`equilibria`], or why there is none.
 pub fn least_energy(
     ends: HeldEnds,
