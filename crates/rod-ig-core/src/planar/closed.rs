@@ -12,7 +12,8 @@ mod estimates;
 mod theorems;
 pub(crate) use det_fields::DetFrame;
 pub(crate) use estimates::{
-    SeriesNeed, CLOSED_J_REL, CLOSED_J_TOLERANCE, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F,
+    SeriesNeed, CLOSED_J_REL, CLOSED_J_TOLERANCE, ENERGY_REL_TOLERANCE, SEPARATRIX_M1,
+    SERIES_DD_MAX_ROOT_F,
 };
 use estimates::{DEEP_SEPARATRIX_M1, MAX_PHASE};
 

@@ -1,39 +1,35 @@
-//! The one dispatcher of the planar evaluation (issue 44). Every entry point (`tip`,
-//! `pose_and_jacobian`, `energy`, `stability`, `stability_verdict`, `evaluate`, the shape
-//! `PlanarRod::new`, and the solvers' `tip_and_jacobian_for_iteration` / `_for_substep`) asks its [`Question`] through
-//! [`answer`], which walks one ordered table of formulations ([`super::formulation`]) and
-//! takes the first answer. It is the only place where a rod's regime is decided, so the entry
-//! points share one domain and one refusal.
+//! The one dispatcher of the planar evaluation (issues 44 and 53). A rod's regime is decided
+//! once, by [`classify`] (or [`regime`] for the questions the full evaluation does not
+//! answer); every entry point (`tip`, `pose_and_jacobian`, `energy`, `stability`,
+//! `stability_verdict`, `evaluate`, the shape `PlanarRod::new`, and the solvers'
+//! `tip_and_jacobian_for_iteration` / `_for_substep`) is one function here with one `match`
+//! on it, and its fallbacks named in order. It is the only place where a regime is decided,
+//! so the entry points share one domain and one refusal.
 //!
-//! | row | formulation | when it is asked | why here |
-//! | --- | --- | --- | --- |
-//! | 0 | (refusal) | a non-finite | nothing can answer |
-//! | 1 | [`FullEvaluation`] | ‖(a4, a5)‖ > [`ORDINARY_FORCE`] | beyond, one formulation may refuse what another answers: the full evaluation decides for all |
-//! | 2 | [`SmallAngle`] | the energy only | its bound is the cheapest certificate, and the identity cancels on nearly straight rods |
-//! | 2½ | [`SeparatrixLimit`] | a barely bent rod under a strong force (ρ = max(\|β\|, \|a3\|/√R) ≤ 1e-7) | exact in log form where 1 − k² underflows and every closed form loses its phase |
-//! | 3 | [`Series`] (no closed form) | ρ ≤ [`SERIES_RHO`] | one series step; the closed form's own estimate would reject nearly all of them |
-//! | 4 | (refusal), [`Series`] | the closed form overflows | beyond √‖F‖ = ln(f64::MAX) under tension every f64 evaluation is wrong; below, the series has its own overflow detection |
-//! | 5 | [`ClosedForm`] | its error estimate holds; for the verdict, a theorem or det J(1) | ≈ 0.3–2 µs, exact to ≈ 1e-10 |
-//! | 6 | [`SmallAngle`] | the closed form declined, or the stability | nearly straight rods: the closed form's x row is rounding there |
-//! | 7 | [`ClosedScan`] | the stability | the closed form's scans (its own bounds; the small-m scan) |
-//! | 8 | [`IllConditioned`] | by the separatrix | rounding grows like e^{√‖F‖}: double-double, or the cross-check |
-//! | 9 | [`Series`] | whatever is left | the f64 series is exact to ~1e-14 where only the closed form cancels |
+//! | regime | when | who answers, in order |
+//! | --- | --- | --- |
+//! | refused | a non-finite | nobody: `RodError::NonFinite` naming `a` |
+//! | [`Class::StrongForce`] | ‖(a4, a5)‖ > [`ORDINARY_FORCE`] | the full evaluation (its refusals are every question's); J at t < 1, the evaluation itself, the shape and a solver's iterations take the regime below |
+//! | [`Regime::SeparatrixLimit`] | a barely bent rod under a strong force (ρ = max(\|β\|, \|a3\|/√R) ≤ 1e-7) | its soliton lattice, exact in log form where 1 − k² underflows (the energy asks the small-angle expansion first) |
+//! | [`Regime::GentlyBent`] | ρ ≤ [`SERIES_RHO`] | the rows after the closed form, without one (one series step; the closed form's own estimate would reject nearly all of them) |
+//! | [`Regime::ClosedForm`] | the rest | the closed form (f64 for the tip, energy and shape; dual numbers for J, the stability and the evaluation) where its error estimate holds (≈ 0.3–2 µs, exact to ≈ 1e-10); the verdict where a theorem or det J(1) decides. Where it cannot be built: refused beyond √‖F‖ = ln(f64::MAX) under tension, else the rows after it |
 //!
-//! A formulation answers a quantity inside its own domain for it and says `None` outside (e.g.
-//! [`FullEvaluation`] has J at t = 1 only): the next row is asked.
+//! The rows after the closed form, in order: the small-angle expansion (nearly straight rods,
+//! where the closed form's x row is rounding), the closed form's stability scans (the
+//! stability alone), the ill-conditioned routes by the separatrix (double-double, the
+//! cross-check), and the f64 series, which answers everything that reaches it. A new regime is
+//! one variant of [`Regime`] and one arm in each question's `match` (the compiler asks for
+//! every one); a question a formulation cannot answer is a method it does not have.
 
 use super::closed::Closed;
-
 use super::formulation::{
-    Answer, ClosedForm, ClosedScan, Formulation, FullEvaluation, IllConditioned, Need, Precision,
-    Rod, SeparatrixLimit, Series, SmallAngle,
+    ClosedForm, ClosedScan, Evaluation, IllConditioned, Precision, Rod, SeparatrixLimit, Series,
+    SmallAngle,
 };
-use crate::planar::entry::{evaluate, Evaluation};
 use crate::planar::shape::PlanarRod;
-use crate::planar::taylor::curvature_scale;
+use crate::planar::taylor::{curvature_scale, overflow_force, LN_F64_MAX};
 use crate::scalar::Dual3;
 use crate::StabilityVerdict;
-
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 
 /// Rods with ρ = max(|a3|, √‖(a4, a5)‖) up to this value are evaluated by the Taylor series
@@ -44,9 +40,6 @@ use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport}
 /// m (near-circles under a tiny force, nearly straight rods under compression) and on gently
 /// bent rods whose entries of J are far smaller than the elliptic quantities they come from.
 pub(super) const SERIES_RHO: f64 = 0.25;
-
-/// ln(f64::MAX): under tension F the rod's J grows like e^{√F t}; beyond this √F it overflows.
-pub(super) const LN_F64_MAX: f64 = 709.7;
 
 /// ‖(a4, a5)‖ up to which every planar entry point answers every finite a (none refused on
 /// 180,000 rods of log-scale |a3| up to 1e12 and |a4|, |a5| up to this, with exact zeros:
@@ -73,7 +66,7 @@ pub(super) fn beyond_ordinary_force(a: &PlanarParams) -> bool {
 #[cold]
 #[inline(never)]
 pub(super) fn domain_evaluation(a: &PlanarParams) -> Result<Evaluation, RodError> {
-    evaluate(a)
+    evaluation(a)
 }
 
 /// True when the series is chosen without building the closed form.
@@ -93,13 +86,6 @@ fn tension_within_f64(a: &PlanarParams) -> Result<(), RodError> {
     Ok(())
 }
 
-pub(super) fn overflow_force() -> RodError {
-    RodError::Overflow(format!(
-        "planar rod: under this force J(t, a) grows like e^(sqrt|F| t) and exceeds f64 \
-         (sqrt|F| > {LN_F64_MAX})"
-    ))
-}
-
 /// Checks a at every public entry, and charges the evaluation to the deadline in force (one
 /// unit: a closed-form evaluation is bounded, ≈ 0.3–2 µs; the series inside charge their
 /// steps).
@@ -108,236 +94,312 @@ pub(super) fn check_params(a: &PlanarParams) -> Result<(), RodError> {
     RodError::check_finite("a", a.as_slice())
 }
 
-/// The closed form a question evaluates: in f64 (the tip; the energy) or in dual numbers
-/// seeded with the identity on a (J, stability, evaluation); without its phase φ where the
-/// addition theorems place the poses it asks (`Closed::complete`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Build {
-    /// f64, without the phase (the tip alone).
-    F64,
-    /// f64 with its phase (the energy, which uses its ζ form).
-    F64WithPhase,
-    /// Dual numbers without the phase (poses and J alone: the same bits either way).
-    Dual,
-    /// Dual numbers with the phase (the scans sample along the rod).
-    DualWithPhase,
+/// Where a rod stands against the one domain: beyond the ordinary force the full evaluation
+/// decides every quantity, within it the [`Regime`].
+pub(crate) enum Class<'a> {
+    /// ‖(a4, a5)‖ > [`ORDINARY_FORCE`] (or its square overflowed): the full evaluation.
+    StrongForce,
+    /// Within the ordinary force.
+    Within(Regime<'a>),
 }
 
-/// What an entry point asks of the rod: which quantity ([`Self::ask`]), from which rows.
-pub(crate) trait Question: Copy {
-    /// The quantity.
-    type Answer;
-    /// The closed form this question evaluates.
-    const BUILD: Build;
-    /// Whether row 1 ([`FullEvaluation`]) applies: not to the evaluation itself, which it
-    /// is, nor to a solver's iterations, which verify their answer through the entry points.
-    const FULL_EVALUATION: bool = true;
-    /// Whether row 2 applies (the energy).
-    const SMALL_ANGLE_FIRST: bool = false;
-    /// The formulation's answer to this question.
-    fn ask<F: Formulation>(self, f: &F) -> Answer<Self::Answer>;
+/// How a rod within the ordinary force is evaluated (module docs' table).
+pub(crate) enum Regime<'a> {
+    /// A barely bent rod under a strong force: its soliton lattice (boxed: the other regimes,
+    /// nearly every rod, move a pointer-sized value, not the lattice; a copy of it cost 10 %
+    /// of the tip's instructions).
+    SeparatrixLimit(Box<SeparatrixLimit<'a>>),
+    /// ρ ≤ [`SERIES_RHO`]: the series, no closed form.
+    GentlyBent,
+    /// The closed form where its own error estimate holds, the rows after it elsewhere.
+    ClosedForm,
 }
 
-/// The table (module docs): the first answer of its rows, in order.
+/// The one classification: refuses a non-finite a (and charges the evaluation to the deadline
+/// in force), else its [`Class`].
 #[inline]
-pub(crate) fn answer<Q: Question>(a: &PlanarParams, q: Q) -> Result<Q::Answer, RodError> {
+pub(crate) fn classify(a: &PlanarParams) -> Result<Class<'_>, RodError> {
     check_params(a)?;
-    if Q::FULL_EVALUATION && beyond_ordinary_force(a) {
-        let e = domain_evaluation(a)?;
-        if let Some(answer) = q.ask(&FullEvaluation(&e)) {
-            return answer;
-        }
+    if beyond_ordinary_force(a) {
+        return Ok(Class::StrongForce);
     }
-    let without_closed = Rod {
-        a,
-        closed: None,
-        need: Need::NoClosedForm,
-        case: None,
-        precise_series: false,
-    };
-    if Q::SMALL_ANGLE_FIRST {
-        if let Some(answer) = q.ask(&SmallAngle(without_closed)) {
-            return answer;
-        }
-    }
-    if let Some(limit) = SeparatrixLimit::of(a) {
-        if let Some(answer) = q.ask(&limit) {
-            return answer;
-        }
-    }
-    from_closed_form(a, q, without_closed)
+    Ok(Class::Within(regime_within(a)))
 }
 
-/// Rows 3–9 of the table: what the separatrix limit asks where its own theorems do not decide
-/// the stability (an inflectional rod with one or two inflection points on the rod).
-pub(crate) fn stability_from_closed_form(a: &PlanarParams) -> Result<StabilityReport, RodError> {
-    let without_closed = Rod {
-        a,
-        closed: None,
-        need: Need::NoClosedForm,
-        case: None,
-        precise_series: false,
-    };
-    from_closed_form(a, Stability, without_closed)
-}
-
-/// Rows 3–9 of the table.
+/// [`classify`] for the questions the full evaluation does not answer (the evaluation itself,
+/// the shape, a solver's iterations): the regime whatever the force.
 #[inline]
-fn from_closed_form<Q: Question>(
-    a: &PlanarParams,
-    q: Q,
-    without_closed: Rod,
-) -> Result<Q::Answer, RodError> {
-    if series_first(a) {
-        return after_closed_form(q, without_closed);
-    }
-    match Q::BUILD {
-        Build::F64 | Build::F64WithPhase => {
-            // Built in place (`Closed::complete`): through an Option the form was copied.
-            let mut c = Closed::<f64>::straight(a[0], a[1], a[2]);
-            if !c.complete(a[0], a[1], a[2], Q::BUILD == Build::F64WithPhase) {
-                tension_within_f64(a)?;
-                return after_closed_form(q, without_closed);
-            }
-            let closed_form = ClosedForm::new(&c, a);
-            match q.ask(&closed_form) {
-                Some(answer) => answer,
-                None => after_closed_form(q, Rod::after(&closed_form, None)),
-            }
-        }
-        Build::Dual | Build::DualWithPhase => {
-            let (a3, a4, a5) = (
-                Dual3::variable(a[0], 0),
-                Dual3::variable(a[1], 1),
-                Dual3::variable(a[2], 2),
-            );
-            // ≈ 1 KB of dual numbers, borrowed where it is built, never moved.
-            let mut c = Closed::straight(a3, a4, a5);
-            if !c.complete(a3, a4, a5, Q::BUILD == Build::DualWithPhase) {
-                // The closed form's intermediate ratios overflowed (e.g. a tiny moment against
-                // a moderate force).
-                tension_within_f64(a)?;
-                return after_closed_form(q, without_closed);
-            }
-            let closed_form = ClosedForm::new(&c, a);
-            match q.ask(&closed_form) {
-                Some(answer) => answer,
-                None => after_closed_form(q, Rod::after(&closed_form, Some(&c))),
-            }
-        }
-    }
+pub(crate) fn regime(a: &PlanarParams) -> Result<Regime<'_>, RodError> {
+    check_params(a)?;
+    Ok(regime_within(a))
 }
 
-/// Rows 6–9 of the table.
-fn after_closed_form<Q: Question>(q: Q, rod: Rod) -> Result<Q::Answer, RodError> {
-    // A question that asked the expansion first (row 2) has its answer already: not twice.
-    if !Q::SMALL_ANGLE_FIRST {
-        if let Some(answer) = q.ask(&SmallAngle(rod)) {
-            return answer;
-        }
+#[inline]
+fn regime_within(a: &PlanarParams) -> Regime<'_> {
+    if let Some(limit) = SeparatrixLimit::of(a) {
+        return Regime::SeparatrixLimit(Box::new(limit));
     }
-    if let Some(answer) = q.ask(&ClosedScan(rod)) {
-        return answer;
+    if series_first(a) {
+        return Regime::GentlyBent;
     }
-    if let Some(answer) = q.ask(&IllConditioned(rod)) {
-        return answer;
+    Regime::ClosedForm
+}
+
+/// The f64 closed form of a (with its phase φ when `phase`, else placed by the addition
+/// theorems) handed to `closed`; where it cannot be built, refused beyond √‖F‖ = ln(f64::MAX)
+/// under tension, else the rod without it handed to `after`. Built in place
+/// (`Closed::complete`): through an Option the form was copied.
+#[inline]
+fn with_closed_f64<R>(
+    a: &PlanarParams,
+    phase: bool,
+    closed: impl FnOnce(&ClosedForm<'_, f64>) -> Result<R, RodError>,
+    after: impl FnOnce(Rod<'_>) -> Result<R, RodError>,
+) -> Result<R, RodError> {
+    let mut c = Closed::<f64>::straight(a[0], a[1], a[2]);
+    if !c.complete(a[0], a[1], a[2], phase) {
+        tension_within_f64(a)?;
+        return after(Rod::without_closed(a));
     }
-    q.ask(&Series(rod)).unwrap_or_else(|| {
-        Err(RodError::OutOfDomain(
-            "planar rod: no formulation answers this quantity".into(),
-        ))
-    })
+    closed(&ClosedForm::new(&c, a))
+}
+
+/// [`with_closed_f64`] in dual numbers seeded with the identity on a (≈ 1 KB, borrowed where
+/// it is built, never moved): `closed` gets the formulation and the form itself.
+#[inline]
+fn with_closed_dual<R>(
+    a: &PlanarParams,
+    phase: bool,
+    closed: impl FnOnce(&ClosedForm<'_, Dual3>, &Closed<Dual3>) -> Result<R, RodError>,
+    after: impl FnOnce(Rod<'_>) -> Result<R, RodError>,
+) -> Result<R, RodError> {
+    let (a3, a4, a5) = (
+        Dual3::variable(a[0], 0),
+        Dual3::variable(a[1], 1),
+        Dual3::variable(a[2], 2),
+    );
+    let mut c = Closed::straight(a3, a4, a5);
+    if !c.complete(a3, a4, a5, phase) {
+        // The closed form's intermediate ratios overflowed (e.g. a tiny moment against a
+        // moderate force).
+        tension_within_f64(a)?;
+        return after(Rod::without_closed(a));
+    }
+    closed(&ClosedForm::new(&c, a), &c)
 }
 
 /// The tip q(1).
-#[derive(Clone, Copy)]
-pub(crate) struct Tip;
-impl Question for Tip {
-    type Answer = PlanarPose;
-    const BUILD: Build = Build::F64;
-    fn ask<F: Formulation>(self, f: &F) -> Answer<PlanarPose> {
-        f.tip()
+#[inline]
+pub(crate) fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
+    match classify(a)? {
+        Class::StrongForce => Ok(domain_evaluation(a)?.tip),
+        Class::Within(Regime::SeparatrixLimit(limit)) => limit.tip(),
+        Class::Within(Regime::GentlyBent) => tip_after(Rod::without_closed(a)),
+        Class::Within(Regime::ClosedForm) => with_closed_f64(
+            a,
+            false,
+            |cf| cf.tip().unwrap_or_else(|| tip_after(Rod::after(cf, None))),
+            tip_after,
+        ),
     }
 }
 
-/// q(t) and J(t) for an answer.
-#[derive(Clone, Copy)]
-pub(crate) struct PoseAndJacobian(pub(crate) f64);
-impl Question for PoseAndJacobian {
-    type Answer = (PlanarPose, PlanarJacobian);
-    const BUILD: Build = Build::Dual;
-    fn ask<F: Formulation>(self, f: &F) -> Answer<Self::Answer> {
-        f.pose_and_jacobian(self.0, Precision::Answer)
+fn tip_after(rod: Rod) -> Result<PlanarPose, RodError> {
+    SmallAngle(rod)
+        .tip()
+        .or_else(|| IllConditioned(rod).tip())
+        .unwrap_or_else(|| Series(rod).tip())
+}
+
+/// q(t) and J(t) for an answer (beyond the ordinary force the full evaluation's J(1), and its
+/// refusal at any t).
+#[inline]
+pub(crate) fn pose_and_jacobian(
+    a: &PlanarParams,
+    t: f64,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    let regime = match classify(a)? {
+        Class::Within(regime) => regime,
+        Class::StrongForce => {
+            let e = domain_evaluation(a)?;
+            if t == 1.0 {
+                return Ok((e.tip, e.jacobian));
+            }
+            regime_within(a)
+        }
+    };
+    pose_and_jacobian_in(a, regime, t, Precision::Answer)
+}
+
+/// q(1) and J(1) for a solver's iteration or a continuation's substep (no full evaluation:
+/// solvers verify their answer through the entry points).
+#[inline]
+pub(crate) fn solver_tip_and_jacobian(
+    a: &PlanarParams,
+    precision: Precision,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    pose_and_jacobian_in(a, regime(a)?, 1.0, precision)
+}
+
+#[inline]
+fn pose_and_jacobian_in(
+    a: &PlanarParams,
+    regime: Regime,
+    t: f64,
+    precision: Precision,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    let after = |rod: Rod| {
+        SmallAngle(rod)
+            .pose_and_jacobian(t, precision)
+            .or_else(|| IllConditioned(rod).pose_and_jacobian(t, precision))
+            .unwrap_or_else(|| Series(rod).pose_and_jacobian(t, precision))
+    };
+    match regime {
+        Regime::SeparatrixLimit(limit) => limit.pose_and_jacobian(t, precision),
+        Regime::GentlyBent => after(Rod::without_closed(a)),
+        Regime::ClosedForm => with_closed_dual(
+            a,
+            false,
+            |cf, c| {
+                cf.pose_and_jacobian(t, precision)
+                    .unwrap_or_else(|| after(Rod::after(cf, Some(c))))
+            },
+            after,
+        ),
     }
 }
 
-/// q(1) and J(1) for a solver's iteration or a continuation's substep.
-#[derive(Clone, Copy)]
-pub(crate) struct SolverTipAndJacobian(pub(crate) Precision);
-impl Question for SolverTipAndJacobian {
-    type Answer = (PlanarPose, PlanarJacobian);
-    const BUILD: Build = Build::Dual;
-    const FULL_EVALUATION: bool = false;
-    fn ask<F: Formulation>(self, f: &F) -> Answer<Self::Answer> {
-        f.pose_and_jacobian(1.0, self.0)
+/// The elastic energy: the small-angle expansion first (its bound is the cheapest
+/// certificate, and the identity cancels on nearly straight rods).
+#[inline]
+pub(crate) fn energy(a: &PlanarParams) -> Result<f64, RodError> {
+    let regime = match classify(a)? {
+        Class::StrongForce => return Ok(domain_evaluation(a)?.energy),
+        Class::Within(regime) => regime,
+    };
+    if let Some(e) = SmallAngle(Rod::without_closed(a)).energy() {
+        return e;
     }
-}
-
-/// The elastic energy.
-#[derive(Clone, Copy)]
-pub(crate) struct Energy;
-impl Question for Energy {
-    type Answer = f64;
-    const BUILD: Build = Build::F64WithPhase;
-    const SMALL_ANGLE_FIRST: bool = true;
-    fn ask<F: Formulation>(self, f: &F) -> Answer<f64> {
-        f.energy()
+    // The expansion was asked: not twice.
+    let after = |rod: Rod| {
+        IllConditioned(rod)
+            .energy()
+            .unwrap_or_else(|| Series(rod).energy())
+    };
+    match regime {
+        Regime::SeparatrixLimit(limit) => limit.energy(),
+        Regime::GentlyBent => after(Rod::without_closed(a)),
+        Regime::ClosedForm => with_closed_f64(
+            a,
+            true,
+            |cf| cf.energy().unwrap_or_else(|| after(Rod::after(cf, None))),
+            after,
+        ),
     }
 }
 
 /// The stability report.
-#[derive(Clone, Copy)]
-pub(crate) struct Stability;
-impl Question for Stability {
-    type Answer = StabilityReport;
-    const BUILD: Build = Build::DualWithPhase;
-    fn ask<F: Formulation>(self, f: &F) -> Answer<StabilityReport> {
-        f.stability()
+#[inline]
+pub(crate) fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
+    match classify(a)? {
+        Class::StrongForce => Ok(domain_evaluation(a)?.stability),
+        Class::Within(Regime::SeparatrixLimit(limit)) => limit.stability(),
+        Class::Within(Regime::GentlyBent) => stability_after(Rod::without_closed(a)),
+        Class::Within(Regime::ClosedForm) => stability_by_closed_form(a),
     }
 }
 
-/// The stability verdict alone.
-#[derive(Clone, Copy)]
-pub(crate) struct Verdict;
-impl Question for Verdict {
-    type Answer = StabilityVerdict;
-    const BUILD: Build = Build::DualWithPhase;
-    fn ask<F: Formulation>(self, f: &F) -> Answer<StabilityVerdict> {
-        f.stability_verdict()
+/// The closed form's regime of the stability (its rows): what the separatrix limit asks where
+/// its own theorems do not decide (an inflectional rod with one or two inflection points).
+pub(crate) fn stability_from_closed_form(a: &PlanarParams) -> Result<StabilityReport, RodError> {
+    if series_first(a) {
+        return stability_after(Rod::without_closed(a));
+    }
+    stability_by_closed_form(a)
+}
+
+/// The closed form has no stability of its own: it is built for the scans after it.
+#[inline]
+fn stability_by_closed_form(a: &PlanarParams) -> Result<StabilityReport, RodError> {
+    with_closed_dual(
+        a,
+        true,
+        |cf, c| stability_after(Rod::after(cf, Some(c))),
+        stability_after,
+    )
+}
+
+fn stability_after(rod: Rod) -> Result<StabilityReport, RodError> {
+    SmallAngle(rod)
+        .stability()
+        .or_else(|| ClosedScan(rod).stability())
+        .or_else(|| IllConditioned(rod).stability())
+        .unwrap_or_else(|| Series(rod).stability())
+}
+
+/// The stability verdict alone: the closed form's where a theorem or det J(1) decides, else
+/// the report's.
+#[inline]
+pub(crate) fn verdict(a: &PlanarParams) -> Result<StabilityVerdict, RodError> {
+    let after = |rod: Rod| stability_after(rod).map(|r| r.verdict());
+    match classify(a)? {
+        Class::StrongForce => Ok(domain_evaluation(a)?.stability.verdict()),
+        Class::Within(Regime::SeparatrixLimit(limit)) => limit.stability().map(|r| r.verdict()),
+        Class::Within(Regime::GentlyBent) => after(Rod::without_closed(a)),
+        Class::Within(Regime::ClosedForm) => with_closed_dual(
+            a,
+            true,
+            |cf, c| {
+                cf.stability_verdict()
+                    .unwrap_or_else(|| after(Rod::after(cf, Some(c))))
+            },
+            after,
+        ),
     }
 }
 
-/// The whole evaluation (row 1 is this question's own answer: it does not ask it).
-#[derive(Clone, Copy)]
-pub(crate) struct Evaluate;
-impl Question for Evaluate {
-    type Answer = Evaluation;
-    const BUILD: Build = Build::DualWithPhase;
-    const FULL_EVALUATION: bool = false;
-    fn ask<F: Formulation>(self, f: &F) -> Answer<Evaluation> {
-        f.evaluate()
+/// Tip, J(1), energy and stability at full accuracy (the full evaluation itself: every
+/// force takes its regime).
+#[inline]
+pub(crate) fn evaluation(a: &PlanarParams) -> Result<Evaluation, RodError> {
+    let after = |rod: Rod| {
+        SmallAngle(rod)
+            .evaluate()
+            .or_else(|| IllConditioned(rod).evaluate())
+            .unwrap_or_else(|| Series(rod).evaluate())
+    };
+    match regime(a)? {
+        Regime::SeparatrixLimit(limit) => limit.evaluate(),
+        Regime::GentlyBent => after(Rod::without_closed(a)),
+        Regime::ClosedForm => with_closed_dual(
+            a,
+            true,
+            |cf, c| {
+                cf.evaluate()
+                    .unwrap_or_else(|| after(Rod::after(cf, Some(c))))
+            },
+            after,
+        ),
     }
 }
 
-/// The shape ([`PlanarRod`]): its refusals and tip beyond row 1 are the full evaluation's,
-/// which `PlanarRod::new` asks first.
-#[derive(Clone, Copy)]
-pub(crate) struct Shape;
-impl Question for Shape {
-    type Answer = PlanarRod;
-    const BUILD: Build = Build::F64WithPhase;
-    const FULL_EVALUATION: bool = false;
-    fn ask<F: Formulation>(self, f: &F) -> Answer<PlanarRod> {
-        f.shape()
+/// The shape ([`PlanarRod`]): its refusals and tip beyond the ordinary force are the full
+/// evaluation's, which `PlanarRod::new` asks first.
+pub(crate) fn shape(a: &PlanarParams) -> Result<PlanarRod, RodError> {
+    let after = |rod: Rod| {
+        SmallAngle(rod)
+            .shape()
+            .or_else(|| IllConditioned(rod).shape())
+            .unwrap_or_else(|| Series(rod).shape())
+    };
+    match regime(a)? {
+        Regime::SeparatrixLimit(limit) => limit.shape(),
+        Regime::GentlyBent => after(Rod::without_closed(a)),
+        Regime::ClosedForm => with_closed_f64(
+            a,
+            true,
+            |cf| cf.shape().unwrap_or_else(|| after(Rod::after(cf, None))),
+            after,
+        ),
     }
 }

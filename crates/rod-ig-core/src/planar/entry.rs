@@ -5,7 +5,9 @@
 
 use super::closed::{Closed, SeriesNeed};
 use super::dispatch::{self, check_params, series_first};
+pub use super::formulation::Evaluation;
 use super::formulation::Precision;
+use super::shape::PlanarRod;
 
 use crate::{
     PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport, StabilityVerdict,
@@ -35,7 +37,7 @@ pub(crate) fn tip_by_closed_form(a: &PlanarParams) -> Option<PlanarPose> {
 /// may differ from [`evaluate`]'s tip in the last bits (both within the closed form's pose
 /// bound, `tip_without_the_phase_within_the_pose_bound`).
 pub fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
-    dispatch::answer(a, dispatch::Tip)
+    dispatch::tip(a)
 }
 
 /// Pose q(t, a) and J(t, a) = ∂q(t)/∂a (rows x, y, θ; columns a3, a4, a5), exact up to
@@ -49,7 +51,7 @@ pub fn pose_and_jacobian(
     t: f64,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
     RodError::check_finite("t", &[t])?;
-    dispatch::answer(a, dispatch::PoseAndJacobian(t))
+    dispatch::pose_and_jacobian(a, t)
 }
 
 /// Largest estimated error (ε·e^{√‖F‖}) of the f64 series for which a solver's iterations
@@ -79,7 +81,7 @@ pub(crate) fn tip_and_jacobian_for_iteration(
     } else {
         Precision::Iteration
     };
-    dispatch::answer(a, dispatch::SolverTipAndJacobian(precision))
+    dispatch::solver_tip_and_jacobian(a, precision)
 }
 
 /// q(1) and J(1, a) for the intermediate poses of a continuation
@@ -88,7 +90,7 @@ pub(crate) fn tip_and_jacobian_for_iteration(
 pub(crate) fn tip_and_jacobian_for_substep(
     a: &PlanarParams,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-    dispatch::answer(a, dispatch::SolverTipAndJacobian(Precision::Substep))
+    dispatch::solver_tip_and_jacobian(a, Precision::Substep)
 }
 
 /// Tip pose q(1, a) and J(1, a) (see [`pose_and_jacobian`]).
@@ -111,7 +113,7 @@ pub fn tip_and_jacobian(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian)
 /// its margin the scan's (floored at 0). Negative values of g within their error bound
 /// before the first conjugate point can come are rounding and carry no sign in the scan.
 pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
-    dispatch::answer(a, dispatch::Stability)
+    dispatch::stability(a)
 }
 
 /// The stability verdict alone: the outcome of [`stability`]`(a)?.`[`verdict`](
@@ -131,21 +133,38 @@ pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
 /// # Ok::<(), rod_ig_core::RodError>(())
 /// ```
 pub fn stability_verdict(a: &PlanarParams) -> Result<StabilityVerdict, RodError> {
-    dispatch::answer(a, dispatch::Verdict)
+    dispatch::verdict(a)
 }
 
 /// Elastic energy ½∫₀¹κ² (docs/math.md §1 identity λ2/2 − a4 x(1) − a5 y(1) where its bound holds;
 /// the small-angle expansion, ζ or the series elsewhere).
 pub fn energy(a: &PlanarParams) -> Result<f64, RodError> {
-    dispatch::answer(a, dispatch::Energy)
+    dispatch::energy(a)
 }
-
-/// Tip, J(1, a) (rows x, y, θ; columns a3, a4, a5), ½∫κ² and the stability verdict of one rod
-/// at full accuracy: the solvers' evaluation type ([`crate::solver::ModelEvaluation`]) for the
-/// planar rod.
-pub type Evaluation = crate::solver::ModelEvaluation<3, PlanarPose>;
 
 /// Tip, J(1, a), energy and stability in one call (one precomputation shared by all).
 pub fn evaluate(a: &PlanarParams) -> Result<Evaluation, RodError> {
-    dispatch::answer(a, dispatch::Evaluate)
+    dispatch::evaluation(a)
+}
+
+impl PlanarRod {
+    /// Precomputes the rod for a. Errors: [`RodError::NonFinite`] if a component of a is NaN
+    /// or ±∞; every refusal of [`evaluate`](crate::planar::evaluate) (one domain: beyond ‖(a4, a5)‖ = 625 the full
+    /// evaluation runs first, and its tip is the shape's); [`RodError::Overflow`] where the
+    /// shape cannot be represented in f64 (its series beyond √‖(a4, a5)‖ = ln(f64::MAX), the
+    /// one kind of rod forward answers and the shape does not: `tests/domain.rs`).
+    pub fn new(a: &PlanarParams) -> Result<Self, RodError> {
+        // Forward's refusals are the shape's too (one domain; NaN and ±∞ count as beyond, and
+        // the evaluation refuses them); its tip is the shape's.
+        let known = if dispatch::beyond_ordinary_force(a) {
+            Some(dispatch::domain_evaluation(a)?)
+        } else {
+            None
+        };
+        let rod = dispatch::shape(a)?;
+        Ok(match known {
+            Some(e) => rod.with_tip(e.tip),
+            None => rod,
+        })
+    }
 }

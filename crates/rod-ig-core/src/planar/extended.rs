@@ -4,7 +4,7 @@
 //! series, in double-double too, takes milliseconds (√‖F‖ up to 27) or cannot be certified
 //! at all (beyond).
 
-use super::closed::{Case, Closed, CLOSED_J_TOLERANCE};
+use super::closed::{Case, Closed, CLOSED_J_TOLERANCE, ENERGY_REL_TOLERANCE};
 use crate::dd::{Dd, DualDd, DD_EPSILON};
 use crate::{PlanarJacobian, PlanarParams, PlanarPose};
 
@@ -16,9 +16,6 @@ const EXTENDED_TIP_TOLERANCE: f64 = 1e-13;
 /// on (tests/data/separatrix_truth*.jsonl; the `--edge` file reaches √‖F‖ = 692 at up to 1,200
 /// bits, near where J ≈ e^{√‖F‖} overflows f64): beyond, it is not used.
 const EXTENDED_MAX_ROOT_F: f64 = 700.0;
-
-/// Relative accuracy asked of the energy (as for the f64 closed form's identity).
-const ENERGY_REL_TOLERANCE: f64 = 1e-9;
 
 /// The f64 closed form's pose error model ([`Closed::pose_abs_error`]) scaled to 2⁻¹⁰⁴
 /// underestimates the double-double pose's error by up to 3.7× (seen through the energy

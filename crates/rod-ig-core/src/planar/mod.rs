@@ -24,6 +24,7 @@
 
 mod closed;
 pub(crate) mod dispatch;
+mod energy;
 mod entry;
 mod extended;
 mod formulation;

@@ -1,11 +1,9 @@
 //! The shape of a planar rod: [`PlanarRod`], the rod ready to be sampled along its length.
 
-use super::{dispatch, small_angle};
+use super::small_angle;
 use crate::planar::closed::{overflow, Case, Closed};
-use crate::planar::dispatch::{
-    beyond_ordinary_force, domain_evaluation, overflow_force, LN_F64_MAX,
-};
-use crate::planar::formulation::closed_energy;
+use crate::planar::energy::closed_energy;
+use crate::planar::taylor::{overflow_force, LN_F64_MAX};
 use crate::planar::taylor::{series_f64, TaylorRod};
 use crate::{PlanarParams, PlanarPose, RodError};
 
@@ -69,24 +67,10 @@ pub(crate) fn series_backend(a: &PlanarParams) -> Result<Backend, RodError> {
 }
 
 impl PlanarRod {
-    /// Precomputes the rod for a. Errors: [`RodError::NonFinite`] if a component of a is NaN
-    /// or ±∞; every refusal of [`evaluate`](crate::planar::evaluate) (one domain: beyond ‖(a4, a5)‖ = 625 the full
-    /// evaluation runs first, and its tip is the shape's); [`RodError::Overflow`] where the
-    /// shape cannot be represented in f64 (its series beyond √‖(a4, a5)‖ = ln(f64::MAX), the
-    /// one kind of rod forward answers and the shape does not: `tests/domain.rs`).
-    pub fn new(a: &PlanarParams) -> Result<Self, RodError> {
-        // Forward's refusals are the shape's too (one domain; NaN and ±∞ count as beyond, and
-        // the evaluation refuses them); its tip is the shape's.
-        let known = if beyond_ordinary_force(a) {
-            Some(domain_evaluation(a)?)
-        } else {
-            None
-        };
-        let mut rod = dispatch::answer(a, dispatch::Shape)?;
-        if let Some(e) = known {
-            rod.tip = e.tip;
-        }
-        Ok(rod)
+    /// The rod with `tip` as its tip (the full evaluation's, beyond the ordinary force).
+    pub(crate) fn with_tip(mut self, tip: PlanarPose) -> Self {
+        self.tip = tip;
+        self
     }
 
     /// The rod from the parts a formulation built (`planar/formulation/`); refused where its

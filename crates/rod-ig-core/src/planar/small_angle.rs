@@ -25,7 +25,7 @@
 //! (`checked_*`): None where a bound exceeds the tolerance asked of an answer.
 
 use super::closed::CLOSED_J_TOLERANCE;
-use crate::planar::formulation::ENERGY_REL_TOLERANCE;
+use crate::planar::closed::ENERGY_REL_TOLERANCE;
 
 use crate::{PlanarJacobian, PlanarParams, PlanarPose};
 
@@ -629,7 +629,7 @@ pub(super) fn checked_tip(a: &PlanarParams) -> Option<[f64; 3]> {
 }
 
 /// ½∫κ² of a nearly straight rod from the small-angle expansion, where its bound is within
-/// [`crate::planar::formulation::ENERGY_REL_TOLERANCE`].
+/// [`crate::planar::closed::ENERGY_REL_TOLERANCE`].
 pub(super) fn checked_energy(a: &PlanarParams) -> Option<f64> {
     checked_energy_at(a, effective_angle(a[0], a[1], a[2]))
 }

@@ -849,8 +849,8 @@ pub(crate) fn series_dd<const TIGHT: bool>(
     max_root_f: f64,
 ) -> Result<TaylorRod<DualF64x2<TIGHT>>, RodError> {
     let root_f = a[1].hypot(a[2]).sqrt();
-    if root_f > crate::planar::dispatch::LN_F64_MAX {
-        return Err(crate::planar::dispatch::overflow_force());
+    if root_f > LN_F64_MAX {
+        return Err(overflow_force());
     }
     if root_f > max_root_f {
         return Err(RodError::OutOfDomain(format!(
@@ -897,6 +897,17 @@ pub(crate) fn series_pose_and_jac(
         rod.pose(t.max(0.0))
             .ok_or_else(crate::planar::closed::overflow)?,
     )
+}
+
+/// ln(f64::MAX): under tension F the rod's J grows like e^{√F t}; beyond this √F it overflows.
+pub(crate) const LN_F64_MAX: f64 = 709.7;
+
+/// The refusal of a rod under a tension whose J exceeds f64.
+pub(crate) fn overflow_force() -> RodError {
+    RodError::Overflow(format!(
+        "planar rod: under this force J(t, a) grows like e^(sqrt|F| t) and exceeds f64 \
+         (sqrt|F| > {LN_F64_MAX})"
+    ))
 }
 
 /// ρ = max(|a3|, √‖(a4, a5)‖): the rod's curvature scale (its Taylor terms grow like ρᵏ/k!).

@@ -3,16 +3,17 @@
 use super::closed::{CLOSED_J_TOLERANCE, SERIES_DD_MAX_ROOT_F};
 use super::dispatch::SERIES_RHO;
 
-use super::formulation::{ill_conditioned_tip, SUBSTEP_J_TOLERANCE, ZETA_ENERGY_ULPS};
+use super::energy::ZETA_ENERGY_ULPS;
+use super::formulation::{ill_conditioned_tip, SUBSTEP_J_TOLERANCE};
 use super::taylor::Gradient;
 use super::{closed, pendulum, small_angle};
+use crate::planar::closed::ENERGY_REL_TOLERANCE;
 use crate::planar::closed::{seeded_closed, Case, Closed, SeriesNeed};
-use crate::planar::dispatch::LN_F64_MAX;
 use crate::planar::entry::{
     energy, evaluate, pose_and_jacobian, tip, tip_and_jacobian, tip_and_jacobian_for_substep,
 };
-use crate::planar::formulation::ENERGY_REL_TOLERANCE;
 use crate::planar::stability::STABILITY_DD_MAX_ROOT_F;
+use crate::planar::taylor::LN_F64_MAX;
 use crate::planar::taylor::{curvature_scale, pose_jac_from, series_dd, series_dual};
 use crate::rng::SplitMix64;
 use crate::scalar::Dual3;

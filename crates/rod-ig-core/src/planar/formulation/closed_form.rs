@@ -1,19 +1,15 @@
 //! The closed form (docs/math.md §1–§3) as a formulation: its answers where its a-priori error
 //! estimate holds, and the energy by the identity of docs/math.md §1 or by ζ where their bounds do.
 
-use super::super::closed::{Case, Closed, SeriesNeed, SEPARATRIX_M1, SERIES_DD_MAX_ROOT_F};
+use super::super::closed::{Closed, SeriesNeed, SEPARATRIX_M1};
 use super::super::shape::Backend;
-use super::super::taylor::Gradient;
 use crate::planar::shape::PlanarRod;
 
-use super::super::{extended, small_angle, stability};
-use crate::planar::closed::overflow;
-use crate::planar::taylor::{series_dd, series_dual, series_f64};
+use super::super::stability;
+use crate::planar::energy::{closed_energy, energy_by_identity, identity_or_zeta};
+use crate::planar::taylor::series_dual;
 
-use super::{
-    full_accuracy, with_theorem, Answer, Evaluation, Formulation, Need, Precision, Rod,
-    SERIES_F64_TIP_MAX_ROOT_F,
-};
+use super::{full_accuracy, with_theorem, Answer, Evaluation, Need, Precision, Rod};
 use crate::scalar::{Dual3, Real};
 use crate::StabilityVerdict;
 
@@ -64,10 +60,10 @@ impl<'c, T: Real> ClosedForm<'c, T> {
     }
 }
 
-impl Formulation for ClosedForm<'_, f64> {
+impl ClosedForm<'_, f64> {
     /// The closed form with everything that depends on a only precomputed, where its estimate
     /// holds.
-    fn shape(&self) -> Answer<PlanarRod> {
+    pub(crate) fn shape(&self) -> Answer<PlanarRod> {
         (self.need() == Need::Closed).then(|| {
             let backend = Backend::Closed(*self.c);
             PlanarRod::from_parts(self.a, self.c.case, backend, self.c.pose(1.0))
@@ -76,12 +72,12 @@ impl Formulation for ClosedForm<'_, f64> {
     /// q(1) (docs/math.md §1–§3), where the estimate holds. Built without the phase, the tip is
     /// placed by the addition theorems (~18 % of q(1)); it may differ from the evaluation's in
     /// the last bits, both within the closed form's pose bound.
-    fn tip(&self) -> Answer<PlanarPose> {
+    pub(crate) fn tip(&self) -> Answer<PlanarPose> {
         (self.need() == Need::Closed).then(|| super::finite_tip(self.c.pose(1.0)))
     }
     /// The identity or ζ where their bounds hold ([`identity_or_zeta`]); the other rows
     /// elsewhere.
-    fn energy(&self) -> Answer<f64> {
+    pub(crate) fn energy(&self) -> Answer<f64> {
         if self.need() != Need::Closed {
             return None;
         }
@@ -97,10 +93,10 @@ impl Formulation for ClosedForm<'_, f64> {
 /// 1e-14; the series costs 3 ms there, the closed form under 1 µs.
 pub(crate) const SUBSTEP_J_TOLERANCE: f64 = 1e-8 * 100.0;
 
-impl Formulation for ClosedForm<'_, Dual3> {
+impl ClosedForm<'_, Dual3> {
     /// q(t) and J(t) in forward-mode dual numbers, exact up to rounding, where the estimate
     /// holds at t (for a continuation's substep, within [`SUBSTEP_J_TOLERANCE`]).
-    fn pose_and_jacobian(
+    pub(crate) fn pose_and_jacobian(
         &self,
         t: f64,
         precision: Precision,
@@ -111,57 +107,22 @@ impl Formulation for ClosedForm<'_, Dual3> {
     }
     /// The verdict where a theorem, the sign of det J(1) or the scan from the theorem's
     /// conjugate-free time decides ([`stability::verdict_of`]); the stability rows elsewhere.
-    fn stability_verdict(&self) -> Answer<StabilityVerdict> {
+    pub(crate) fn stability_verdict(&self) -> Answer<StabilityVerdict> {
         stability::verdict_of(self.c, self.a).transpose()
     }
-    fn evaluate(&self) -> Answer<Evaluation> {
+    pub(crate) fn evaluate(&self) -> Answer<Evaluation> {
         (self.need() == Need::Closed).then(|| {
             evaluate_closed(self.c, self.a).map(|e| with_theorem(e, || self.c.theorem_verdict()))
         })
     }
 }
 
-/// λ2/2 − a4 x(1) − a5 y(1) with λ2 = a3² + 2a4 (docs/math.md §1).
-pub(crate) fn energy_from_tip(a: &PlanarParams, tip: &PlanarPose) -> f64 {
-    let (a3, a4, a5) = (a[0], a[1], a[2]);
-    0.5 * a3 * a3 + a4 - a4 * tip.x - a5 * tip.y
-}
-
-/// Relative accuracy asked of the energy: issue 9 asks 1e-8; 10× inside, with a bound that
-/// is itself ≥ 2× the measured error.
-pub(crate) const ENERGY_REL_TOLERANCE: f64 = 1e-9;
-
-/// Rounding of [`Closed::energy_by_zeta_bounded`] in ulps of its terms: measured ≤ 10.1 on
-/// 1,160 rods of cases I and II against the 320-bit references (tests/data/separatrix_truth*
-/// .jsonl) and the double-double series (`zeta_energy_meets_its_bound`), ×3.
-pub(crate) const ZETA_ENERGY_ULPS: f64 = 32.0;
-
-/// The energy by the identity λ2/2 − a4 x − a5 y of docs/math.md §1 where its error bound allows,
-/// else None. The identity subtracts a4·x + a5·y from λ2/2, both ≈ ‖F‖ on a nearly straight
-/// rod under force, whose energy is orders of magnitude smaller: its error is (|a4| + |a5|)
-/// times the pose error ([`Closed::pose_abs_error`]) plus the rounding of the sum.
-pub(crate) fn energy_by_identity<T: Real>(
-    c: &Closed<T>,
-    a: &PlanarParams,
-    tip: &PlanarPose,
-) -> Result<Option<f64>, RodError> {
-    let (a3, a4, a5) = (a[0], a[1], a[2]);
-    let e = energy_from_tip(a, tip);
-    let rounding =
-        4.0 * f64::EPSILON * (0.5 * a3 * a3 + a4.abs() + (a4 * tip.x).abs() + (a5 * tip.y).abs());
-    let bound = (a4.abs() + a5.abs()) * c.pose_abs_error() + rounding;
-    if !e.is_finite() {
-        return Err(overflow());
-    }
-    Ok((bound <= ENERGY_REL_TOLERANCE * e.abs()).then_some(e))
-}
-
 /// The closed form's own stability scans (a row after the small-angle expansion's: on a
 /// nearly straight rod the expansion decides, `stability::closed_report`).
 pub(crate) struct ClosedScan<'c>(pub(crate) Rod<'c>);
 
-impl Formulation for ClosedScan<'_> {
-    fn stability(&self) -> Answer<StabilityReport> {
+impl ClosedScan<'_> {
+    pub(crate) fn stability(&self) -> Answer<StabilityReport> {
         let c = self.0.closed?;
         let need = match self.0.need {
             Need::Closed => SeriesNeed::None,
@@ -171,65 +132,6 @@ impl Formulation for ClosedScan<'_> {
         let report = stability::closed_report(c, self.0.a, need, self.0.precise_series);
         let report = report.transpose()?;
         Some(report.map(|r| stability::with_theorem(r, || c.theorem_verdict())))
-    }
-}
-
-/// The energy by the identity ([`energy_by_identity`], free) where its error bound allows,
-/// else by ζ where its rounding does; None elsewhere (the other formulations' rows).
-fn identity_or_zeta<T: Real>(
-    c: &Closed<T>,
-    a: &PlanarParams,
-    tip: &PlanarPose,
-) -> Result<Option<f64>, RodError> {
-    if let Some(e) = energy_by_identity(c, a, tip)? {
-        return Ok(Some(e));
-    }
-    // Case I below m = ½ (a nearly straight rod under compression, where the identity
-    // cancels): ∫cn² in closed form, within 2.2e-11 of the double-double series on 4,000
-    // log-scale rods (1.7e-14 on those under compression; tests: see
-    // `small_m_compression_closed_form_meets_its_estimate`); near m = 1 its Z/m terms cancel.
-    // Elsewhere (case I from m = ½ up to the separatrix, case II) it is taken where its
-    // rounding, a few ulps of its terms, is below the tolerance (a rod with some bending
-    // under a strong tension: the series there takes 100+ steps).
-    if let Some((e, terms)) = c.energy_by_zeta_bounded() {
-        let bound = ZETA_ENERGY_ULPS * f64::EPSILON * terms;
-        if (c.case == Case::I && c.m.re() < 0.5) || bound <= ENERGY_REL_TOLERANCE * e.abs() {
-            return Ok(Some(e));
-        }
-    }
-    Ok(None)
-}
-
-/// The energy of a rod whose tip came from the closed form `c`, for the shape and the
-/// evaluation near the separatrix, which hold the closed form already: [`identity_or_zeta`],
-/// then what the energy rows after the closed form give (the expansion, the double-double
-/// identity or series by the separatrix under a strong force, the f64 series).
-pub(crate) fn closed_energy<T: Real>(
-    c: &Closed<T>,
-    a: &PlanarParams,
-    tip: &PlanarPose,
-) -> Result<f64, RodError> {
-    if let Some(e) = identity_or_zeta(c, a, tip)? {
-        return Ok(e);
-    }
-    if let Some(e) = small_angle::checked_energy(a) {
-        return Ok(e);
-    }
-    let root_f = a[1].hypot(a[2]).sqrt();
-    let e = if c.needs_precise_series() && root_f > SERIES_F64_TIP_MAX_ROOT_F {
-        match extended::energy(a) {
-            Some(e) => e,
-            None => series_dd::<false>(a, false, SERIES_DD_MAX_ROOT_F)?
-                .energy()
-                .value(),
-        }
-    } else {
-        series_f64(a, false)?.energy()
-    };
-    if e.is_finite() {
-        Ok(e)
-    } else {
-        Err(overflow())
     }
 }
 

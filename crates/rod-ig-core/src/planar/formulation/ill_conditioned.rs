@@ -12,9 +12,10 @@ use crate::planar::taylor::{pose_jac_from, series_dd, series_dual};
 use super::super::stability;
 use crate::planar::stability::STABILITY_DD_MAX_ROOT_F;
 
-use super::closed_form::{energy_by_identity, energy_from_tip, ENERGY_REL_TOLERANCE};
-use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Formulation, Need};
-use super::{Precision, Rod, SERIES_F64_TIP_MAX_ROOT_F};
+use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Need};
+use super::{Precision, Rod};
+use crate::planar::closed::ENERGY_REL_TOLERANCE;
+use crate::planar::energy::{energy_by_identity, energy_from_tip, SERIES_F64_TIP_MAX_ROOT_F};
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 
 /// The rod by the separatrix ([`Need::IllConditioned`]), where every f64 evaluation loses
@@ -22,15 +23,15 @@ use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport}
 /// whose identity cancels there under a strong force (√‖F‖ > [`SERIES_F64_TIP_MAX_ROOT_F`]).
 pub(crate) struct IllConditioned<'c>(pub(crate) Rod<'c>);
 
-impl Formulation for IllConditioned<'_> {
-    fn tip(&self) -> Answer<PlanarPose> {
+impl IllConditioned<'_> {
+    pub(crate) fn tip(&self) -> Answer<PlanarPose> {
         (self.0.need == Need::IllConditioned).then(|| {
             let (p, _, _) = ill_conditioned_tip(self.0.a)?;
             finite_tip([p.x, p.y, p.theta])
         })
     }
     /// Not for a solver's iterations, which take the f64 series ([`Precision::Iteration`]).
-    fn pose_and_jacobian(
+    pub(crate) fn pose_and_jacobian(
         &self,
         t: f64,
         precision: Precision,
@@ -48,7 +49,7 @@ impl Formulation for IllConditioned<'_> {
     }
     /// The identity in double-double (40–80 µs), else the double-double series (ms): the f64
     /// series' rounding grows like e^{√‖F‖} here.
-    fn energy(&self) -> Answer<f64> {
+    pub(crate) fn energy(&self) -> Answer<f64> {
         let a = self.0.a;
         if !(self.0.precise_series && a[1].hypot(a[2]).sqrt() > SERIES_F64_TIP_MAX_ROOT_F) {
             return None;
@@ -67,7 +68,7 @@ impl Formulation for IllConditioned<'_> {
     }
     /// By the separatrix: the closed scan with norm-wise bounds, then in double-double, then
     /// the double-double series (`stability::precise_scan`).
-    fn stability(&self) -> Answer<StabilityReport> {
+    pub(crate) fn stability(&self) -> Answer<StabilityReport> {
         let c = self.0.closed?;
         if !self.0.precise_series {
             return None;
@@ -78,7 +79,7 @@ impl Formulation for IllConditioned<'_> {
     /// The f64 series' poses with the tip of the ill-conditioned routes (near the separatrix
     /// the f64 series' tip drifts): the small-angle tip first, as `tip` does, so that forward
     /// and shape answer the same rods.
-    fn shape(&self) -> Answer<PlanarRod> {
+    pub(crate) fn shape(&self) -> Answer<PlanarRod> {
         if self.0.need != Need::IllConditioned {
             return None;
         }
@@ -92,7 +93,7 @@ impl Formulation for IllConditioned<'_> {
         )
     }
     /// One double-double closed form for the forward map and the stability scan.
-    fn evaluate(&self) -> Answer<Evaluation> {
+    pub(crate) fn evaluate(&self) -> Answer<Evaluation> {
         let c = self.0.closed?;
         (self.0.need == Need::IllConditioned).then(|| {
             let a = self.0.a;

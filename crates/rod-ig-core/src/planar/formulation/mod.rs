@@ -1,24 +1,27 @@
-//! The formulations of the planar rod behind one trait (issue 44). Each is one way of
-//! evaluating the rod: it answers a quantity only inside its own domain for that quantity
-//! (the a-priori error bound that decides it) and says `None` elsewhere, so that the
-//! dispatcher ([`super::dispatch`]) takes the next row of its table. None calls the
-//! dispatcher back.
+//! The formulations of the planar rod (issues 44 and 53). Each is one way of evaluating the
+//! rod, with inherent methods for the quantities it can give: a method of a formulation that
+//! answers only inside its own domain for that quantity (the a-priori error bound that decides
+//! it) returns `None` outside, and the question's `match` in [`super::dispatch`] names its next
+//! formulation explicitly; [`Series`] and [`SeparatrixLimit`] always answer. A quantity a
+//! formulation does not have is a method it does not have: asking it does not compile. None
+//! calls the dispatcher back.
 //!
 //! | formulation | module | answers |
 //! | --- | --- | --- |
 //! | [`SeparatrixLimit`] | `separatrix_limit` | a barely bent rod under a strong force (ρ ≤ 1e-7): every quantity from its soliton lattice, exact where 1 − k² underflows |
-//! | [`FullEvaluation`] | `full` (here) | beyond ‖(a4, a5)‖ = 625: every quantity from one full evaluation |
 //! | [`ClosedForm`] | `closed_form` | where the closed form's error estimate holds (J to 1e-8); the verdict where a theorem or det J(1) decides |
 //! | [`ClosedScan`] | `closed_form` | the stability scans on the closed form, after the small-angle expansion's |
 //! | [`SmallAngle`] | `small_angle` | nearly straight rods, where the expansion's (or the pendulum's) bounds hold |
 //! | [`IllConditioned`] | `ill_conditioned` | by the separatrix: double-double closed form, f64 / double-double series, cross-check |
-//! | [`Series`] | `series` | gently bent rods (ρ ≤ 0.25), closed forms that overflow, closed-form J that cancels |
+//! | [`Series`] | `series` | gently bent rods (ρ ≤ 0.25), closed forms that overflow, closed-form J that cancels: every quantity |
+//!
+//! Beyond ‖(a4, a5)‖ = 625 the full evaluation decides every quantity (the dispatcher's
+//! `Regime::StrongForce`).
 
 use super::closed::Case;
 
 use super::closed::{Closed, SeriesNeed, CLOSED_J_TOLERANCE};
 use super::shape::{case_without_closed, series_backend, Backend};
-use crate::planar::entry::Evaluation;
 use crate::planar::shape::PlanarRod;
 use crate::scalar::Dual3;
 use crate::StabilityVerdict;
@@ -31,9 +34,9 @@ mod separatrix_limit;
 mod series;
 mod small_angle;
 
-pub(crate) use closed_form::{closed_energy, ClosedForm, ClosedScan, ENERGY_REL_TOLERANCE};
 #[cfg(test)]
-pub(crate) use closed_form::{SUBSTEP_J_TOLERANCE, ZETA_ENERGY_ULPS};
+pub(crate) use closed_form::SUBSTEP_J_TOLERANCE;
+pub(crate) use closed_form::{ClosedForm, ClosedScan};
 #[cfg(test)]
 pub(crate) use ill_conditioned::ill_conditioned_tip;
 pub(crate) use ill_conditioned::{IllConditioned, CROSS_CHECK_J, CROSS_CHECK_TIP};
@@ -41,57 +44,15 @@ pub(crate) use separatrix_limit::SeparatrixLimit;
 pub(crate) use series::Series;
 pub(crate) use small_angle::SmallAngle;
 
-/// Largest √‖F‖ for which the f64 series answers the tip, J and energy of an ill-conditioned
-/// rod. Its rounding grows like e^{√‖F‖ t} at most, and far less where the rod only leaves the
-/// straight equilibrium: against the 320-bit references (the 82 rods of
-/// `tests/data/separatrix_truth*.jsonl` near the separatrix with √‖F‖ from 10.7 to 27) its J is
-/// within 0.04·ε·e^{√‖F‖} and its tip within a hundredth of that. With ×3, J stays within 1e-9
-/// up to √‖F‖ = 17.4, a hundred times inside the 1e-6 asked of J, at ~1/50 of the
-/// double-double series' cost.
-pub(crate) const SERIES_F64_TIP_MAX_ROOT_F: f64 = 17.0;
+/// Tip, J(1, a) (rows x, y, θ; columns a3, a4, a5), ½∫κ² and the stability verdict of one rod
+/// at full accuracy: the solvers' evaluation type ([`crate::solver::ModelEvaluation`]) for the
+/// planar rod.
+pub type Evaluation = crate::solver::ModelEvaluation<3, PlanarPose>;
 
 /// An answer of a formulation: `None` outside its domain, else its value or its refusal.
 pub(crate) type Answer<T> = Option<Result<T, RodError>>;
 
-/// One way of evaluating the planar rod (module docs). Every method answers for the rod the
-/// formulation was made for; a formulation that has no such quantity keeps the default, `None`.
-pub(crate) trait Formulation {
-    /// Tip pose q(1).
-    fn tip(&self) -> Answer<PlanarPose> {
-        None
-    }
-    /// q(t) and J(t) = ∂q(t)/∂a, to the accuracy `precision` asks.
-    fn pose_and_jacobian(
-        &self,
-        _t: f64,
-        _precision: Precision,
-    ) -> Answer<(PlanarPose, PlanarJacobian)> {
-        None
-    }
-    /// Elastic energy ½∫₀¹κ² to 1e-9 relative.
-    fn energy(&self) -> Answer<f64> {
-        None
-    }
-    /// The stability report (docs/math.md §5): the scan over this formulation's det J(t), or the
-    /// theorem that decides.
-    fn stability(&self) -> Answer<StabilityReport> {
-        None
-    }
-    /// The verdict alone (what [`Self::stability`]'s report says, possibly without its scan).
-    fn stability_verdict(&self) -> Answer<StabilityVerdict> {
-        self.stability().map(|r| r.map(|r| r.verdict()))
-    }
-    /// Tip, J(1), energy and stability at full accuracy.
-    fn evaluate(&self) -> Answer<Evaluation> {
-        None
-    }
-    /// The rod ready to be sampled along its length (its tip this formulation's).
-    fn shape(&self) -> Answer<PlanarRod> {
-        None
-    }
-}
-
-/// How accurate the J of [`Formulation::pose_and_jacobian`] must be.
+/// How accurate the J of `pose_and_jacobian` must be.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Precision {
     /// An answer: J to 1e-8 relative and the tip to 1e-11, wherever a formulation certifies them.
@@ -156,6 +117,19 @@ pub(crate) struct Rod<'c> {
 }
 
 impl<'c> Rod<'c> {
+    /// The rod a without a closed form (gently bent, one whose closed form overflowed, or
+    /// before the closed form is asked).
+    #[inline]
+    pub(crate) fn without_closed(a: &'c PlanarParams) -> Self {
+        Rod {
+            a,
+            closed: None,
+            need: Need::NoClosedForm,
+            case: None,
+            precise_series: false,
+        }
+    }
+
     /// The rod of a built closed form, for the rows after it (the closed form declined).
     pub(crate) fn after<T: crate::scalar::Real>(
         closed_form: &ClosedForm<'c, T>,
@@ -191,26 +165,6 @@ impl<'c> Rod<'c> {
             Some(c) if t < 1.0 => Need::at(c, t),
             _ => self.need,
         }
-    }
-}
-
-/// Beyond ‖(a4, a5)‖ = 625 the full evaluation decides the domain for every quantity (a
-/// formulation may refuse there what another answers), and its answer is theirs.
-pub(crate) struct FullEvaluation<'e>(pub(crate) &'e Evaluation);
-
-impl Formulation for FullEvaluation<'_> {
-    fn tip(&self) -> Answer<PlanarPose> {
-        Some(Ok(self.0.tip))
-    }
-    /// J(1) only: at t < 1 the rows after it answer (within the same domain).
-    fn pose_and_jacobian(&self, t: f64, _: Precision) -> Answer<(PlanarPose, PlanarJacobian)> {
-        (t == 1.0).then_some(Ok((self.0.tip, self.0.jacobian)))
-    }
-    fn energy(&self) -> Answer<f64> {
-        Some(Ok(self.0.energy))
-    }
-    fn stability(&self) -> Answer<StabilityReport> {
-        Some(Ok(self.0.stability))
     }
 }
 

@@ -7,7 +7,7 @@ use super::super::taylor::pose_jac_from;
 use super::super::{shape::case_without_closed, shape::Backend, stability};
 use crate::planar::shape::PlanarRod;
 
-use super::{finite_tip, full_accuracy, Answer, Evaluation, Formulation, Precision};
+use super::{finite_tip, full_accuracy, Evaluation, Precision};
 use crate::scalar::Dual3;
 
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
@@ -63,38 +63,40 @@ impl<'a> SeparatrixLimit<'a> {
     }
 }
 
-impl Formulation for SeparatrixLimit<'_> {
-    fn tip(&self) -> Answer<PlanarPose> {
-        Some(finite_tip(self.lattice.pose(1.0)))
+impl SeparatrixLimit<'_> {
+    pub(crate) fn tip(&self) -> Result<PlanarPose, RodError> {
+        finite_tip(self.lattice.pose(1.0))
     }
-    fn pose_and_jacobian(&self, t: f64, _: Precision) -> Answer<(PlanarPose, PlanarJacobian)> {
-        Some(self.pose_and_jacobian_at(t))
+    pub(crate) fn pose_and_jacobian(
+        &self,
+        t: f64,
+        _: Precision,
+    ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+        self.pose_and_jacobian_at(t)
     }
-    fn energy(&self) -> Answer<f64> {
-        Some(self.finite_energy())
+    pub(crate) fn energy(&self) -> Result<f64, RodError> {
+        self.finite_energy()
     }
-    fn stability(&self) -> Answer<StabilityReport> {
-        Some(self.report())
+    pub(crate) fn stability(&self) -> Result<StabilityReport, RodError> {
+        self.report()
     }
-    fn evaluate(&self) -> Answer<Evaluation> {
-        Some((|| {
-            let (tip, jacobian) = self.pose_and_jacobian_at(1.0)?;
-            Ok(full_accuracy(
-                tip,
-                jacobian,
-                self.finite_energy()?,
-                self.report()?,
-            ))
-        })())
+    pub(crate) fn evaluate(&self) -> Result<Evaluation, RodError> {
+        let (tip, jacobian) = self.pose_and_jacobian_at(1.0)?;
+        Ok(full_accuracy(
+            tip,
+            jacobian,
+            self.finite_energy()?,
+            self.report()?,
+        ))
     }
-    fn shape(&self) -> Answer<PlanarRod> {
+    pub(crate) fn shape(&self) -> Result<PlanarRod, RodError> {
         let a = self.a;
         let tip = self.lattice.pose(1.0);
-        Some(PlanarRod::from_parts(
+        PlanarRod::from_parts(
             a,
             case_without_closed(a),
             Backend::Separatrix(self.lattice),
             tip,
-        ))
+        )
     }
 }

@@ -8,7 +8,7 @@ use crate::planar::shape::PlanarRod;
 use super::super::stability;
 use crate::planar::taylor::{pose_jac_from, series_dual, series_f64, series_pose_and_jac};
 
-use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Formulation};
+use super::{finite_tip, full_accuracy, with_theorem, Evaluation};
 use super::{Precision, Rod};
 use crate::StabilityVerdict;
 
@@ -20,53 +20,55 @@ use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport}
 /// budget and its overflow.
 pub(crate) struct Series<'c>(pub(crate) Rod<'c>);
 
-impl Formulation for Series<'_> {
-    fn tip(&self) -> Answer<PlanarPose> {
-        Some(series_f64(self.0.a, false).and_then(|r| finite_tip(r.tip())))
+impl Series<'_> {
+    pub(crate) fn tip(&self) -> Result<PlanarPose, RodError> {
+        series_f64(self.0.a, false).and_then(|r| finite_tip(r.tip()))
     }
-    fn pose_and_jacobian(&self, t: f64, _: Precision) -> Answer<(PlanarPose, PlanarJacobian)> {
-        Some(series_pose_and_jac(self.0.a, t))
+    pub(crate) fn pose_and_jacobian(
+        &self,
+        t: f64,
+        _: Precision,
+    ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+        series_pose_and_jac(self.0.a, t)
     }
     /// ½∫κ² integrated along (the identity cancels on a nearly straight rod under force).
-    fn energy(&self) -> Answer<f64> {
+    pub(crate) fn energy(&self) -> Result<f64, RodError> {
         let e = series_f64(self.0.a, false).map(|r| r.energy());
-        Some(e.and_then(|e| {
+        e.and_then(|e| {
             if e.is_finite() {
                 Ok(e)
             } else {
                 Err(crate::planar::closed::overflow())
             }
-        }))
+        })
     }
     /// The series scan (the small-angle row before it declined), with the theorem that
     /// decides where the series runs out of steps.
-    fn stability(&self) -> Answer<StabilityReport> {
+    pub(crate) fn stability(&self) -> Result<StabilityReport, RodError> {
         let a = self.0.a;
-        Some(match self.0.closed {
+        match self.0.closed {
             Some(c) => stability::series_report_after_closed(c, a)
                 .map(|r| stability::with_theorem(r, || c.theorem_verdict())),
             None => stability::series_after_small_angle(a, None, None, None)
                 .map(|r| stability::with_theorem(r, || theorem_verdict(a))),
-        })
+        }
     }
     /// The dense f64 series (or the expansion where the series cannot run).
-    fn shape(&self) -> Answer<PlanarRod> {
+    pub(crate) fn shape(&self) -> Result<PlanarRod, RodError> {
         let a = self.0.a;
-        Some(self.0.series_shape(|backend| {
-            match backend {
-                Backend::Series(r) => Ok(r.tip()),
-                _ => super::super::small_angle::checked_tip(a)
-                    .ok_or_else(crate::planar::closed::overflow),
-            }
-        }))
+        self.0.series_shape(|backend| match backend {
+            Backend::Series(r) => Ok(r.tip()),
+            _ => super::super::small_angle::checked_tip(a)
+                .ok_or_else(crate::planar::closed::overflow),
+        })
     }
     /// With the theorem of the rod's closed form where one was built, else of its f64 one.
-    fn evaluate(&self) -> Answer<Evaluation> {
+    pub(crate) fn evaluate(&self) -> Result<Evaluation, RodError> {
         let e = evaluate_series(self.0.a);
-        Some(e.map(|e| match self.0.closed {
+        e.map(|e| match self.0.closed {
             Some(c) => with_theorem(e, || c.theorem_verdict()),
             None => with_theorem(e, || theorem_verdict(self.0.a)),
-        }))
+        })
     }
 }
 

@@ -6,7 +6,7 @@ use super::super::shape::Backend;
 use super::super::{small_angle, stability};
 use crate::planar::shape::PlanarRod;
 
-use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Formulation, Need};
+use super::{finite_tip, full_accuracy, with_theorem, Answer, Evaluation, Need};
 use super::{Precision, Rod};
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 
@@ -23,28 +23,32 @@ impl SmallAngle<'_> {
     }
 }
 
-impl Formulation for SmallAngle<'_> {
-    fn tip(&self) -> Answer<PlanarPose> {
+impl SmallAngle<'_> {
+    pub(crate) fn tip(&self) -> Answer<PlanarPose> {
         if !self.declined_at(1.0) {
             return None;
         }
         small_angle::checked_tip(self.0.a).map(finite_tip)
     }
-    fn pose_and_jacobian(&self, t: f64, _: Precision) -> Answer<(PlanarPose, PlanarJacobian)> {
+    pub(crate) fn pose_and_jacobian(
+        &self,
+        t: f64,
+        _: Precision,
+    ) -> Answer<(PlanarPose, PlanarJacobian)> {
         if !self.declined_at(t) {
             return None;
         }
         small_angle::checked_pose_and_jacobian(self.0.a, t).map(Ok)
     }
-    fn energy(&self) -> Answer<f64> {
+    pub(crate) fn energy(&self) -> Answer<f64> {
         small_angle::checked_energy(self.0.a).map(Ok)
     }
     /// Where the closed form declined and no series can run (beyond √‖F‖ = ln(f64::MAX), a
     /// nearly straight rod under compression).
-    fn shape(&self) -> Answer<PlanarRod> {
+    pub(crate) fn shape(&self) -> Answer<PlanarRod> {
         let a = self.0.a;
         let beyond_series =
-            crate::scalar::fast_hypot(a[1], a[2]).sqrt() > crate::planar::dispatch::LN_F64_MAX;
+            crate::scalar::fast_hypot(a[1], a[2]).sqrt() > crate::planar::taylor::LN_F64_MAX;
         if self.0.need == Need::Closed || !beyond_series {
             return None;
         }
@@ -58,14 +62,14 @@ impl Formulation for SmallAngle<'_> {
     }
     /// The stability of a nearly straight rod from the expansion's det J, where its bounds
     /// decide the verdict with certainty (`stability::small_angle_report`), before any scan.
-    fn stability(&self) -> Answer<StabilityReport> {
+    pub(crate) fn stability(&self) -> Answer<StabilityReport> {
         let report = stability::small_angle_report(self.0.a).transpose()?;
         Some(report.map(|r| match self.0.closed {
             Some(c) => stability::with_theorem(r, || c.theorem_verdict()),
             None => stability::with_theorem(r, || super::series::theorem_verdict(self.0.a)),
         }))
     }
-    fn evaluate(&self) -> Answer<Evaluation> {
+    pub(crate) fn evaluate(&self) -> Answer<Evaluation> {
         if !self.declined_at(1.0) {
             return None;
         }

@@ -1411,22 +1411,19 @@ impl Grid {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::planar::heavy::catenary;
 
-    /// Cables whose second variations the tests take apart: level and tilted cables from their
-    /// catenary seeds, solved (w = 200, 2,000), and a cable hanging from its base by a free tip
-    /// (not an equilibrium: any state gives a grid).
+    /// Cables whose second variations the tests take apart, integrated from the base (the
+    /// grids need a state, not an equilibrium): the level cable's base wrench at w = 200 and
+    /// 2,000, a tilted one, and a cable hanging by a free tip.
     fn cables() -> Vec<Cable> {
         let mut out = Vec::new();
-        for (w, target) in [
-            (200.0, PlanarPose::new(0.8, 0.0, 0.0)),
-            (2_000.0, PlanarPose::new(0.8, 0.0, 0.0)),
-            (2_000.0, PlanarPose::new(0.5, 0.3, 1.0)),
+        for (w, a) in [
+            (200.0, PlanarParams::new(-9.0, 60.0, -100.0)),
+            (2_000.0, PlanarParams::new(-32.9, 557.7, -1_000.0)),
+            (2_000.0, PlanarParams::new(12.0, -300.0, -700.0)),
         ] {
             let g = Gravity::new(w, [0.0, -1.0]).expect("gravity");
-            let (mut cable, target) = catenary::seed(&target, &g).expect("seed").expect("a seed");
-            cable.solve(&target).expect("solved from its seed");
-            out.push(cable);
+            out.push(Cable::from_params(&a, &g).expect("integrated"));
         }
         let g = Gravity::new(300.0, [0.3, -1.0]).expect("gravity");
         let free = HeldEnds::new(EndCondition::Clamped, EndCondition::Free).expect("ends");

@@ -3,6 +3,7 @@
 use crate::{StabilityReport, StabilityVerdict};
 use scan::Scan;
 
+mod closed_g;
 mod closed_scan;
 mod lattice_scan;
 mod scan;

@@ -1,7 +1,7 @@
 //! Stability scans on the Taylor series: near-relaxed rods, and the double-double series where
 //! the closed form's error estimate fails.
 
-use super::closed_scan::normalised_det;
+use super::closed_g::normalised_det;
 
 use super::scan::{sample_times, scan, value_only, Probe, Scan};
 use super::{

@@ -1,8 +1,10 @@
 //! Tests of the stability scans.
 
+use super::closed_g::{
+    normalised_det, normalised_det_extended, normalised_det_sloped, COLUMN_WISE_MAX_M,
+};
 use super::closed_scan::{
-    closed_scan, normalised_det, normalised_det_extended, normalised_det_sloped, plain_closed_scan,
-    small_m_scan, unstable_at_the_end, verdict_of, CLOSED_G_ERROR, COLUMN_WISE_MAX_M,
+    closed_scan, plain_closed_scan, small_m_scan, unstable_at_the_end, verdict_of, CLOSED_G_ERROR,
     SHORT_SERIES_REACH,
 };
 use super::scan::{find_root, refine_min, Probe, ROOT_TOL};
