@@ -145,34 +145,179 @@ fn regime_within(a: &PlanarParams) -> Regime<'_> {
     Regime::ClosedForm
 }
 
+/// What a question's route records (issue 53: each answer can say which formulation answered
+/// and which declined). The questions run with `()`, which records nothing and compiles away;
+/// [`route`] runs them with a [`Route`].
+pub(crate) trait Record {
+    /// The rod's regime (or class).
+    fn regime(&mut self, name: &'static str);
+    /// A formulation was asked; `answered` is false where it declined (outside its bound).
+    fn asked(&mut self, formulation: &'static str, answered: bool);
+}
+
+impl Record for () {
+    #[inline(always)]
+    fn regime(&mut self, _: &'static str) {}
+    #[inline(always)]
+    fn asked(&mut self, _: &'static str, _: bool) {}
+}
+
+/// The route one question took for one rod: its regime and the formulations asked, in order,
+/// each with whether it answered (the last one that answered gave the answer).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Route {
+    /// "strong force", "separatrix limit", "gently bent" or "closed form".
+    pub regime: &'static str,
+    /// (formulation, answered) in the order they were asked.
+    pub asked: Vec<(&'static str, bool)>,
+}
+
+impl Route {
+    /// The formulation that answered (the last one asked that did).
+    pub fn answered_by(&self) -> Option<&'static str> {
+        self.asked.iter().rev().find(|(_, ok)| *ok).map(|(f, _)| *f)
+    }
+}
+
+impl Record for Route {
+    fn regime(&mut self, name: &'static str) {
+        self.regime = name;
+    }
+    fn asked(&mut self, formulation: &'static str, answered: bool) {
+        self.asked.push((formulation, answered));
+    }
+}
+
+/// A question of [`route`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// The tip q(1) ([`crate::planar::tip`]).
+    Tip,
+    /// q(1) and J(1) ([`crate::planar::tip_and_jacobian`]).
+    TipAndJacobian,
+    /// The elastic energy ([`crate::planar::energy`]).
+    Energy,
+    /// The stability report ([`crate::planar::stability`]).
+    Stability,
+    /// The verdict alone ([`crate::planar::stability_verdict`]).
+    Verdict,
+    /// The whole evaluation ([`crate::planar::evaluate`]).
+    Evaluation,
+    /// The shape ([`crate::planar::PlanarRod::new`]).
+    Shape,
+}
+
+/// The route `quantity` takes for the rod a, computed by asking it: which regime a is in and
+/// which formulations were asked, in order, and which answered. For debugging and for
+/// reading the dispatcher against a rod; the refusals are the question's own.
+///
+/// ```
+/// use rod_ig_core::planar::{route, Quantity};
+/// use rod_ig_core::PlanarParams;
+/// let r = route(&PlanarParams::new(2.0, -10.0, 5.0), Quantity::TipAndJacobian)?;
+/// assert_eq!((r.regime, r.answered_by()), ("closed form", Some("closed form")));
+/// let r = route(&PlanarParams::new(1e-3, 0.0, 1e-3), Quantity::Tip)?;
+/// assert_eq!(r.regime, "gently bent");
+/// # Ok::<(), rod_ig_core::RodError>(())
+/// ```
+pub fn route(a: &PlanarParams, quantity: Quantity) -> Result<Route, RodError> {
+    let mut r = Route::default();
+    match quantity {
+        Quantity::Tip => tip_with(a, &mut r).map(drop),
+        Quantity::TipAndJacobian => pose_and_jacobian_with(a, 1.0, &mut r).map(drop),
+        Quantity::Energy => energy_with(a, &mut r).map(drop),
+        Quantity::Stability => stability_with(a, &mut r).map(drop),
+        Quantity::Verdict => verdict_with(a, &mut r).map(drop),
+        Quantity::Evaluation => evaluation_with(a, &mut r).map(drop),
+        Quantity::Shape => shape_with(a, &mut r).map(drop),
+    }?;
+    Ok(r)
+}
+
+/// `answer` from `formulation`, recorded.
+#[inline(always)]
+fn ask<T, R: Record>(
+    r: &mut R,
+    formulation: &'static str,
+    answer: Option<Result<T, RodError>>,
+) -> Option<Result<T, RodError>> {
+    r.asked(formulation, answer.is_some());
+    answer
+}
+
+/// The answer of a formulation that always answers, recorded.
+#[inline(always)]
+fn last<T, R: Record>(
+    r: &mut R,
+    formulation: &'static str,
+    answer: Result<T, RodError>,
+) -> Result<T, RodError> {
+    r.asked(formulation, true);
+    answer
+}
+
+/// [`classify`], recorded.
+#[inline(always)]
+fn classified<'a, R: Record>(a: &'a PlanarParams, r: &mut R) -> Result<Class<'a>, RodError> {
+    let class = classify(a)?;
+    r.regime(match &class {
+        Class::StrongForce => "strong force",
+        Class::Within(regime) => regime.name(),
+    });
+    Ok(class)
+}
+
+/// [`regime`], recorded.
+#[inline(always)]
+fn regime_recorded<'a, R: Record>(a: &'a PlanarParams, r: &mut R) -> Result<Regime<'a>, RodError> {
+    let regime = regime(a)?;
+    r.regime(regime.name());
+    Ok(regime)
+}
+
+impl Regime<'_> {
+    /// Its name in a [`Route`].
+    #[inline(always)]
+    fn name(&self) -> &'static str {
+        match self {
+            Regime::SeparatrixLimit(_) => "separatrix limit",
+            Regime::GentlyBent => "gently bent",
+            Regime::ClosedForm => "closed form",
+        }
+    }
+}
+
 /// The f64 closed form of a (with its phase φ when `phase`, else placed by the addition
 /// theorems) handed to `closed`; where it cannot be built, refused beyond √‖F‖ = ln(f64::MAX)
 /// under tension, else the rod without it handed to `after`. Built in place
 /// (`Closed::complete`): through an Option the form was copied.
 #[inline]
-fn with_closed_f64<R>(
+fn with_closed_f64<T, R: Record>(
     a: &PlanarParams,
     phase: bool,
-    closed: impl FnOnce(&ClosedForm<'_, f64>) -> Result<R, RodError>,
-    after: impl FnOnce(Rod<'_>) -> Result<R, RodError>,
-) -> Result<R, RodError> {
+    r: &mut R,
+    closed: impl FnOnce(&ClosedForm<'_, f64>, &mut R) -> Result<T, RodError>,
+    after: impl FnOnce(Rod<'_>, &mut R) -> Result<T, RodError>,
+) -> Result<T, RodError> {
     let mut c = Closed::<f64>::straight(a[0], a[1], a[2]);
     if !c.complete(a[0], a[1], a[2], phase) {
+        r.asked("closed form (overflowed)", false);
         tension_within_f64(a)?;
-        return after(Rod::without_closed(a));
+        return after(Rod::without_closed(a), r);
     }
-    closed(&ClosedForm::new(&c, a))
+    closed(&ClosedForm::new(&c, a), r)
 }
 
 /// [`with_closed_f64`] in dual numbers seeded with the identity on a (≈ 1 KB, borrowed where
 /// it is built, never moved): `closed` gets the formulation and the form itself.
 #[inline]
-fn with_closed_dual<R>(
+fn with_closed_dual<T, R: Record>(
     a: &PlanarParams,
     phase: bool,
-    closed: impl FnOnce(&ClosedForm<'_, Dual3>, &Closed<Dual3>) -> Result<R, RodError>,
-    after: impl FnOnce(Rod<'_>) -> Result<R, RodError>,
-) -> Result<R, RodError> {
+    r: &mut R,
+    closed: impl FnOnce(&ClosedForm<'_, Dual3>, &Closed<Dual3>, &mut R) -> Result<T, RodError>,
+    after: impl FnOnce(Rod<'_>, &mut R) -> Result<T, RodError>,
+) -> Result<T, RodError> {
     let (a3, a4, a5) = (
         Dual3::variable(a[0], 0),
         Dual3::variable(a[1], 1),
@@ -182,33 +327,47 @@ fn with_closed_dual<R>(
     if !c.complete(a3, a4, a5, phase) {
         // The closed form's intermediate ratios overflowed (e.g. a tiny moment against a
         // moderate force).
+        r.asked("closed form (overflowed)", false);
         tension_within_f64(a)?;
-        return after(Rod::without_closed(a));
+        return after(Rod::without_closed(a), r);
     }
-    closed(&ClosedForm::new(&c, a), &c)
+    closed(&ClosedForm::new(&c, a), &c, r)
 }
 
 /// The tip q(1).
 #[inline]
 pub(crate) fn tip(a: &PlanarParams) -> Result<PlanarPose, RodError> {
-    match classify(a)? {
-        Class::StrongForce => Ok(domain_evaluation(a)?.tip),
-        Class::Within(Regime::SeparatrixLimit(limit)) => limit.tip(),
-        Class::Within(Regime::GentlyBent) => tip_after(Rod::without_closed(a)),
+    tip_with(a, &mut ())
+}
+
+#[inline]
+fn tip_with<R: Record>(a: &PlanarParams, r: &mut R) -> Result<PlanarPose, RodError> {
+    match classified(a, r)? {
+        Class::StrongForce => last(r, "full evaluation", domain_evaluation(a).map(|e| e.tip)),
+        Class::Within(Regime::SeparatrixLimit(limit)) => last(r, "separatrix limit", limit.tip()),
+        Class::Within(Regime::GentlyBent) => tip_after(Rod::without_closed(a), r),
         Class::Within(Regime::ClosedForm) => with_closed_f64(
             a,
             false,
-            |cf| cf.tip().unwrap_or_else(|| tip_after(Rod::after(cf, None))),
+            r,
+            |cf, r| match ask(r, "closed form", cf.tip()) {
+                Some(answer) => answer,
+                None => tip_after(Rod::after(cf, None), r),
+            },
             tip_after,
         ),
     }
 }
 
-fn tip_after(rod: Rod) -> Result<PlanarPose, RodError> {
-    SmallAngle(rod)
-        .tip()
-        .or_else(|| IllConditioned(rod).tip())
-        .unwrap_or_else(|| Series(rod).tip())
+#[inline]
+fn tip_after<R: Record>(rod: Rod, r: &mut R) -> Result<PlanarPose, RodError> {
+    if let Some(answer) = ask(r, "small angle", SmallAngle(rod).tip()) {
+        return answer;
+    }
+    if let Some(answer) = ask(r, "ill-conditioned", IllConditioned(rod).tip()) {
+        return answer;
+    }
+    last(r, "series", Series(rod).tip())
 }
 
 /// q(t) and J(t) for an answer (beyond the ordinary force the full evaluation's J(1), and its
@@ -218,17 +377,28 @@ pub(crate) fn pose_and_jacobian(
     a: &PlanarParams,
     t: f64,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-    let regime = match classify(a)? {
+    pose_and_jacobian_with(a, t, &mut ())
+}
+
+#[inline]
+fn pose_and_jacobian_with<R: Record>(
+    a: &PlanarParams,
+    t: f64,
+    r: &mut R,
+) -> Result<(PlanarPose, PlanarJacobian), RodError> {
+    let regime = match classified(a, r)? {
         Class::Within(regime) => regime,
         Class::StrongForce => {
             let e = domain_evaluation(a)?;
             if t == 1.0 {
+                r.asked("full evaluation", true);
                 return Ok((e.tip, e.jacobian));
             }
+            r.asked("full evaluation (J(1) only)", false);
             regime_within(a)
         }
     };
-    pose_and_jacobian_in(a, regime, t, Precision::Answer)
+    pose_and_jacobian_in(a, regime, t, Precision::Answer, r)
 }
 
 /// q(1) and J(1) for a solver's iteration or a continuation's substep (no full evaluation:
@@ -238,31 +408,46 @@ pub(crate) fn solver_tip_and_jacobian(
     a: &PlanarParams,
     precision: Precision,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-    pose_and_jacobian_in(a, regime(a)?, 1.0, precision)
+    pose_and_jacobian_in(a, regime(a)?, 1.0, precision, &mut ())
 }
 
 #[inline]
-fn pose_and_jacobian_in(
+fn pose_and_jacobian_in<R: Record>(
     a: &PlanarParams,
     regime: Regime,
     t: f64,
     precision: Precision,
+    r: &mut R,
 ) -> Result<(PlanarPose, PlanarJacobian), RodError> {
-    let after = |rod: Rod| {
-        SmallAngle(rod)
-            .pose_and_jacobian(t, precision)
-            .or_else(|| IllConditioned(rod).pose_and_jacobian(t, precision))
-            .unwrap_or_else(|| Series(rod).pose_and_jacobian(t, precision))
+    let after = |rod: Rod, r: &mut R| {
+        if let Some(answer) = ask(
+            r,
+            "small angle",
+            SmallAngle(rod).pose_and_jacobian(t, precision),
+        ) {
+            return answer;
+        }
+        if let Some(answer) = ask(
+            r,
+            "ill-conditioned",
+            IllConditioned(rod).pose_and_jacobian(t, precision),
+        ) {
+            return answer;
+        }
+        last(r, "series", Series(rod).pose_and_jacobian(t, precision))
     };
     match regime {
-        Regime::SeparatrixLimit(limit) => limit.pose_and_jacobian(t, precision),
-        Regime::GentlyBent => after(Rod::without_closed(a)),
+        Regime::SeparatrixLimit(limit) => {
+            last(r, "separatrix limit", limit.pose_and_jacobian(t, precision))
+        }
+        Regime::GentlyBent => after(Rod::without_closed(a), r),
         Regime::ClosedForm => with_closed_dual(
             a,
             false,
-            |cf, c| {
-                cf.pose_and_jacobian(t, precision)
-                    .unwrap_or_else(|| after(Rod::after(cf, Some(c))))
+            r,
+            |cf, c, r| match ask(r, "closed form", cf.pose_and_jacobian(t, precision)) {
+                Some(answer) => answer,
+                None => after(Rod::after(cf, Some(c)), r),
             },
             after,
         ),
@@ -273,26 +458,41 @@ fn pose_and_jacobian_in(
 /// certificate, and the identity cancels on nearly straight rods).
 #[inline]
 pub(crate) fn energy(a: &PlanarParams) -> Result<f64, RodError> {
-    let regime = match classify(a)? {
-        Class::StrongForce => return Ok(domain_evaluation(a)?.energy),
+    energy_with(a, &mut ())
+}
+
+#[inline]
+fn energy_with<R: Record>(a: &PlanarParams, r: &mut R) -> Result<f64, RodError> {
+    let regime = match classified(a, r)? {
+        Class::StrongForce => {
+            return last(r, "full evaluation", domain_evaluation(a).map(|e| e.energy))
+        }
         Class::Within(regime) => regime,
     };
-    if let Some(e) = SmallAngle(Rod::without_closed(a)).energy() {
+    if let Some(e) = ask(
+        r,
+        "small angle",
+        SmallAngle(Rod::without_closed(a)).energy(),
+    ) {
         return e;
     }
     // The expansion was asked: not twice.
-    let after = |rod: Rod| {
-        IllConditioned(rod)
-            .energy()
-            .unwrap_or_else(|| Series(rod).energy())
+    let after = |rod: Rod, r: &mut R| match ask(r, "ill-conditioned", IllConditioned(rod).energy())
+    {
+        Some(answer) => answer,
+        None => last(r, "series", Series(rod).energy()),
     };
     match regime {
-        Regime::SeparatrixLimit(limit) => limit.energy(),
-        Regime::GentlyBent => after(Rod::without_closed(a)),
+        Regime::SeparatrixLimit(limit) => last(r, "separatrix limit", limit.energy()),
+        Regime::GentlyBent => after(Rod::without_closed(a), r),
         Regime::ClosedForm => with_closed_f64(
             a,
             true,
-            |cf| cf.energy().unwrap_or_else(|| after(Rod::after(cf, None))),
+            r,
+            |cf, r| match ask(r, "closed form", cf.energy()) {
+                Some(answer) => answer,
+                None => after(Rod::after(cf, None), r),
+            },
             after,
         ),
     }
@@ -301,11 +501,22 @@ pub(crate) fn energy(a: &PlanarParams) -> Result<f64, RodError> {
 /// The stability report.
 #[inline]
 pub(crate) fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
-    match classify(a)? {
-        Class::StrongForce => Ok(domain_evaluation(a)?.stability),
-        Class::Within(Regime::SeparatrixLimit(limit)) => limit.stability(),
-        Class::Within(Regime::GentlyBent) => stability_after(Rod::without_closed(a)),
-        Class::Within(Regime::ClosedForm) => stability_by_closed_form(a),
+    stability_with(a, &mut ())
+}
+
+#[inline]
+fn stability_with<R: Record>(a: &PlanarParams, r: &mut R) -> Result<StabilityReport, RodError> {
+    match classified(a, r)? {
+        Class::StrongForce => last(
+            r,
+            "full evaluation",
+            domain_evaluation(a).map(|e| e.stability),
+        ),
+        Class::Within(Regime::SeparatrixLimit(limit)) => {
+            last(r, "separatrix limit", limit.stability())
+        }
+        Class::Within(Regime::GentlyBent) => stability_after(Rod::without_closed(a), r),
+        Class::Within(Regime::ClosedForm) => stability_by_closed_form(a, r),
     }
 }
 
@@ -313,45 +524,68 @@ pub(crate) fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
 /// its own theorems do not decide (an inflectional rod with one or two inflection points).
 pub(crate) fn stability_from_closed_form(a: &PlanarParams) -> Result<StabilityReport, RodError> {
     if series_first(a) {
-        return stability_after(Rod::without_closed(a));
+        return stability_after(Rod::without_closed(a), &mut ());
     }
-    stability_by_closed_form(a)
+    stability_by_closed_form(a, &mut ())
 }
 
 /// The closed form has no stability of its own: it is built for the scans after it.
 #[inline]
-fn stability_by_closed_form(a: &PlanarParams) -> Result<StabilityReport, RodError> {
+fn stability_by_closed_form<R: Record>(
+    a: &PlanarParams,
+    r: &mut R,
+) -> Result<StabilityReport, RodError> {
     with_closed_dual(
         a,
         true,
-        |cf, c| stability_after(Rod::after(cf, Some(c))),
+        r,
+        |cf, c, r| stability_after(Rod::after(cf, Some(c)), r),
         stability_after,
     )
 }
 
-fn stability_after(rod: Rod) -> Result<StabilityReport, RodError> {
-    SmallAngle(rod)
-        .stability()
-        .or_else(|| ClosedScan(rod).stability())
-        .or_else(|| IllConditioned(rod).stability())
-        .unwrap_or_else(|| Series(rod).stability())
+fn stability_after<R: Record>(rod: Rod, r: &mut R) -> Result<StabilityReport, RodError> {
+    if let Some(answer) = ask(r, "small angle", SmallAngle(rod).stability()) {
+        return answer;
+    }
+    if let Some(answer) = ask(r, "closed-form scans", ClosedScan(rod).stability()) {
+        return answer;
+    }
+    if let Some(answer) = ask(r, "ill-conditioned", IllConditioned(rod).stability()) {
+        return answer;
+    }
+    last(r, "series", Series(rod).stability())
 }
 
 /// The stability verdict alone: the closed form's where a theorem or det J(1) decides, else
 /// the report's.
 #[inline]
 pub(crate) fn verdict(a: &PlanarParams) -> Result<StabilityVerdict, RodError> {
-    let after = |rod: Rod| stability_after(rod).map(|r| r.verdict());
-    match classify(a)? {
-        Class::StrongForce => Ok(domain_evaluation(a)?.stability.verdict()),
-        Class::Within(Regime::SeparatrixLimit(limit)) => limit.stability().map(|r| r.verdict()),
-        Class::Within(Regime::GentlyBent) => after(Rod::without_closed(a)),
+    verdict_with(a, &mut ())
+}
+
+#[inline]
+fn verdict_with<R: Record>(a: &PlanarParams, r: &mut R) -> Result<StabilityVerdict, RodError> {
+    let after = |rod: Rod, r: &mut R| stability_after(rod, r).map(|report| report.verdict());
+    match classified(a, r)? {
+        Class::StrongForce => last(
+            r,
+            "full evaluation",
+            domain_evaluation(a).map(|e| e.stability.verdict()),
+        ),
+        Class::Within(Regime::SeparatrixLimit(limit)) => last(
+            r,
+            "separatrix limit",
+            limit.stability().map(|report| report.verdict()),
+        ),
+        Class::Within(Regime::GentlyBent) => after(Rod::without_closed(a), r),
         Class::Within(Regime::ClosedForm) => with_closed_dual(
             a,
             true,
-            |cf, c| {
-                cf.stability_verdict()
-                    .unwrap_or_else(|| after(Rod::after(cf, Some(c))))
+            r,
+            |cf, c, r| match ask(r, "closed form", cf.stability_verdict()) {
+                Some(answer) => answer,
+                None => after(Rod::after(cf, Some(c)), r),
             },
             after,
         ),
@@ -362,21 +596,30 @@ pub(crate) fn verdict(a: &PlanarParams) -> Result<StabilityVerdict, RodError> {
 /// force takes its regime).
 #[inline]
 pub(crate) fn evaluation(a: &PlanarParams) -> Result<Evaluation, RodError> {
-    let after = |rod: Rod| {
-        SmallAngle(rod)
-            .evaluate()
-            .or_else(|| IllConditioned(rod).evaluate())
-            .unwrap_or_else(|| Series(rod).evaluate())
+    evaluation_with(a, &mut ())
+}
+
+#[inline]
+fn evaluation_with<R: Record>(a: &PlanarParams, r: &mut R) -> Result<Evaluation, RodError> {
+    let after = |rod: Rod, r: &mut R| {
+        if let Some(answer) = ask(r, "small angle", SmallAngle(rod).evaluate()) {
+            return answer;
+        }
+        if let Some(answer) = ask(r, "ill-conditioned", IllConditioned(rod).evaluate()) {
+            return answer;
+        }
+        last(r, "series", Series(rod).evaluate())
     };
-    match regime(a)? {
-        Regime::SeparatrixLimit(limit) => limit.evaluate(),
-        Regime::GentlyBent => after(Rod::without_closed(a)),
+    match regime_recorded(a, r)? {
+        Regime::SeparatrixLimit(limit) => last(r, "separatrix limit", limit.evaluate()),
+        Regime::GentlyBent => after(Rod::without_closed(a), r),
         Regime::ClosedForm => with_closed_dual(
             a,
             true,
-            |cf, c| {
-                cf.evaluate()
-                    .unwrap_or_else(|| after(Rod::after(cf, Some(c))))
+            r,
+            |cf, c, r| match ask(r, "closed form", cf.evaluate()) {
+                Some(answer) => answer,
+                None => after(Rod::after(cf, Some(c)), r),
             },
             after,
         ),
@@ -386,19 +629,30 @@ pub(crate) fn evaluation(a: &PlanarParams) -> Result<Evaluation, RodError> {
 /// The shape ([`PlanarRod`]): its refusals and tip beyond the ordinary force are the full
 /// evaluation's, which `PlanarRod::new` asks first.
 pub(crate) fn shape(a: &PlanarParams) -> Result<PlanarRod, RodError> {
-    let after = |rod: Rod| {
-        SmallAngle(rod)
-            .shape()
-            .or_else(|| IllConditioned(rod).shape())
-            .unwrap_or_else(|| Series(rod).shape())
+    shape_with(a, &mut ())
+}
+
+fn shape_with<R: Record>(a: &PlanarParams, r: &mut R) -> Result<PlanarRod, RodError> {
+    let after = |rod: Rod, r: &mut R| {
+        if let Some(answer) = ask(r, "small angle", SmallAngle(rod).shape()) {
+            return answer;
+        }
+        if let Some(answer) = ask(r, "ill-conditioned", IllConditioned(rod).shape()) {
+            return answer;
+        }
+        last(r, "series", Series(rod).shape())
     };
-    match regime(a)? {
-        Regime::SeparatrixLimit(limit) => limit.shape(),
-        Regime::GentlyBent => after(Rod::without_closed(a)),
+    match regime_recorded(a, r)? {
+        Regime::SeparatrixLimit(limit) => last(r, "separatrix limit", limit.shape()),
+        Regime::GentlyBent => after(Rod::without_closed(a), r),
         Regime::ClosedForm => with_closed_f64(
             a,
             true,
-            |cf| cf.shape().unwrap_or_else(|| after(Rod::after(cf, None))),
+            r,
+            |cf, r| match ask(r, "closed form", cf.shape()) {
+                Some(answer) => answer,
+                None => after(Rod::after(cf, None), r),
+            },
             after,
         ),
     }

@@ -39,6 +39,7 @@ mod stability;
 mod taylor;
 
 pub use closed::Case;
+pub use dispatch::{route, Quantity, Route};
 pub use entry::{
     energy, evaluate, pose_and_jacobian, stability, stability_verdict, tip, tip_and_jacobian,
     Evaluation,

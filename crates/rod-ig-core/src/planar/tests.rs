@@ -793,3 +793,51 @@ mod substep_tests {
         );
     }
 }
+
+/// Each question reports its route (issue 53, item 1): the regime `classify` decided and the
+/// formulations asked in order; the one that answered is the chain's. A box rod's tip is the
+/// closed form's; a strong force's, the full evaluation's (its evaluation takes the separatrix
+/// limit where the rod is barely bent); a gently bent rod never builds the closed form; the
+/// energy asks the small-angle expansion first. Refusals are the question's own.
+#[test]
+fn every_question_reports_its_route() {
+    use crate::planar::dispatch::{route, Quantity};
+    let boxed = PlanarParams::new(2.0, -10.0, 5.0);
+    let r = route(&boxed, Quantity::Tip).expect("a box rod");
+    assert_eq!(
+        (r.regime, r.answered_by()),
+        ("closed form", Some("closed form"))
+    );
+    assert_eq!(r.asked, vec![("closed form", true)]);
+    let r = route(&boxed, Quantity::Energy).expect("a box rod");
+    assert_eq!(r.asked.first(), Some(&("small angle", false)));
+    let r = route(&boxed, Quantity::Stability).expect("a box rod");
+    assert!(r.asked.iter().all(|(f, _)| *f != "closed form"), "{r:?}");
+    let strong = PlanarParams::new(1e-200, 490_000.0, 0.0);
+    let r = route(&strong, Quantity::Tip).expect("answered");
+    assert_eq!(
+        (r.regime, r.answered_by()),
+        ("strong force", Some("full evaluation"))
+    );
+    let r = route(&strong, Quantity::Evaluation).expect("answered");
+    assert_eq!(
+        (r.regime, r.answered_by()),
+        ("separatrix limit", Some("separatrix limit"))
+    );
+    let gentle = PlanarParams::new(1e-3, 0.0, 1e-3);
+    for q in [
+        Quantity::Tip,
+        Quantity::TipAndJacobian,
+        Quantity::Shape,
+        Quantity::Verdict,
+    ] {
+        let r = route(&gentle, q).expect("a gently bent rod");
+        assert_eq!(r.regime, "gently bent", "{q:?}");
+        assert!(
+            r.asked.iter().all(|(f, _)| !f.starts_with("closed form")),
+            "{q:?}: {r:?}"
+        );
+        assert!(r.answered_by().is_some(), "{q:?}");
+    }
+    assert!(route(&PlanarParams::new(f64::NAN, 0.0, 0.0), Quantity::Tip).is_err());
+}

@@ -63,6 +63,7 @@ impl<'c, T: Real> ClosedForm<'c, T> {
 impl ClosedForm<'_, f64> {
     /// The closed form with everything that depends on a only precomputed, where its estimate
     /// holds.
+    #[inline]
     pub(crate) fn shape(&self) -> Answer<PlanarRod> {
         (self.need() == Need::Closed).then(|| {
             let backend = Backend::Closed(*self.c);
@@ -72,11 +73,13 @@ impl ClosedForm<'_, f64> {
     /// q(1) (docs/math.md §1–§3), where the estimate holds. Built without the phase, the tip is
     /// placed by the addition theorems (~18 % of q(1)); it may differ from the evaluation's in
     /// the last bits, both within the closed form's pose bound.
+    #[inline(always)]
     pub(crate) fn tip(&self) -> Answer<PlanarPose> {
         (self.need() == Need::Closed).then(|| super::finite_tip(self.c.pose(1.0)))
     }
     /// The identity or ζ where their bounds hold ([`identity_or_zeta`]); the other rows
     /// elsewhere.
+    #[inline]
     pub(crate) fn energy(&self) -> Answer<f64> {
         if self.need() != Need::Closed {
             return None;
@@ -96,6 +99,7 @@ pub(crate) const SUBSTEP_J_TOLERANCE: f64 = 1e-8 * 100.0;
 impl ClosedForm<'_, Dual3> {
     /// q(t) and J(t) in forward-mode dual numbers, exact up to rounding, where the estimate
     /// holds at t (for a continuation's substep, within [`SUBSTEP_J_TOLERANCE`]).
+    #[inline(always)]
     pub(crate) fn pose_and_jacobian(
         &self,
         t: f64,
@@ -107,9 +111,11 @@ impl ClosedForm<'_, Dual3> {
     }
     /// The verdict where a theorem, the sign of det J(1) or the scan from the theorem's
     /// conjugate-free time decides ([`stability::verdict_of`]); the stability rows elsewhere.
+    #[inline]
     pub(crate) fn stability_verdict(&self) -> Answer<StabilityVerdict> {
         stability::verdict_of(self.c, self.a).transpose()
     }
+    #[inline]
     pub(crate) fn evaluate(&self) -> Answer<Evaluation> {
         (self.need() == Need::Closed).then(|| {
             evaluate_closed(self.c, self.a).map(|e| with_theorem(e, || self.c.theorem_verdict()))
@@ -122,6 +128,7 @@ impl ClosedForm<'_, Dual3> {
 pub(crate) struct ClosedScan<'c>(pub(crate) Rod<'c>);
 
 impl ClosedScan<'_> {
+    #[inline]
     pub(crate) fn stability(&self) -> Answer<StabilityReport> {
         let c = self.0.closed?;
         let need = match self.0.need {
