@@ -16,9 +16,11 @@
 //! constants known to 32 digits). Overflow of the Dekker split (|x| ≳ 1e300) gives NaN, which
 //! the closed form reports as overflow.
 
+use crate::dual::{Dual, DualScalar};
 use crate::eft::{two_prod, two_sum};
+#[cfg(test)]
 use crate::scalar::Real;
-use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
+use std::ops::{Add, Div, Mul, Neg, Sub};
 
 /// Unit roundoff assumed for double-double arithmetic in error estimates: 2⁻¹⁰⁴ (the sloppy
 /// operations here lose up to two bits of the 2⁻¹⁰⁶ of an exact double-double rounding).
@@ -93,6 +95,17 @@ impl Dd {
         let r = r - Dd::from_f64(b).mul_f64(q2);
         let q3 = r.hi / b;
         quick_two_sum(q1, q2).add_f64(q3)
+    }
+
+    /// Division by a small positive integer `n` (a series' k + 1): one Newton-corrected
+    /// quotient, the remainder exact by Dekker's product; enough for a divisor exact in f64.
+    #[inline]
+    pub(crate) fn div_small_int(self, n: f64) -> Self {
+        let q1 = self.hi / n;
+        let (p, e) = two_prod(q1, n);
+        let r = ((self.hi - p) - e + self.lo) / n;
+        let (hi, lo) = two_sum(q1, r);
+        Self { hi, lo }
     }
 
     /// Scaling by a power of two (exact).
@@ -299,279 +312,97 @@ impl Div for Dd {
 }
 
 /// Forward-mode dual number over [`Dd`]: a value and its gradient with respect to three
-/// inputs, every part in double-double. The [`Real`] implementation that the closed forms run
-/// on for rods where f64 cancels ([`Real::EXTENDED`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct DualDd {
-    /// Value.
-    pub v: Dd,
-    /// Gradient ∂v/∂(p0, p1, p2).
-    pub g: [Dd; 3],
-}
+/// inputs, every part in double-double. The [`crate::scalar::Real`] implementation that the closed forms run
+/// on for rods where f64 cancels ([`crate::scalar::Real::EXTENDED`]); the chain rule is [`crate::dual`]'s.
+pub type DualDd = Dual<Dd>;
 
-impl DualDd {
-    /// A constant (zero gradient).
-    #[inline]
-    pub const fn constant(v: Dd) -> Self {
-        Self {
-            v,
-            g: [Dd::from_f64(0.0); 3],
-        }
-    }
-
-    /// The i-th independent variable at value v (gradient = i-th unit vector).
-    pub fn variable(v: f64, i: usize) -> Self {
-        let mut d = Self::constant(Dd::from_f64(v));
-        if let Some(gi) = d.g.get_mut(i) {
-            *gi = Dd::from_f64(1.0);
-        }
-        d
-    }
-
-    /// f with value `v` and derivative `d` (chain rule).
-    #[inline]
-    fn chain(self, v: Dd, d: Dd) -> Self {
-        Self {
-            v,
-            g: self.g.map(|g| g * d),
-        }
-    }
-
-    /// The value and the gradient rounded to f64.
-    pub fn to_f64(self) -> (f64, [f64; 3]) {
-        (self.v.to_f64(), self.g.map(Dd::to_f64))
-    }
-}
-
-impl Add for DualDd {
-    type Output = Self;
-    #[inline]
-    fn add(self, o: Self) -> Self {
-        Self {
-            v: self.v + o.v,
-            g: [self.g[0] + o.g[0], self.g[1] + o.g[1], self.g[2] + o.g[2]],
-        }
-    }
-}
-impl Sub for DualDd {
-    type Output = Self;
-    #[inline]
-    fn sub(self, o: Self) -> Self {
-        Self {
-            v: self.v - o.v,
-            g: [self.g[0] - o.g[0], self.g[1] - o.g[1], self.g[2] - o.g[2]],
-        }
-    }
-}
-impl Mul for DualDd {
-    type Output = Self;
-    #[inline]
-    fn mul(self, o: Self) -> Self {
-        Self {
-            v: self.v * o.v,
-            g: [
-                self.g[0] * o.v + self.v * o.g[0],
-                self.g[1] * o.v + self.v * o.g[1],
-                self.g[2] * o.v + self.v * o.g[2],
-            ],
-        }
-    }
-}
-impl Div for DualDd {
-    type Output = Self;
-    #[inline]
-    fn div(self, o: Self) -> Self {
-        let v = self.v / o.v;
-        let inv = o.v.recip();
-        Self {
-            v,
-            g: [
-                (self.g[0] - v * o.g[0]) * inv,
-                (self.g[1] - v * o.g[1]) * inv,
-                (self.g[2] - v * o.g[2]) * inv,
-            ],
-        }
-    }
-}
-impl Neg for DualDd {
-    type Output = Self;
-    #[inline]
-    fn neg(self) -> Self {
-        Self {
-            v: -self.v,
-            g: self.g.map(|g| -g),
-        }
-    }
-}
-impl Add<f64> for DualDd {
-    type Output = Self;
-    #[inline]
-    fn add(self, o: f64) -> Self {
-        Self {
-            v: self.v.add_f64(o),
-            g: self.g,
-        }
-    }
-}
-impl Sub<f64> for DualDd {
-    type Output = Self;
-    #[inline]
-    fn sub(self, o: f64) -> Self {
-        self + (-o)
-    }
-}
-impl Mul<f64> for DualDd {
-    type Output = Self;
-    #[inline]
-    fn mul(self, o: f64) -> Self {
-        Self {
-            v: self.v.mul_f64(o),
-            g: self.g.map(|g| g.mul_f64(o)),
-        }
-    }
-}
-impl Div<f64> for DualDd {
-    type Output = Self;
-    /// A true division (generic code writes x / 3.0 for exact thirds).
-    #[inline]
-    fn div(self, o: f64) -> Self {
-        Self {
-            v: self.v.div_f64(o),
-            g: self.g.map(|g| g.div_f64(o)),
-        }
-    }
-}
-impl AddAssign for DualDd {
-    #[inline]
-    fn add_assign(&mut self, o: Self) {
-        *self = *self + o;
-    }
-}
-impl SubAssign for DualDd {
-    #[inline]
-    fn sub_assign(&mut self, o: Self) {
-        *self = *self - o;
-    }
-}
-impl MulAssign for DualDd {
-    #[inline]
-    fn mul_assign(&mut self, o: Self) {
-        *self = *self * o;
-    }
-}
-
-impl Real for DualDd {
-    const HAS_DERIVATIVES: bool = true;
+impl DualScalar for Dd {
+    const ZERO: Self = Dd::from_f64(0.0);
+    const ONE: Self = Dd::from_f64(1.0);
     const EXTENDED: bool = true;
     const EPSILON: f64 = DD_EPSILON;
     #[inline]
     fn from_f64(v: f64) -> Self {
-        Self::constant(Dd::from_f64(v))
+        Dd::from_f64(v)
+    }
+    #[inline]
+    fn leading(self) -> f64 {
+        self.hi
+    }
+    #[inline]
+    fn to_f64(self) -> f64 {
+        Dd::to_f64(self)
     }
     #[inline]
     fn pi() -> Self {
-        Self::constant(PI_DD)
+        PI_DD
     }
     #[inline]
-    fn re(self) -> f64 {
-        self.v.hi
+    fn add_f64(self, v: f64) -> Self {
+        Dd::add_f64(self, v)
     }
-    /// Replaces the value by an f64: only for values known to f64 accuracy (generic code that
-    /// runs on [`DualDd`] must not call it; see [`Real::EXTENDED`]).
     #[inline]
-    fn with_re(self, v: f64) -> Self {
-        Self {
-            v: Dd::from_f64(v),
-            g: self.g,
-        }
+    fn mul_f64(self, v: f64) -> Self {
+        Dd::mul_f64(self, v)
+    }
+    /// A true division (generic code writes x / 3.0 for exact thirds).
+    #[inline]
+    fn div_f64(self, v: f64) -> Self {
+        Dd::div_f64(self, v)
+    }
+    #[inline]
+    fn quotient_and_recip(self, d: Self) -> (Self, Self) {
+        (self / d, d.recip())
+    }
+    #[inline]
+    fn recip(self) -> Self {
+        Dd::recip(self)
     }
     fn sqrt(self) -> Self {
-        let s = self.v.sqrt();
-        let d = if s.hi > 0.0 {
-            s.recip().scale(0.5)
-        } else {
-            Dd::default()
-        };
-        self.chain(s, d)
-    }
-    fn sin(self) -> Self {
-        let (s, c) = self.v.sin_cos();
-        self.chain(s, c)
-    }
-    fn cos(self) -> Self {
-        let (s, c) = self.v.sin_cos();
-        self.chain(c, -s)
+        Dd::sqrt(self)
     }
     fn sin_cos(self) -> (Self, Self) {
-        let (s, c) = self.v.sin_cos();
-        (self.chain(s, c), self.chain(c, -s))
+        Dd::sin_cos(self)
     }
-    fn asin(self) -> Self {
+    fn asin_and_slope(self) -> (Self, Self) {
         let one = Dd::from_f64(1.0);
-        let x = if self.v.hi > 1.0 {
+        let x = if self.hi > 1.0 {
             one
-        } else if self.v.hi < -1.0 {
+        } else if self.hi < -1.0 {
             -one
         } else {
-            self.v
+            self
         };
         let w = ((one - x) * (one + x)).sqrt();
         let d = if w.hi > 0.0 { w.recip() } else { Dd::default() };
-        self.chain(x.atan2(w), d)
+        (x.atan2(w), d)
     }
     fn atan(self) -> Self {
-        let one = Dd::from_f64(1.0);
-        self.chain(self.v.atan2(one), (one + self.v * self.v).recip())
+        Dd::atan2(self, Dd::from_f64(1.0))
     }
     fn atan2(self, x: Self) -> Self {
-        let y = self;
-        let r2 = x.v * x.v + y.v * y.v;
-        let inv = if r2.hi > 0.0 {
-            r2.recip()
-        } else {
-            Dd::default()
-        };
-        Self {
-            v: y.v.atan2(x.v),
-            g: [0, 1, 2].map(|i| (x.v * y.g[i] - y.v * x.g[i]) * inv),
-        }
+        Dd::atan2(self, x)
     }
     fn exp(self) -> Self {
-        let e = self.v.exp();
-        self.chain(e, e)
+        Dd::exp(self)
     }
     fn ln(self) -> Self {
-        self.chain(self.v.ln(), self.v.recip())
+        Dd::ln(self)
     }
     fn tanh(self) -> Self {
-        let t = self.v.tanh();
-        self.chain(t, Dd::from_f64(1.0) - t * t)
+        Dd::tanh(self)
     }
     fn sinh(self) -> Self {
-        self.chain(self.v.sinh(), self.v.cosh())
+        Dd::sinh(self)
     }
     fn cosh(self) -> Self {
-        self.chain(self.v.cosh(), self.v.sinh())
+        Dd::cosh(self)
     }
     fn asinh(self) -> Self {
-        let d = (Dd::from_f64(1.0) + self.v * self.v).sqrt().recip();
-        self.chain(self.v.asinh(), d)
-    }
-    #[inline]
-    fn abs(self) -> Self {
-        if self.v.hi < 0.0 {
-            -self
-        } else {
-            self
-        }
-    }
-    fn recip(self) -> Self {
-        let inv = self.v.recip();
-        self.chain(inv, -(inv * inv))
+        Dd::asinh(self)
     }
     fn is_finite(self) -> bool {
-        let fin = |d: Dd| d.hi.is_finite() && d.lo.is_finite();
-        fin(self.v) && self.g.iter().all(|&g| fin(g))
+        self.hi.is_finite() && self.lo.is_finite()
     }
 }
 

@@ -12,6 +12,7 @@
 //! Modules:
 //! - [`scalar`]: the [`scalar::Real`] trait and forward-mode dual numbers, so the closed forms
 //!   give exact derivatives.
+//! - [`dual`]: the one forward-mode dual number, generic over f64 and double-double.
 //! - [`dd`]: double-double numbers and their dual numbers, on which the same closed forms run
 //!   where f64 cancels (near the separatrix).
 //! - [`elliptic`]: Jacobi elliptic functions and Legendre/Carlson integrals, accurate when the
@@ -34,6 +35,7 @@
 mod angle;
 pub mod dd;
 pub mod deadline;
+pub mod dual;
 mod eft;
 pub mod elliptic;
 pub mod ends;

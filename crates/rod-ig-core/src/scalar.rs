@@ -1,11 +1,13 @@
-//! Scalars for the closed forms: the [`Real`] trait, implemented for `f64` and for the
-//! forward-mode dual number [`Dual3`] (value + gradient with respect to three inputs).
+//! Scalars for the closed forms: the [`Real`] trait, implemented for `f64` and for every
+//! forward-mode dual number [`crate::dual::Dual`] (value + gradient with respect to three
+//! inputs): [`Dual3`] over f64, [`crate::dd::DualDd`] over double-double.
 //!
 //! The planar closed forms (docs/math.md §1–§3) are written once, generic over [`Real`]. Run with
 //! `f64` they give the pose; run with [`Dual3`] seeded with the identity on a = (a3, a4, a5)
 //! they give the pose and its exact Jacobian J = ∂q/∂a in one pass (no finite differences).
 //! Branch decisions inside generic code are taken on [`Real::re`], the f64 value.
 
+use crate::dual::{Dual, DualScalar};
 use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 
 /// A real scalar usable by the closed forms: `f64` or a dual number.
@@ -283,198 +285,143 @@ pub fn fast_atan2(y: f64, x: f64) -> f64 {
     }
 }
 
-/// Forward-mode dual number: a value `v` and its gradient `g` with respect to three inputs.
-///
-/// Every operation applies the chain rule exactly; there is no heap allocation.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Dual3 {
-    /// Value.
-    pub v: f64,
-    /// Gradient ∂v/∂(p0, p1, p2).
-    pub g: [f64; 3],
-}
+/// Forward-mode dual number over f64: a value and its gradient with respect to three inputs
+/// (the chain rule is written once, in [`crate::dual`]).
+pub type Dual3 = Dual<f64>;
 
-impl Dual3 {
-    /// atan2(self, x) with the given value: d atan2(y, x) = (x dy − y dx)/(x² + y²).
-    #[inline]
-    fn atan2_with(self, x: Self, value: f64) -> Self {
-        let y = self;
-        let r2 = x.v * x.v + y.v * y.v;
-        let inv = if r2 > 0.0 { 1.0 / r2 } else { 0.0 };
-        Self {
-            v: value,
-            g: [
-                (x.v * y.g[0] - y.v * x.g[0]) * inv,
-                (x.v * y.g[1] - y.v * x.g[1]) * inv,
-                (x.v * y.g[2] - y.v * x.g[2]) * inv,
-            ],
-        }
-    }
-
-    /// A dual number from its value and gradient.
-    #[inline]
-    pub const fn new(v: f64, g: [f64; 3]) -> Self {
-        Self { v, g }
-    }
-    /// A constant (zero gradient).
-    #[inline]
-    pub const fn constant(v: f64) -> Self {
-        Self { v, g: [0.0; 3] }
-    }
-    /// The i-th independent variable (gradient = i-th unit vector); `i` ≥ 3 gives a constant.
-    #[inline]
-    pub fn variable(v: f64, i: usize) -> Self {
-        let mut g = [0.0; 3];
-        if let Some(gi) = g.get_mut(i) {
-            *gi = 1.0;
-        }
-        Self { v, g }
-    }
-    /// Applies f with value `v` and derivative `d` (chain rule).
-    #[inline]
-    fn chain(self, v: f64, d: f64) -> Self {
-        Self {
-            v,
-            g: [d * self.g[0], d * self.g[1], d * self.g[2]],
-        }
-    }
-}
-
-impl Add for Dual3 {
-    type Output = Self;
-    #[inline]
-    fn add(self, o: Self) -> Self {
-        Self {
-            v: self.v + o.v,
-            g: [self.g[0] + o.g[0], self.g[1] + o.g[1], self.g[2] + o.g[2]],
-        }
-    }
-}
-impl Sub for Dual3 {
-    type Output = Self;
-    #[inline]
-    fn sub(self, o: Self) -> Self {
-        Self {
-            v: self.v - o.v,
-            g: [self.g[0] - o.g[0], self.g[1] - o.g[1], self.g[2] - o.g[2]],
-        }
-    }
-}
-impl Mul for Dual3 {
-    type Output = Self;
-    #[inline]
-    fn mul(self, o: Self) -> Self {
-        Self {
-            v: self.v * o.v,
-            g: [
-                self.g[0] * o.v + self.v * o.g[0],
-                self.g[1] * o.v + self.v * o.g[1],
-                self.g[2] * o.v + self.v * o.g[2],
-            ],
-        }
-    }
-}
-impl Div for Dual3 {
-    type Output = Self;
-    #[inline]
-    fn div(self, o: Self) -> Self {
-        let inv = 1.0 / o.v;
-        let v = self.v * inv;
-        Self {
-            v,
-            g: [
-                (self.g[0] - v * o.g[0]) * inv,
-                (self.g[1] - v * o.g[1]) * inv,
-                (self.g[2] - v * o.g[2]) * inv,
-            ],
-        }
-    }
-}
-impl Neg for Dual3 {
-    type Output = Self;
-    #[inline]
-    fn neg(self) -> Self {
-        Self {
-            v: -self.v,
-            g: [-self.g[0], -self.g[1], -self.g[2]],
-        }
-    }
-}
-impl Add<f64> for Dual3 {
-    type Output = Self;
-    #[inline]
-    fn add(self, o: f64) -> Self {
-        Self {
-            v: self.v + o,
-            g: self.g,
-        }
-    }
-}
-impl Sub<f64> for Dual3 {
-    type Output = Self;
-    #[inline]
-    fn sub(self, o: f64) -> Self {
-        Self {
-            v: self.v - o,
-            g: self.g,
-        }
-    }
-}
-impl Mul<f64> for Dual3 {
-    type Output = Self;
-    #[inline]
-    fn mul(self, o: f64) -> Self {
-        Self {
-            v: self.v * o,
-            g: [self.g[0] * o, self.g[1] * o, self.g[2] * o],
-        }
-    }
-}
-impl Div<f64> for Dual3 {
-    type Output = Self;
-    #[inline]
-    fn div(self, o: f64) -> Self {
-        let inv = 1.0 / o;
-        self * inv
-    }
-}
-impl AddAssign for Dual3 {
-    #[inline]
-    fn add_assign(&mut self, o: Self) {
-        *self = *self + o;
-    }
-}
-impl SubAssign for Dual3 {
-    #[inline]
-    fn sub_assign(&mut self, o: Self) {
-        *self = *self - o;
-    }
-}
-impl MulAssign for Dual3 {
-    #[inline]
-    fn mul_assign(&mut self, o: Self) {
-        *self = *self * o;
-    }
-}
-
-impl Real for Dual3 {
-    const HAS_DERIVATIVES: bool = true;
+impl DualScalar for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const EXTENDED: bool = false;
+    const EPSILON: f64 = f64::EPSILON;
     #[inline]
     fn from_f64(v: f64) -> Self {
-        Self::constant(v)
+        v
+    }
+    #[inline]
+    fn leading(self) -> f64 {
+        self
+    }
+    #[inline]
+    fn to_f64(self) -> f64 {
+        self
+    }
+    #[inline]
+    fn pi() -> Self {
+        std::f64::consts::PI
+    }
+    #[inline]
+    fn add_f64(self, v: f64) -> Self {
+        self + v
+    }
+    #[inline]
+    fn mul_f64(self, v: f64) -> Self {
+        self * v
+    }
+    /// By the reciprocal (one division for the value and the three derivatives).
+    #[inline]
+    fn div_f64(self, v: f64) -> Self {
+        self * (1.0 / v)
+    }
+    #[inline]
+    fn quotient_and_recip(self, d: Self) -> (Self, Self) {
+        let inv = 1.0 / d;
+        (self * inv, inv)
+    }
+    #[inline]
+    fn recip(self) -> Self {
+        1.0 / self
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline]
+    fn sin_cos(self) -> (Self, Self) {
+        f64::sin_cos(self)
+    }
+    #[inline]
+    fn asin_and_slope(self) -> (Self, Self) {
+        let x = self.clamp(-1.0, 1.0);
+        let w = (1.0 - x * x).sqrt();
+        (x.asin(), if w > 0.0 { 1.0 / w } else { 0.0 })
+    }
+    #[inline]
+    fn atan(self) -> Self {
+        f64::atan(self)
+    }
+    #[inline]
+    fn atan2(self, x: Self) -> Self {
+        f64::atan2(self, x)
+    }
+    #[inline]
+    fn atan2_fast(self, x: Self) -> Self {
+        fast_atan2(self, x)
+    }
+    #[inline]
+    fn exp(self) -> Self {
+        f64::exp(self)
+    }
+    #[inline]
+    fn ln(self) -> Self {
+        f64::ln(self)
+    }
+    #[inline]
+    fn tanh(self) -> Self {
+        f64::tanh(self)
+    }
+    #[inline]
+    fn sinh(self) -> Self {
+        f64::sinh(self)
+    }
+    #[inline]
+    fn cosh(self) -> Self {
+        f64::cosh(self)
+    }
+    #[inline]
+    fn asinh(self) -> Self {
+        f64::asinh(self)
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+}
+
+/// The elementary functions of every dual number, by the chain rule on its scalar's own.
+impl<S: DualScalar> Real for Dual<S> {
+    const HAS_DERIVATIVES: bool = true;
+    const EXTENDED: bool = S::EXTENDED;
+    const EPSILON: f64 = S::EPSILON;
+    #[inline]
+    fn from_f64(v: f64) -> Self {
+        Self::constant(S::from_f64(v))
+    }
+    #[inline]
+    fn pi() -> Self {
+        Self::constant(S::pi())
     }
     #[inline]
     fn re(self) -> f64 {
-        self.v
+        self.v.leading()
     }
+    /// Replaces the value by an f64: for a double-double scalar only for values known to f64
+    /// accuracy (generic code that runs on it must not call this; see [`Real::EXTENDED`]).
     #[inline]
     fn with_re(self, v: f64) -> Self {
-        Dual3 { v, g: self.g }
+        Self {
+            v: S::from_f64(v),
+            g: self.g,
+        }
     }
     #[inline]
     fn sqrt(self) -> Self {
         let s = self.v.sqrt();
-        let d = if s > 0.0 { 0.5 / s } else { 0.0 };
+        let d = if s.leading() > 0.0 {
+            s.recip().mul_f64(0.5)
+        } else {
+            S::ZERO
+        };
         self.chain(s, d)
     }
     #[inline]
@@ -494,14 +441,12 @@ impl Real for Dual3 {
     }
     #[inline]
     fn asin(self) -> Self {
-        let x = self.v.clamp(-1.0, 1.0);
-        let w = (1.0 - x * x).sqrt();
-        let d = if w > 0.0 { 1.0 / w } else { 0.0 };
-        self.chain(x.asin(), d)
+        let (v, d) = self.v.asin_and_slope();
+        self.chain(v, d)
     }
     #[inline]
     fn atan(self) -> Self {
-        self.chain(self.v.atan(), 1.0 / (1.0 + self.v * self.v))
+        self.chain(self.v.atan(), (S::ONE + self.v * self.v).recip())
     }
     #[inline]
     fn atan2(self, x: Self) -> Self {
@@ -509,11 +454,11 @@ impl Real for Dual3 {
     }
     #[inline]
     fn atan2_slope(self, x: Self) -> Self {
-        self.atan2_with(x, 0.0)
+        self.atan2_with(x, S::ZERO)
     }
     #[inline]
     fn atan2_fast(self, x: Self) -> Self {
-        self.atan2_with(x, fast_atan2(self.v, x.v))
+        self.atan2_with(x, self.v.atan2_fast(x.v))
     }
     #[inline]
     fn exp(self) -> Self {
@@ -522,12 +467,12 @@ impl Real for Dual3 {
     }
     #[inline]
     fn ln(self) -> Self {
-        self.chain(self.v.ln(), 1.0 / self.v)
+        self.chain(self.v.ln(), self.v.recip())
     }
     #[inline]
     fn tanh(self) -> Self {
         let t = self.v.tanh();
-        self.chain(t, 1.0 - t * t)
+        self.chain(t, S::ONE - t * t)
     }
     #[inline]
     fn sinh(self) -> Self {
@@ -539,11 +484,12 @@ impl Real for Dual3 {
     }
     #[inline]
     fn asinh(self) -> Self {
-        self.chain(self.v.asinh(), 1.0 / (1.0 + self.v * self.v).sqrt())
+        let d = (S::ONE + self.v * self.v).sqrt().recip();
+        self.chain(self.v.asinh(), d)
     }
     #[inline]
     fn abs(self) -> Self {
-        if self.v < 0.0 {
+        if self.v.leading() < 0.0 {
             -self
         } else {
             self
@@ -551,8 +497,8 @@ impl Real for Dual3 {
     }
     #[inline]
     fn recip(self) -> Self {
-        let inv = 1.0 / self.v;
-        self.chain(inv, -inv * inv)
+        let inv = self.v.recip();
+        self.chain(inv, -(inv * inv))
     }
     #[inline]
     fn is_finite(self) -> bool {

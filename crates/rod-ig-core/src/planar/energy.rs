@@ -4,7 +4,7 @@
 //! shape, which both ask it.
 
 use crate::planar::closed::{overflow, Case, Closed, ENERGY_REL_TOLERANCE, SERIES_DD_MAX_ROOT_F};
-use crate::planar::taylor::{series_dd, series_f64, Gradient};
+use crate::planar::taylor::{series_dd, series_f64, DdStandard, Gradient};
 use crate::planar::{extended, small_angle};
 use crate::scalar::Real;
 use crate::{PlanarParams, PlanarPose, RodError};
@@ -98,7 +98,7 @@ pub(crate) fn closed_energy<T: Real>(
     let e = if c.needs_precise_series() && root_f > SERIES_F64_TIP_MAX_ROOT_F {
         match extended::energy(a) {
             Some(e) => e,
-            None => series_dd::<false>(a, false, SERIES_DD_MAX_ROOT_F)?
+            None => series_dd::<DdStandard>(a, false, SERIES_DD_MAX_ROOT_F)?
                 .energy()
                 .value(),
         }

@@ -23,7 +23,7 @@
 //! step from 0 to 1; otherwise h shrinks until the estimate holds at [`MAX_ORDER`]. The scale of
 //! every series is kept up to date term by term, so each order's test reads two terms only.
 
-use crate::eft::{two_prod, two_sum};
+use crate::dd::{Dd, DualDd};
 use crate::scalar::Dual3;
 use crate::RodError;
 
@@ -44,8 +44,8 @@ const MIN_STEP: f64 = 1e-9;
 
 /// What the recurrences need of a scalar: ring operations, exact division by the small
 /// integers k + 1, and the magnitudes used for error control (the value and, for a dual number,
-/// each derivative). Implemented by f64, [`Dual3`] (J in the same pass) and [`DoubleF64`]
-/// (tips of ill-conditioned rods).
+/// each derivative). Implemented by f64, [`Dual3`] (J in the same pass) and [`DualDd`]
+/// (ill-conditioned rods).
 pub(crate) trait Measured:
     Copy
     + std::ops::Add<Output = Self>
@@ -54,7 +54,7 @@ pub(crate) trait Measured:
     + std::ops::Neg<Output = Self>
     + std::ops::AddAssign
 {
-    /// Number of measured parts (1 for f64 and [`DoubleF64`], 4 for [`Dual3`]).
+    /// Number of measured parts (1 for f64, 4 for a dual number).
     const PARTS: usize;
     /// Truncation tolerance relative to each series' own scale: one unit roundoff of the type,
     /// so the truncation error stays below the rounding error of the sum.
@@ -127,58 +127,104 @@ impl Measured for Dual3 {
 /// to 1e-10 of its own scale.
 pub(crate) const COARSE_TAIL_TOL: f64 = 1e-10;
 
-/// A [`Dual3`] whose series are truncated at [`COARSE_TAIL_TOL`] instead of one unit roundoff:
-/// longer steps (about 1.4× at order 32) for the short series of the stability scan, whose g
-/// is taken to 1e-3 (see `stability::ShortSeries`); its entries carry a correspondingly larger
-/// error bound there.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct CoarseDual3(pub(crate) Dual3);
+/// Truncation per step of the tight double-double series, near the 1e-32 rounding of the
+/// type: the cross-check of the closed form beyond √‖F‖ = 27, where rounding and truncation
+/// grow like 1/m1 per loop past the straight equilibrium (with 1e-22 the series disagreed with
+/// the closed form on 59 of 1,300 reference rods, with this on 12, for ≈ 1.7× the steps).
+const TIGHT_TAIL_TOL: f64 = 1e-30;
 
-impl std::ops::Add for CoarseDual3 {
+/// Where a series scalar truncates each step, instead of at its own unit roundoff.
+pub(crate) trait TailTolerance: Copy + std::fmt::Debug + Default + PartialEq {
+    /// Truncation relative to each series' own scale ([`Measured::TAIL_TOL`]).
+    const TOL: f64;
+}
+
+/// [`COARSE_TAIL_TOL`]: longer steps (about 1.4× at order 32) for the short series of the
+/// stability scan, whose g is taken to 1e-3 (see `stability::ShortSeries`); its entries carry
+/// a correspondingly larger error bound there.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Coarse;
+impl TailTolerance for Coarse {
+    const TOL: f64 = COARSE_TAIL_TOL;
+}
+
+/// 1e-22 per step for the double-double series: the rods that need double-double amplify
+/// local errors by up to e^{√F} ≲ 1e12 over the rest of the rod (√F ≲ 28 along the straight
+/// part before and after the loop, measured on the strong-force oracle block), which leaves
+/// ≤ 1e-10 at the tip; a smaller tolerance costs ≈ 2.4× the steps per 12 decades.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct DdStandard;
+impl TailTolerance for DdStandard {
+    const TOL: f64 = 1e-22;
+}
+
+/// [`TIGHT_TAIL_TOL`]: the double-double series as the closed form's cross-check.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct DdTight;
+impl TailTolerance for DdTight {
+    const TOL: f64 = TIGHT_TAIL_TOL;
+}
+
+/// A series scalar `T` truncated at `K`'s tolerance: the same arithmetic, another step length.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Truncated<T, K>(pub(crate) T, std::marker::PhantomData<K>);
+
+impl<T, K> Truncated<T, K> {
+    /// `t` truncated at `K`'s tolerance.
+    #[inline]
+    pub(crate) const fn new(t: T) -> Self {
+        Self(t, std::marker::PhantomData)
+    }
+}
+
+/// [`Dual3`] truncated at [`COARSE_TAIL_TOL`]: the stability scan's short series.
+pub(crate) type CoarseDual3 = Truncated<Dual3, Coarse>;
+
+impl<T: std::ops::Add<Output = T>, K> std::ops::Add for Truncated<T, K> {
     type Output = Self;
     #[inline]
     fn add(self, o: Self) -> Self {
-        Self(self.0 + o.0)
+        Self::new(self.0 + o.0)
     }
 }
 
-impl std::ops::Sub for CoarseDual3 {
+impl<T: std::ops::Sub<Output = T>, K> std::ops::Sub for Truncated<T, K> {
     type Output = Self;
     #[inline]
     fn sub(self, o: Self) -> Self {
-        Self(self.0 - o.0)
+        Self::new(self.0 - o.0)
     }
 }
 
-impl std::ops::Mul for CoarseDual3 {
+impl<T: std::ops::Mul<Output = T>, K> std::ops::Mul for Truncated<T, K> {
     type Output = Self;
     #[inline]
     fn mul(self, o: Self) -> Self {
-        Self(self.0 * o.0)
+        Self::new(self.0 * o.0)
     }
 }
 
-impl std::ops::Neg for CoarseDual3 {
+impl<T: std::ops::Neg<Output = T>, K> std::ops::Neg for Truncated<T, K> {
     type Output = Self;
     #[inline]
     fn neg(self) -> Self {
-        Self(-self.0)
+        Self::new(-self.0)
     }
 }
 
-impl std::ops::AddAssign for CoarseDual3 {
+impl<T: std::ops::AddAssign, K> std::ops::AddAssign for Truncated<T, K> {
     #[inline]
     fn add_assign(&mut self, o: Self) {
         self.0 += o.0;
     }
 }
 
-impl Measured for CoarseDual3 {
-    const PARTS: usize = 4;
-    const TAIL_TOL: f64 = COARSE_TAIL_TOL;
+impl<T: Measured, K: TailTolerance> Measured for Truncated<T, K> {
+    const PARTS: usize = T::PARTS;
+    const TAIL_TOL: f64 = K::TOL;
     #[inline]
     fn constant(v: f64) -> Self {
-        Self(Dual3::constant(v))
+        Self::new(T::constant(v))
     }
     #[inline]
     fn part(self, i: usize) -> f64 {
@@ -186,225 +232,55 @@ impl Measured for CoarseDual3 {
     }
     #[inline]
     fn div_n(self, n: f64) -> Self {
-        Self(self.0.div_n(n))
+        Self::new(self.0.div_n(n))
     }
     #[inline]
     fn mul_f(self, h: f64) -> Self {
-        Self(self.0.mul_f(h))
+        Self::new(self.0.mul_f(h))
     }
     #[inline]
     fn mul_values(self, o: Self) -> Self {
-        Self(self.0.mul_values(o.0))
+        Self::new(self.0.mul_values(o.0))
     }
 }
 
-/// A double-double number hi + lo (|lo| ≤ ulp(hi)/2), ≈ 106-bit significand, by the error-free
-/// transformations of Dekker (1971) and Knuth (TwoSum). Used for the tip of rods whose f64
-/// integration is ill-conditioned (strong axial force: rounding made while the rod loops grows
-/// like e^{√F (1 − t)} while it then sits near the unstable straight equilibrium).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct DoubleF64 {
-    hi: f64,
-    lo: f64,
-}
-
-impl DoubleF64 {
-    /// The nearest f64.
-    pub fn to_f64(self) -> f64 {
-        self.hi + self.lo
-    }
-    #[inline]
-    fn renorm(hi: f64, lo: f64) -> Self {
-        let (hi, lo) = two_sum(hi, lo);
-        Self { hi, lo }
-    }
-}
-
-impl std::ops::Add for DoubleF64 {
-    type Output = Self;
-    #[inline]
-    fn add(self, o: Self) -> Self {
-        let (s, e) = two_sum(self.hi, o.hi);
-        Self::renorm(s, e + self.lo + o.lo)
-    }
-}
-impl std::ops::Neg for DoubleF64 {
-    type Output = Self;
-    #[inline]
-    fn neg(self) -> Self {
-        Self {
-            hi: -self.hi,
-            lo: -self.lo,
-        }
-    }
-}
-impl std::ops::Sub for DoubleF64 {
-    type Output = Self;
-    #[inline]
-    fn sub(self, o: Self) -> Self {
-        self + (-o)
-    }
-}
-impl std::ops::Mul for DoubleF64 {
-    type Output = Self;
-    #[inline]
-    fn mul(self, o: Self) -> Self {
-        let (p, e) = two_prod(self.hi, o.hi);
-        Self::renorm(p, e + self.hi * o.lo + self.lo * o.hi)
-    }
-}
-impl std::ops::AddAssign for DoubleF64 {
-    #[inline]
-    fn add_assign(&mut self, o: Self) {
-        *self = *self + o;
-    }
-}
-
-impl Measured for DoubleF64 {
-    const PARTS: usize = 1;
-    /// Truncation 1e-22 per step: the rods that need double-double amplify local errors by up
-    /// to e^{√F} ≲ 1e12 over the rest of the rod (√F ≲ 28 along the straight part before and
-    /// after the loop, measured on the strong-force oracle block), which leaves ≤ 1e-10 at the
-    /// tip; a smaller tolerance costs ≈ 2.4× the steps per 12 decades.
-    const TAIL_TOL: f64 = 1e-22;
-    #[inline]
-    fn constant(v: f64) -> Self {
-        Self { hi: v, lo: 0.0 }
-    }
-    #[inline]
-    fn part(self, _: usize) -> f64 {
-        self.hi.abs()
-    }
-    #[inline]
-    fn div_n(self, n: f64) -> Self {
-        // One Newton-corrected quotient: q = hi/n, remainder exact by two_prod.
-        let q1 = self.hi / n;
-        let (p, e) = two_prod(q1, n);
-        let r = ((self.hi - p) - e + self.lo) / n;
-        Self::renorm(q1, r)
-    }
-    #[inline]
-    fn mul_f(self, h: f64) -> Self {
-        let (p, e) = two_prod(self.hi, h);
-        Self::renorm(p, e + self.lo * h)
-    }
-}
-
-/// Truncation per step of the tight double-double series (`DualF64x2<true>`), near the 1e-32
-/// rounding of the type: the cross-check of the closed form beyond √‖F‖ = 27, where rounding and
-/// truncation grow like 1/m1 per loop past the straight equilibrium (with 1e-22 the series
-/// disagreed with the closed form on 59 of 1,300 reference rods, with this on 12, for ≈ 1.7×
-/// the steps).
-const TIGHT_TAIL_TOL: f64 = 1e-30;
-
-/// A dual number over [`DoubleF64`]: J of ill-conditioned rods in the same pass as the tip.
-/// `TIGHT` selects the truncation tolerance ([`TIGHT_TAIL_TOL`] instead of 1e-22).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct DualF64x2<const TIGHT: bool = false> {
-    v: DoubleF64,
-    g: [DoubleF64; 3],
-}
-
-impl<const TIGHT: bool> DualF64x2<TIGHT> {
-    /// The i-th independent variable.
-    pub fn variable(v: f64, i: usize) -> Self {
-        let mut g = [DoubleF64::default(); 3];
-        g[i] = DoubleF64::constant(1.0);
-        Self {
-            v: DoubleF64::constant(v),
-            g,
-        }
-    }
-}
-
-impl<const TIGHT: bool> std::ops::Add for DualF64x2<TIGHT> {
-    type Output = Self;
-    #[inline]
-    fn add(self, o: Self) -> Self {
-        Self {
-            v: self.v + o.v,
-            g: [self.g[0] + o.g[0], self.g[1] + o.g[1], self.g[2] + o.g[2]],
-        }
-    }
-}
-impl<const TIGHT: bool> std::ops::Neg for DualF64x2<TIGHT> {
-    type Output = Self;
-    #[inline]
-    fn neg(self) -> Self {
-        Self {
-            v: -self.v,
-            g: [-self.g[0], -self.g[1], -self.g[2]],
-        }
-    }
-}
-impl<const TIGHT: bool> std::ops::Sub for DualF64x2<TIGHT> {
-    type Output = Self;
-    #[inline]
-    fn sub(self, o: Self) -> Self {
-        self + (-o)
-    }
-}
-impl<const TIGHT: bool> std::ops::Mul for DualF64x2<TIGHT> {
-    type Output = Self;
-    #[allow(clippy::suspicious_arithmetic_impl)] // the product rule adds two products
-    #[inline]
-    fn mul(self, o: Self) -> Self {
-        let g = |i: usize| self.g[i] * o.v + self.v * o.g[i];
-        Self {
-            v: self.v * o.v,
-            g: [g(0), g(1), g(2)],
-        }
-    }
-}
-impl<const TIGHT: bool> std::ops::AddAssign for DualF64x2<TIGHT> {
-    #[inline]
-    fn add_assign(&mut self, o: Self) {
-        *self = *self + o;
-    }
-}
-
-impl<const TIGHT: bool> Measured for DualF64x2<TIGHT> {
+/// The double-double dual number ([`DualDd`]) as a series scalar: J of ill-conditioned rods
+/// (strong axial force: rounding made while the rod loops grows like e^{√F (1 − t)} while it
+/// then sits near the unstable straight equilibrium) in the same pass as the tip. Used through
+/// [`Truncated`] with [`DdStandard`] or [`DdTight`].
+impl Measured for DualDd {
     const PARTS: usize = 4;
-    const TAIL_TOL: f64 = if TIGHT {
-        TIGHT_TAIL_TOL
-    } else {
-        DoubleF64::TAIL_TOL
-    };
+    const TAIL_TOL: f64 = crate::dd::DD_EPSILON;
     #[inline]
     fn constant(v: f64) -> Self {
-        Self {
-            v: DoubleF64::constant(v),
-            g: [DoubleF64::default(); 3],
-        }
+        DualDd::constant(Dd::from_f64(v))
     }
     #[inline]
     fn part(self, i: usize) -> f64 {
         if i == 0 {
-            self.v.part(0)
+            self.v.hi.abs()
         } else {
-            self.g[i - 1].part(0)
+            self.g[i - 1].hi.abs()
         }
     }
     #[inline]
     fn div_n(self, n: f64) -> Self {
-        Self {
-            v: self.v.div_n(n),
-            g: [self.g[0].div_n(n), self.g[1].div_n(n), self.g[2].div_n(n)],
-        }
+        Self::new(
+            self.v.div_small_int(n),
+            [
+                self.g[0].div_small_int(n),
+                self.g[1].div_small_int(n),
+                self.g[2].div_small_int(n),
+            ],
+        )
     }
     #[inline]
     fn mul_f(self, h: f64) -> Self {
-        Self {
-            v: self.v.mul_f(h),
-            g: [self.g[0].mul_f(h), self.g[1].mul_f(h), self.g[2].mul_f(h)],
-        }
+        self * h
     }
     #[inline]
     fn mul_values(self, o: Self) -> Self {
-        Self {
-            v: self.v * o.v,
-            g: [DoubleF64::default(); 3],
-        }
+        DualDd::constant(self.v * o.v)
     }
 }
 
@@ -425,21 +301,21 @@ impl Gradient for Dual3 {
     }
 }
 
-impl Gradient for CoarseDual3 {
-    fn value(self) -> f64 {
-        self.0.v
-    }
-    fn gradient(self) -> [f64; 3] {
-        self.0.g
-    }
-}
-
-impl<const TIGHT: bool> Gradient for DualF64x2<TIGHT> {
+impl Gradient for DualDd {
     fn value(self) -> f64 {
         self.v.to_f64()
     }
     fn gradient(self) -> [f64; 3] {
-        [self.g[0].to_f64(), self.g[1].to_f64(), self.g[2].to_f64()]
+        self.to_f64().1
+    }
+}
+
+impl<T: Gradient, K: TailTolerance> Gradient for Truncated<T, K> {
+    fn value(self) -> f64 {
+        self.0.value()
+    }
+    fn gradient(self) -> [f64; 3] {
+        self.0.gradient()
     }
 }
 
@@ -843,11 +719,11 @@ pub(crate) fn series_dual(a: &PlanarParams, dense: bool) -> Result<TaylorRod<Dua
 /// the rod loops grows like e^{√F (1 − t)} while it then sits near the unstable straight
 /// equilibrium; an f64 integration, the oracle's included, is off by up to 1e-5 there, see
 /// tests/relaxed_oracle.rs), so they are integrated with a 106-bit significand.
-pub(crate) fn series_dd<const TIGHT: bool>(
+pub(crate) fn series_dd<K: TailTolerance>(
     a: &PlanarParams,
     dense: bool,
     max_root_f: f64,
-) -> Result<TaylorRod<DualF64x2<TIGHT>>, RodError> {
+) -> Result<TaylorRod<Truncated<DualDd, K>>, RodError> {
     let root_f = a[1].hypot(a[2]).sqrt();
     if root_f > LN_F64_MAX {
         return Err(overflow_force());
@@ -861,9 +737,9 @@ pub(crate) fn series_dd<const TIGHT: bool>(
         )));
     }
     TaylorRod::new(
-        DualF64x2::variable(a[0], 0),
-        DualF64x2::variable(a[1], 1),
-        DualF64x2::variable(a[2], 2),
+        Truncated::new(DualDd::variable(a[0], 0)),
+        Truncated::new(DualDd::variable(a[1], 1)),
+        Truncated::new(DualDd::variable(a[2], 2)),
         SERIES_DD_MAX_STEPS,
         dense,
     )

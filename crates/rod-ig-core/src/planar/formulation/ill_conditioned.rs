@@ -7,7 +7,7 @@ use crate::planar::shape::PlanarRod;
 
 use super::super::extended;
 use crate::planar::closed::{overflow, seeded_closed};
-use crate::planar::taylor::{pose_jac_from, series_dd, series_dual};
+use crate::planar::taylor::{pose_jac_from, series_dd, series_dual, DdStandard, DdTight};
 
 use super::super::stability;
 use crate::planar::stability::STABILITY_DD_MAX_ROOT_F;
@@ -43,7 +43,7 @@ impl IllConditioned<'_> {
         Some(if t >= 1.0 {
             ill_conditioned_tip(a).map(|(p, j, _)| (p, j))
         } else {
-            series_dd::<false>(a, true, SERIES_DD_MAX_ROOT_F)
+            series_dd::<DdStandard>(a, true, SERIES_DD_MAX_ROOT_F)
                 .and_then(|rod| pose_jac_from(rod.pose(t.max(0.0)).ok_or_else(overflow)?))
         })
     }
@@ -56,7 +56,9 @@ impl IllConditioned<'_> {
         }
         let e = match extended::energy(a) {
             Some(e) => Ok(e),
-            None => series_dd::<false>(a, false, SERIES_DD_MAX_ROOT_F).map(|r| r.energy().value()),
+            None => {
+                series_dd::<DdStandard>(a, false, SERIES_DD_MAX_ROOT_F).map(|r| r.energy().value())
+            }
         };
         Some(e.and_then(|e| {
             if e.is_finite() {
@@ -134,7 +136,7 @@ fn ill_conditioned_tip_with(
         let (p, j) = pose_jac_from(rod.tip())?;
         return Ok((p, j, rod.energy().v));
     }
-    let rod = series_dd::<false>(a, false, SERIES_DD_MAX_ROOT_F)?;
+    let rod = series_dd::<DdStandard>(a, false, SERIES_DD_MAX_ROOT_F)?;
     let (p, j) = pose_jac_from(rod.tip())?;
     Ok((p, j, rod.energy().value()))
 }
@@ -162,7 +164,7 @@ fn cross_checked_tip(a: &PlanarParams) -> Result<(PlanarPose, PlanarJacobian, f6
             a[1].hypot(a[2])
         ))
     };
-    let rod = series_dd::<true>(a, false, STABILITY_DD_MAX_ROOT_F)?;
+    let rod = series_dd::<DdTight>(a, false, STABILITY_DD_MAX_ROOT_F)?;
     let (tip_s, j_s) = pose_jac_from(rod.tip())?;
     let Some(c) = seeded_closed(a) else {
         return Err(refuse("the closed form overflows".into()));

@@ -617,9 +617,9 @@ impl ShortSeries {
             // Started empty and grown below: a budget that runs out before the first end
             // still leaves the steps taken.
             *slot = match TaylorRod::new_to(
-                CoarseDual3(Dual3::variable(a3, 0)),
-                CoarseDual3(Dual3::variable(self.a[1], 1)),
-                CoarseDual3(Dual3::variable(a5, 2)),
+                CoarseDual3::new(Dual3::variable(a3, 0)),
+                CoarseDual3::new(Dual3::variable(self.a[1], 1)),
+                CoarseDual3::new(Dual3::variable(a5, 2)),
                 0.0,
                 0,
                 true,

@@ -64,7 +64,7 @@ pub(super) fn whole_series_scan(
         .unwrap_or_else(|| std::f64::consts::TAU / crate::planar::taylor::curvature_scale(a));
     let spacing = (0.25 * wavelength).clamp(1e-3, SERIES_SPACING);
     if let Some(closed) = precise {
-        let rod = crate::planar::taylor::series_dd::<false>(
+        let rod = crate::planar::taylor::series_dd::<crate::planar::taylor::DdStandard>(
             &b,
             true,
             crate::planar::stability::STABILITY_DD_MAX_ROOT_F,
@@ -88,7 +88,7 @@ pub(super) fn whole_series_scan(
 }
 
 /// Relative error per step of the double-double series (its truncation, see
-/// `taylor::DoubleF64`): near the separatrix it grows like e^{√‖F‖ t} along the rod.
+/// `crate::dd::Dd`): near the separatrix it grows like e^{√‖F‖ t} along the rod.
 pub(super) const SERIES_DD_STEP_REL: f64 = 1e-22;
 
 /// How the double-double series' g is bounded near the separatrix (see [`scan_series`]).

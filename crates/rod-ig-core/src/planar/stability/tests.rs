@@ -832,9 +832,9 @@ fn coarse_short_series_within_its_bound() {
             continue;
         };
         let coarse = TaylorRod::new_to(
-            CoarseDual3(seed(0)),
-            CoarseDual3(seed(1)),
-            CoarseDual3(seed(2)),
+            CoarseDual3::new(seed(0)),
+            CoarseDual3::new(seed(1)),
+            CoarseDual3::new(seed(2)),
             reach,
             1000,
             true,
