@@ -17,6 +17,8 @@
 //!   where f64 cancels (near the separatrix).
 //! - [`elliptic`]: Jacobi elliptic functions and Legendre/Carlson integrals, accurate when the
 //!   complementary parameter m1 = 1 − m is passed directly.
+//! - `conjugate` (internal): the one stability scan — sampling g(t) = det J/D0, the first
+//!   conjugate point, the margin and its error bound — that every rod model runs.
 //! - [`planar`]: closed-form shape q(t), sensitivity J(t, a), stability and energy.
 //! - [`ode`]: numerical integrators (adaptive Dormand–Prince 8(5,3) and fixed-step RK4) and the
 //!   planar ODE reference with variational equations.
@@ -33,6 +35,7 @@
 #![warn(missing_docs)]
 
 mod angle;
+mod conjugate;
 pub mod dd;
 pub mod deadline;
 pub mod dual;

@@ -138,7 +138,7 @@ pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyReference, RodErro
     let (tip, jacobian, energy, elastic_energy) = tip_and_jacobian(a, g, rtol)?;
     let grid = super::planar_reference::stability_grid();
     let (w, d) = (g.weight(), g.direction());
-    let mut scan = super::GridScan::new(0.05);
+    let mut scan = crate::conjugate::Stream::new();
     solve_dense(
         |_, s, ds| rhs(w, d, s, ds, true),
         0.0,
@@ -146,7 +146,7 @@ pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyReference, RodErro
         &grid,
         &opts(rtol),
         |_, t, s| {
-            scan.push(t, jacobian_of(s).determinant(), det_leading_term(a, g, t));
+            let _ = scan.sample_det(t, jacobian_of(s).determinant(), det_leading_term(a, g, t));
             ControlFlow::Continue(())
         },
     )?;
@@ -155,6 +155,6 @@ pub fn evaluate(a: &PlanarParams, g: &Gravity) -> Result<HeavyReference, RodErro
         jacobian,
         energy,
         elastic_energy,
-        stability: scan.report(),
+        stability: scan.exact_report(),
     })
 }

@@ -15,6 +15,7 @@
 use super::dop853::{solve, solve_dense};
 use super::rk4::{rk4_solve, rk4_solve_with, steps_for};
 use super::OdeOptions;
+use crate::conjugate::Stream;
 use crate::{PlanarJacobian, PlanarParams, PlanarPose, RodError, StabilityReport};
 use std::ops::ControlFlow;
 
@@ -241,82 +242,9 @@ pub fn det_leading_term(a: &PlanarParams, t: f64) -> f64 {
     crate::planar_det_leading_term(a[0], a[2], t)
 }
 
-/// Accumulates the stability verdict over a sequence of (t, det J(t)).
-struct StabilityScan {
-    a: PlanarParams,
-    margin: f64,
-    prev: Option<(f64, f64)>,
-    first_conjugate: Option<f64>,
-}
-
-impl StabilityScan {
-    fn new(a: &PlanarParams) -> Self {
-        Self {
-            a: *a,
-            margin: f64::INFINITY,
-            prev: None,
-            first_conjugate: None,
-        }
-    }
-
-    /// Returns Break at the first non-positive det (the verdict is then known).
-    fn push(&mut self, t: f64, det: f64) -> ControlFlow<()> {
-        if t >= MARGIN_T_MIN - 1e-12 {
-            let lead = det_leading_term(&self.a, t);
-            if lead > 0.0 {
-                self.margin = self.margin.min(det / lead);
-            }
-        }
-        if !(det > 0.0) {
-            // Locate the crossing by linear interpolation with the previous positive sample.
-            let tc = match self.prev {
-                Some((tp, dp)) if dp > 0.0 && det.is_finite() && dp - det > 0.0 => {
-                    tp + (t - tp) * dp / (dp - det)
-                }
-                _ => t,
-            };
-            self.first_conjugate = Some(tc);
-            if !(self.margin < 0.0) {
-                let lead = det_leading_term(&self.a, t.max(MARGIN_T_MIN));
-                self.margin = if lead > 0.0 && det.is_finite() {
-                    (det / lead).min(0.0)
-                } else {
-                    0.0
-                };
-            }
-            return ControlFlow::Break(());
-        }
-        self.prev = Some((t, det));
-        ControlFlow::Continue(())
-    }
-
-    fn report(self) -> StabilityReport {
-        let stable = self.first_conjugate.is_none();
-        StabilityReport {
-            stable,
-            margin: if self.margin.is_finite() {
-                self.margin
-            } else {
-                0.0
-            },
-            uncertain: false,
-            first_conjugate_t: self.first_conjugate,
-        }
-    }
-}
-
 fn straight_rod(a: &PlanarParams) -> Option<StabilityReport> {
-    if a[0] == 0.0 && a[2] == 0.0 {
-        // docs/math.md §5: the x-row of J vanishes identically; det ≡ 0: undecidable.
-        Some(StabilityReport {
-            stable: false,
-            margin: 0.0,
-            uncertain: true,
-            first_conjugate_t: None,
-        })
-    } else {
-        None
-    }
+    // docs/math.md §5: the x-row of J vanishes identically; det ≡ 0: undecidable.
+    (a[0] == 0.0 && a[2] == 0.0).then(crate::conjugate::undecided)
 }
 
 /// Stability by the rule of docs/math.md §5: det J(t, a) > 0 at every t of [`stability_grid`],
@@ -338,7 +266,7 @@ pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
         error_components: usize::MAX,
     };
     let grid = stability_grid();
-    let mut scan = StabilityScan::new(a);
+    let mut scan = Stream::new();
     let mut nonfinite = false;
     solve_dense(
         |_, s, ds| var_rhs(s, ds),
@@ -352,13 +280,13 @@ pub fn stability(a: &PlanarParams) -> Result<StabilityReport, RodError> {
                 nonfinite = true;
                 return ControlFlow::Break(());
             }
-            scan.push(t, det)
+            scan.sample_det(t, det, det_leading_term(a, t))
         },
     )?;
     if nonfinite {
         return Err(RodError::Overflow("non-finite Jacobian".into()));
     }
-    Ok(scan.report())
+    Ok(scan.exact_report())
 }
 
 /// The paper's baseline: tip pose by classic RK4 with fixed step ≤ `dt` (n = ⌈1/dt⌉ equal
@@ -398,13 +326,13 @@ pub fn rk4_stability(a: &PlanarParams, dt: f64) -> Result<StabilityReport, RodEr
     if let Some(r) = straight_rod(a) {
         return Ok(r);
     }
-    let mut scan = StabilityScan::new(a);
+    let mut scan = Stream::new();
     let mut f = |_: f64, s: &[f64; 24], ds: &mut [f64; 24]| var_rhs(s, ds);
     rk4_solve_with(&mut f, 0.0, initial_var(a), 1.0, n, |_, t, s| {
         if t < RK4_STABILITY_T_MIN {
             return ControlFlow::Continue(());
         }
-        scan.push(t, jac_of(s).determinant())
+        scan.sample_det(t, jac_of(s).determinant(), det_leading_term(a, t))
     })?;
-    Ok(scan.report())
+    Ok(scan.exact_report())
 }

@@ -67,6 +67,7 @@ impl DipTimes {
 /// Most sample times [`Closed::dip_times`] gives, from the base (a share of the scan's sample
 /// budget; a rod with more periods has the grid alone beyond the eighth).
 pub(crate) const MAX_DIP_TIMES: usize = 8;
+const _: () = assert!(MAX_DIP_TIMES <= crate::conjugate::MAX_EXTRA_SAMPLES);
 
 /// Smallest m for which a form built without its phase ([`Closed::complete`]) leaves it out:
 /// the small-m regimes (nearly straight rods under compression, near-circles) keep the form

@@ -25,7 +25,8 @@
 
 use super::heavy_ode::{self, Gravity3, NB};
 use super::{SpatialParams, SpatialPose, Stiffness};
-use crate::ode::{dop853, GridScan, OdeOptions};
+use crate::conjugate::Stream;
+use crate::ode::{dop853, OdeOptions};
 use crate::planar::heavy::cable::{CableError, GROWTH_PER_SEGMENT, MAX_SEGMENTS};
 use crate::{RodError, StabilityReport};
 use nalgebra::{DMatrix, DVector, Quaternion, SMatrix, UnitQuaternion, Vector3};
@@ -504,7 +505,7 @@ impl SpatialCable {
         }
         // det U = sign_u · e^{log_u} (module docs).
         let (mut sign_u, mut log_u) = (1.0, 0.0);
-        let mut scan = GridScan::new(super::stability::MARGIN_T_MIN);
+        let mut scan = Stream::new();
         let mut least_ratio = f64::INFINITY;
         let a_vec = self.params();
         let (ci, a, load) = (self.stiffness.inv(), self.a, self.gravity.load());
@@ -540,9 +541,10 @@ impl SpatialCable {
                     let sign = det.signum() * sign_u;
                     if lead > 0.0 && det != 0.0 {
                         let log_ratio = det.abs().ln() + log_u - lead.ln();
-                        scan.push(t, sign * log_ratio.min(690.0).exp(), 1.0);
+                        let g = sign * log_ratio.min(690.0).exp();
+                        let _ = scan.sample(t, g, g);
                     } else {
-                        scan.push(t, if det == 0.0 { 0.0 } else { sign }, 0.0);
+                        let _ = scan.sample(t, if det == 0.0 { 0.0 } else { sign }, f64::NAN);
                     }
                     ControlFlow::Continue(())
                 },
@@ -555,7 +557,7 @@ impl SpatialCable {
             }
             basis = qr.q();
         }
-        let mut report = scan.report();
+        let mut report = scan.exact_report();
         if report.stable && !(least_ratio > MARGIN_FLOOR) {
             report.stable = false;
             report.uncertain = true;

@@ -123,7 +123,7 @@ pub fn evaluate(
     let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
     let grid: Vec<f64> = (40..=2000).map(|i| f64::from(i) / 2000.0).collect();
     let mut last = initial();
-    let mut scan = crate::ode::GridScan::new(super::stability::MARGIN_T_MIN);
+    let mut scan = crate::conjugate::Stream::new();
     let mut finite = true;
     solve_dense(
         |t, s, ds| rhs::<NV, 6>(&ci, &av, load, t, s, ds, true),
@@ -134,7 +134,7 @@ pub fn evaluate(
         |_, t, s| {
             let det = jac(s).determinant();
             finite &= det.is_finite();
-            scan.push(t, det, super::det_leading_term(a, t));
+            let _ = scan.sample_det(t, det, super::det_leading_term(a, t));
             last = *s;
             ControlFlow::Continue(())
         },
@@ -153,19 +153,18 @@ pub fn evaluate(
     };
     let jacobian = jac(&last);
     let condition = condition_of(a, &jacobian);
-    let undecided = StabilityReport {
-        stable: false,
-        margin: 0.0,
-        first_conjugate_t: None,
-        uncertain: true,
-    };
+    let undecided = crate::conjugate::undecided();
     let mut e = HeavyEvaluation3d {
         tip: pose(&last),
         jacobian,
         condition,
         energy: last[7] + potential,
         elastic_energy: last[7],
-        stability: if degenerate { undecided } else { scan.report() },
+        stability: if degenerate {
+            undecided
+        } else {
+            scan.exact_report()
+        },
     };
     if long && !(condition <= crate::planar::heavy::MAX_TRUSTED_CONDITION) {
         // The tip of this f64 `a` is not determined to the accuracy of the verdict.

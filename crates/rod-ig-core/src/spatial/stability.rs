@@ -17,6 +17,7 @@
 
 use super::reduced::{self, jac as jac_of, pose as pose_of, ENERGY, NR as NV};
 use super::{check_params, options_for, Evaluation3d, SpatialParams, Stiffness};
+use crate::conjugate::Stream;
 use crate::ode::{DenseStep, Dop853};
 use crate::{RodError, StabilityReport};
 
@@ -170,16 +171,22 @@ fn sample(planar: Option<&nalgebra::Matrix6<f64>>, s: &[f64]) -> (f64, f64) {
     }
 }
 
+/// The 3-D rod's side of the scan: its grid rule (coarse samples, the rule's grid points
+/// checked one by one after a non-positive one) and g on the dense output; the crossings and
+/// the margin are the crate's one [`Stream`].
 struct Scan {
     a: SpatialParams,
     planar: Option<nalgebra::Matrix6<f64>>,
     stride: u32,
     next_coarse: u32,
+    /// Last t where the rule held.
     last_pos: f64,
-    margin: f64,
-    failed: Option<f64>,
+    stream: Stream,
     nonfinite: bool,
 }
+
+/// Width to which a crossing is located on the dense output.
+const ROOT_TOL: f64 = 1e-10;
 
 impl Scan {
     fn new(a: &SpatialParams, opts: &StabilityOptions) -> Self {
@@ -189,8 +196,7 @@ impl Scan {
             stride: opts.coarse_stride.clamp(1, GRID_N),
             next_coarse: GRID_START,
             last_pos: STABILITY_T_MIN - 0.5 / GRID_N as f64,
-            margin: f64::INFINITY,
-            failed: None,
+            stream: Stream::new(),
             nonfinite: false,
         }
     }
@@ -199,57 +205,49 @@ impl Scan {
         i as f64 / GRID_N as f64
     }
 
+    fn failed(&self) -> bool {
+        self.stream.first().is_some()
+    }
+
+    /// g = det J/D0 for the margin: where the rule fails, its negative magnitude (for a
+    /// planar rod both blocks can fail while their product stays positive); NaN where D0 ≤ 0.
     #[inline]
-    fn note_margin(&mut self, t: f64, det: f64) {
-        if t >= MARGIN_T_MIN - 1e-12 {
-            let lead = det_leading_term(&self.a, t);
-            if lead > 0.0 {
-                self.margin = self.margin.min(det / lead);
-            }
+    fn normalised(&self, t: f64, sign: f64, det: f64) -> f64 {
+        let lead = det_leading_term(&self.a, t);
+        if !(lead > 0.0) {
+            f64::NAN
+        } else if sign > 0.0 {
+            det / lead
+        } else {
+            -(det / lead).abs()
         }
     }
 
-    /// Checks grid points in (last_pos, t_bad] one by one; on failure refines the crossing.
+    /// Checks grid points in (last_pos, t_bad] one by one; the first failing one is located
+    /// on the dense output ([`Stream::sample_on`]).
     fn refine(&mut self, d: &DenseStep<NV>, t_bad: f64) {
         let lo_i = ((self.last_pos * GRID_N as f64).floor() as u32 + 1).max(GRID_START);
-        let mut prev_t = self.last_pos;
+        let planar = self.planar;
+        let sign_at = |t: f64| sample(planar.as_ref(), &d.eval(t)).0;
+        let since = self.last_pos.max(STABILITY_T_MIN.min(t_bad));
         let mut i = lo_i;
         while i <= GRID_N {
             let t = Self::grid_t(i);
             if t > t_bad + 1e-15 {
                 break;
             }
-            let s = d.eval(t);
-            let (g, det) = sample(self.planar.as_ref(), &s);
+            let (g, det) = sample(self.planar.as_ref(), &d.eval(t));
             if !g.is_finite() {
                 self.nonfinite = true;
                 return;
             }
-            if g <= 0.0 {
-                // Bisection for the crossing on (prev_t, t].
-                let (mut lo, mut hi) = (prev_t.max(STABILITY_T_MIN.min(t)), t);
-                if lo < hi {
-                    for _ in 0..40 {
-                        let mid = 0.5 * (lo + hi);
-                        let (gm, _) = sample(self.planar.as_ref(), &d.eval(mid));
-                        if gm > 0.0 {
-                            lo = mid;
-                        } else {
-                            hi = mid;
-                        }
-                        if hi - lo < 1e-10 {
-                            break;
-                        }
-                    }
-                }
-                self.failed = Some(hi);
-                let lead = det_leading_term(&self.a, t);
-                let m = if lead > 0.0 { -(det / lead).abs() } else { 0.0 };
-                self.margin = self.margin.min(m).min(0.0);
+            let normalised = self.normalised(t, g, det);
+            let _ = self
+                .stream
+                .sample_on(&sign_at, since, (t, g, normalised), ROOT_TOL);
+            if self.failed() {
                 return;
             }
-            self.note_margin(t, det);
-            prev_t = t;
             i += 1;
         }
         // The excursion lies between grid points: the rule still holds.
@@ -259,7 +257,7 @@ impl Scan {
     /// Processes the accepted step (t0, t1] with its dense output.
     #[inline(always)] // into both builds of the scan (crate::simd)
     fn step(&mut self, d: &DenseStep<NV>, t1: f64, y1: &[f64; NV]) {
-        if self.failed.is_some() || self.nonfinite || t1 < STABILITY_T_MIN {
+        if self.failed() || self.nonfinite || t1 < STABILITY_T_MIN {
             return;
         }
         // Coarse grid points inside the step, then the step end.
@@ -286,23 +284,22 @@ impl Scan {
         }
     }
 
-    /// Step-end-only variant (no dense output): a non-positive sample is a failure.
+    /// Step-end-only variant (no dense output): a non-positive sample is a failure, placed
+    /// between the last passing sample and it by interpolation.
     #[inline]
     fn step_end_only(&mut self, t1: f64, y1: &[f64; NV]) {
-        if self.failed.is_some() || self.nonfinite || t1 < STABILITY_T_MIN {
+        if self.failed() || self.nonfinite || t1 < STABILITY_T_MIN {
             return;
         }
         let (g, det) = sample(self.planar.as_ref(), y1);
         if !g.is_finite() {
             self.nonfinite = true;
-        } else if g > 0.0 {
-            self.note_margin(t1, det);
+            return;
+        }
+        let normalised = self.normalised(t1, g, det);
+        let _ = self.stream.sample(t1, g, normalised);
+        if g > 0.0 {
             self.last_pos = t1;
-        } else {
-            self.failed = Some(t1);
-            let lead = det_leading_term(&self.a, t1);
-            let m = if lead > 0.0 { -(det / lead).abs() } else { 0.0 };
-            self.margin = self.margin.min(m).min(0.0);
         }
     }
 
@@ -315,36 +312,18 @@ impl Scan {
             return false;
         }
         if g > 0.0 {
-            self.note_margin(t, det);
+            let normalised = self.normalised(t, g, det);
+            let _ = self.stream.sample(t, g, normalised);
             self.last_pos = t;
             true
         } else {
             self.refine(d, t);
-            self.failed.is_none() && !self.nonfinite
+            !self.failed() && !self.nonfinite
         }
     }
 
     fn report(&self) -> StabilityReport {
-        StabilityReport {
-            stable: self.failed.is_none(),
-            margin: if self.margin.is_finite() {
-                self.margin
-            } else {
-                0.0
-            },
-            uncertain: false,
-            first_conjugate_t: self.failed,
-        }
-    }
-}
-
-fn straight_report() -> StabilityReport {
-    StabilityReport {
-        stable: false,
-        margin: 0.0,
-        // det J ≡ 0 for the straight rod: the test can neither pass nor fail.
-        uncertain: true,
-        first_conjugate_t: None,
+        self.stream.exact_report()
     }
 }
 
@@ -364,7 +343,7 @@ fn run(
     let ap = reduced::params(a);
     let straight = is_straight(a);
     if straight && early_exit {
-        return Ok((None, straight_report()));
+        return Ok((None, crate::conjugate::undecided()));
     }
     let options = options_for(a, opts.rtol, opts.atol);
     let dense = !straight && opts.coarse_stride != 0;
@@ -385,7 +364,7 @@ fn run(
         return Err(RodError::Overflow("non-finite rod state".into()));
     }
     let report = if straight {
-        straight_report()
+        crate::conjugate::undecided()
     } else {
         scan.report()
     };
@@ -460,7 +439,7 @@ where
             if scan.nonfinite {
                 return Err(RodError::Overflow("non-finite Jacobian".into()));
             }
-            if early_exit && scan.failed.is_some() {
+            if early_exit && scan.failed() {
                 return Ok(None);
             }
         }

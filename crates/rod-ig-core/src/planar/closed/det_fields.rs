@@ -118,6 +118,7 @@ impl DetFrame {
     }
 
     /// The canonical elastica at s from its Jacobi values (sn, cn, dn, D = ∫₀ˢ sn²).
+    #[inline]
     fn canonical(&self, s: f64, (sn, cn, dn, d): (f64, f64, f64, f64)) -> Canonical {
         let (m, k) = (self.m, self.k);
         // One division per sample (1/dn); 1/(2 m1) and 1/m are the frame's.

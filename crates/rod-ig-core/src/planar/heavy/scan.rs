@@ -9,8 +9,12 @@
 //! adds, which is the only one left when a3 = a5 = 0: det J ~ t¹³), so the scan starts at
 //! t = 0.02 where f64 resolves det J, and the margin is min over t ∈ [0.05, 1] of
 //! g(t) = det J(t) / D0(t) (the normalisation of `shared/oracle/gravity_public.jsonl`).
+//!
+//! The scan itself (crossings, margin, verdict) is the crate's one [`crate::conjugate::Stream`];
+//! what is the heavy rod's own is det J on a step, a polynomial, and its error bound.
 
 use super::series::{horner, Step, ORDER};
+use crate::conjugate::{golden_min, undecided, Stream};
 use crate::{StabilityReport, STABILITY_T_MIN};
 
 const N: usize = ORDER + 1;
@@ -20,6 +24,9 @@ const N: usize = ORDER + 1;
 const SAMPLES: usize = 16;
 /// Smallest t of the margin ([`crate::STABILITY_MARGIN_T_MIN`]).
 pub(crate) const MARGIN_T_MIN: f64 = crate::STABILITY_MARGIN_T_MIN;
+/// Width to which a conjugate point is located on a step's polynomial (bisection: its sign is
+/// all the polynomial is trusted for there).
+const ROOT_TOL: f64 = 1e-12;
 /// Relative error of an entry of J per integration step, measured against DOP853 at rtol
 /// 1e-13 (worst 3e-14 over the tests' families) with a factor 10 of headroom.
 const J_REL_PER_STEP: f64 = 3e-13;
@@ -70,13 +77,9 @@ pub(crate) struct Scan {
     /// a3², a5², (w ĝ_y)² of D0.
     lead: [f64; 3],
     steps: usize,
-    /// Last sample (t, det) on [T_MIN, 1].
-    prev: Option<(f64, f64)>,
-    first_conjugate: Option<f64>,
-    /// Least g(t) on [0.05, 1], its det J and that det's error bound.
-    min_g: f64,
-    min_det: f64,
-    min_err: f64,
+    stream: Stream,
+    /// The error bound of g where the margin was refined (det J's bound over D0 there).
+    g_error: f64,
 }
 
 impl Scan {
@@ -84,11 +87,8 @@ impl Scan {
         Self {
             lead: [a3 * a3, a5 * a5, load_across * load_across],
             steps: 0,
-            prev: None,
-            first_conjugate: None,
-            min_g: f64::INFINITY,
-            min_det: f64::INFINITY,
-            min_err: 0.0,
+            stream: Stream::new(),
+            g_error: 0.0,
         }
     }
 
@@ -104,7 +104,9 @@ impl Scan {
         self.lead == [0.0; 3]
     }
 
-    /// Scans one step.
+    /// Scans one step: its samples' signs (the margin is refined, not sampled: the step's
+    /// least sample is refined by golden section between its neighbours, and that minimum is
+    /// offered with its error bound).
     pub(crate) fn push(&mut self, s: &Step) {
         self.steps += 1;
         let t_end = s.t0 + s.h;
@@ -115,17 +117,16 @@ impl Scan {
         let tau_lo = (STABILITY_T_MIN - s.t0).max(0.0);
         let lead = Self { ..*self };
         let g = |tau: f64| horner(&det, tau) / lead.leading_term(s.t0 + tau);
+        let sign_at = |t: f64| horner(&det, t - s.t0);
         let mut best: Option<(usize, f64)> = None;
         let taus: [f64; SAMPLES + 1] =
             std::array::from_fn(|i| tau_lo + (s.h - tau_lo) * i as f64 / SAMPLES as f64);
+        let since = s.t0 + tau_lo;
         for (i, &tau) in taus.iter().enumerate() {
             let t = s.t0 + tau;
-            let d = horner(&det, tau);
-            if self.first_conjugate.is_none() && !(d > 0.0) {
-                let lo = self.prev.map_or(tau_lo, |(tp, _)| (tp - s.t0).max(tau_lo));
-                self.first_conjugate = Some(s.t0 + root(&det, lo, tau));
-            }
-            self.prev = Some((t, d));
+            let _ =
+                self.stream
+                    .sample_on(&sign_at, since, (t, horner(&det, tau), f64::NAN), ROOT_TOL);
             if t >= MARGIN_T_MIN && best.is_none_or(|(_, v)| g(tau) < v) {
                 best = Some((i, g(tau)));
             }
@@ -135,99 +136,24 @@ impl Scan {
         let lo = taus[i.saturating_sub(1)].max(MARGIN_T_MIN - s.t0);
         let hi = taus[(i + 1).min(SAMPLES)];
         let tau = golden_min(&g, lo, hi).max(lo);
-        let gv = g(tau);
-        if gv < self.min_g {
-            if self.first_conjugate.is_none() && !(horner(&det, tau) > 0.0) {
-                self.first_conjugate = Some(s.t0 + root(&det, lo, tau));
-            }
-            self.min_g = gv;
+        if self
+            .stream
+            .offer_minimum(&sign_at, s.t0 + lo, (s.t0 + tau, g(tau)), ROOT_TOL)
+        {
             let j = s.jacobian_at(tau);
             let rel = J_REL_PER_STEP * self.steps as f64;
             let column = |c: usize| j.iter().map(|r| r[c].abs()).fold(0.0, f64::max) * rel;
-            let (d, err) =
+            let (_, err) =
                 crate::types::det_and_error_by_column(&j, [column(0), column(1), column(2)]);
-            self.min_det = d;
-            self.min_err = err;
+            self.g_error = err / self.leading_term(s.t0 + tau);
         }
     }
 
     /// The report after the last step.
     pub(crate) fn report(self) -> StabilityReport {
         if self.degenerate() {
-            return StabilityReport {
-                stable: false,
-                margin: 0.0,
-                first_conjugate_t: None,
-                uncertain: true,
-            };
+            return undecided();
         }
-        let margin = if self.min_g.is_finite() {
-            self.min_g
-        } else {
-            0.0
-        };
-        let uncertain = !(self.min_det.abs() > self.min_err);
-        let stable = self.first_conjugate.is_none() && !uncertain;
-        StabilityReport {
-            stable,
-            margin,
-            first_conjugate_t: if uncertain {
-                None
-            } else {
-                self.first_conjugate
-            },
-            uncertain,
-        }
-    }
-}
-
-/// A root of the polynomial `p` on [lo, hi] where p(lo) > 0 ≥ p(hi) (bisection, then the
-/// secant's last digits; the bracket is kept).
-fn root(p: &[f64; N], mut lo: f64, mut hi: f64) -> f64 {
-    if !(horner(p, lo) > 0.0) {
-        return lo;
-    }
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if mid <= lo || mid >= hi {
-            break;
-        }
-        if horner(p, mid) > 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
-}
-
-/// The minimum of f on [lo, hi] by golden-section search (f unimodal there by the sampling).
-fn golden_min(f: &impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
-    const R: f64 = 0.618_033_988_749_894_8;
-    if !(hi > lo) {
-        return lo;
-    }
-    let mut x1 = hi - R * (hi - lo);
-    let mut x2 = lo + R * (hi - lo);
-    let (mut f1, mut f2) = (f(x1), f(x2));
-    for _ in 0..24 {
-        if f1 < f2 {
-            hi = x2;
-            x2 = x1;
-            f2 = f1;
-            x1 = hi - R * (hi - lo);
-            f1 = f(x1);
-        } else {
-            lo = x1;
-            x1 = x2;
-            f1 = f2;
-            x2 = lo + R * (hi - lo);
-            f2 = f(x2);
-        }
-    }
-    if f1 < f2 {
-        x1
-    } else {
-        x2
+        self.stream.report(self.g_error)
     }
 }

@@ -1,10 +1,10 @@
 //! Stability scans on the closed form (docs/math.md §5), with the short series, the small-m
 //! scan and the margin certification where its own error estimate fails.
 
+use super::around;
 use super::closed_g::{
     normalised_det, normalised_det_extended, normalised_det_sloped, normalised_det_value,
 };
-use super::scan::{sample_times, scan, value_only, Probe, Scan};
 use super::series::{
     certified_verdict, normalisation_scaled, normalised_det_of, normalised_det_series,
     scaled_jacobian, scaled_series_jacobian, series_after_small_angle,
@@ -13,9 +13,10 @@ use super::small_angle_scan::{
     small_angle_prefix, small_angle_report, SMALL_ANGLE_MAX_TRUNCATION, SMALL_ANGLE_TRUNCATION_C,
 };
 use super::{
-    straight_report, verdict, COARSE_AMPLIFIED, COARSE_ENTRY_REL, SERIES_ENTRY_REL, SERIES_SPACING,
+    straight_report, COARSE_AMPLIFIED, COARSE_ENTRY_REL, SERIES_ENTRY_REL, SERIES_SPACING,
     SIGMA_RAY, T_MARGIN, T_MIN,
 };
+use crate::conjugate::{sample_times, scan, value_only, verdict, Probe, Scan};
 use crate::dd::DualDd;
 
 use crate::planar::closed::{Case, Closed, DetFrame, SeriesNeed};
@@ -207,12 +208,12 @@ pub(super) fn small_m_scan(
     let t0 = (0.1 * wl).clamp(T_MIN, T_MARGIN);
     let spacing = (0.25 * wl).clamp(1e-3, SERIES_SPACING);
     let closed = |t: f64| normalised_det_value(c, a3, a5, t);
-    let s = scan(&value_only(closed), t0, spacing, (a3, a5), &[])?;
+    let s = scan(&value_only(closed), t0, spacing, around(a3, a5), &[])?;
     // The first sample past the sign change where g < 0: the unstable verdict's witness.
     let witness = match s.first {
         None => None,
         Some(first) => {
-            let (ts, np) = sample_times(t0, spacing, (a3, a5), &[]);
+            let (ts, np) = sample_times(t0, spacing, around(a3, a5), &[]);
             let t = ts[..np]
                 .iter()
                 .copied()
@@ -300,7 +301,9 @@ pub(super) struct ClosedSamples<'a> {
 
 impl ClosedSamples<'_> {
     /// g(t), its bound and its slope (NaN where the value does not come from the f64 closed
-    /// form within its acceptance).
+    /// form within its acceptance). Inline: called from the scan's root and minimum searches,
+    /// which live in `crate::conjugate` (another codegen unit).
+    #[inline]
     fn eval(&self, t: f64) -> (f64, f64, f64) {
         let (a, a3, a5, root_f) = (self.a, self.a[0], self.a[2], self.root_f);
         // Relative to |g| where g is large: under a strong tension g reaches 1e4 between the
@@ -400,7 +403,7 @@ pub(super) fn closed_scan_from(
         &signs_where_possible(&sloped, c.conjugate_span_bound()),
         t0,
         spacing,
-        (a3, a5),
+        around(a3, a5),
         c.dip_times(spacing).as_slice(),
     )?;
     if !norm_wise {
@@ -461,6 +464,7 @@ impl<G: Fn(f64) -> (f64, f64, f64)> Recorded<G> {
     }
 
     /// g(t), its bound and its slope, computed and recorded.
+    #[inline]
     fn eval(&self, t: f64) -> (f64, f64, f64) {
         let (v, e, d) = (self.g)(t);
         let mut seen = self.seen.borrow_mut();

@@ -5,10 +5,11 @@
 //! entries reach 1e300 where the normalisation a3²t⁹/8640 underflows); else the closed form's
 //! scans (the lattice's det J cancels by its solitons, beyond a bound it could prove).
 
-use super::scan::{scan, value_only};
+use super::around;
 use super::series::certified_verdict;
 use super::small_angle_scan::small_angle_report;
 use super::{with_theorem, SERIES_SPACING, T_MARGIN};
+use crate::conjugate::{scan, value_only};
 use crate::planar::soliton::Lattice;
 use crate::scalar::Dual3;
 use crate::types::det_and_error;
@@ -78,7 +79,7 @@ fn report(lattice: &Lattice<Dual3>, a: &PlanarParams) -> Result<StabilityReport,
         &value_only(probe),
         T_MARGIN,
         spacing,
-        (a3, a5),
+        around(a3, a5),
         &extra[..n_extra],
     )?;
     let report = certified_verdict(s, &g, (T_MARGIN, spacing, a3, a5));

@@ -1,12 +1,11 @@
 //! Fast stability test on the closed form (docs/math.md §5).
 
+use crate::conjugate::undecided as straight_report;
 use crate::{StabilityReport, StabilityVerdict};
-use scan::Scan;
 
 mod closed_g;
 mod closed_scan;
 mod lattice_scan;
-mod scan;
 mod series;
 mod small_angle_scan;
 #[cfg(test)]
@@ -66,17 +65,19 @@ const SIGMA_RAY: f64 = 1e-60;
 /// to 100), where its tips and J were off by up to 0.25 and 100 %.
 pub(crate) const STABILITY_DD_MAX_ROOT_F: f64 = 120.0;
 
-/// The straight rod a3 = a5 = 0: J's x row vanishes (∂x/∂a ≡ 0: an inextensible straight rod
-/// stays straight to first order), so det J ≡ 0 on (0, 1]. The test "det J > 0 on (0, 1]"
-/// neither passes nor fails: the rod is a singular point of the a-chart, on the boundary of
-/// the reachable set (|tip| = 1). Reported uncertain, margin 0.
-fn straight_report() -> StabilityReport {
-    StabilityReport {
-        stable: false,
-        margin: 0.0,
-        first_conjugate_t: None,
-        uncertain: true,
-    }
+/// The sample times where the planar normalisation D0(t) = t⁹(a3²/8640 + a5²t²/33600) changes
+/// regime, at t* = √(33600/8640)|a3/a5| (0.7 t*, t*, 1.4 t*; NaN without a5), where g often has
+/// a narrow dip: the scan samples them for the margin ([`crate::conjugate::scan`]'s `around`).
+/// The straight rod a3 = a5 = 0 (J's x row vanishes: det J ≡ 0) is
+/// [`crate::conjugate::undecided`].
+#[inline]
+fn around(a3: f64, a5: f64) -> [f64; 3] {
+    let ts_star = if a5 != 0.0 {
+        (33600.0f64 / 8640.0).sqrt() * (a3 / a5).abs()
+    } else {
+        f64::NAN
+    };
+    [ts_star * 0.7, ts_star, ts_star * 1.4]
 }
 
 /// The report with the verdict a theorem gives where one applies ([`Closed::theorem_verdict`]:
@@ -117,20 +118,5 @@ fn unstable_by_theorem(report: StabilityReport) -> StabilityReport {
         margin: report.margin.min(0.0),
         first_conjugate_t: report.first_conjugate_t,
         uncertain: false,
-    }
-}
-
-/// The verdict from a scan and the error bound of g where the margin was found.
-fn verdict(scan: Scan, g_error: f64) -> StabilityReport {
-    let clear = scan.margin.abs() > g_error;
-    let (stable, uncertain) = match scan.first {
-        None => (clear, !clear),
-        Some(_) => (false, !clear),
-    };
-    StabilityReport {
-        stable,
-        margin: scan.margin,
-        first_conjugate_t: if uncertain { None } else { scan.first },
-        uncertain,
     }
 }

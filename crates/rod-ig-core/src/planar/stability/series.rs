@@ -3,11 +3,12 @@
 
 use super::closed_g::normalised_det;
 
-use super::scan::{sample_times, scan, value_only, Probe, Scan};
+use super::around;
 use super::{
-    straight_report, verdict, SERIES_ENTRY_REL, SERIES_SLOPED_MAX_SPACING, SERIES_SPACING,
-    SERIES_T_MIN, SIGMA_RAY,
+    straight_report, SERIES_ENTRY_REL, SERIES_SLOPED_MAX_SPACING, SERIES_SPACING, SERIES_T_MIN,
+    SIGMA_RAY,
 };
+use crate::conjugate::{sample_times, scan, value_only, verdict, Probe, Scan};
 use crate::planar::closed::Closed;
 
 use crate::planar::taylor::{Gradient, TaylorRod};
@@ -143,14 +144,14 @@ pub(super) fn scan_series<T: Gradient>(
         // The f64 series with slopes: twice the value-only spacing.
         let sloped_spacing = (2.0 * spacing).min(SERIES_SLOPED_MAX_SPACING);
         let probe = |t| series_probe(rod, a3, a5, t);
-        let s = scan(&probe, SERIES_T_MIN, sloped_spacing, (a3, a5), &[])?;
+        let s = scan(&probe, SERIES_T_MIN, sloped_spacing, around(a3, a5), &[])?;
         return Ok(verdict(s, normalised_det_series(rod, a3, a5, s.t_margin).1));
     };
     let s = scan(
         &value_only(|t| normalised_det_series_value(rod, a3, a5, t)),
         SERIES_T_MIN,
         spacing,
-        (a3, a5),
+        around(a3, a5),
         &[],
     )?;
     let g = |t: f64| {
@@ -198,7 +199,7 @@ pub(super) fn every_sample_positive(
     g: &impl Fn(f64) -> (f64, f64),
     (t0, spacing, a3, a5): (f64, f64, f64, f64),
 ) -> bool {
-    let (ts, np) = sample_times(t0, spacing, (a3, a5), &[]);
+    let (ts, np) = sample_times(t0, spacing, around(a3, a5), &[]);
     ts[..np].iter().all(|&t| {
         let (v, e) = g(t);
         v > e
@@ -219,7 +220,7 @@ pub(super) fn certified_verdict(
     };
     // Just past the sign change g is small but its bound, where it comes from cancellation
     // near the straight equilibrium, is smaller still: try a few points there first.
-    let (ts, np) = sample_times(t0, spacing, (a3, a5), &[]);
+    let (ts, np) = sample_times(t0, spacing, around(a3, a5), &[]);
     let near = [0.05, 0.1, 0.2, 0.4].map(|f| first + f * spacing);
     let certified = near
         .iter()

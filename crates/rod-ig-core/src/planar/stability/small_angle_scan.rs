@@ -1,9 +1,10 @@
 //! The stability of nearly straight rods by the small-angle expansion's det J (its own scan
 //! spacing, truncation and rounding bounds).
 
-use super::scan::{scan, Probe};
+use super::around;
 use super::series::certified_verdict;
 use super::SERIES_T_MIN;
+use crate::conjugate::{scan, Probe};
 use crate::planar::small_angle;
 use crate::{PlanarParams, RodError, StabilityReport};
 
@@ -92,7 +93,7 @@ pub(crate) fn small_angle_report(a: &PlanarParams) -> Result<Option<StabilityRep
         let (v, _, d) = small_angle::normalised_det_sloped(a3, a4, a5, t);
         Probe { v, d }
     };
-    let s = scan(&sloped, SERIES_T_MIN, spacing, (a3, a5), &[])?;
+    let s = scan(&sloped, SERIES_T_MIN, spacing, around(a3, a5), &[])?;
     let bounded = |t: f64| {
         let (v, rounding) = small_angle::normalised_det(a3, a4, a5, t);
         let bound = (truncation + SMALL_ANGLE_ROUNDING) * v.abs().max(1.0) + rounding;
