@@ -26,6 +26,7 @@ mod jsonl;
 mod motion_cmds;
 mod planar_cmds;
 mod spatial_cmds;
+mod spatial_track;
 mod svg;
 mod timing;
 
@@ -125,6 +126,15 @@ enum Command {
         #[arg(long)]
         svg: Option<PathBuf>,
     },
+    /// Quasi-static motion of the 3-D rod (with or without weight): `track`'s 3-D twin.
+    /// Reads JSON lines {"target": {"position": [..], "quaternion": [qx, qy, qz, qw]}, "a0"?:
+    /// [6 numbers] (first line: the rod held at the start; without it the first target is a
+    /// fresh solve, least energy with weight), "tolerance"?, "deadline_ms"? (default 1000),
+    /// "weight"?, "gravity"?, "stiffness"? (as `solve3d`; set by the first line: a later line
+    /// may restate them, not change them)}; writes the fields of `solve3d` plus "event"
+    /// ("none" | "snap" | "lost" | "buckle"), "progress", "held_a" and, after a snap,
+    /// "critical", "critical_a" and "energy_released" (as `track`).
+    Track3d,
     /// Plans a stable gripper path. Reads JSON lines {"start": [a3, a4, a5], "goal": {"x",
     /// "y", "theta"}, "obstacles"?: [{"type": "disc", "center": [x, y], "radius": r} |
     /// {"type": "polygon", "points": [[x, y], ...]}], "deadline_ms"? (default 500), "weight"?, "gravity"? (as `solve`)}; writes
@@ -547,6 +557,7 @@ fn main() -> ExitCode {
             .map_err(|e| e.to_string())
         }
         Command::Track { svg } => track(stdin, stdout, svg.as_deref()),
+        Command::Track3d => spatial_track::run(stdin, stdout, warm_up),
         Command::Plan { svg } => plan(stdin, stdout, svg.as_deref()),
         Command::Shape {
             params,

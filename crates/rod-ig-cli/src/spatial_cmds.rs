@@ -16,27 +16,27 @@ use serde_json::Value;
 /// A pose as it travels in JSON.
 #[derive(Serialize, Deserialize, Clone, Copy)]
 #[serde(deny_unknown_fields)]
-struct PoseJson {
+pub(crate) struct PoseJson {
     position: [f64; 3],
     /// (x, y, z, w), any nonzero norm on input; unit with w ≥ 0 on output.
     quaternion: [f64; 4],
 }
 
 impl PoseJson {
-    fn from_pose(p: &SpatialPose) -> Self {
+    pub(crate) fn from_pose(p: &SpatialPose) -> Self {
         PoseJson {
             position: [p.position.x, p.position.y, p.position.z],
             quaternion: p.quaternion_xyzw(),
         }
     }
 
-    fn to_pose(self) -> Result<SpatialPose, String> {
+    pub(crate) fn to_pose(self) -> Result<SpatialPose, String> {
         SpatialPose::from_xyzw(Vector3::from(self.position), self.quaternion)
             .map_err(|e| format!("target: {e}"))
     }
 }
 
-fn stiffness(c: Option<[f64; 3]>) -> Result<Stiffness, String> {
+pub(crate) fn stiffness(c: Option<[f64; 3]>) -> Result<Stiffness, String> {
     let k = match c {
         Some([c1, c2, c3]) => Stiffness { c1, c2, c3 },
         None => Stiffness::default(),
@@ -241,7 +241,7 @@ pub fn solve3d_line(line: &str, verbose: bool) -> Result<Value, String> {
 
 /// Adds the gripper wrenches (`base_wrench`, `tip_wrench`) to a `solve3d` answer and its
 /// `solutions`.
-fn with_wrenches(value: &mut Value, k: &Stiffness, g: &Gravity3) {
+pub(crate) fn with_wrenches(value: &mut Value, k: &Stiffness, g: &Gravity3) {
     jsonl::with_fields_of_a(value, |a| match <[f64; 6]>::try_from(a) {
         Ok(a) => jsonl::wrench_fields(heavy3::wrenches(&SpatialParams::from(a), k, g).ok()),
         Err(_) => Vec::new(),

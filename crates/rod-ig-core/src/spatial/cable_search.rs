@@ -124,6 +124,10 @@ fn lift_pose(normal: Vector3<f64>, in_plane: Vector3<f64>, pose: &PlanarPose) ->
     }
 }
 
+/// Share of the time left that the planar search of [`all`] may spend before its rods are
+/// lifted to 3-D.
+const PLANAR_SHARE: f64 = 0.6;
+
 fn planar_options(options: &SolveOptions<SVector<f64, 6>>) -> PlanarOptions {
     PlanarOptions {
         method: options.method,
@@ -215,7 +219,13 @@ pub(crate) fn first(
     options: &SolveOptions<SVector<f64, 6>>,
 ) -> Option<Solution<SpatialParams, SpatialPose>> {
     let planar = HeavyPlanar::new(reduction.gravity);
-    let opts = planar_options(options);
+    // The first rod, whatever the caller's objective: a least-energy planar search runs to
+    // its deadline and leaves the lift none (a least-energy solve3d at w = 500 answered on
+    // its deadline's edge, or nothing); the caller's least energy ranges over [`all`].
+    let opts = PlanarOptions {
+        objective: crate::solver::Objective::FirstFound,
+        ..planar_options(options)
+    };
     if let Ok(s) = planar.robust(&reduction.target, &opts) {
         if let Some(out) = lifted_solution(rod, reduction, &s, target) {
             return Some(out);
@@ -236,7 +246,12 @@ pub(crate) fn all(
     options: &SolveOptions<SVector<f64, 6>>,
 ) -> Found<SpatialParams, SpatialPose> {
     let planar = HeavyPlanar::new(reduction.gravity);
-    let found = planar.robust_all(&reduction.target, &planar_options(options));
+    let found = {
+        // The planar search may run to the deadline (least energy, `all`): the lifts of what
+        // it found get the rest of the time (after it, they fail on the expired deadline).
+        let _share = crate::deadline::share_of_remaining(PLANAR_SHARE);
+        planar.robust_all(&reduction.target, &planar_options(options))
+    };
     Found {
         solutions: found
             .solutions

@@ -1,0 +1,261 @@
+//! `rod-ig track3d`: the 3-D rod (with or without weight) follows its equilibrium branch as
+//! the tip gripper moves, JSON lines in and out (`track`'s 3-D twin). No math here: the
+//! solver crate's one `BranchFollower` on `Spatial` or `HeavySpatial`.
+
+use crate::answer::SolveAnswer;
+use crate::jsonl;
+use crate::spatial_cmds::{stiffness, with_wrenches, PoseJson};
+use rod_ig_core::solver::{BranchEvent, BranchFollower, Move, Objective, SolveOptions};
+use rod_ig_core::spatial::heavy::Gravity3;
+use rod_ig_core::spatial::{HeavySpatial, Spatial, SpatialParams, SpatialPose, Stiffness};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// One `track3d` line.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Track3dRequest {
+    /// The rod the gripper holds at the start (first line only, optional).
+    a0: Option<[f64; 6]>,
+    target: PoseJson,
+    tolerance: Option<f64>,
+    /// Wall-time budget of the line in ms (default 1000, at most 10000).
+    deadline_ms: Option<f64>,
+    /// Dimensionless weight w = ρgAL³/EI (the stream's: set by its first line, default 0).
+    weight: Option<f64>,
+    /// Direction of gravity in the base frame (the stream's, default [0, 0, -1]).
+    gravity: Option<[f64; 3]>,
+    /// (c1, c2, c3) (the stream's, default (1, 1, 1)).
+    stiffness: Option<[f64; 3]>,
+}
+
+/// A `track3d` answer: the `solve3d` fields plus the branch event.
+#[derive(Serialize)]
+struct Track3dAnswer {
+    #[serde(flatten)]
+    solve: SolveAnswer<[f64; 6], PoseJson>,
+    /// "none", "snap", "lost" or "buckle" (as `track`).
+    event: &'static str,
+    /// After a snap: the gripper pose where the branch ended.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    critical: Option<PoseJson>,
+    /// After a snap: the last stable rod of the old branch.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    critical_a: Option<[f64; 6]>,
+    /// After a snap: the elastic energy it released.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    energy_released: Option<f64>,
+    /// How far along the gripper's path the rod was followed (1 when the target was reached).
+    progress: f64,
+    /// The rod held after this line (null once lost).
+    held_a: Option<[f64; 6]>,
+}
+
+/// The follower of a stream: the weightless rod, or the rod with weight.
+enum Follower3d {
+    Weightless(BranchFollower<6, Spatial>),
+    Heavy(BranchFollower<6, HeavySpatial>),
+}
+
+impl Follower3d {
+    fn new(k: Stiffness, g: Gravity3, options: SolveOptions<SpatialParams>) -> Self {
+        if g.is_weightless() {
+            Self::Weightless(BranchFollower::new(Spatial::with_stiffness(k), options))
+        } else {
+            let model = HeavySpatial {
+                stiffness: k,
+                gravity: g,
+            };
+            Self::Heavy(BranchFollower::new(model, options))
+        }
+    }
+
+    fn holding(
+        k: Stiffness,
+        g: Gravity3,
+        options: SolveOptions<SpatialParams>,
+        a: SpatialParams,
+    ) -> Result<Self, String> {
+        let held = if g.is_weightless() {
+            BranchFollower::holding(Spatial::with_stiffness(k), options, a).map(Self::Weightless)
+        } else {
+            let model = HeavySpatial {
+                stiffness: k,
+                gravity: g,
+            };
+            BranchFollower::holding(model, options, a).map(Self::Heavy)
+        };
+        held.map_err(|e| e.to_string())
+    }
+
+    fn follow(
+        &mut self,
+        target: &SpatialPose,
+        options: SolveOptions<SpatialParams>,
+    ) -> Move<SpatialParams, SpatialPose> {
+        match self {
+            Self::Weightless(f) => {
+                f.set_options(options);
+                f.follow(target)
+            }
+            Self::Heavy(f) => {
+                f.set_options(options);
+                f.follow(target)
+            }
+        }
+    }
+
+    fn rod(&self) -> Option<SpatialParams> {
+        match self {
+            Self::Weightless(f) => f.rod(),
+            Self::Heavy(f) => f.rod(),
+        }
+    }
+}
+
+/// The stream's rod model, fixed by its first line.
+#[derive(Clone, Copy, PartialEq)]
+struct StreamModel {
+    stiffness: Stiffness,
+    gravity: Gravity3,
+}
+
+/// The state of a `track3d` stream.
+#[derive(Default)]
+pub struct Tracking3d {
+    follower: Option<Follower3d>,
+    model: Option<StreamModel>,
+}
+
+fn params6(a: &SpatialParams) -> [f64; 6] {
+    std::array::from_fn(|i| a[i])
+}
+
+impl Tracking3d {
+    /// Answers one `track3d` line.
+    pub fn line(&mut self, line: &str) -> Result<Value, String> {
+        let request: Track3dRequest = jsonl::parse(line)?;
+        let target = request.target.to_pose()?;
+        let model = self.model_of(&request)?;
+        let mut options = SolveOptions::<SpatialParams>::default();
+        jsonl::apply_newton_knobs(
+            (None, None, request.tolerance),
+            (
+                &mut options.alpha,
+                &mut options.max_iterations,
+                &mut options.tolerance,
+            ),
+        )?;
+        if let Some(ms) = request.deadline_ms {
+            options.deadline = jsonl::deadline_from_ms(ms)?;
+        }
+        if !model.gravity.is_weightless() {
+            // A fresh solve with weight answers the hanging cable (least energy), as `track`.
+            options.objective = Objective::LeastEnergy;
+        }
+        if let Some(a0) = request.a0 {
+            if self.follower.is_some() {
+                return Err(
+                    "\"a0\" is only accepted on the first line (before any rod is held)".into(),
+                );
+            }
+            let held = Follower3d::holding(
+                model.stiffness,
+                model.gravity,
+                options,
+                SpatialParams::from(a0),
+            )
+            .map_err(|e| format!("a0 cannot be held: {e}"))?;
+            self.follower = Some(held);
+        }
+        self.model = Some(model);
+        let follower = self
+            .follower
+            .get_or_insert_with(|| Follower3d::new(model.stiffness, model.gravity, options));
+        let m = follower.follow(&target, options);
+        let held_a = follower.rod().map(|a| params6(&a));
+        let mut value = jsonl::to_value(&answer_of(&m, held_a))?;
+        with_wrenches(&mut value, &model.stiffness, &model.gravity);
+        Ok(value)
+    }
+
+    /// The line's model: the stream's, which a later line may restate but not change (a
+    /// change of weight or gravity at fixed grippers is not followed in 3-D yet).
+    fn model_of(&self, request: &Track3dRequest) -> Result<StreamModel, String> {
+        let k = match (request.stiffness, self.model) {
+            (None, Some(m)) => m.stiffness,
+            (c, _) => stiffness(c)?,
+        };
+        let g = match (request.weight, request.gravity, self.model) {
+            (None, None, Some(m)) => m.gravity,
+            (w, d, held) => {
+                let held = held.map(|m| m.gravity);
+                let weight = w.or(held.map(|g| g.weight())).unwrap_or(0.0);
+                let direction = d
+                    .or(held.map(|g| g.direction()))
+                    .unwrap_or([0.0, 0.0, -1.0]);
+                Gravity3::new(weight, direction).map_err(|e| e.to_string())?
+            }
+        };
+        let model = StreamModel {
+            stiffness: k,
+            gravity: g,
+        };
+        match self.model {
+            Some(m) if m != model && self.follower.is_some() => Err(
+                "track3d: weight, gravity and stiffness are the stream's (set by its first \
+                 line); changing them under a held 3-D rod is not supported yet"
+                    .into(),
+            ),
+            _ => Ok(model),
+        }
+    }
+}
+
+/// `rod-ig track3d`: answers each line of `input` on `output`.
+pub fn run<R: std::io::BufRead, W: std::io::Write>(
+    input: R,
+    output: W,
+    warm_up: impl FnOnce(),
+) -> Result<(), String> {
+    // A rod with weight starts from the planar rods (their atlas, built as for `solve3d`).
+    warm_up();
+    let mut tracking = Tracking3d::default();
+    jsonl::run(input, output, |line| tracking.line(line)).map_err(|e| e.to_string())
+}
+
+/// The answer to one move.
+fn answer_of(m: &Move<SpatialParams, SpatialPose>, held_a: Option<[f64; 6]>) -> Track3dAnswer {
+    let solve = match &m.result {
+        Ok(s) => SolveAnswer::success(s, params6, PoseJson::from_pose),
+        Err(f) => SolveAnswer::failure(
+            f.iterations,
+            f.residual,
+            f.reason.to_string(),
+            f.termination(),
+        )
+        .with_starts(f.starts)
+        .with_elapsed_us(f.elapsed_us),
+    };
+    let mut answer = Track3dAnswer {
+        solve,
+        event: m.event.as_str(),
+        critical: None,
+        critical_a: None,
+        energy_released: None,
+        progress: m.progress,
+        held_a,
+    };
+    if let BranchEvent::Snap {
+        critical,
+        critical_a,
+        energy_released,
+        ..
+    } = m.event
+    {
+        answer.critical = Some(PoseJson::from_pose(&critical));
+        answer.critical_a = Some(params6(&critical_a));
+        answer.energy_released = Some(energy_released);
+    }
+    answer
+}
