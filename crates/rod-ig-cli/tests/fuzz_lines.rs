@@ -47,7 +47,7 @@ const NUMBERS: [&str; 28] = [
     "{}",
 ];
 
-const TEMPLATES: [(&str, &[&str]); 6] = [
+const TEMPLATES: [(&str, &[&str]); 7] = [
     (
         "forward",
         &[
@@ -91,6 +91,14 @@ const TEMPLATES: [(&str, &[&str]); 6] = [
         "solve3d",
         &[
             "{\"target\": {\"position\": [#, #, #], \"quaternion\": [#, #, #, #]}, \"max_iterations\": #, \"tolerance\": #, \"deadline_ms\": 30}",
+            "{\"target\": {\"position\": [#, #, #], \"quaternion\": [#, #, #, #]}, \"weight\": #, \"gravity\": [#, #, #], \"deadline_ms\": 30}",
+        ],
+    ),
+    (
+        "track3d",
+        &[
+            "{\"target\": {\"position\": [#, #, #], \"quaternion\": [#, #, #, #]}, \"tolerance\": #, \"deadline_ms\": 30}",
+            "{\"target\": {\"position\": [#, #, #], \"quaternion\": [#, #, #, #]}, \"a0\": [#, #, #, #, #, #], \"deadline_ms\": #}",
             "{\"target\": {\"position\": [#, #, #], \"quaternion\": [#, #, #, #]}, \"weight\": #, \"gravity\": [#, #, #], \"deadline_ms\": 30}",
         ],
     ),
