@@ -4,7 +4,7 @@
 
 use nalgebra::SVector;
 use rod_ig_core::solver::{
-    self, observe, Event, InverseGeometry, IterationLog, Solution, SolveOptions,
+    self, observe, BranchEvent, Event, InverseGeometry, IterationLog, Move, Solution, SolveOptions,
 };
 use serde::Serialize;
 use std::io::Write;
@@ -108,6 +108,73 @@ impl<A, T> SolveAnswer<A, T> {
     pub fn with_starts(mut self, starts: u32) -> Self {
         self.starts = starts;
         self
+    }
+}
+
+/// A `track` or `track3d` answer: the `solve` fields plus what happened to the held rod.
+#[derive(Serialize)]
+pub struct MoveAnswer<A, T> {
+    #[serde(flatten)]
+    pub solve: SolveAnswer<A, T>,
+    /// "none", "snap", "lost" or "buckle".
+    pub event: &'static str,
+    /// After a snap: the gripper pose where the branch ended.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub critical: Option<T>,
+    /// After a snap: the last stable rod of the old branch.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub critical_a: Option<A>,
+    /// After a snap: the elastic energy it released.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub energy_released: Option<f64>,
+    /// How far along the gripper's path the rod was followed (1 when the target was reached;
+    /// on a deadline, where the rod now held is).
+    pub progress: f64,
+    /// The rod held after this line (null once lost): on a deadline, the last equilibrium
+    /// reached, from which the next line goes on.
+    pub held_a: Option<A>,
+}
+
+impl<A, T> MoveAnswer<A, T> {
+    /// The answer to the follower's move `m`, the rod it holds after it being `held`.
+    pub fn of<P, X: Copy>(
+        m: &Move<P, X>,
+        held: Option<&P>,
+        a_of: impl Fn(&P) -> A,
+        tip_of: impl Fn(&X) -> T,
+    ) -> Self {
+        let solve = match &m.result {
+            Ok(s) => SolveAnswer::success(s, &a_of, &tip_of),
+            Err(f) => SolveAnswer::failure(
+                f.iterations,
+                f.residual,
+                f.reason.to_string(),
+                f.termination(),
+            )
+            .with_starts(f.starts)
+            .with_elapsed_us(f.elapsed_us),
+        };
+        let mut answer = MoveAnswer {
+            solve,
+            event: m.event.as_str(),
+            critical: None,
+            critical_a: None,
+            energy_released: None,
+            progress: m.progress,
+            held_a: held.map(&a_of),
+        };
+        if let BranchEvent::Snap {
+            critical,
+            critical_a,
+            energy_released,
+            ..
+        } = &m.event
+        {
+            answer.critical = Some(tip_of(critical));
+            answer.critical_a = Some(a_of(critical_a));
+            answer.energy_released = Some(*energy_released);
+        }
+        answer
     }
 }
 

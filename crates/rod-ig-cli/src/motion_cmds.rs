@@ -1,7 +1,7 @@
 //! `rod-ig track` and `rod-ig plan`: quasi-static motion of the planar rod, JSON lines in and
 //! out, optional SVG pictures of the rod sequence. No math here.
 
-use crate::answer::SolveAnswer;
+use crate::answer::MoveAnswer;
 use crate::jsonl;
 use crate::svg::{Obstacle as DrawnObstacle, SequenceKind, SequenceRod};
 use rod_ig_core::plan::{self, Obstacle, PlanRequest, Planner};
@@ -103,30 +103,6 @@ struct GravityChange {
     /// No stable rod was found under the new gravity where the gripper stands: the rod was
     /// lost (the event "lost"; the line's target is then solved afresh).
     lost: bool,
-}
-
-/// A `track` answer: the `solve` fields plus the branch event.
-#[derive(Serialize)]
-struct TrackAnswer {
-    #[serde(flatten)]
-    solve: SolveAnswer<[f64; 3], PlanarPose>,
-    /// "none", "snap" or "lost".
-    event: &'static str,
-    /// After a snap: the gripper pose where the branch ended.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    critical: Option<PlanarPose>,
-    /// After a snap: the last stable rod of the old branch.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    critical_a: Option<[f64; 3]>,
-    /// After a snap: the elastic energy it released.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    energy_released: Option<f64>,
-    /// How far along the gripper's path the rod was followed (1 when the target was reached;
-    /// on a deadline, where the rod now held is).
-    progress: f64,
-    /// The rod held after this line (null once lost): on a deadline, the last equilibrium
-    /// reached, from which the next line goes on.
-    held_a: Option<[f64; 3]>,
 }
 
 /// Most rods kept for a `track --svg` picture: past it, every other rod along the motion is
@@ -288,7 +264,7 @@ impl Tracking {
             .follower
             .get_or_insert_with(|| Follower::new(gravity, options));
         let m = follower.follow(&request.target, options);
-        let held_a = follower.rod().map(|a| params3(&a));
+        let held_a = follower.rod();
         let answer = self.answer(&m, change, held_a, &gravity);
         let mut value = jsonl::to_value(&answer)?;
         jsonl::with_fields_of_a(&mut value, |a| match <[f64; 3]>::try_from(a) {
@@ -351,40 +327,12 @@ impl Tracking {
         &mut self,
         m: &Move<PlanarParams, PlanarPose>,
         change: Option<GravityChange>,
-        held_a: Option<[f64; 3]>,
+        held_a: Option<PlanarParams>,
         gravity: &Gravity,
-    ) -> TrackAnswer {
+    ) -> MoveAnswer<[f64; 3], PlanarPose> {
         let gravity = *gravity;
-        let solve = match &m.result {
-            Ok(s) => SolveAnswer::success(s, params3, |t| *t),
-            Err(f) => SolveAnswer::failure(
-                f.iterations,
-                f.residual,
-                f.reason.to_string(),
-                f.termination(),
-            )
-            .with_starts(f.starts)
-            .with_elapsed_us(f.elapsed_us),
-        };
-        let mut answer = TrackAnswer {
-            solve,
-            event: m.event.as_str(),
-            critical: None,
-            critical_a: None,
-            energy_released: None,
-            progress: m.progress,
-            held_a,
-        };
-        if let BranchEvent::Snap {
-            critical,
-            critical_a,
-            energy_released,
-            ..
-        } = m.event
-        {
-            answer.critical = Some(critical);
-            answer.critical_a = Some(params3(&critical_a));
-            answer.energy_released = Some(energy_released);
+        let mut answer = MoveAnswer::of(m, held_a.as_ref(), params3, |t| *t);
+        if let BranchEvent::Snap { critical_a, .. } = m.event {
             self.draw(&critical_a, &gravity, SequenceKind::Critical);
         } else if let Some(GravityChange { lost: true, .. }) = change {
             answer.event = "lost";

@@ -2,13 +2,13 @@
 //! the tip gripper moves, JSON lines in and out (`track`'s 3-D twin). No math here: the
 //! solver crate's one `BranchFollower` on `Spatial` or `HeavySpatial`.
 
-use crate::answer::SolveAnswer;
+use crate::answer::MoveAnswer;
 use crate::jsonl;
 use crate::spatial_cmds::{stiffness, with_wrenches, PoseJson};
-use rod_ig_core::solver::{BranchEvent, BranchFollower, Move, Objective, SolveOptions};
+use rod_ig_core::solver::{BranchFollower, Move, Objective, SolveOptions};
 use rod_ig_core::spatial::heavy::Gravity3;
 use rod_ig_core::spatial::{HeavySpatial, Spatial, SpatialParams, SpatialPose, Stiffness};
-use serde::{Deserialize, Serialize};
+use serde::Deserialize;
 use serde_json::Value;
 
 /// One `track3d` line.
@@ -27,28 +27,6 @@ struct Track3dRequest {
     gravity: Option<[f64; 3]>,
     /// (c1, c2, c3) (the stream's, default (1, 1, 1)).
     stiffness: Option<[f64; 3]>,
-}
-
-/// A `track3d` answer: the `solve3d` fields plus the branch event.
-#[derive(Serialize)]
-struct Track3dAnswer {
-    #[serde(flatten)]
-    solve: SolveAnswer<[f64; 6], PoseJson>,
-    /// "none", "snap", "lost" or "buckle" (as `track`).
-    event: &'static str,
-    /// After a snap: the gripper pose where the branch ended.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    critical: Option<PoseJson>,
-    /// After a snap: the last stable rod of the old branch.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    critical_a: Option<[f64; 6]>,
-    /// After a snap: the elastic energy it released.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    energy_released: Option<f64>,
-    /// How far along the gripper's path the rod was followed (1 when the target was reached).
-    progress: f64,
-    /// The rod held after this line (null once lost).
-    held_a: Option<[f64; 6]>,
 }
 
 /// The follower of a stream: the weightless rod, or the rod with weight.
@@ -173,8 +151,9 @@ impl Tracking3d {
             .follower
             .get_or_insert_with(|| Follower3d::new(model.stiffness, model.gravity, options));
         let m = follower.follow(&target, options);
-        let held_a = follower.rod().map(|a| params6(&a));
-        let mut value = jsonl::to_value(&answer_of(&m, held_a))?;
+        let held = follower.rod();
+        let answer = MoveAnswer::of(&m, held.as_ref(), params6, PoseJson::from_pose);
+        let mut value = jsonl::to_value(&answer)?;
         with_wrenches(&mut value, &model.stiffness, &model.gravity);
         Ok(value)
     }
@@ -222,40 +201,4 @@ pub fn run<R: std::io::BufRead, W: std::io::Write>(
     warm_up();
     let mut tracking = Tracking3d::default();
     jsonl::run(input, output, |line| tracking.line(line)).map_err(|e| e.to_string())
-}
-
-/// The answer to one move.
-fn answer_of(m: &Move<SpatialParams, SpatialPose>, held_a: Option<[f64; 6]>) -> Track3dAnswer {
-    let solve = match &m.result {
-        Ok(s) => SolveAnswer::success(s, params6, PoseJson::from_pose),
-        Err(f) => SolveAnswer::failure(
-            f.iterations,
-            f.residual,
-            f.reason.to_string(),
-            f.termination(),
-        )
-        .with_starts(f.starts)
-        .with_elapsed_us(f.elapsed_us),
-    };
-    let mut answer = Track3dAnswer {
-        solve,
-        event: m.event.as_str(),
-        critical: None,
-        critical_a: None,
-        energy_released: None,
-        progress: m.progress,
-        held_a,
-    };
-    if let BranchEvent::Snap {
-        critical,
-        critical_a,
-        energy_released,
-        ..
-    } = m.event
-    {
-        answer.critical = Some(PoseJson::from_pose(&critical));
-        answer.critical_a = Some(params6(&critical_a));
-        answer.energy_released = Some(energy_released);
-    }
-    answer
 }
