@@ -4,7 +4,8 @@
 
 use nalgebra::SVector;
 use rod_ig_core::solver::{
-    self, observe, BranchEvent, Event, InverseGeometry, IterationLog, Move, Solution, SolveOptions,
+    self, observe, BranchEvent, Event, Failure, InverseGeometry, IterationLog, Move, Solution,
+    SolveOptions,
 };
 use serde::Serialize;
 use std::io::Write;
@@ -98,6 +99,17 @@ impl<A, T> SolveAnswer<A, T> {
 }
 
 impl<A, T> SolveAnswer<A, T> {
+    /// The answer to the solver's failure `f` (its reason, termination and starts).
+    pub fn from_failure<P>(f: &Failure<P>) -> Self {
+        Self::failure(
+            f.iterations,
+            f.residual,
+            f.reason.to_string(),
+            f.termination(),
+        )
+        .with_starts(f.starts)
+    }
+
     /// The answer with its wall time set from the solver's measure (µs).
     pub fn with_elapsed_us(mut self, us: f64) -> Self {
         self.elapsed_ms = us / 1e3;
@@ -145,14 +157,7 @@ impl<A, T> MoveAnswer<A, T> {
     ) -> Self {
         let solve = match &m.result {
             Ok(s) => SolveAnswer::success(s, &a_of, &tip_of),
-            Err(f) => SolveAnswer::failure(
-                f.iterations,
-                f.residual,
-                f.reason.to_string(),
-                f.termination(),
-            )
-            .with_starts(f.starts)
-            .with_elapsed_us(f.elapsed_us),
+            Err(f) => SolveAnswer::from_failure(f).with_elapsed_us(f.elapsed_us),
         };
         let mut answer = MoveAnswer {
             solve,
@@ -215,13 +220,7 @@ where
     };
     let mut answer = match &first {
         Ok(s) => SolveAnswer::success(s, &a_of, &tip_of),
-        Err(f) => SolveAnswer::failure(
-            f.iterations,
-            f.residual,
-            f.reason.to_string(),
-            f.termination(),
-        )
-        .with_starts(f.starts),
+        Err(f) => SolveAnswer::from_failure(f),
     };
     answer.elapsed_ms = t0.elapsed().as_secs_f64() * 1e3;
     if let Some(solver::Every {

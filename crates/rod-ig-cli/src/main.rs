@@ -21,6 +21,7 @@ mod answer;
 mod bench;
 mod bench_deadlines;
 mod bench_tails;
+mod follower;
 mod held_cmds;
 mod jsonl;
 mod motion_cmds;

@@ -2,13 +2,14 @@
 //! out, optional SVG pictures of the rod sequence. No math here.
 
 use crate::answer::MoveAnswer;
+use crate::follower::{Follower, Model};
 use crate::jsonl;
 use crate::svg::{Obstacle as DrawnObstacle, SequenceKind, SequenceRod};
 use rod_ig_core::plan::{self, Obstacle, PlanRequest, Planner};
 use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
 use rod_ig_core::planar::ig::SolveOptions;
 use rod_ig_core::planar::PlanarClosedForm;
-use rod_ig_core::solver::{self, BranchEvent, BranchFollower, Move, Objective};
+use rod_ig_core::solver::{self, BranchEvent, Move, Objective};
 use rod_ig_core::{PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -37,58 +38,14 @@ struct TrackRequest {
 }
 
 /// The branch follower of a stream: the weightless closed forms until a line gives weight.
-enum Follower {
-    Weightless(BranchFollower<3, PlanarClosedForm>),
-    Heavy(BranchFollower<3, HeavyPlanar>),
-}
+type PlanarFollower = Follower<3, PlanarClosedForm, HeavyPlanar>;
 
-impl Follower {
-    fn new(g: Gravity, options: SolveOptions) -> Self {
-        if g.is_weightless() {
-            Self::Weightless(BranchFollower::new(PlanarClosedForm, options))
-        } else {
-            Self::Heavy(BranchFollower::new(HeavyPlanar::new(g), options))
-        }
-    }
-
-    fn holding(g: Gravity, options: SolveOptions, a: PlanarParams) -> Result<Self, String> {
-        let held = if g.is_weightless() {
-            BranchFollower::holding(PlanarClosedForm, options, a).map(Self::Weightless)
-        } else {
-            BranchFollower::holding(HeavyPlanar::new(g), options, a).map(Self::Heavy)
-        };
-        held.map_err(|e| e.to_string())
-    }
-
-    fn follow(
-        &mut self,
-        target: &PlanarPose,
-        options: SolveOptions,
-    ) -> Move<PlanarParams, PlanarPose> {
-        match self {
-            Self::Weightless(f) => {
-                f.set_options(options);
-                f.follow(target)
-            }
-            Self::Heavy(f) => {
-                f.set_options(options);
-                f.follow(target)
-            }
-        }
-    }
-
-    fn rod(&self) -> Option<PlanarParams> {
-        match self {
-            Self::Weightless(f) => f.rod(),
-            Self::Heavy(f) => f.rod(),
-        }
-    }
-
-    fn gripper(&self) -> Option<PlanarPose> {
-        match self {
-            Self::Weightless(f) => f.gripper(),
-            Self::Heavy(f) => f.gripper(),
-        }
+/// The model under gravity `g`.
+fn model_of(g: Gravity) -> Model<PlanarClosedForm, HeavyPlanar> {
+    if g.is_weightless() {
+        Model::Weightless(PlanarClosedForm)
+    } else {
+        Model::Heavy(HeavyPlanar::new(g))
     }
 }
 
@@ -113,7 +70,7 @@ pub const MAX_DRAWN_RODS: usize = 1000;
 /// The state of a `track` stream: the follower and, for `--svg`, the rods so far.
 #[derive(Default)]
 pub struct Tracking {
-    follower: Option<Follower>,
+    follower: Option<PlanarFollower>,
     /// The stream's rod when its lines hold it by pinned or free ends.
     held: crate::held_cmds::HeldTrack,
     /// The stream's gravity (a line with `weight` or `gravity` changes it for the next lines).
@@ -185,14 +142,14 @@ fn shape(a: &PlanarParams, g: &Gravity) -> Vec<PlanarPose> {
 /// Carries the rod `follower` holds from gravity `from` to `to`, the gripper fixed: along its
 /// branch, or, where the branch folds, by a snap to the least-energy stable rod under `to`.
 fn change_gravity(
-    follower: &Follower,
+    follower: &PlanarFollower,
     from: &Gravity,
     to: &Gravity,
     options: SolveOptions,
-) -> Result<(Follower, GravityChange), String> {
+) -> Result<(PlanarFollower, GravityChange), String> {
     let (Some(a), Some(gripper)) = (follower.rod(), follower.gripper()) else {
         return Ok((
-            Follower::new(*to, options),
+            PlanarFollower::new(model_of(*to), options),
             GravityChange {
                 snapped_from: None,
                 gripper: None,
@@ -208,7 +165,10 @@ fn change_gravity(
             energy_released: 0.0,
             lost: false,
         };
-        return Ok((Follower::holding(*to, options, s.a)?, change));
+        return Ok((
+            PlanarFollower::holding(model_of(*to), options, s.a)?,
+            change,
+        ));
     }
     let least = SolveOptions {
         objective: Objective::LeastEnergy,
@@ -222,7 +182,7 @@ fn change_gravity(
             energy_released: 0.0,
             lost: true,
         };
-        return Ok((Follower::new(*to, options), change));
+        return Ok((PlanarFollower::new(model_of(*to), options), change));
     };
     let before = heavy::energy(&a, to).map(|e| e.0).unwrap_or(f64::NAN);
     let change = GravityChange {
@@ -231,7 +191,10 @@ fn change_gravity(
         energy_released: before - s.energy,
         lost: false,
     };
-    Ok((Follower::holding(*to, options, s.a)?, change))
+    Ok((
+        PlanarFollower::holding(model_of(*to), options, s.a)?,
+        change,
+    ))
 }
 
 impl Tracking {
@@ -262,7 +225,7 @@ impl Tracking {
         let change = self.hold(&request, gravity, options)?;
         let follower = self
             .follower
-            .get_or_insert_with(|| Follower::new(gravity, options));
+            .get_or_insert_with(|| PlanarFollower::new(model_of(gravity), options));
         let m = follower.follow(&request.target, options);
         let held_a = follower.rod();
         let answer = self.answer(&m, change, held_a, &gravity);
@@ -301,7 +264,7 @@ impl Tracking {
                 );
             }
             let a0 = PlanarParams::from(a0);
-            let follower = Follower::holding(gravity, options, a0)
+            let follower = PlanarFollower::holding(model_of(gravity), options, a0)
                 .map_err(|e| format!("a0 cannot be held: {e}"))?;
             self.draw(&a0, &gravity, SequenceKind::Start);
             self.follower = Some(follower);

@@ -3,11 +3,12 @@
 //! solver crate's one `BranchFollower` on `Spatial` or `HeavySpatial`.
 
 use crate::answer::MoveAnswer;
+use crate::follower::{Follower, Model};
 use crate::jsonl;
 use crate::spatial_cmds::{stiffness, with_wrenches, PoseJson};
-use rod_ig_core::solver::{BranchFollower, Move, Objective, SolveOptions};
+use rod_ig_core::solver::{Objective, SolveOptions};
 use rod_ig_core::spatial::heavy::Gravity3;
-use rod_ig_core::spatial::{HeavySpatial, Spatial, SpatialParams, SpatialPose, Stiffness};
+use rod_ig_core::spatial::{HeavySpatial, Spatial, SpatialParams, Stiffness};
 use serde::Deserialize;
 use serde_json::Value;
 
@@ -30,64 +31,17 @@ struct Track3dRequest {
 }
 
 /// The follower of a stream: the weightless rod, or the rod with weight.
-enum Follower3d {
-    Weightless(BranchFollower<6, Spatial>),
-    Heavy(BranchFollower<6, HeavySpatial>),
-}
+type Follower3d = Follower<6, Spatial, HeavySpatial>;
 
-impl Follower3d {
-    fn new(k: Stiffness, g: Gravity3, options: SolveOptions<SpatialParams>) -> Self {
-        if g.is_weightless() {
-            Self::Weightless(BranchFollower::new(Spatial::with_stiffness(k), options))
-        } else {
-            let model = HeavySpatial {
-                stiffness: k,
-                gravity: g,
-            };
-            Self::Heavy(BranchFollower::new(model, options))
-        }
-    }
-
-    fn holding(
-        k: Stiffness,
-        g: Gravity3,
-        options: SolveOptions<SpatialParams>,
-        a: SpatialParams,
-    ) -> Result<Self, String> {
-        let held = if g.is_weightless() {
-            BranchFollower::holding(Spatial::with_stiffness(k), options, a).map(Self::Weightless)
-        } else {
-            let model = HeavySpatial {
-                stiffness: k,
-                gravity: g,
-            };
-            BranchFollower::holding(model, options, a).map(Self::Heavy)
-        };
-        held.map_err(|e| e.to_string())
-    }
-
-    fn follow(
-        &mut self,
-        target: &SpatialPose,
-        options: SolveOptions<SpatialParams>,
-    ) -> Move<SpatialParams, SpatialPose> {
-        match self {
-            Self::Weightless(f) => {
-                f.set_options(options);
-                f.follow(target)
-            }
-            Self::Heavy(f) => {
-                f.set_options(options);
-                f.follow(target)
-            }
-        }
-    }
-
-    fn rod(&self) -> Option<SpatialParams> {
-        match self {
-            Self::Weightless(f) => f.rod(),
-            Self::Heavy(f) => f.rod(),
-        }
+/// The model of stiffness `k` under gravity `g`.
+fn model_of(k: Stiffness, g: Gravity3) -> Model<Spatial, HeavySpatial> {
+    if g.is_weightless() {
+        Model::Weightless(Spatial::with_stiffness(k))
+    } else {
+        Model::Heavy(HeavySpatial {
+            stiffness: k,
+            gravity: g,
+        })
     }
 }
 
@@ -138,8 +92,7 @@ impl Tracking3d {
                 );
             }
             let held = Follower3d::holding(
-                model.stiffness,
-                model.gravity,
+                model_of(model.stiffness, model.gravity),
                 options,
                 SpatialParams::from(a0),
             )
@@ -147,9 +100,9 @@ impl Tracking3d {
             self.follower = Some(held);
         }
         self.model = Some(model);
-        let follower = self
-            .follower
-            .get_or_insert_with(|| Follower3d::new(model.stiffness, model.gravity, options));
+        let follower = self.follower.get_or_insert_with(|| {
+            Follower3d::new(model_of(model.stiffness, model.gravity), options)
+        });
         let m = follower.follow(&target, options);
         let held = follower.rod();
         let answer = MoveAnswer::of(&m, held.as_ref(), params6, PoseJson::from_pose);
