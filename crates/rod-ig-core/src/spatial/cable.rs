@@ -26,6 +26,7 @@
 use super::heavy_ode::{self, Gravity3, NB};
 use super::{SpatialParams, SpatialPose, Stiffness};
 use crate::conjugate::Stream;
+use crate::ends::EndCondition;
 use crate::ode::{dop853, OdeOptions};
 use crate::planar::heavy::cable::{CableError, GROWTH_PER_SEGMENT, MAX_SEGMENTS};
 use crate::{RodError, StabilityReport};
@@ -84,6 +85,42 @@ impl Node {
             rotation: self.rotation * UnitQuaternion::from_scaled_axis(eps),
             position: self.position + self.rotation * Vector3::new(d[3], d[4], d[5]),
             moment_arm: self.moment_arm + Vector3::new(d[6], d[7], d[8]),
+        }
+    }
+}
+
+/// What the equations at a 3-D cable's tip hold (issue 52): its six last rows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TipGoal {
+    /// A clamped tip at this pose: its body error (6 rows).
+    Pose(SpatialPose),
+    /// A pinned tip at this position (base frame): p(1) − target (3 rows) and no moment there,
+    /// M(1) = 0 (3 rows).
+    Position(Vector3<f64>),
+    /// A free tip: no moment, M(1) = 0 (3 rows), and no force but `tip_load`, i.e. the base
+    /// force a_f = w ĝ + tip_load (3 rows).
+    Free {
+        /// A point force at the tip (base frame; zero for a cable hanging free).
+        tip_load: Vector3<f64>,
+    },
+}
+
+impl TipGoal {
+    /// The goal `s` of the way from `self` to `to` (positions and forces on a line,
+    /// orientations by slerp); None when the two are not of one kind.
+    fn between(&self, to: &TipGoal, s: f64) -> Option<TipGoal> {
+        match (self, to) {
+            (TipGoal::Pose(a), TipGoal::Pose(b)) => Some(TipGoal::Pose(SpatialPose {
+                position: a.position + (b.position - a.position) * s,
+                rotation: a.rotation.slerp(&b.rotation, s),
+            })),
+            (TipGoal::Position(a), TipGoal::Position(b)) => {
+                Some(TipGoal::Position(a + (b - a) * s))
+            }
+            (TipGoal::Free { tip_load: a }, TipGoal::Free { tip_load: b }) => Some(TipGoal::Free {
+                tip_load: a + (b - a) * s,
+            }),
+            _ => None,
         }
     }
 }
@@ -278,6 +315,21 @@ impl SpatialCable {
         Ok(out)
     }
 
+    /// The wrenches the rod exerts on its grippers ([`crate::wrench::spatial`]): the world
+    /// wrench at the tip n(1) = a_f − w ĝ and, about the base, a_m − P(1) × w ĝ.
+    pub fn wrenches(
+        &self,
+    ) -> Result<crate::wrench::GripperWrenches<crate::wrench::SpatialWrench>, RodError> {
+        let (tip, arm) = self.tip_and_moment_arm()?;
+        let l = Vector3::from(self.gravity.load());
+        let a = self.params();
+        let (am, af) = (
+            Vector3::new(a[0], a[1], a[2]),
+            Vector3::new(a[3], a[4], a[5]),
+        );
+        Ok(crate::wrench::spatial(&a, &tip, af - l, am - arm.cross(&l)))
+    }
+
     /// Elastic energy and total energy (elastic + gravitational, −w ĝ · P(1)).
     pub fn energies(&self) -> Result<(f64, f64), RodError> {
         let mut elastic = 0.0;
@@ -309,7 +361,7 @@ impl SpatialCable {
     /// derivative in the unknowns (a, then each node's correction).
     fn residual(
         &self,
-        target: &SpatialPose,
+        goal: &TipGoal,
         jacobian: bool,
     ) -> Result<(DVector<f64>, Option<DMatrix<f64>>), RodError> {
         let m = self.segments();
@@ -326,11 +378,95 @@ impl SpatialCable {
             };
             if k + 1 < m {
                 self.continuity_rows(k, &e, &mut r, j.as_mut());
-            } else {
+            } else if let TipGoal::Pose(target) = goal {
                 tip_rows(k, &e, target, &mut r, j.as_mut());
+            } else {
+                self.held_tip_rows(k, &e, goal, &mut r, j.as_mut());
             }
         }
         Ok((r, j))
+    }
+
+    /// The world moment at the end `e` of the last segment, M(1) = a_m − P(1) × w ĝ −
+    /// p(1) × n(1) with n(1) = a_f − w ĝ (module docs of [`super::heavy`]), and, for column `c`
+    /// of that segment's variations, its derivative: δa_m − δP × w ĝ − (R η_v) × n(1) −
+    /// p(1) × δa_f.
+    fn tip_moment(&self, e: &[f64; FULL], column: Option<usize>) -> Vector3<f64> {
+        let l = Vector3::from(self.gravity.load());
+        let end = Node::of_state(e);
+        let n1 = Vector3::new(self.a[3], self.a[4], self.a[5]) - l;
+        let Some(c) = column else {
+            let am = Vector3::new(self.a[0], self.a[1], self.a[2]);
+            return am - end.moment_arm.cross(&l) - end.position.cross(&n1);
+        };
+        let col = |rr: usize| e[NB + COLUMNS * rr + c];
+        let dp_world = end.rotation * Vector3::new(col(3), col(4), col(5));
+        let d_arm = Vector3::new(col(6), col(7), col(8));
+        let mut d = -d_arm.cross(&l) - dp_world.cross(&n1);
+        if c >= ROWS {
+            let mut unit = [0.0; 6];
+            unit[c - ROWS] = 1.0;
+            d += Vector3::new(unit[0], unit[1], unit[2]);
+            d -= end.position.cross(&Vector3::new(unit[3], unit[4], unit[5]));
+        }
+        d
+    }
+
+    /// The last rows for a pinned or free tip ([`TipGoal`]): the position (pinned) or the base
+    /// force (free), then M(1) = 0, scaled by 1 / max(1, ‖a‖∞) so that its rounding compares
+    /// with the position's.
+    fn held_tip_rows(
+        &self,
+        k: usize,
+        e: &[f64; FULL],
+        goal: &TipGoal,
+        r: &mut DVector<f64>,
+        j: Option<&mut DMatrix<f64>>,
+    ) {
+        let row = ROWS * k;
+        let scale = 1.0 / self.a.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+        let end = Node::of_state(e);
+        let first = match goal {
+            TipGoal::Position(p) => end.position - p,
+            TipGoal::Free { tip_load } => {
+                let l = Vector3::from(self.gravity.load());
+                Vector3::new(self.a[3], self.a[4], self.a[5]) - l - tip_load
+            }
+            TipGoal::Pose(_) => unreachable!("a clamped tip has its own rows"),
+        };
+        let moment = self.tip_moment(e, None) * scale;
+        for i in 0..3 {
+            r[row + i] = first[i];
+            r[row + 3 + i] = moment[i];
+        }
+        let Some(j) = j else { return };
+        for c in 0..COLUMNS {
+            let Some(jc) = start_column(k, c) else {
+                continue;
+            };
+            let dm = self.tip_moment(e, Some(c)) * scale;
+            let d_first = match goal {
+                TipGoal::Position(_) => {
+                    end.rotation
+                        * Vector3::new(
+                            e[NB + COLUMNS * 3 + c],
+                            e[NB + COLUMNS * 4 + c],
+                            e[NB + COLUMNS * 5 + c],
+                        )
+                }
+                _ => Vector3::zeros(),
+            };
+            for i in 0..3 {
+                j[(row + i, jc)] = d_first[i];
+                j[(row + 3 + i, jc)] = dm[i];
+            }
+        }
+        if matches!(goal, TipGoal::Free { .. }) {
+            // a_f − w ĝ − load: ∂/∂a_f = 1.
+            for i in 0..3 {
+                j[(row + i, 3 + i)] = 1.0;
+            }
+        }
     }
 
     /// The rows "segment `k`, ended at `e`, ends at node k + 1" (module docs).
@@ -382,6 +518,13 @@ impl SpatialCable {
     /// Newton on the multiple-shooting equations from this cable's state: the equilibrium whose
     /// tip is at `target`. Backtracks on the residual's max norm. Returns the iterations.
     pub fn solve(&mut self, target: &SpatialPose) -> Result<usize, CableError> {
+        self.solve_goal(&TipGoal::Pose(*target))
+    }
+
+    /// Newton on the multiple-shooting equations with the tip held by `goal` ([`TipGoal`]):
+    /// as [`SpatialCable::solve`].
+    pub fn solve_goal(&mut self, goal: &TipGoal) -> Result<usize, CableError> {
+        let target = goal;
         let (r, _) = self.residual(target, false)?;
         let mut norm = r.amax();
         for it in 0..NEWTON_ITERATIONS {
@@ -449,10 +592,19 @@ impl SpatialCable {
     /// 1/1024 of the way (a fold of the branch), after 64 steps taken or refused, or on the
     /// deadline. The cable is left where the last step converged.
     pub fn carry(&mut self, from: &SpatialPose, to: &SpatialPose) -> Result<usize, CableError> {
-        const MIN_STEP: f64 = 1.0 / 1024.0;
         let (dp, dr) = from.distance_to(to);
         if dp <= 1e-9 && dr <= 1e-9 {
             return self.solve(to);
+        }
+        self.carry_goal(&TipGoal::Pose(*from), &TipGoal::Pose(*to))
+    }
+
+    /// [`SpatialCable::carry`] between two tip goals of one kind ([`TipGoal`]): a pinned
+    /// tip's position on a line, a free tip's load on a line.
+    pub fn carry_goal(&mut self, from: &TipGoal, to: &TipGoal) -> Result<usize, CableError> {
+        const MIN_STEP: f64 = 1.0 / 1024.0;
+        if from.between(to, 1.0).is_none() {
+            return Err(CableError::Singular);
         }
         let (mut s, mut ds, mut iterations) = (0.0_f64, 0.25_f64, 0);
         // At most this many steps, taken or refused (a way of 1,024 smallest steps is a fold).
@@ -466,12 +618,11 @@ impl SpatialCable {
                 });
             }
             let next = (s + ds).min(1.0);
-            let goal = SpatialPose {
-                position: from.position + (to.position - from.position) * next,
-                rotation: from.rotation.slerp(&to.rotation, next),
+            let Some(goal) = from.between(to, next) else {
+                return Err(CableError::Singular);
             };
             let mut trial = self.clone();
-            match trial.solve(&goal) {
+            match trial.solve_goal(&goal) {
                 Ok(it) => {
                     *self = trial;
                     iterations += it;
@@ -490,7 +641,13 @@ impl SpatialCable {
 
     /// The residual's max norm at `target` (rod lengths, radians).
     pub fn residual_at(&self, target: &SpatialPose) -> Result<f64, RodError> {
-        Ok(self.residual(target, false)?.0.amax())
+        self.residual_at_goal(&TipGoal::Pose(*target))
+    }
+
+    /// The residual's max norm with the tip held by `goal` (the moment rows scaled as in
+    /// Newton).
+    pub fn residual_at_goal(&self, goal: &TipGoal) -> Result<f64, RodError> {
+        Ok(self.residual(goal, false)?.0.amax())
     }
 
     /// Stability by the orthonormalised conjugate-point scan (module docs): det J(t) > 0 on
@@ -499,6 +656,15 @@ impl SpatialCable {
     /// undecided where det X_η is within 1e-12 of the product of its rows' norms (the bound on
     /// its rounding, Hadamard's inequality).
     pub fn stability(&self) -> Result<StabilityReport, RodError> {
+        Ok(self.conjugate_scan()?.0)
+    }
+
+    /// The verdict of [`SpatialCable::stability`], the Jacobi fields at the tip X(1) in the
+    /// orthonormalised basis (15 × 6) and the state at the tip.
+    fn conjugate_scan(
+        &self,
+    ) -> Result<(StabilityReport, SMatrix<f64, COLUMNS, 6>, [f64; NB]), RodError> {
+        let mut end_state = [0.0; NB];
         let mut basis = SMatrix::<f64, COLUMNS, 6>::zeros();
         for c in 0..6 {
             basis[(ROWS + c, c)] = 1.0;
@@ -528,6 +694,7 @@ impl SpatialCable {
                 |_, t, s| {
                     let x = propagated(s, &basis);
                     at_end = x;
+                    end_state.copy_from_slice(&s[..NB]);
                     if t < f64::from(GRID_FROM) / f64::from(GRID) - 1e-12 {
                         return ControlFlow::Continue(());
                     }
@@ -549,6 +716,14 @@ impl SpatialCable {
                     ControlFlow::Continue(())
                 },
             )?;
+            if k + 1 == self.segments() {
+                let mut report = scan.exact_report();
+                if report.stable && !(least_ratio > MARGIN_FLOOR) {
+                    report.stable = false;
+                    report.uncertain = true;
+                }
+                return Ok((report, at_end, end_state));
+            }
             let qr = at_end.qr();
             let u = qr.r();
             for i in 0..6 {
@@ -557,12 +732,81 @@ impl SpatialCable {
             }
             basis = qr.q();
         }
-        let mut report = scan.exact_report();
-        if report.stable && !(least_ratio > MARGIN_FLOOR) {
-            report.stable = false;
-            report.uncertain = true;
+        unreachable!("a cable has at least one segment")
+    }
+
+    /// Stability with the tip held by `tip` (docs/ends.md, "3-D"): the rod clamped at both
+    /// ends must be stable ([`SpatialCable::stability`]; a conjugate point makes the held rod
+    /// unstable too, its variations being admissible), and the energy reduced to the tip's
+    /// free coordinates must have a positive definite Hessian there. That Hessian is
+    /// H = G J⁻¹ with J = ∂(ε_ω, ε_v)(1) and G = ∂(Rᵀ M(1), Rᵀ n(1)) over the Jacobi fields
+    /// from the base (dE = M · δφ + n · δp: the tip wrench is the energy's gradient); a pinned
+    /// tip keeps its ε_ω block, a free tip all of it. By Haynsworth's inertia additivity the
+    /// held rod's Morse index is the clamped one's plus H's. The verdict is undecided where
+    /// H's least eigenvalue is within its asymmetry (its rounding) of zero. The margin is the
+    /// clamped margin, capped by λ_min(H) / λ₀ with λ₀ the straight weightless rod's
+    /// ([`held_stiffness_scale`]).
+    pub fn held_stability(&self, tip: EndCondition) -> Result<StabilityReport, RodError> {
+        let (clamped, x, end) = self.conjugate_scan()?;
+        if tip == EndCondition::Clamped || !clamped.stable {
+            return Ok(clamped);
         }
-        Ok(report)
+        let Some(h) = self.tip_hessian(&x, &end, tip) else {
+            return Ok(StabilityReport {
+                stable: false,
+                uncertain: true,
+                ..clamped
+            });
+        };
+        let (least, error) = h;
+        let scale = held_stiffness_scale(&self.stiffness, tip);
+        let uncertain = least.abs() <= error;
+        let stable = least > error;
+        Ok(StabilityReport {
+            stable,
+            uncertain,
+            margin: clamped.margin.min(least / scale),
+            first_conjugate_t: None,
+        })
+    }
+
+    /// The least eigenvalue of the reduced Hessian at the tip ([`SpatialCable::held_stability`])
+    /// and its error bound (the asymmetry of H plus 1e-9 ‖H‖); None where J(1) is singular.
+    fn tip_hessian(
+        &self,
+        x: &SMatrix<f64, COLUMNS, 6>,
+        end: &[f64; NB],
+        tip: EndCondition,
+    ) -> Option<(f64, f64)> {
+        let node = Node::of_state(end);
+        let r = node.rotation;
+        let l = Vector3::from(self.gravity.load());
+        let n1 = Vector3::new(self.a[3], self.a[4], self.a[5]) - l;
+        let jac = x.fixed_view::<6, 6>(0, 0).into_owned();
+        let mut g = SMatrix::<f64, 6, 6>::zeros();
+        for c in 0..6 {
+            let row = |i: usize| x[(i, c)];
+            let dp = r * Vector3::new(row(3), row(4), row(5));
+            let d_arm = Vector3::new(row(6), row(7), row(8));
+            let dam = Vector3::new(row(9), row(10), row(11));
+            let daf = Vector3::new(row(12), row(13), row(14));
+            let dm = dam - d_arm.cross(&l) - dp.cross(&n1) - node.position.cross(&daf);
+            let dm_body = r.inverse() * dm;
+            let dn_body = r.inverse() * daf;
+            for i in 0..3 {
+                g[(i, c)] = dm_body[i];
+                g[(3 + i, c)] = dn_body[i];
+            }
+        }
+        let h = g * jac.try_inverse()?;
+        // A pinned tip's position is held: its free coordinates are ε_ω alone.
+        let dim = if tip == EndCondition::Pinned { 3 } else { 6 };
+        let h = h.view((0, 0), (dim, dim)).into_owned();
+        let sym = (&h + h.transpose()) * 0.5;
+        let asym = (&h - h.transpose()).norm() * 0.5;
+        let least = sym.clone().symmetric_eigenvalues().min();
+        let error = asym + 1e-9 * sym.norm();
+        (least.is_finite() && error.is_finite()).then_some((least, error))
     }
 
     /// The state at the start of segment `k`; with `N` = the full state, unit columns.
@@ -580,6 +824,20 @@ impl SpatialCable {
             }
         }
         y
+    }
+}
+
+/// λ₀ of [`SpatialCable::held_stability`]: the least eigenvalue of the straight weightless
+/// rod's reduced Hessian at its tip (stiffnesses c1 torsion, c2, c3 bending, unit length).
+/// Pinned tip (its rotation free, its position held): the rotational stiffness of a beam
+/// clamped at its other end, 4 c in bending and c1 in torsion. Free tip: the cantilever's
+/// tip stiffness in (deflection, rotation), c [[12, −6], [−6, 4]], whose least eigenvalue is
+/// (8 − √52) c, and c1 in torsion (inextensible: no axial term).
+pub fn held_stiffness_scale(k: &Stiffness, tip: EndCondition) -> f64 {
+    let c = k.c2.min(k.c3);
+    match tip {
+        EndCondition::Pinned => (4.0 * c).min(k.c1),
+        _ => ((8.0 - 52.0_f64.sqrt()) * c).min(k.c1),
     }
 }
 

@@ -95,6 +95,48 @@ impl PlanarReduction {
         })
     }
 
+    /// The plane through e1 with unit normal `normal` (⊥ e1), for a rod of isotropic bending
+    /// whose gravity lies in it (to [`PLANE_TOLERANCE`]); the target the planar `target`.
+    /// None otherwise. How the 3-D rods with held ends start ([`super::held`]).
+    pub(crate) fn through(
+        normal: Vector3<f64>,
+        k: &Stiffness,
+        g: &Gravity3,
+        target: PlanarPose,
+    ) -> Option<Self> {
+        let gd = Vector3::from(g.direction());
+        if !k.is_bending_isotropic()
+            || normal.dot(&Vector3::x()).abs() > PLANE_TOLERANCE
+            || (!g.is_weightless() && gd.dot(&normal).abs() > PLANE_TOLERANCE)
+        {
+            return None;
+        }
+        let normal = normal.normalize();
+        let in_plane = normal.cross(&Vector3::x());
+        let gravity = Gravity::new(
+            g.weight() / k.c2,
+            [gd.dot(&Vector3::x()), gd.dot(&in_plane)],
+        )
+        .ok()?;
+        Some(Self {
+            normal,
+            in_plane,
+            c: k.c2,
+            target,
+            gravity,
+        })
+    }
+
+    /// A point of Π's coordinates (x along e1, y along b2) in the base frame.
+    pub(crate) fn lift_point(&self, x: f64, y: f64) -> Vector3<f64> {
+        Vector3::x() * x + self.in_plane * y
+    }
+
+    /// Π's in-plane axis b2 = n̂ × e1.
+    pub(crate) fn in_plane(&self) -> Vector3<f64> {
+        self.in_plane
+    }
+
     /// The planar target as a 3-D pose.
     pub(crate) fn lifted_target(&self) -> SpatialPose {
         lift_pose(self.normal, self.in_plane, &self.target)
@@ -107,7 +149,7 @@ impl PlanarReduction {
         SpatialParams::new(m.x, m.y, m.z, f.x, f.y, f.z)
     }
 
-    fn lift_node(&self, node: &[f64; 4]) -> (UnitQuaternion<f64>, Vector3<f64>) {
+    pub(crate) fn lift_node(&self, node: &[f64; 4]) -> (UnitQuaternion<f64>, Vector3<f64>) {
         let pose = lift_pose(
             self.normal,
             self.in_plane,

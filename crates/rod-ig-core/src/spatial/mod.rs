@@ -28,6 +28,7 @@ mod cable_search;
 pub mod heavy;
 mod heavy_model;
 mod heavy_ode;
+pub mod held;
 pub mod ig;
 mod model;
 mod reduced;

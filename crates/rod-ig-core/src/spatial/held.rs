@@ -1,0 +1,335 @@
+//! The 3-D rod held by a clamped base and a pinned or free tip (issue 52; docs/ends.md, "3-D").
+//!
+//! The equations are the long cable's multiple shooting ([`super::cable`]) with the tip's six
+//! rows chosen by its condition ([`TipGoal`]): a pinned tip holds its position and has no
+//! moment, a free tip has no moment and no force (the base carries the weight). Stability is
+//! [`SpatialCable::held_stability`]: the rod clamped at both ends stable, and the energy
+//! reduced to the tip's free coordinates convex there.
+//!
+//! The search starts where the problem is planar: with isotropic bending and gravity in the
+//! plane Π through the base tangent e1 and ĝ, the planar held rods of
+//! [`crate::planar::heavy::held`] (stiffness c, weight w / c) are 3-D equilibria. Each is
+//! lifted, polished by the 3-D Newton and admitted by the 3-D test (out-of-plane buckling
+//! included). A pinned tip off Π starts from its projection on Π and is carried there along a
+//! line of positions. Without weight Π is the plane through e1 and the target.
+//! Not built: a pinned base in 3-D (its orientation is an unknown), anisotropic bending
+//! (c2 ≠ c3: no plane is invariant), and a free tip's point load.
+
+use super::cable::{SpatialCable, TipGoal};
+use super::cable_search::PlanarReduction;
+use super::heavy_ode::Gravity3;
+use super::{SpatialParams, SpatialPose, Stiffness};
+use crate::ends::{EndCondition, HeldEnds};
+use crate::planar::heavy::cable::{CableError, SHAPE_CHECK_SAMPLES};
+use crate::planar::heavy::held::{self as planar_held, HeldError, HeldSolution};
+use crate::planar::ig::SolveOptions;
+use crate::wrench::{GripperWrenches, SpatialWrench};
+use crate::{PlanarPose, RodError, StabilityReport};
+use nalgebra::Vector3;
+
+/// How far (rod lengths) a pinned tip's target may be from Π and still be solved in Π.
+const IN_PLANE: f64 = 1e-9;
+
+/// One 3-D equilibrium with held ends.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpatialHeldSolution {
+    /// a = (base moment, base force) in the base frame (a_f = w ĝ for a free tip).
+    pub a: SpatialParams,
+    /// The tip pose.
+    pub tip: SpatialPose,
+    /// Total energy (elastic + gravitational).
+    pub energy: f64,
+    /// Elastic energy.
+    pub elastic_energy: f64,
+    /// Stability with the tip's natural conditions ([`SpatialCable::held_stability`]).
+    pub stability: StabilityReport,
+    /// Full turns of the planar rod it was lifted from (0: loop-free).
+    pub turns: u32,
+    /// The planar rod it was lifted from crosses itself.
+    pub self_intersects: bool,
+    /// The equilibrium's node states.
+    pub cable: SpatialCable,
+}
+
+impl SpatialHeldSolution {
+    /// The cable solved with its tip held by `tip` as an answer: energies and stability.
+    pub fn of(
+        cable: SpatialCable,
+        tip: EndCondition,
+        turns: u32,
+        self_intersects: bool,
+    ) -> Result<Self, RodError> {
+        let (elastic_energy, energy) = cable.energies()?;
+        Ok(Self {
+            a: cable.params(),
+            tip: cable.tip()?,
+            energy,
+            elastic_energy,
+            stability: cable.held_stability(tip)?,
+            turns,
+            self_intersects,
+            cable,
+        })
+    }
+
+    /// The wrenches the rod exerts on its grippers ([`crate::wrench`]): zero moment at a
+    /// pinned tip, no wrench at a free one.
+    pub fn wrenches(&self) -> Result<GripperWrenches<SpatialWrench>, RodError> {
+        self.cable.wrenches()
+    }
+}
+
+/// What a 3-D search with held ends found.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SpatialHeldSearch {
+    /// The admitted (stable, within `max_turns`) equilibria, least energy first.
+    pub solutions: Vec<SpatialHeldSolution>,
+    /// Equilibria found and not admitted (unstable in 3-D, or in the plane).
+    pub rejected: usize,
+    /// Starts tried (the planar rods lifted).
+    pub starts: u32,
+    /// The deadline passed before every start was tried.
+    pub cut_short: bool,
+}
+
+impl SpatialHeldSearch {
+    /// Why the search found no admitted equilibrium.
+    pub fn not_found(&self, ends: HeldEnds) -> HeldError {
+        HeldError::NotFound {
+            base: ends.base(),
+            tip: ends.tip(),
+            starts: self.starts,
+            cut: if self.cut_short {
+                ", cut short by the deadline"
+            } else {
+                ""
+            },
+            last: String::new(),
+        }
+    }
+}
+
+/// The ends the 3-D rod supports: a clamped base, a pinned or free tip (refusals name the
+/// field), with isotropic bending.
+fn check(ends: HeldEnds, k: &Stiffness) -> Result<(), HeldError> {
+    if ends.base() != EndCondition::Clamped {
+        return Err(HeldError::Target {
+            field: "base_condition",
+            why: "a pinned base is not built for the 3-D rod (its orientation would be an \
+                  unknown); the planar rod has it"
+                .into(),
+        });
+    }
+    if !k.is_bending_isotropic() {
+        return Err(HeldError::Target {
+            field: "stiffness",
+            why: "pinned and free tips of the 3-D rod need isotropic bending (c2 = c3)".into(),
+        });
+    }
+    Ok(())
+}
+
+/// The plane Π of the search (module docs) and the target's distance from it.
+fn plane(
+    k: &Stiffness,
+    g: &Gravity3,
+    target: Option<&Vector3<f64>>,
+) -> Option<(PlanarReduction, f64)> {
+    let e1 = Vector3::x();
+    let gd = Vector3::from(g.direction());
+    let candidates = [
+        (!g.is_weightless()).then(|| e1.cross(&gd)),
+        target.map(|p| e1.cross(p)),
+        Some(Vector3::z()),
+    ];
+    let normal = candidates
+        .into_iter()
+        .flatten()
+        .find(|n| n.norm() > 1e-6)?
+        .normalize();
+    let r = PlanarReduction::through(normal, k, g, PlanarPose::new(0.0, 0.0, 0.0))?;
+    let off = target.map_or(0.0, |p| p.dot(&normal).abs());
+    Some((r, off))
+}
+
+/// The stable 3-D equilibria of the rod of stiffnesses `k` under `gravity`, held by `ends`
+/// (clamped base; pinned tip at `target`, or free tip with `target` None), least energy
+/// first, within `options.deadline` and admitting at most `options.max_turns` turns (module
+/// docs).
+pub fn equilibria(
+    ends: HeldEnds,
+    k: &Stiffness,
+    gravity: &Gravity3,
+    target: Option<&Vector3<f64>>,
+    options: &SolveOptions,
+) -> Result<SpatialHeldSearch, HeldError> {
+    check(ends, k)?;
+    let tip = ends.tip();
+    match (tip, target) {
+        (EndCondition::Free, Some(_)) => {
+            return Err(HeldError::Target {
+                field: "target",
+                why: "a free tip has no target: the cable hangs from its base".into(),
+            })
+        }
+        (EndCondition::Pinned, None) => {
+            return Err(HeldError::Target {
+                field: "target",
+                why: "a pinned tip needs its position".into(),
+            })
+        }
+        (EndCondition::Pinned, Some(p))
+            if !(p.iter().all(|v| v.is_finite()) && p.norm() <= 1.0) =>
+        {
+            return Err(HeldError::Target {
+                field: "target",
+                why: format!(
+                    "unreachable: the tip is {:.6} from the base, the rod is 1 long",
+                    p.norm()
+                ),
+            })
+        }
+        _ => {}
+    }
+    let _deadline = crate::deadline::scope(options.deadline);
+    let Some((reduction, off)) = plane(k, gravity, target) else {
+        return Err(HeldError::Target {
+            field: "gravity",
+            why: "no plane through the base tangent holds gravity".into(),
+        });
+    };
+    // The target as Π sees it: its projection (a pinned tip off Π is carried there after).
+    let planar_target = target.map(|p| {
+        let b2 = reduction.in_plane();
+        PlanarPose::new(p.x, p.dot(&b2), 0.0)
+    });
+    let planar_ends = HeldEnds::new(EndCondition::Clamped, tip).map_err(|e| HeldError::Target {
+        field: "tip_condition",
+        why: e.to_string(),
+    })?;
+    let planar = {
+        let _share = crate::deadline::share_of_remaining(0.6);
+        planar_held::equilibria(
+            planar_ends,
+            &reduction.gravity,
+            planar_target.as_ref(),
+            options,
+        )?
+    };
+    let goal = match target {
+        Some(p) => TipGoal::Position(*p),
+        None => TipGoal::Free {
+            tip_load: Vector3::zeros(),
+        },
+    };
+    let mut out = SpatialHeldSearch {
+        rejected: planar.equilibria.len() - planar.solutions.len(),
+        cut_short: planar.cut_short,
+        ..SpatialHeldSearch::default()
+    };
+    for s in &planar.solutions {
+        if crate::deadline::expired() {
+            out.cut_short = true;
+            break;
+        }
+        out.starts += 1;
+        match lifted(&reduction, s, &goal, off, k, gravity) {
+            Ok(Some(solution)) if solution.stability.stable => out.solutions.push(solution),
+            _ => out.rejected += 1,
+        }
+    }
+    out.solutions.sort_by(|a, b| a.energy.total_cmp(&b.energy));
+    Ok(out)
+}
+
+/// The planar held rod `s` lifted to 3-D, solved on `goal` (carried there along a line of
+/// positions when the target is `off` Π) and evaluated; None where Newton fails.
+fn lifted(
+    reduction: &PlanarReduction,
+    s: &HeldSolution,
+    goal: &TipGoal,
+    off: f64,
+    k: &Stiffness,
+    gravity: &Gravity3,
+) -> Result<Option<SpatialHeldSolution>, RodError> {
+    let a = reduction.lift_params(&s.a);
+    let poses: Vec<_> = s
+        .cable
+        .nodes()
+        .iter()
+        .map(|n| reduction.lift_node(n))
+        .collect();
+    let mut cable = SpatialCable::from_poses(&a, k, gravity, s.cable.mesh().to_vec(), &poses)?;
+    let solved = match goal {
+        TipGoal::Position(p) if off > IN_PLANE => {
+            let start = TipGoal::Position(reduction.lift_point(s.tip.x, s.tip.y));
+            cable.carry_goal(&start, goal)
+        }
+        _ => cable.solve_goal(goal),
+    };
+    match solved {
+        Ok(_) => {}
+        Err(CableError::Rod(e @ RodError::Deadline { .. })) => return Err(e),
+        Err(_) => return Ok(None),
+    }
+    let tip = match goal {
+        TipGoal::Free { .. } => EndCondition::Free,
+        _ => EndCondition::Pinned,
+    };
+    SpatialHeldSolution::of(cable, tip, s.turns, s.self_intersects).map(Some)
+}
+
+/// The forward map of the 3-D rod held by a clamped base with base wrench `a` and a tip held
+/// by `tip` (no search): the cable integrated from the base ([`SpatialCable::from_params`];
+/// exact where single shooting keeps its digits, w ≲ 300), its energies, wrenches and the
+/// stability with the tip's natural conditions. A free tip's base force must be w ĝ (it holds
+/// no force); refused otherwise, naming the field.
+pub fn evaluate(
+    a: &SpatialParams,
+    k: &Stiffness,
+    gravity: &Gravity3,
+    tip: EndCondition,
+) -> Result<SpatialHeldSolution, HeldError> {
+    check(
+        HeldEnds::new(EndCondition::Clamped, tip).map_err(|e| HeldError::Target {
+            field: "tip_condition",
+            why: e.to_string(),
+        })?,
+        k,
+    )?;
+    if tip == EndCondition::Free {
+        let l = gravity.load();
+        if (0..3).any(|i| (a[3 + i] - l[i]).abs() > 1e-9 * (1.0 + gravity.weight())) {
+            return Err(HeldError::Target {
+                field: "a",
+                why: format!(
+                    "a free tip holds no force: (a4, a5, a6) must be w ĝ = ({}, {}, {})",
+                    l[0], l[1], l[2]
+                ),
+            });
+        }
+    }
+    let rod = |e: RodError| HeldError::Target {
+        field: "a",
+        why: e.to_string(),
+    };
+    let cable = SpatialCable::from_params(a, k, gravity).map_err(rod)?;
+    let shape = cable
+        .poses_at(
+            &(0..=SHAPE_CHECK_SAMPLES)
+                .map(|i| i as f64 / SHAPE_CHECK_SAMPLES as f64)
+                .collect::<Vec<_>>(),
+        )
+        .map_err(rod)?;
+    let turns = winding(&shape);
+    SpatialHeldSolution::of(cable, tip, turns, false).map_err(rod)
+}
+
+/// Full turns of the tangent (its total turning over 2π, rounded down): a 3-D rod's loops.
+fn winding(shape: &[SpatialPose]) -> u32 {
+    let total: f64 = shape
+        .windows(2)
+        .map(|w| (w[0].rotation * Vector3::x()).angle(&(w[1].rotation * Vector3::x())))
+        .sum();
+    (total / std::f64::consts::TAU).floor() as u32
+}

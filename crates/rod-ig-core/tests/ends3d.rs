@@ -1,0 +1,282 @@
+//! The 3-D rod with a pinned or free tip (issue 52) against an independent reference: the
+//! energy itself, evaluated by quadrature on shapes R(t) = R_eq(t) exp(ξ(t)) around the
+//! answer, ξ a Ritz basis of sines sin((k − ½)πt) e_c (ξ(0) = 0: the clamped base; the tip
+//! free). No shooting and no Jacobi field: the gradient of L = E − n(1) · p(1) at ξ = 0 says
+//! whether the shape is an equilibrium, and its Hessian by central differences, on the tangent
+//! space of the held tip's position, gives the Morse index. Ritz values bound the second
+//! variation's eigenvalues from above, so a negative one proves the rod unstable; with 10
+//! sines per component a positive least one is taken as stable (the planar cases agree with
+//! the planar second variation, docs/ends.md).
+
+use nalgebra::{DMatrix, DVector, UnitQuaternion, Vector3};
+use rod_ig_core::ends::{EndCondition, HeldEnds};
+use rod_ig_core::planar::heavy::{held, Gravity};
+use rod_ig_core::planar::ig::SolveOptions;
+use rod_ig_core::spatial::heavy::Gravity3;
+use rod_ig_core::spatial::held::{self as held3, SpatialHeldSolution};
+use rod_ig_core::spatial::{SpatialParams, Stiffness};
+use std::time::Duration;
+
+/// Quadrature intervals of the reference energy.
+const STEPS: usize = 600;
+/// Sines per component of ξ.
+const MODES: usize = 10;
+/// Central-difference step of the Hessian.
+const STEP: f64 = 1e-4;
+
+/// The reference energy of a rod sampled at t_j = j / STEPS.
+struct Reference {
+    frames: Vec<UnitQuaternion<f64>>,
+    stiffness: Stiffness,
+    load: Vector3<f64>,
+    /// The tip force n(1) (the gripper's Lagrange multiplier); zero for a free tip.
+    tip_force: Vector3<f64>,
+}
+
+impl Reference {
+    fn of(s: &SpatialHeldSolution, k: &Stiffness, g: &Gravity3) -> Self {
+        let ts: Vec<f64> = (0..=STEPS).map(|j| j as f64 / STEPS as f64).collect();
+        let poses = s.cable.poses_at(&ts).unwrap();
+        let load = Vector3::from(g.load());
+        Self {
+            frames: poses.iter().map(|p| p.rotation).collect(),
+            stiffness: *k,
+            load,
+            tip_force: Vector3::new(s.a[3], s.a[4], s.a[5]) - load,
+        }
+    }
+
+    fn xi(&self, coef: &DVector<f64>, t: f64) -> Vector3<f64> {
+        let mut v = Vector3::zeros();
+        for c in 0..3 {
+            for k in 0..MODES {
+                v[c] += coef[c * MODES + k] * ((k as f64 + 0.5) * std::f64::consts::PI * t).sin();
+            }
+        }
+        v
+    }
+
+    /// (L = E_elastic + E_gravity − n(1) · p(1), p(1)) of the shape with coefficients `coef`.
+    fn lagrangian(&self, coef: &DVector<f64>) -> (f64, Vector3<f64>) {
+        let h = 1.0 / STEPS as f64;
+        let frames: Vec<UnitQuaternion<f64>> = self
+            .frames
+            .iter()
+            .enumerate()
+            .map(|(j, r)| r * UnitQuaternion::from_scaled_axis(self.xi(coef, j as f64 * h)))
+            .collect();
+        let k = &self.stiffness;
+        let (mut elastic, mut p, mut arm) = (0.0, Vector3::zeros(), Vector3::zeros());
+        for j in 0..STEPS {
+            let rel = (frames[j].inverse() * frames[j + 1]).scaled_axis();
+            let u = rel / h;
+            elastic += 0.5 * h * (k.c1 * u.x * u.x + k.c2 * u.y * u.y + k.c3 * u.z * u.z);
+            // The midpoint frame's tangent, and ∫p by the trapezoid on each step.
+            let mid = frames[j] * UnitQuaternion::from_scaled_axis(rel * 0.5);
+            let next = p + mid * Vector3::x() * h;
+            arm += (p + next) * (0.5 * h);
+            p = next;
+        }
+        let gravity = -self.load.dot(&arm);
+        (elastic + gravity - self.tip_force.dot(&p), p)
+    }
+
+    /// The gradient's max norm, and the least eigenvalue and index of the Hessian on the
+    /// tangent space of the tip's position (`pinned`), or on every ξ (free tip).
+    fn second_variation(&self, pinned: bool) -> (f64, f64, usize) {
+        let n = 3 * MODES;
+        let zero = DVector::zeros(n);
+        let at = |i: usize, di: f64, j: usize, dj: f64| {
+            let mut c = zero.clone();
+            c[i] += di;
+            c[j] += dj;
+            self.lagrangian(&c)
+        };
+        let mut grad: f64 = 0.0;
+        let mut dp = DMatrix::zeros(3, n);
+        let mut h = DMatrix::zeros(n, n);
+        let l0 = self.lagrangian(&zero).0;
+        for i in 0..n {
+            let (lp, pp) = at(i, STEP, i, 0.0);
+            let (lm, pm) = at(i, -STEP, i, 0.0);
+            grad = grad.max(((lp - lm) / (2.0 * STEP)).abs());
+            for r in 0..3 {
+                dp[(r, i)] = (pp[r] - pm[r]) / (2.0 * STEP);
+            }
+            h[(i, i)] = (lp - 2.0 * l0 + lm) / (STEP * STEP);
+            for j in 0..i {
+                let v =
+                    (at(i, STEP, j, STEP).0 - at(i, STEP, j, -STEP).0 - at(i, -STEP, j, STEP).0
+                        + at(i, -STEP, j, -STEP).0)
+                        / (4.0 * STEP * STEP);
+                h[(i, j)] = v;
+                h[(j, i)] = v;
+            }
+        }
+        let q = if pinned {
+            // Null space of the position's gradient: the unit eigenvectors of its projector.
+            let gram = (&dp * dp.transpose()).try_inverse().unwrap();
+            let projector = DMatrix::identity(n, n) - dp.transpose() * gram * &dp;
+            let e = projector.symmetric_eigen();
+            let keep: Vec<usize> = (0..n).filter(|&i| e.eigenvalues[i] > 0.5).collect();
+            let z = e.eigenvectors.select_columns(&keep);
+            z.transpose() * &h * z
+        } else {
+            h
+        };
+        let eig = q.symmetric_eigenvalues();
+        let least = eig.min();
+        let index = eig.iter().filter(|&&v| v < 0.0).count();
+        (grad, least, index)
+    }
+}
+
+fn options() -> SolveOptions {
+    SolveOptions {
+        deadline: Duration::from_millis(5000),
+        ..SolveOptions::default()
+    }
+}
+
+/// A free tip: the cable hanging from a level gripper. The 3-D search answers the planar
+/// search's hanging rod (a and energy to 1e-9), its verdict agrees with the reference; the
+/// planar search's other in-plane-stable rod (arched back under the gripper) is refused, and
+/// the reference finds it unstable (a negative Ritz value), out of the plane.
+#[test]
+fn free_tip_against_the_energy() {
+    let k = Stiffness::default();
+    for w in [5.0, 50.0, 150.0] {
+        let g3 = Gravity3::new(w, [0.0, 0.0, -1.0]).unwrap();
+        let ends = HeldEnds::new(EndCondition::Clamped, EndCondition::Free).unwrap();
+        let found = held3::equilibria(ends, &k, &g3, None, &options()).unwrap();
+        let best = &found.solutions[0];
+        let planar = held::equilibria(
+            ends,
+            &Gravity::new(w, [0.0, -1.0]).unwrap(),
+            None,
+            &options(),
+        )
+        .unwrap();
+        let p = &planar.solutions[0];
+        // Π's normal is e1 × ĝ = y, its in-plane axis −z: a_m = −κ(0) y.
+        assert!(
+            (best.a[1] + p.a[0]).abs() < 1e-9 * (1.0 + w),
+            "w {w}: {:?} {:?}",
+            best.a,
+            p.a
+        );
+        assert!((best.energy - p.energy).abs() < 1e-9 * (1.0 + w), "w {w}");
+        let wr = best.wrenches().unwrap();
+        assert!(wr
+            .tip
+            .force
+            .iter()
+            .chain(&wr.tip.moment)
+            .all(|v| v.abs() < 1e-9 * (1.0 + w)));
+        for s in planar.equilibria.iter() {
+            let a = SpatialParams::new(0.0, -s.a[0], 0.0, 0.0, 0.0, -w);
+            let e = held3::evaluate(&a, &k, &g3, EndCondition::Free).unwrap();
+            let (grad, least, index) = Reference::of(&e, &k, &g3).second_variation(false);
+            // The quadrature's gradient is O(h²) of the shooting's equilibrium.
+            assert!(grad < 1e-4 * (1.0 + w), "w {w} a {a:?}: gradient {grad}");
+            assert_eq!(
+                e.stability.stable,
+                index == 0,
+                "w {w} a {a:?}: ref {least} {index}, {:?}",
+                e.stability
+            );
+            assert!(!e.stability.uncertain);
+            if index == 0 {
+                assert!(
+                    found
+                        .solutions
+                        .iter()
+                        .any(|f| (f.a - a).amax() < 1e-7 * (1.0 + w)),
+                    "w {w}: stable {a:?} not found"
+                );
+            }
+        }
+    }
+}
+
+/// A pinned tip (a hook): in the plane of gravity every planar equilibrium, lifted, gets the
+/// reference's verdict (a = (0, −κ(0), 0, n_x, 0, n_y) for the planar rod under gravity −y
+/// whose y is the 3-D z), and the 3-D search answers the least-energy one the reference finds
+/// stable. Off the plane the search's answers are equilibria (gradient), on target to 1e-9,
+/// with no tip moment, and stable by the reference.
+#[test]
+fn pinned_tip_against_the_energy() {
+    let k = Stiffness::default();
+    let ends = HeldEnds::new(EndCondition::Clamped, EndCondition::Pinned).unwrap();
+    let mut unstable_seen = 0;
+    for (w, target) in [
+        (10.0, Vector3::new(0.6, 0.0, -0.3)),
+        (100.0, Vector3::new(0.5, 0.0, -0.2)),
+        // Every equilibrium through this hook is unstable (it swings out of the plane).
+        (30.0, Vector3::new(0.5, 0.0, -0.4)),
+        (10.0, Vector3::new(0.6, 0.2, -0.3)),
+        (30.0, Vector3::new(0.7, 0.2, 0.0)),
+        (0.0, Vector3::new(0.3, 0.4, 0.5)),
+    ] {
+        let g3 = Gravity3::new(w, [0.0, 0.0, -1.0]).unwrap();
+        let found = held3::equilibria(ends, &k, &g3, Some(&target), &options()).unwrap();
+        assert!(
+            target.y == 0.0 || !found.solutions.is_empty(),
+            "w {w} {target:?}: none"
+        );
+        for s in &found.solutions {
+            assert!((s.tip.position - target).amax() < 1e-9, "w {w}");
+            let wr = s.wrenches().unwrap();
+            assert!(
+                wr.tip.moment.iter().all(|v| v.abs() < 1e-8 * (1.0 + w)),
+                "{wr:?}"
+            );
+            let (grad, least, index) = Reference::of(s, &k, &g3).second_variation(true);
+            assert!(grad < 1e-4 * (1.0 + w), "w {w}: gradient {grad}");
+            assert_eq!(
+                index, 0,
+                "w {w} {target:?}: answer {:?} has ref least {least}",
+                s.a
+            );
+        }
+        if target.y != 0.0 {
+            continue;
+        }
+        let mut stable_seen = 0;
+        let planar = held::equilibria(
+            ends,
+            &Gravity::new(w, [0.0, -1.0]).unwrap(),
+            Some(&rod_ig_core::PlanarPose::new(target.x, target.z, 0.0)),
+            &options(),
+        )
+        .unwrap();
+        for p in &planar.equilibria {
+            let a = SpatialParams::new(0.0, -p.a[0], 0.0, p.a[1], 0.0, p.a[2]);
+            let e = held3::evaluate(&a, &k, &g3, EndCondition::Pinned).unwrap();
+            assert!(
+                (e.tip.position - target).amax() < 1e-7,
+                "w {w} {a:?}: {:?}",
+                e.tip
+            );
+            let (_, least, index) = Reference::of(&e, &k, &g3).second_variation(true);
+            assert_eq!(
+                e.stability.stable,
+                index == 0,
+                "w {w} {a:?}: ref {least} {index}, {:?}",
+                e.stability
+            );
+            assert!(!e.stability.uncertain, "w {w} {a:?}");
+            unstable_seen += usize::from(index > 0);
+            stable_seen += usize::from(index == 0);
+            if index == 0 && !found.solutions.is_empty() {
+                assert!(found.solutions[0].energy <= e.energy + 1e-9 * (1.0 + w));
+            }
+        }
+        assert_eq!(
+            found.solutions.is_empty(),
+            stable_seen == 0,
+            "w {w} {target:?}"
+        );
+    }
+    assert!(unstable_seen > 0, "no unstable rod checked");
+}
