@@ -22,6 +22,7 @@ mod bench;
 mod bench_deadlines;
 mod bench_tails;
 mod follower;
+mod held3d_cmds;
 mod held_cmds;
 mod jsonl;
 mod motion_cmds;
@@ -546,14 +547,14 @@ fn main() -> ExitCode {
                 .map_err(|e| e.to_string())
         }
         Command::Forward3d => {
-            jsonl::run(stdin, stdout, spatial_cmds::forward3d_line).map_err(|e| e.to_string())
+            jsonl::run(stdin, stdout, held3d_cmds::forward3d_line).map_err(|e| e.to_string())
         }
         Command::Solve3d { verbose } => {
             // A rod with weight starts from the planar rods (their atlas, built outside the
             // first line's deadline as for `solve`).
             warm_up();
             jsonl::run(stdin, stdout, |line| {
-                spatial_cmds::solve3d_line(line, verbose)
+                held3d_cmds::solve3d_line(line, verbose)
             })
             .map_err(|e| e.to_string())
         }

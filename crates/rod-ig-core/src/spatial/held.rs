@@ -129,6 +129,37 @@ fn check(ends: HeldEnds, k: &Stiffness) -> Result<(), HeldError> {
     Ok(())
 }
 
+/// A pinned tip's target is a reachable position; a free tip has none.
+fn check_target(tip: EndCondition, target: Option<&Vector3<f64>>) -> Result<(), HeldError> {
+    match (tip, target) {
+        (EndCondition::Free, Some(_)) => {
+            return Err(HeldError::Target {
+                field: "target",
+                why: "a free tip has no target: the cable hangs from its base".into(),
+            })
+        }
+        (EndCondition::Pinned, None) => {
+            return Err(HeldError::Target {
+                field: "target",
+                why: "a pinned tip needs its position".into(),
+            })
+        }
+        (EndCondition::Pinned, Some(p))
+            if !(p.iter().all(|v| v.is_finite()) && p.norm() <= 1.0) =>
+        {
+            return Err(HeldError::Target {
+                field: "target",
+                why: format!(
+                    "unreachable: the tip is {:.6} from the base, the rod is 1 long",
+                    p.norm()
+                ),
+            })
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
 /// The plane Π of the search (module docs) and the target's distance from it.
 fn plane(
     k: &Stiffness,
@@ -165,32 +196,7 @@ pub fn equilibria(
 ) -> Result<SpatialHeldSearch, HeldError> {
     check(ends, k)?;
     let tip = ends.tip();
-    match (tip, target) {
-        (EndCondition::Free, Some(_)) => {
-            return Err(HeldError::Target {
-                field: "target",
-                why: "a free tip has no target: the cable hangs from its base".into(),
-            })
-        }
-        (EndCondition::Pinned, None) => {
-            return Err(HeldError::Target {
-                field: "target",
-                why: "a pinned tip needs its position".into(),
-            })
-        }
-        (EndCondition::Pinned, Some(p))
-            if !(p.iter().all(|v| v.is_finite()) && p.norm() <= 1.0) =>
-        {
-            return Err(HeldError::Target {
-                field: "target",
-                why: format!(
-                    "unreachable: the tip is {:.6} from the base, the rod is 1 long",
-                    p.norm()
-                ),
-            })
-        }
-        _ => {}
-    }
+    check_target(tip, target)?;
     let _deadline = crate::deadline::scope(options.deadline);
     let Some((reduction, off)) = plane(k, gravity, target) else {
         return Err(HeldError::Target {

@@ -1,0 +1,254 @@
+//! `rod-ig solve3d` and `forward3d` with a pinned or free tip (`base_condition`,
+//! `tip_condition`): JSON in, JSON out; the search is `rod_ig_core::spatial::held`.
+
+use crate::held_cmds::{held_ends_of, DEFAULT_HELD_DEADLINE};
+use crate::jsonl::{self, ObjectiveName};
+use crate::planar_cmds::MAX_TURNS;
+use crate::spatial_cmds::{stiffness, PoseJson};
+use nalgebra::Vector3;
+use rod_ig_core::ends::{EndCondition, HeldEnds};
+use rod_ig_core::planar::ig::SolveOptions;
+use rod_ig_core::spatial::heavy::Gravity3;
+use rod_ig_core::spatial::held::{self, SpatialHeldSearch, SpatialHeldSolution};
+use rod_ig_core::spatial::SpatialParams;
+use rod_ig_core::wrench::SpatialWrench;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use std::time::Instant;
+
+/// The ends a 3-D request names when either is not clamped.
+fn ends_of(line: &str) -> Result<Option<HeldEnds>, String> {
+    held_ends_of(&jsonl::parse::<Value>(line)?)
+}
+
+/// Answers one `solve3d` line: with a pinned or free tip here, else the clamped solver
+/// ([`crate::spatial_cmds::solve3d_line`], `verbose`: its events on stderr).
+pub fn solve3d_line(line: &str, verbose: bool) -> Result<Value, String> {
+    match ends_of(line)? {
+        Some(ends) => solve3d_held(line, ends),
+        None => crate::spatial_cmds::solve3d_line(line, verbose),
+    }
+}
+
+/// Answers one `forward3d` line: with a pinned or free tip here, else the clamped rod's.
+pub fn forward3d_line(line: &str) -> Result<Value, String> {
+    match ends_of(line)? {
+        Some(ends) => forward3d_held(line, ends),
+        None => crate::spatial_cmds::forward3d_line(line),
+    }
+}
+
+/// A pinned tip's target: its position (its orientation is free).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PositionJson {
+    position: [f64; 3],
+    /// Refused with the reason (a pinned tip turns freely).
+    quaternion: Option<Value>,
+}
+
+/// One `solve3d` request with a pinned or free tip.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Held3dRequest {
+    target: Option<PositionJson>,
+    #[allow(dead_code)] // read by `ends_of`
+    base_condition: Option<Value>,
+    #[allow(dead_code)] // read by `ends_of`
+    tip_condition: Option<Value>,
+    /// "least_energy" or "first": both answer the least-energy rod found.
+    #[allow(dead_code)]
+    objective: Option<ObjectiveName>,
+    #[serde(default)]
+    all: bool,
+    deadline_ms: Option<f64>,
+    weight: Option<f64>,
+    gravity: Option<[f64; 3]>,
+    stiffness: Option<[f64; 3]>,
+    max_turns: Option<u32>,
+}
+
+/// One rod of a 3-D held answer.
+#[derive(Serialize)]
+struct Held3dRod {
+    a: [f64; 6],
+    tip: PoseJson,
+    stable: bool,
+    energy: f64,
+    elastic_energy: f64,
+    /// The clamped margin, capped by the reduced Hessian's λ_min / λ₀ (docs/ends.md).
+    stability_margin: f64,
+    stability_uncertain: bool,
+    turns: u32,
+    base_wrench: SpatialWrench,
+    tip_wrench: SpatialWrench,
+    /// Distance from the tip to a pinned tip's target.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    position_error: Option<f64>,
+}
+
+/// One 3-D held answer: the least-energy rod (or why none), and with `all` every stable one.
+#[derive(Serialize)]
+struct Held3dAnswer {
+    success: bool,
+    #[serde(flatten)]
+    rod: Option<Held3dRod>,
+    base_condition: EndCondition,
+    tip_condition: EndCondition,
+    termination: &'static str,
+    starts: u32,
+    elapsed_ms: f64,
+    complete: bool,
+    /// Equilibria found and not admitted (unstable in 3-D or in the plane, or looped).
+    rejected: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    reason: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    solutions: Option<Vec<Held3dRod>>,
+}
+
+fn rod_of(s: &SpatialHeldSolution, target: Option<&Vector3<f64>>) -> Result<Held3dRod, String> {
+    let w = s.wrenches().map_err(|e| e.to_string())?;
+    Ok(Held3dRod {
+        a: std::array::from_fn(|i| s.a[i]),
+        tip: PoseJson::from_pose(&s.tip),
+        stable: s.stability.stable,
+        energy: s.energy,
+        elastic_energy: s.elastic_energy,
+        stability_margin: s.stability.margin,
+        stability_uncertain: s.stability.uncertain,
+        turns: s.turns,
+        base_wrench: w.base,
+        tip_wrench: w.tip,
+        position_error: target.map(|t| (s.tip.position - t).norm()),
+    })
+}
+
+fn gravity3(weight: Option<f64>, gravity: Option<[f64; 3]>) -> Result<Gravity3, String> {
+    Gravity3::new(weight.unwrap_or(0.0), gravity.unwrap_or([0.0, 0.0, -1.0]))
+        .map_err(|e| e.to_string())
+}
+
+/// Answers one `solve3d` line whose tip is pinned or free.
+pub fn solve3d_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
+    let started = Instant::now();
+    let request: Held3dRequest = jsonl::parse(line)?;
+    let target =
+        match (request.target, ends.tip()) {
+            (
+                Some(PositionJson {
+                    quaternion: Some(_),
+                    ..
+                }),
+                EndCondition::Pinned,
+            ) => return Err(
+                "target: a pinned tip's target is {\"position\"} (it turns freely: no quaternion)"
+                    .into(),
+            ),
+            (t, _) => t.map(|t| Vector3::from(t.position)),
+        };
+    let max_turns = request.max_turns.unwrap_or(0);
+    if max_turns > MAX_TURNS {
+        return Err(format!(
+            "max_turns must be in [0, {MAX_TURNS}] (got {max_turns})"
+        ));
+    }
+    let options = SolveOptions {
+        deadline: match request.deadline_ms {
+            Some(ms) => jsonl::deadline_from_ms(ms)?,
+            None => DEFAULT_HELD_DEADLINE,
+        },
+        max_turns,
+        ..SolveOptions::default()
+    };
+    let k = stiffness(request.stiffness)?;
+    let g = gravity3(request.weight, request.gravity)?;
+    let found =
+        held::equilibria(ends, &k, &g, target.as_ref(), &options).map_err(|e| e.to_string())?;
+    jsonl::to_value(&answer_of(
+        ends,
+        &found,
+        target.as_ref(),
+        request.all,
+        started,
+    )?)
+}
+
+fn answer_of(
+    ends: HeldEnds,
+    found: &SpatialHeldSearch,
+    target: Option<&Vector3<f64>>,
+    all: bool,
+    started: Instant,
+) -> Result<Held3dAnswer, String> {
+    let best = found.solutions.first();
+    let termination = match (best, found.cut_short) {
+        (Some(_), _) => "converged",
+        (None, true) => "deadline",
+        (None, false) => "no_stable_solution",
+    };
+    let solutions = if all {
+        Some(
+            found
+                .solutions
+                .iter()
+                .map(|s| rod_of(s, target))
+                .collect::<Result<Vec<_>, _>>()?,
+        )
+    } else {
+        None
+    };
+    Ok(Held3dAnswer {
+        success: best.is_some(),
+        rod: best.map(|s| rod_of(s, target)).transpose()?,
+        base_condition: ends.base(),
+        tip_condition: ends.tip(),
+        termination,
+        starts: found.starts,
+        elapsed_ms: started.elapsed().as_secs_f64() * 1e3,
+        complete: !found.cut_short,
+        rejected: found.rejected,
+        reason: best.is_none().then(|| found.not_found(ends).to_string()),
+        solutions,
+    })
+}
+
+/// One `forward3d` request with a pinned or free tip.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HeldForward3dRequest {
+    /// (a_m, a_f); a free tip's a_f must be w ĝ.
+    a: [f64; 6],
+    #[allow(dead_code)] // read by `ends_of`
+    base_condition: Option<Value>,
+    #[allow(dead_code)] // read by `ends_of`
+    tip_condition: Option<Value>,
+    weight: Option<f64>,
+    gravity: Option<[f64; 3]>,
+    stiffness: Option<[f64; 3]>,
+    deadline_ms: Option<f64>,
+}
+
+/// Answers one `forward3d` line whose tip is pinned or free: the rod integrated from the
+/// base, with the tip's natural conditions in its verdict.
+pub fn forward3d_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
+    let request: HeldForward3dRequest = jsonl::parse(line)?;
+    let deadline = match request.deadline_ms {
+        Some(ms) => jsonl::deadline_from_ms(ms)?,
+        None => rod_ig_core::solver::DEFAULT_DEADLINE_3D,
+    };
+    let _deadline = rod_ig_core::deadline::scope(deadline);
+    if ends.base() != EndCondition::Clamped {
+        return Err("base_condition: a pinned base is not built for the 3-D rod".into());
+    }
+    let k = stiffness(request.stiffness)?;
+    let g = gravity3(request.weight, request.gravity)?;
+    let s = held::evaluate(&SpatialParams::from(request.a), &k, &g, ends.tip())
+        .map_err(|e| e.to_string())?;
+    let mut value = jsonl::to_value(&rod_of(&s, None)?)?;
+    if let Value::Object(map) = &mut value {
+        map.insert("base_condition".into(), ends.base().name().into());
+        map.insert("tip_condition".into(), ends.tip().name().into());
+    }
+    Ok(value)
+}
