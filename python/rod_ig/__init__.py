@@ -214,6 +214,12 @@ class Forward3dResult:
     f64 ``a`` not determined: ``condition`` > 1e9); ``stable`` is then False."""
     condition: FloatArray | None = None
     """(...): ||J(1)||_inf * max(1, ||a||_inf), as :class:`ForwardResult`'s."""
+    base_quaternion: FloatArray | None = None
+    """With a pinned or free end: (..., 4) the base's orientation (x, y, z, w); the identity
+    unless the base is pinned (its x axis is where the rod leaves the hook). ``jacobian`` and
+    ``condition`` are NaN then (not formed for held ends)."""
+    elastic_energy: FloatArray | None = None
+    """With a pinned or free end: (...) the elastic part of ``energy``."""
 
 
 @dataclass(frozen=True)
@@ -257,6 +263,9 @@ class SolveResult:
     shape: FloatArray | None = None
     """With a pinned or free end and ``samples``: (..., samples, 3) the rod found, poses
     (x, y, theta) from base to tip (NaN where the solve failed)."""
+    base_quaternion: FloatArray | None = None
+    """3-D with a pinned or free end: (..., 4) the base's orientation (x, y, z, w): the
+    identity for a clamped base, a pinned base's own (NaN where the solve failed)."""
 
 
 def _solve_result(
@@ -578,10 +587,24 @@ def forward3d(
     threads: int | None = None,
     weight: npt.ArrayLike | None = None,
     gravity: npt.ArrayLike | None = None,
+    base_condition: EndName = "clamped",
+    tip_condition: EndName = "clamped",
+    base_quaternion: npt.ArrayLike | None = None,
 ) -> Forward3dResult:
     """3-D forward map of rods ``a`` (..., 6) by numerical integration (docs/math.md §10), with
     stiffness (c1 torsion, c2, c3 bending) each in [1e-6, 1e6]. ``weight`` and ``gravity``
-    ((..., 3), default (0, 0, -1)) broadcast against the batch: the 3-D rod with weight."""
+    ((..., 3), default (0, 0, -1)) broadcast against the batch: the 3-D rod with weight.
+
+    ``base_condition`` / ``tip_condition`` (docs/ends.md, "3-D"): a clamped base with a pinned
+    or free tip, or both pinned; the verdict is then the second variation's with the natural
+    conditions. A pinned base (a_m = 0) leaves at ``base_quaternion`` ((..., 4), x y z w,
+    default the identity); a free tip's force must be its weight."""
+    if base_condition != "clamped" or tip_condition != "clamped":
+        return _forward_held3d(
+            a, stiffness, weight, gravity, base_condition, tip_condition, base_quaternion
+        )
+    if base_quaternion is not None:
+        raise ValueError("base_quaternion applies to a pinned base only")
     arr, _ = _batch("a", a, 6)
     flat, batch = _broadcast(arr, *_weight_arrays(weight, gravity, 3))
     d = _rod_ig.forward3d(
@@ -601,9 +624,116 @@ def forward3d(
     )
 
 
+def _forward_held3d(
+    a: npt.ArrayLike,
+    stiffness: tuple[float, float, float],
+    weight: npt.ArrayLike | None,
+    gravity: npt.ArrayLike | None,
+    base_condition: str,
+    tip_condition: str,
+    base_quaternion: npt.ArrayLike | None,
+) -> Forward3dResult:
+    """``forward3d`` with a pinned or free end (the native ``forward_held3d``)."""
+    arrays = [_batch("a", a, 6)[0]]
+    if base_quaternion is not None:
+        arrays.append(_batch("base_quaternion", base_quaternion, 4)[0])
+    heavy = _weight_arrays(weight, gravity, 3)
+    flat, batch = _broadcast(*arrays, *heavy)
+    d = _rod_ig.forward_held3d(
+        flat[0],
+        base_condition,
+        tip_condition,
+        base_quaternion=flat[1] if base_quaternion is not None else None,
+        stiffness=tuple(stiffness),
+        **_weight_kwargs(flat, len(arrays)),
+    )
+    n = int(np.prod(batch, dtype=np.int64))
+    tip = d["tip"].reshape(batch + (7,))
+    return Forward3dResult(
+        position=tip[..., :3],
+        quaternion=tip[..., 3:],
+        jacobian=np.full(batch + (6, 6), np.nan),
+        stable=_shaped(d["stable"], batch),
+        margin=_shaped(d["margin"], batch),
+        energy=_shaped(d["energy"], batch),
+        base_wrench=_wrench(d["base_wrench"], batch, 3),
+        tip_wrench=_wrench(d["tip_wrench"], batch, 3),
+        uncertain=_shaped(d["uncertain"], batch),
+        condition=_shaped(np.full(n, np.nan), batch),
+        base_quaternion=d["base_quaternion"].reshape(batch + (4,)),
+        elastic_energy=_shaped(d["elastic_energy"], batch),
+    )
+
+
+def _solve_held3d(
+    position: npt.ArrayLike | None,
+    base_condition: str,
+    tip_condition: str,
+    stiffness: tuple[float, float, float],
+    deadline_ms: float | None,
+    all: bool,
+    threads: int | None,
+    weight: npt.ArrayLike | None,
+    gravity: npt.ArrayLike | None,
+    max_turns: int,
+) -> SolveResult:
+    """``solve3d`` with a pinned or free end (the native ``solve_held3d``)."""
+    arrays = []
+    if tip_condition == "free":
+        if position is not None:
+            raise ValueError("position: a free tip has no target (the cable hangs from its base)")
+    elif position is None:
+        raise ValueError("position: a pinned tip needs its position (..., 3)")
+    else:
+        arrays.append(_batch("position", position, 3)[0])
+    heavy = _weight_arrays(weight, gravity, 3)
+    if not arrays and not heavy:
+        heavy = _weight_arrays(0.0, None, 3)
+    flat, batch = _broadcast(*arrays, *heavy)
+    n = int(np.prod(batch, dtype=np.int64))
+    d = _rod_ig.solve_held3d(
+        n,
+        positions=flat[0] if arrays else None,
+        base_condition=base_condition,
+        tip_condition=tip_condition,
+        stiffness=tuple(stiffness),
+        all=all,
+        deadline_ms=deadline_ms,
+        max_turns=_integer("max_turns", max_turns, 0, 100),
+        threads=_threads(threads),
+        **_weight_kwargs(flat, len(arrays)),
+    )
+    solutions = None
+    if all:
+        solutions = np.empty(n, dtype=object)
+        for i, sol in enumerate(d["solutions"]):
+            solutions[i] = sol.reshape(-1, 6)
+        solutions = _shaped(solutions, batch)
+    nan = np.full(n, np.nan)
+    return SolveResult(
+        success=_shaped(d["success"], batch),
+        a=d["a"].reshape(batch + (6,)),
+        termination=_shaped(np.array(d["termination"], dtype=str), batch),
+        reason=_shaped(np.array(d["reason"], dtype=str), batch),
+        iterations=_shaped(np.zeros(n, dtype=np.uint32), batch),
+        margin=_shaped(d["margin"], batch),
+        energy=_shaped(d["energy"], batch),
+        position_error=_shaped(d["position_error"], batch),
+        orientation_error=_shaped(nan, batch),
+        starts=_shaped(d["starts"], batch),
+        complete=_shaped(d["complete"], batch),
+        solutions=solutions,
+        turns=_shaped(np.where(d["success"], d["turns"], -1).astype(np.int64), batch),
+        base_wrench=_wrench(d["base_wrench"], batch, 3),
+        tip_wrench=_wrench(d["tip_wrench"], batch, 3),
+        tip=d["tip"].reshape(batch + (7,)),
+        base_quaternion=d["base_quaternion"].reshape(batch + (4,)),
+    )
+
+
 def solve3d(
-    position: npt.ArrayLike,
-    quaternion: npt.ArrayLike,
+    position: npt.ArrayLike | None,
+    quaternion: npt.ArrayLike | None = None,
     a0: npt.ArrayLike | None = None,
     objective: Objective = "first",
     method: Method = "robust",
@@ -616,10 +746,43 @@ def solve3d(
     threads: int | None = None,
     weight: npt.ArrayLike | None = None,
     gravity: npt.ArrayLike | None = None,
+    base_condition: EndName = "clamped",
+    tip_condition: EndName = "clamped",
+    max_turns: int = 0,
 ) -> SolveResult:
     """3-D inverse geometry: targets given by ``position`` (..., 3) and ``quaternion``
     (..., 4) as (x, y, z, w), broadcast together; the options of :func:`solve`; ``weight``
-    and ``gravity`` as for :func:`forward3d`."""
+    and ``gravity`` as for :func:`forward3d`.
+
+    ``base_condition`` / ``tip_condition`` (docs/ends.md, "3-D"; isotropic bending): a clamped
+    base with a pinned tip (targets ``position`` alone, ``quaternion=None``: a hook) or a free
+    one (``position=None``: the cable hanging from its gripper, one per weight), or both
+    pinned (a cable between two hooks). Such a solve answers the least-energy stable rod found
+    (default deadline 1000 ms; ``max_turns`` as for :func:`solve`) and fills ``tip`` (..., 7:
+    position and quaternion) and ``base_quaternion``; ``a0``, ``method``, ``tolerance``,
+    ``max_iterations`` and ``alpha`` apply to clamped ends only."""
+    if base_condition != "clamped" or tip_condition != "clamped":
+        if a0 is not None or method != "robust" or tolerance is not None:
+            raise ValueError("a0, method and tolerance apply to clamped ends only")
+        if max_iterations is not None or alpha is not None:
+            raise ValueError("max_iterations and alpha apply to clamped ends only")
+        if tip_condition == "clamped":
+            raise ValueError(
+                "base_condition: a 3-D rod pinned at its base and clamped at its tip is the same "
+                "cable as one clamped at its base and pinned at its tip: hold it by the other "
+                "gripper"
+            )
+        if quaternion is not None:
+            raise ValueError("quaternion: a pinned tip turns freely (its target is a position)")
+        return _solve_held3d(
+            position, base_condition, tip_condition, stiffness,
+            deadline_ms, all, threads, weight, gravity,
+            max_turns,
+        )
+    if position is None or quaternion is None:
+        raise ValueError("position and quaternion are required (clamped ends)")
+    if max_turns:
+        raise ValueError("max_turns applies to pinned or free ends in 3-D")
     arrays = [_batch("position", position, 3)[0], _batch("quaternion", quaternion, 4)[0]]
     if a0 is not None:
         arrays.append(_batch("a0", a0, 6)[0])

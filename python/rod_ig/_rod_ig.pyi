@@ -65,6 +65,28 @@ def solve_held(
     tip_load: tuple[float, float] | None = None,
     samples: int = 0,
 ) -> dict[str, Any]: ...
+def solve_held3d(
+    n: int,
+    positions: npt.NDArray[np.float64] | None = None,
+    base_condition: str = "clamped",
+    tip_condition: str = "free",
+    stiffness: tuple[float, ...] = (1.0, 1.0, 1.0),
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
+    all: bool = False,
+    deadline_ms: float | None = None,
+    max_turns: int = 0,
+    threads: int | None = None,
+) -> dict[str, Any]: ...
+def forward_held3d(
+    a: npt.NDArray[np.float64],
+    base_condition: str,
+    tip_condition: str,
+    base_quaternion: npt.NDArray[np.float64] | None = None,
+    stiffness: tuple[float, ...] = (1.0, 1.0, 1.0),
+    weight: npt.NDArray[np.float64] | None = None,
+    gravity: npt.NDArray[np.float64] | None = None,
+) -> dict[str, Any]: ...
 def wrenches(
     a: npt.NDArray[np.float64],
     threads: int | None = None,

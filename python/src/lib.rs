@@ -20,6 +20,8 @@ use rod_ig_core::wrench::{self, GripperWrenches, PlanarWrench, SpatialWrench};
 use rod_ig_core::{planar, PlanarParams, PlanarPose};
 use std::time::Duration;
 
+mod held3d;
+
 /// Rods per block between two checks for Ctrl-C (the GIL is taken back for each check).
 const FORWARD_BLOCK: usize = 1 << 14;
 
@@ -1669,6 +1671,8 @@ fn _rod_ig(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(solve_held, m)?)?;
     m.add_function(wrap_pyfunction!(forward3d, m)?)?;
     m.add_function(wrap_pyfunction!(solve3d, m)?)?;
+    m.add_function(wrap_pyfunction!(held3d::solve_held3d, m)?)?;
+    m.add_function(wrap_pyfunction!(held3d::forward_held3d, m)?)?;
     m.add_function(wrap_pyfunction!(wrenches, m)?)?;
     m.add_function(wrap_pyfunction!(wrenches3d, m)?)?;
     m.add_function(wrap_pyfunction!(turns, m)?)?;

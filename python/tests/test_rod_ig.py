@@ -690,6 +690,47 @@ def test_pinned_and_free_ends() -> None:
         rod_ig.solve([0.8, 0.0], tip_condition="pinned", a0=[0.0, 1.0, 0.0])
 
 
+def test_3d_pinned_and_free_ends() -> None:
+    """3-D base_condition / tip_condition (issue 52): a cable between two hooks 0.8 apart at
+    w = 50 is the planar one (its energy to 1e-8), with no moment at either end, and
+    forward3d gives it back from its base orientation; cables hanging from a level gripper
+    (free tip) have no tip wrench; a hook off every plane of the base is reached; refusals
+    name the argument."""
+    both = rod_ig.solve3d(
+        [0.8, 0.0, 0.0], base_condition="pinned", tip_condition="pinned", weight=50.0,
+        deadline_ms=5000,
+    )
+    assert both.success
+    assert abs(both.energy + 6.24283394420708) < 1e-8
+    assert both.base_wrench is not None and both.tip_wrench is not None
+    np.testing.assert_allclose(both.base_wrench.moment, 0.0, atol=1e-12)
+    np.testing.assert_allclose(both.tip_wrench.moment, 0.0, atol=1e-8)
+    assert both.base_quaternion is not None and both.tip is not None
+    back = rod_ig.forward3d(
+        both.a, base_condition="pinned", tip_condition="pinned",
+        base_quaternion=both.base_quaternion, weight=50.0,
+    )
+    assert back.stable and back.base_quaternion is not None
+    np.testing.assert_allclose(back.position, [0.8, 0.0, 0.0], atol=1e-9)
+    np.testing.assert_allclose(back.energy, both.energy, rtol=1e-9)
+    free = rod_ig.solve3d(None, tip_condition="free", weight=[5.0, 50.0])
+    assert free.success.all() and free.tip_wrench is not None
+    np.testing.assert_allclose(free.tip_wrench.force, 0.0, atol=1e-9)
+    np.testing.assert_allclose(free.tip_wrench.moment, 0.0, atol=1e-8)
+    np.testing.assert_allclose(free.a[:, 3:], [[0.0, 0.0, -5.0], [0.0, 0.0, -50.0]])
+    hook = rod_ig.solve3d([0.6, 0.2, -0.3], tip_condition="pinned", weight=10.0, deadline_ms=5000)
+    assert hook.success and hook.position_error < 1e-9
+    with pytest.raises(ValueError, match="quaternion"):
+        rod_ig.solve3d([0.6, 0.2, -0.3], [0.0, 0.0, 0.0, 1.0], tip_condition="pinned")
+    with pytest.raises(ValueError, match="base_condition"):
+        rod_ig.solve3d([0.6, 0.2, -0.3], [0.0, 0.0, 0.0, 1.0], base_condition="pinned")
+    with pytest.raises(ValueError, match="position"):
+        rod_ig.solve3d([0.6, 0.2, -0.3], tip_condition="free")
+    aniso = rod_ig.solve3d(None, tip_condition="free", weight=5.0, stiffness=(1.0, 1.0, 2.0))
+    assert not aniso.success and aniso.termination == "invalid_input"
+    assert "stiffness" in str(aniso.reason)
+
+
 def test_a_tracker_with_held_ends_follows_its_gripper() -> None:
     """Tracker with pinned or free ends (issue 52, held-ends motion in Python): a pinned-pinned
     cable at w = 50 follows its gripper along five steps on its branch (event none, on target

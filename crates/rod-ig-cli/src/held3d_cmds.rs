@@ -1,16 +1,16 @@
-//! `rod-ig solve3d` and `forward3d` with a pinned or free tip (`base_condition`,
+//! `rod-ig solve3d` and `forward3d` with pinned or free ends (`base_condition`,
 //! `tip_condition`): JSON in, JSON out; the search is `rod_ig_core::spatial::held`.
 
 use crate::held_cmds::{held_ends_of, DEFAULT_HELD_DEADLINE};
 use crate::jsonl::{self, ObjectiveName};
 use crate::planar_cmds::MAX_TURNS;
 use crate::spatial_cmds::{stiffness, PoseJson};
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 use rod_ig_core::ends::{EndCondition, HeldEnds};
 use rod_ig_core::planar::ig::SolveOptions;
 use rod_ig_core::spatial::heavy::Gravity3;
 use rod_ig_core::spatial::held::{self, SpatialHeldSearch, SpatialHeldSolution};
-use rod_ig_core::spatial::SpatialParams;
+use rod_ig_core::spatial::{SpatialParams, SpatialPose};
 use rod_ig_core::wrench::SpatialWrench;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -72,6 +72,9 @@ struct Held3dRequest {
 #[derive(Serialize)]
 struct Held3dRod {
     a: [f64; 6],
+    /// A pinned base's orientation (x, y, z, w): the rod leaves the hook along its x axis.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    base_quaternion: Option<[f64; 4]>,
     tip: PoseJson,
     stable: bool,
     energy: f64,
@@ -111,6 +114,13 @@ fn rod_of(s: &SpatialHeldSolution, target: Option<&Vector3<f64>>) -> Result<Held
     let w = s.wrenches().map_err(|e| e.to_string())?;
     Ok(Held3dRod {
         a: std::array::from_fn(|i| s.a[i]),
+        base_quaternion: s.cable.is_base_pinned().then(|| {
+            SpatialPose {
+                position: Vector3::zeros(),
+                rotation: s.base_rotation,
+            }
+            .quaternion_xyzw()
+        }),
         tip: PoseJson::from_pose(&s.tip),
         stable: s.stability.stable,
         energy: s.energy,
@@ -217,8 +227,10 @@ fn answer_of(
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct HeldForward3dRequest {
-    /// (a_m, a_f); a free tip's a_f must be w ĝ.
+    /// (a_m, a_f); a free tip's a_f must be w ĝ, a pinned base's a_m 0.
     a: [f64; 6],
+    /// A pinned base's orientation (x, y, z, w; default the identity).
+    base_quaternion: Option<[f64; 4]>,
     #[allow(dead_code)] // read by `ends_of`
     base_condition: Option<Value>,
     #[allow(dead_code)] // read by `ends_of`
@@ -238,12 +250,17 @@ pub fn forward3d_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
         None => rod_ig_core::solver::DEFAULT_DEADLINE_3D,
     };
     let _deadline = rod_ig_core::deadline::scope(deadline);
-    if ends.base() != EndCondition::Clamped {
-        return Err("base_condition: a pinned base is not built for the 3-D rod".into());
-    }
+    let base = match request.base_quaternion {
+        Some(q) => {
+            SpatialPose::from_xyzw(Vector3::zeros(), q)
+                .map_err(|e| format!("base_quaternion: {e}"))?
+                .rotation
+        }
+        None => UnitQuaternion::identity(),
+    };
     let k = stiffness(request.stiffness)?;
     let g = gravity3(request.weight, request.gravity)?;
-    let s = held::evaluate(&SpatialParams::from(request.a), &k, &g, ends.tip())
+    let s = held::evaluate(&SpatialParams::from(request.a), &k, &g, ends, base)
         .map_err(|e| e.to_string())?;
     let mut value = jsonl::to_value(&rod_of(&s, None)?)?;
     if let Value::Object(map) = &mut value {

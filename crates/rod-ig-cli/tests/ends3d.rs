@@ -55,12 +55,13 @@ fn held_tips_answer_and_forward_gives_them_back() {
     assert!(!out[1]["solutions"].as_array().unwrap().is_empty());
 }
 
-/// Refusals name the field: a pinned tip's orientation, a pinned base in 3-D, anisotropic
+/// Refusals name the field: a pinned tip's orientation, a pinned base with a clamped tip in
+/// 3-D (the same cable held by its other gripper), anisotropic
 /// bending, a free tip with a target, a free tip's base force other than its weight.
 #[test]
 fn held_tips_refusals_name_the_field() {
     let lines = "{\"tip_condition\":\"pinned\",\"target\":{\"position\":[0.5,0,0],\"quaternion\":[0,0,0,1]}}\n\
-        {\"base_condition\":\"pinned\",\"tip_condition\":\"pinned\",\"target\":{\"position\":[0.5,0,0]}}\n\
+        {\"base_condition\":\"pinned\",\"target\":{\"position\":[0.5,0,0],\"quaternion\":[0,0,0,1]}}\n\
         {\"tip_condition\":\"free\",\"weight\":5,\"stiffness\":[1,1,2]}\n\
         {\"tip_condition\":\"free\",\"weight\":5,\"target\":{\"position\":[0.5,0,0]}}\n\
         {\"tip_condition\":\"sideways\"}\n";
@@ -82,4 +83,43 @@ fn held_tips_refusals_name_the_field() {
         "{\"tip_condition\":\"free\",\"weight\":5,\"a\":[0,1,0,0,0,-4]}\n",
     )[0];
     assert!(back["error"].as_str().unwrap().starts_with("a:"), "{back}");
+}
+
+/// A cable hung between two hooks (both ends pinned): the answer's base orientation and base
+/// force, given back to `forward3d`, reproduce its tip position, energy and verdict; no
+/// moment at either end.
+#[test]
+fn pinned_at_both_ends_and_forward_gives_it_back() {
+    let line = "{\"base_condition\":\"pinned\",\"tip_condition\":\"pinned\",\"weight\":50,\
+        \"target\":{\"position\":[0.6,0.3,-0.2]}}\n";
+    let answer = &run(&["solve3d"], line)[0];
+    assert_eq!(answer["success"], true, "{answer}");
+    assert_eq!(answer["stable"], true);
+    let a = floats(&answer["a"]);
+    assert_eq!(&a[..3], &[0.0, 0.0, 0.0]);
+    let q = floats(&answer["base_quaternion"]);
+    for end in ["base_wrench", "tip_wrench"] {
+        let m = floats(&answer[end]["moment"]);
+        assert!(m.iter().all(|v| v.abs() < 1e-8), "{end}: {m:?}");
+    }
+    let back = &run(
+        &["forward3d"],
+        &format!(
+            "{{\"base_condition\":\"pinned\",\"tip_condition\":\"pinned\",\"weight\":50,\
+             \"a\":{a:?},\"base_quaternion\":{q:?}}}\n"
+        ),
+    )[0];
+    assert_eq!(back["stable"], true, "{back}");
+    let p = floats(&back["tip"]["position"]);
+    assert!(
+        p.iter()
+            .zip([0.6, 0.3, -0.2])
+            .all(|(x, y)| (x - y).abs() < 1e-9),
+        "{p:?}"
+    );
+    let (e0, e1) = (
+        answer["energy"].as_f64().unwrap(),
+        back["energy"].as_f64().unwrap(),
+    );
+    assert!((e0 - e1).abs() < 1e-9 * (1.0 + e0.abs()));
 }

@@ -26,6 +26,9 @@ const STEP: f64 = 1e-4;
 
 /// The reference energy of a rod sampled at t_j = j / STEPS.
 struct Reference {
+    /// The base is pinned: ξ(0) is free (cosines cos(kπt) in place of the sines), less the
+    /// spin about the tangent, a gauge of the isotropic rod pinned at both ends.
+    pinned_base: bool,
     frames: Vec<UnitQuaternion<f64>>,
     stiffness: Stiffness,
     load: Vector3<f64>,
@@ -39,6 +42,7 @@ impl Reference {
         let poses = s.cable.poses_at(&ts).unwrap();
         let load = Vector3::from(g.load());
         Self {
+            pinned_base: s.cable.is_base_pinned(),
             frames: poses.iter().map(|p| p.rotation).collect(),
             stiffness: *k,
             load,
@@ -50,7 +54,12 @@ impl Reference {
         let mut v = Vector3::zeros();
         for c in 0..3 {
             for k in 0..MODES {
-                v[c] += coef[c * MODES + k] * ((k as f64 + 0.5) * std::f64::consts::PI * t).sin();
+                let mode = if self.pinned_base {
+                    (k as f64 * std::f64::consts::PI * t).cos()
+                } else {
+                    ((k as f64 + 0.5) * std::f64::consts::PI * t).sin()
+                };
+                v[c] += coef[c * MODES + k] * mode;
             }
         }
         v
@@ -113,6 +122,11 @@ impl Reference {
                 h[(j, i)] = v;
             }
         }
+        // A pinned base: the spin's coefficient (c = 0, k = 0) is left out (the gauge).
+        let kept: Vec<usize> = (0..n).filter(|&i| !(self.pinned_base && i == 0)).collect();
+        let h = h.select_rows(&kept).select_columns(&kept);
+        let dp = dp.select_columns(&kept);
+        let n = kept.len();
         let q = if pinned {
             // Null space of the position's gradient: the unit eigenvectors of its projector.
             let gram = (&dp * dp.transpose()).try_inverse().unwrap();
@@ -129,6 +143,10 @@ impl Reference {
         let index = eig.iter().filter(|&&v| v < 0.0).count();
         (grad, least, index)
     }
+}
+
+fn free_ends() -> HeldEnds {
+    HeldEnds::new(EndCondition::Clamped, EndCondition::Free).unwrap()
 }
 
 fn options() -> SolveOptions {
@@ -175,7 +193,7 @@ fn free_tip_against_the_energy() {
             .all(|v| v.abs() < 1e-9 * (1.0 + w)));
         for s in planar.equilibria.iter() {
             let a = SpatialParams::new(0.0, -s.a[0], 0.0, 0.0, 0.0, -w);
-            let e = held3::evaluate(&a, &k, &g3, EndCondition::Free).unwrap();
+            let e = held3::evaluate(&a, &k, &g3, free_ends(), UnitQuaternion::identity()).unwrap();
             let (grad, least, index) = Reference::of(&e, &k, &g3).second_variation(false);
             // The quadrature's gradient is O(h²) of the shooting's equilibrium.
             assert!(grad < 1e-4 * (1.0 + w), "w {w} a {a:?}: gradient {grad}");
@@ -252,7 +270,7 @@ fn pinned_tip_against_the_energy() {
         .unwrap();
         for p in &planar.equilibria {
             let a = SpatialParams::new(0.0, -p.a[0], 0.0, p.a[1], 0.0, p.a[2]);
-            let e = held3::evaluate(&a, &k, &g3, EndCondition::Pinned).unwrap();
+            let e = held3::evaluate(&a, &k, &g3, ends, UnitQuaternion::identity()).unwrap();
             assert!(
                 (e.tip.position - target).amax() < 1e-7,
                 "w {w} {a:?}: {:?}",
@@ -277,6 +295,78 @@ fn pinned_tip_against_the_energy() {
             stable_seen == 0,
             "w {w} {target:?}"
         );
+    }
+    assert!(unstable_seen > 0, "no unstable rod checked");
+}
+
+/// A cable hung between two hooks (pinned at both ends, ball joints): the search's answers
+/// are equilibria (reference gradient), on target to 1e-9 with no moment at either end,
+/// stable by the reference, and of the planar least energy in the vertical plane through the
+/// hooks. Every planar equilibrium there, lifted (its base turned to its angle), gets the
+/// reference's verdict.
+#[test]
+fn pinned_at_both_ends_against_the_energy() {
+    let k = Stiffness::default();
+    let ends = HeldEnds::new(EndCondition::Pinned, EndCondition::Pinned).unwrap();
+    let mut unstable_seen = 0;
+    for (w, target) in [
+        (50.0, Vector3::new(0.6, 0.3, -0.2)),
+        (10.0, Vector3::new(0.5, 0.0, 0.1)),
+        (300.0, Vector3::new(0.4, -0.5, 0.1)),
+    ] {
+        let g3 = Gravity3::new(w, [0.0, 0.0, -1.0]).unwrap();
+        let found = held3::equilibria(ends, &k, &g3, Some(&target), &options()).unwrap();
+        assert!(!found.solutions.is_empty(), "w {w} {target:?}: none");
+        for s in &found.solutions {
+            assert!((s.tip.position - target).amax() < 1e-9, "w {w}");
+            let wr = s.wrenches().unwrap();
+            assert!(
+                wr.tip.moment.iter().all(|v| v.abs() < 1e-8 * (1.0 + w)),
+                "{wr:?}"
+            );
+            assert!(wr.base.moment.iter().all(|v| *v == 0.0), "{wr:?}");
+            let (grad, least, index) = Reference::of(s, &k, &g3).second_variation(true);
+            assert!(grad < 1e-4 * (1.0 + w), "w {w}: gradient {grad}");
+            assert_eq!(
+                index, 0,
+                "w {w} {target:?}: answer {:?} has ref least {least}",
+                s.a
+            );
+        }
+        // The vertical plane through the hooks: x along the chord's horizontal part, y up.
+        let u = Vector3::new(target.x, target.y, 0.0).normalize();
+        let planar = held::equilibria(
+            ends,
+            &Gravity::new(w, [0.0, -1.0]).unwrap(),
+            Some(&rod_ig_core::PlanarPose::new(target.dot(&u), target.z, 0.0)),
+            &options(),
+        )
+        .unwrap();
+        let least = planar.solutions.first().expect("a planar rod");
+        assert!(
+            (found.solutions[0].energy - least.energy).abs() < 1e-8 * (1.0 + w),
+            "w {w}"
+        );
+        for p in &planar.equilibria {
+            let f = u * p.a[1] + Vector3::z() * p.a[2];
+            let a = SpatialParams::new(0.0, 0.0, 0.0, f.x, f.y, f.z);
+            let tangent = u * p.base_angle.cos() + Vector3::z() * p.base_angle.sin();
+            let r0 = UnitQuaternion::rotation_between(&Vector3::x(), &tangent).unwrap();
+            let e = held3::evaluate(&a, &k, &g3, ends, r0).unwrap();
+            assert!(
+                (e.tip.position - target).amax() < 1e-7,
+                "w {w} {a:?}: {:?}",
+                e.tip
+            );
+            let (_, least, index) = Reference::of(&e, &k, &g3).second_variation(true);
+            assert_eq!(
+                e.stability.stable,
+                index == 0,
+                "w {w} {a:?}: ref {least} {index}, {:?}",
+                e.stability
+            );
+            unstable_seen += usize::from(index > 0);
+        }
     }
     assert!(unstable_seen > 0, "no unstable rod checked");
 }

@@ -135,6 +135,9 @@ pub struct SpatialCable {
     a: [f64; 6],
     /// Node states at t₀ … t_{M−1}; the first is the base.
     nodes: Vec<Node>,
+    /// The base is pinned (issue 52): a_m = 0, and the base's orientation is an unknown in
+    /// a_m's place (its correction ε_ω takes the first three slots of the unknowns).
+    pinned_base: bool,
 }
 
 fn ode_options() -> OdeOptions {
@@ -177,6 +180,7 @@ impl SpatialCable {
             mesh,
             a,
             nodes: vec![Node::BASE],
+            pinned_base: false,
         };
         for k in 0..segments - 1 {
             let e = cable.segment::<NB>(k)?;
@@ -196,18 +200,48 @@ impl SpatialCable {
         mesh: Vec<f64>,
         poses: &[(UnitQuaternion<f64>, Vector3<f64>)],
     ) -> Result<Self, RodError> {
+        Self::through_poses(a, stiffness, gravity, mesh, poses, false)
+    }
+
+    /// [`SpatialCable::from_poses`] pinned at its base: the first pose's orientation is the
+    /// base's (a_m is set to 0).
+    pub fn pinned_from_poses(
+        a: &SpatialParams,
+        stiffness: &Stiffness,
+        gravity: &Gravity3,
+        mesh: Vec<f64>,
+        poses: &[(UnitQuaternion<f64>, Vector3<f64>)],
+    ) -> Result<Self, RodError> {
+        Self::through_poses(a, stiffness, gravity, mesh, poses, true)
+    }
+
+    fn through_poses(
+        a: &SpatialParams,
+        stiffness: &Stiffness,
+        gravity: &Gravity3,
+        mesh: Vec<f64>,
+        poses: &[(UnitQuaternion<f64>, Vector3<f64>)],
+        pinned_base: bool,
+    ) -> Result<Self, RodError> {
         super::check_params(a, stiffness)?;
         if mesh.len() < 2 || poses.len() + 1 != mesh.len() {
             return Err(RodError::OutOfDomain(
                 "a cable needs one pose per node of its mesh".into(),
             ));
         }
+        let mut base = Node::BASE;
+        let mut a: [f64; 6] = std::array::from_fn(|i| a[i]);
+        if pinned_base {
+            base.rotation = poses[0].0;
+            a[..3].fill(0.0);
+        }
         let mut cable = Self {
             stiffness: *stiffness,
             gravity: *gravity,
             mesh,
-            a: std::array::from_fn(|i| a[i]),
-            nodes: vec![Node::BASE],
+            a,
+            nodes: vec![base],
+            pinned_base,
         };
         for (rotation, position) in &poses[1..] {
             let k = cable.nodes.len() - 1;
@@ -219,6 +253,44 @@ impl SpatialCable {
             });
         }
         Ok(cable)
+    }
+
+    /// The same rod pinned at its base: its base turned to `rotation` (base frame of the
+    /// grippers; the base position stays at the origin), no moment there (a_m is set to 0),
+    /// the nodes kept. Where the nodes do not fit the turned base, [`SpatialCable::solve_goal`]
+    /// moves them.
+    pub fn pinned_at(mut self, rotation: UnitQuaternion<f64>) -> Self {
+        self.nodes[0].rotation = rotation;
+        self.a[..3].fill(0.0);
+        self.pinned_base = true;
+        self
+    }
+
+    /// The cable of [`SpatialCable::from_params`] pinned at its base, turned to `rotation`:
+    /// its nodes integrated from that base.
+    pub fn pinned_from_params(
+        a: &SpatialParams,
+        stiffness: &Stiffness,
+        gravity: &Gravity3,
+        rotation: UnitQuaternion<f64>,
+    ) -> Result<Self, RodError> {
+        let mut cable = Self::from_params(a, stiffness, gravity)?.pinned_at(rotation);
+        cable.nodes.truncate(1);
+        for k in 0..cable.segments() - 1 {
+            let e = cable.segment::<NB>(k)?;
+            cable.nodes.push(Node::of_state(&e));
+        }
+        Ok(cable)
+    }
+
+    /// The base's orientation (the identity unless the base is pinned).
+    pub fn base_rotation(&self) -> UnitQuaternion<f64> {
+        self.nodes[0].rotation
+    }
+
+    /// True when the base is pinned.
+    pub fn is_base_pinned(&self) -> bool {
+        self.pinned_base
     }
 
     /// a = (a_m, a_f): the base wrench.
@@ -348,7 +420,14 @@ impl SpatialCable {
     }
 
     fn set_unknowns_moved(&mut self, step: &DVector<f64>, alpha: f64) {
-        for i in 0..6 {
+        let first = if self.pinned_base {
+            let d: [f64; ROWS] = std::array::from_fn(|c| if c < 3 { alpha * step[c] } else { 0.0 });
+            self.nodes[0] = self.nodes[0].moved(&d);
+            3
+        } else {
+            0
+        };
+        for i in first..6 {
             self.a[i] += alpha * step[i];
         }
         for k in 1..self.segments() {
@@ -379,7 +458,7 @@ impl SpatialCable {
             if k + 1 < m {
                 self.continuity_rows(k, &e, &mut r, j.as_mut());
             } else if let TipGoal::Pose(target) = goal {
-                tip_rows(k, &e, target, &mut r, j.as_mut());
+                tip_rows(self.pinned_base, k, &e, target, &mut r, j.as_mut());
             } else {
                 self.held_tip_rows(k, &e, goal, &mut r, j.as_mut());
             }
@@ -434,17 +513,33 @@ impl SpatialCable {
             }
             TipGoal::Pose(_) => unreachable!("a clamped tip has its own rows"),
         };
-        let moment = self.tip_moment(e, None) * scale;
+        // Pinned at both ends, an isotropic rod spun about its tangent by a constant angle is
+        // the same rod (its twist is zero): the base's spin is fixed (a gauge row in place of
+        // the tip's twisting moment, which is then zero by itself), the moment's bending
+        // components taken in the tip's frame.
+        let gauge = self.pinned_base && matches!(goal, TipGoal::Position(_));
+        let to_tip = end.rotation.inverse();
+        let body = |m: Vector3<f64>| if gauge { to_tip * m } else { m };
+        let moment = body(self.tip_moment(e, None) * scale);
         for i in 0..3 {
             r[row + i] = first[i];
             r[row + 3 + i] = moment[i];
         }
+        if gauge {
+            r[row + 3] = 0.0;
+        }
         let Some(j) = j else { return };
         for c in 0..COLUMNS {
-            let Some(jc) = start_column(k, c) else {
+            let Some(jc) = start_column(self.pinned_base, k, c) else {
                 continue;
             };
-            let dm = self.tip_moment(e, Some(c)) * scale;
+            let mut dm = self.tip_moment(e, Some(c)) * scale;
+            if gauge {
+                // δ(Rᵀ M) = Rᵀ δM − η_ω × (Rᵀ M).
+                let eta = Vector3::new(e[NB + c], e[NB + COLUMNS + c], e[NB + 2 * COLUMNS + c]);
+                dm = to_tip * dm - eta.cross(&moment);
+                dm[0] = 0.0;
+            }
             let d_first = match goal {
                 TipGoal::Position(_) => {
                     end.rotation
@@ -460,6 +555,9 @@ impl SpatialCable {
                 j[(row + i, jc)] = d_first[i];
                 j[(row + 3 + i, jc)] = dm[i];
             }
+        }
+        if gauge {
+            j[(row + 3, 0)] = 1.0;
         }
         if matches!(goal, TipGoal::Free { .. }) {
             // a_f − w ĝ − load: ∂/∂a_f = 1.
@@ -491,7 +589,7 @@ impl SpatialCable {
         let rel_m = rel.to_rotation_matrix().into_inner();
         let col = |rr: usize, c: usize| e[NB + COLUMNS * rr + c];
         for c in 0..COLUMNS {
-            let Some(jc) = start_column(k, c) else {
+            let Some(jc) = start_column(self.pinned_base, k, c) else {
                 continue;
             };
             let v = rel_m * Vector3::new(col(3, c), col(4, c), col(5, c));
@@ -661,19 +759,14 @@ impl SpatialCable {
 
     /// The verdict of [`SpatialCable::stability`], the Jacobi fields at the tip X(1) in the
     /// orthonormalised basis (15 × 6) and the state at the tip.
-    fn conjugate_scan(
-        &self,
-    ) -> Result<(StabilityReport, SMatrix<f64, COLUMNS, 6>, [f64; NB]), RodError> {
+    fn conjugate_scan(&self) -> Result<(StabilityReport, Basis, [f64; NB]), RodError> {
         let mut end_state = [0.0; NB];
-        let mut basis = SMatrix::<f64, COLUMNS, 6>::zeros();
-        for c in 0..6 {
-            basis[(ROWS + c, c)] = 1.0;
-        }
+        let mut basis = initial_basis();
         // det U = sign_u · e^{log_u} (module docs).
         let (mut sign_u, mut log_u) = (1.0, 0.0);
         let mut scan = Stream::new();
         let mut least_ratio = f64::INFINITY;
-        let a_vec = self.params();
+        let a_vec = self.params_in_base_frame();
         let (ci, a, load) = (self.stiffness.inv(), self.a, self.gravity.load());
         for k in 0..self.segments() {
             let (t0, t1) = (self.mesh[k], self.mesh[k + 1]);
@@ -735,73 +828,93 @@ impl SpatialCable {
         unreachable!("a cable has at least one segment")
     }
 
-    /// Stability with the tip held by `tip` (docs/ends.md, "3-D"): the rod clamped at both
-    /// ends must be stable ([`SpatialCable::stability`]; a conjugate point makes the held rod
-    /// unstable too, its variations being admissible), and the energy reduced to the tip's
-    /// free coordinates must have a positive definite Hessian there. That Hessian is
-    /// H = G J⁻¹ with J = ∂(ε_ω, ε_v)(1) and G = ∂(Rᵀ M(1), Rᵀ n(1)) over the Jacobi fields
-    /// from the base (dE = M · δφ + n · δp: the tip wrench is the energy's gradient); a pinned
-    /// tip keeps its ε_ω block, a free tip all of it. By Haynsworth's inertia additivity the
-    /// held rod's Morse index is the clamped one's plus H's. The verdict is undecided where
-    /// H's least eigenvalue is within its asymmetry (its rounding) of zero. The margin is the
+    /// a in the base's own frame (a pinned base is turned): what the leading term of det J(t)
+    /// takes.
+    fn params_in_base_frame(&self) -> SpatialParams {
+        let to_base = self.nodes[0].rotation.inverse();
+        let (am, af) = (
+            to_base * Vector3::new(self.a[0], self.a[1], self.a[2]),
+            to_base * Vector3::new(self.a[3], self.a[4], self.a[5]),
+        );
+        SpatialParams::new(am.x, am.y, am.z, af.x, af.y, af.z)
+    }
+
+    /// Stability with the tip held by `tip` and the base as this cable holds it (docs/ends.md,
+    /// "3-D"): the rod clamped at both ends must be stable ([`SpatialCable::stability`]; a
+    /// conjugate point makes the held rod unstable too, its variations being admissible), and
+    /// the energy reduced to the ends' free coordinates must have a positive definite Hessian
+    /// there. The ends' coordinates are ε₀ (the base's turn) and ε₁ = (ε_ω, ε_v) (the tip's
+    /// body twist); the energy's gradient in them is the grippers' wrench (dE = −a_m · δφ₀ +
+    /// M(1) · δφ₁ + n(1) · δp₁), so over the Jacobi fields from the base H = G D⁻¹ with
+    /// D = ∂(ε₀, ε₁) and G = ∂(−R₀ᵀ a_m, R₁ᵀ M(1), R₁ᵀ n(1)). The free coordinates: a pinned
+    /// base's turn (its spin about the tangent, a gauge, left out when the tip is pinned
+    /// too), a pinned tip's ε_ω, a free tip's ε₁. By Haynsworth's inertia additivity the held
+    /// rod's Morse index is the clamped one's plus H's. The verdict is undecided where H's
+    /// least eigenvalue is within its asymmetry (its rounding) of zero. The margin is the
     /// clamped margin, capped by λ_min(H) / λ₀ with λ₀ the straight weightless rod's
     /// ([`held_stiffness_scale`]).
     pub fn held_stability(&self, tip: EndCondition) -> Result<StabilityReport, RodError> {
         let (clamped, x, end) = self.conjugate_scan()?;
-        if tip == EndCondition::Clamped || !clamped.stable {
+        let both_clamped = tip == EndCondition::Clamped && !self.pinned_base;
+        if both_clamped || !clamped.stable {
             return Ok(clamped);
         }
-        let Some(h) = self.tip_hessian(&x, &end, tip) else {
+        let Some((least, error)) = self.end_hessian(&x, &end, tip) else {
             return Ok(StabilityReport {
                 stable: false,
                 uncertain: true,
                 ..clamped
             });
         };
-        let (least, error) = h;
-        let scale = held_stiffness_scale(&self.stiffness, tip);
-        let uncertain = least.abs() <= error;
-        let stable = least > error;
+        let scale = held_stiffness_scale(&self.stiffness, self.pinned_base, tip);
         Ok(StabilityReport {
-            stable,
-            uncertain,
+            stable: least > error,
+            uncertain: least.abs() <= error,
             margin: clamped.margin.min(least / scale),
             first_conjugate_t: None,
         })
     }
 
-    /// The least eigenvalue of the reduced Hessian at the tip ([`SpatialCable::held_stability`])
-    /// and its error bound (the asymmetry of H plus 1e-9 ‖H‖); None where J(1) is singular.
-    fn tip_hessian(
-        &self,
-        x: &SMatrix<f64, COLUMNS, 6>,
-        end: &[f64; NB],
-        tip: EndCondition,
-    ) -> Option<(f64, f64)> {
+    /// The least eigenvalue of the reduced Hessian on the ends' free coordinates
+    /// ([`SpatialCable::held_stability`]) and its error bound (the asymmetry of H plus
+    /// 1e-9 ‖H‖); None where D is singular.
+    fn end_hessian(&self, x: &Basis, end: &[f64; NB], tip: EndCondition) -> Option<(f64, f64)> {
         let node = Node::of_state(end);
-        let r = node.rotation;
+        let (r0, r1) = (self.nodes[0].rotation, node.rotation);
         let l = Vector3::from(self.gravity.load());
         let n1 = Vector3::new(self.a[3], self.a[4], self.a[5]) - l;
-        let jac = x.fixed_view::<6, 6>(0, 0).into_owned();
-        let mut g = SMatrix::<f64, 6, 6>::zeros();
-        for c in 0..6 {
+        // Rows: ε₀ (3), ε₁ (6); columns: the nine fields.
+        let mut d = SMatrix::<f64, 9, 9>::zeros();
+        let mut g = SMatrix::<f64, 9, 9>::zeros();
+        for c in 0..9 {
             let row = |i: usize| x[(i, c)];
-            let dp = r * Vector3::new(row(3), row(4), row(5));
-            let d_arm = Vector3::new(row(6), row(7), row(8));
-            let dam = Vector3::new(row(9), row(10), row(11));
-            let daf = Vector3::new(row(12), row(13), row(14));
+            let v3 = |i: usize| Vector3::new(row(i), row(i + 1), row(i + 2));
+            let dp = r1 * v3(3);
+            let (d_arm, dam, daf) = (v3(6), v3(9), v3(12));
             let dm = dam - d_arm.cross(&l) - dp.cross(&n1) - node.position.cross(&daf);
-            let dm_body = r.inverse() * dm;
-            let dn_body = r.inverse() * daf;
+            let g0 = -(r0.inverse() * dam);
+            let (g_m, g_n) = (r1.inverse() * dm, r1.inverse() * daf);
             for i in 0..3 {
-                g[(i, c)] = dm_body[i];
-                g[(3 + i, c)] = dn_body[i];
+                d[(i, c)] = row(COLUMNS + i);
+                d[(3 + i, c)] = row(i);
+                d[(6 + i, c)] = row(3 + i);
+                g[(i, c)] = g0[i];
+                g[(3 + i, c)] = g_m[i];
+                g[(6 + i, c)] = g_n[i];
             }
         }
-        let h = g * jac.try_inverse()?;
-        // A pinned tip's position is held: its free coordinates are ε_ω alone.
-        let dim = if tip == EndCondition::Pinned { 3 } else { 6 };
-        let h = h.view((0, 0), (dim, dim)).into_owned();
+        let h = g * d.try_inverse()?;
+        let mut free: Vec<usize> = Vec::new();
+        if self.pinned_base {
+            let gauge = tip == EndCondition::Pinned;
+            free.extend(if gauge { 1..3 } else { 0..3 });
+        }
+        match tip {
+            EndCondition::Pinned => free.extend(3..6),
+            EndCondition::Free => free.extend(3..9),
+            EndCondition::Clamped => {}
+        }
+        let h = h.select_rows(&free).select_columns(&free);
         let sym = (&h + h.transpose()) * 0.5;
         let asym = (&h - h.transpose()).norm() * 0.5;
         let least = sym.clone().symmetric_eigenvalues().min();
@@ -829,42 +942,67 @@ impl SpatialCable {
 
 /// λ₀ of [`SpatialCable::held_stability`]: the least eigenvalue of the straight weightless
 /// rod's reduced Hessian at its tip (stiffnesses c1 torsion, c2, c3 bending, unit length).
-/// Pinned tip (its rotation free, its position held): the rotational stiffness of a beam
-/// clamped at its other end, 4 c in bending and c1 in torsion. Free tip: the cantilever's
-/// tip stiffness in (deflection, rotation), c [[12, −6], [−6, 4]], whose least eigenvalue is
-/// (8 − √52) c, and c1 in torsion (inextensible: no axial term).
-pub fn held_stiffness_scale(k: &Stiffness, tip: EndCondition) -> f64 {
+/// One end turning freely, the other clamped (a pinned tip, or a pinned base with a clamped
+/// tip): the rotational stiffness of a beam clamped at its other end, 4 c in bending and c1 in
+/// torsion. Both pinned: the two end rotations' bending stiffness c [[4, 2], [2, 4]], least
+/// eigenvalue 2c, and c1 in torsion. Free tip: the cantilever's tip stiffness in (deflection,
+/// rotation), c [[12, −6], [−6, 4]], least eigenvalue (8 − √52) c, and c1 in torsion
+/// (inextensible: no axial term).
+pub fn held_stiffness_scale(k: &Stiffness, pinned_base: bool, tip: EndCondition) -> f64 {
     let c = k.c2.min(k.c3);
-    match tip {
-        EndCondition::Pinned => (4.0 * c).min(k.c1),
-        _ => ((8.0 - 52.0_f64.sqrt()) * c).min(k.c1),
+    match (pinned_base, tip) {
+        (true, EndCondition::Pinned) => (2.0 * c).min(k.c1),
+        (_, EndCondition::Free) => ((8.0 - 52.0_f64.sqrt()) * c).min(k.c1),
+        _ => (4.0 * c).min(k.c1),
     }
 }
 
+/// Jacobi fields in the stability scan's basis: rows η (6), δP (3), δa (6) and the base's
+/// turn δφ₀ (3); columns the six fields of δa, then the three of δφ₀.
+type Basis = SMatrix<f64, { COLUMNS + 3 }, 9>;
+
+/// The scan's basis at the base: the fields of δa (the conjugate-point test's six, first, so
+/// that the QR steps keep their span in the first six columns), then those of a turn of the
+/// base (rows 15..18 carry it; what a pinned base's test needs,
+/// [`SpatialCable::held_stability`]).
+fn initial_basis() -> Basis {
+    let mut basis = Basis::zeros();
+    for c in 0..6 {
+        basis[(ROWS + c, c)] = 1.0;
+    }
+    for c in 0..3 {
+        basis[(c, 6 + c)] = 1.0;
+        basis[(COLUMNS + c, 6 + c)] = 1.0;
+    }
+    basis
+}
+
 /// X(t) = Φ(t) X(t_k) for a segment's state `s` (its 15 columns) and the basis at its start.
-fn propagated(s: &[f64; FULL], basis: &SMatrix<f64, COLUMNS, 6>) -> SMatrix<f64, COLUMNS, 6> {
+fn propagated(s: &[f64; FULL], basis: &Basis) -> Basis {
     let phi = SMatrix::<f64, ROWS, COLUMNS>::from_fn(|r, c| s[NB + COLUMNS * r + c]);
-    let mut x = SMatrix::<f64, COLUMNS, 6>::zeros();
-    x.fixed_view_mut::<ROWS, 6>(0, 0).copy_from(&(phi * basis));
-    x.fixed_view_mut::<6, 6>(ROWS, 0)
-        .copy_from(&basis.fixed_view::<6, 6>(ROWS, 0));
+    let mut x = *basis;
+    x.fixed_view_mut::<ROWS, 9>(0, 0)
+        .copy_from(&(phi * basis.fixed_view::<COLUMNS, 9>(0, 0)));
     x
 }
 
 /// The unknown moved by column `c` of segment `k`'s variations: its start node's correction
 /// (none at the base), then a.
-fn start_column(k: usize, c: usize) -> Option<usize> {
+fn start_column(pinned_base: bool, k: usize, c: usize) -> Option<usize> {
     if c >= ROWS {
-        Some(c - ROWS)
+        // A pinned base's a_m is 0, not an unknown: its slots hold the base's turn.
+        (!pinned_base || c >= ROWS + 3).then_some(c - ROWS)
     } else if k > 0 {
         Some(6 + ROWS * (k - 1) + c)
     } else {
-        None
+        // The base node: only a pinned base's orientation moves.
+        (pinned_base && c < 3).then_some(c)
     }
 }
 
 /// The rows "the last segment, `k`, ended at `e`, ends at `target`": minus its body error.
 fn tip_rows(
+    pinned_base: bool,
     k: usize,
     e: &[f64; FULL],
     target: &SpatialPose,
@@ -884,7 +1022,7 @@ fn tip_rows(
     let ev = Vector3::new(err[3], err[4], err[5]);
     let col = |rr: usize, c: usize| e[NB + COLUMNS * rr + c];
     for c in 0..COLUMNS {
-        let Some(jc) = start_column(k, c) else {
+        let Some(jc) = start_column(pinned_base, k, c) else {
             continue;
         };
         let w = Vector3::new(col(0, c), col(1, c), col(2, c));

@@ -25,7 +25,7 @@ use crate::planar::heavy::held::{self as planar_held, HeldError, HeldSolution};
 use crate::planar::ig::SolveOptions;
 use crate::wrench::{GripperWrenches, SpatialWrench};
 use crate::{PlanarPose, RodError, StabilityReport};
-use nalgebra::Vector3;
+use nalgebra::{UnitQuaternion, Vector3};
 
 /// How far (rod lengths) a pinned tip's target may be from Π and still be solved in Π.
 const IN_PLANE: f64 = 1e-9;
@@ -35,6 +35,9 @@ const IN_PLANE: f64 = 1e-9;
 pub struct SpatialHeldSolution {
     /// a = (base moment, base force) in the base frame (a_f = w ĝ for a free tip).
     pub a: SpatialParams,
+    /// The base's orientation: the identity for a clamped base; a pinned base's own (its
+    /// tangent R₀ e1 is where the rod leaves the hook).
+    pub base_rotation: UnitQuaternion<f64>,
     /// The tip pose.
     pub tip: SpatialPose,
     /// Total energy (elastic + gravitational).
@@ -62,6 +65,7 @@ impl SpatialHeldSolution {
         let (elastic_energy, energy) = cable.energies()?;
         Ok(Self {
             a: cable.params(),
+            base_rotation: cable.base_rotation(),
             tip: cable.tip()?,
             energy,
             elastic_energy,
@@ -112,11 +116,12 @@ impl SpatialHeldSearch {
 /// The ends the 3-D rod supports: a clamped base, a pinned or free tip (refusals name the
 /// field), with isotropic bending.
 fn check(ends: HeldEnds, k: &Stiffness) -> Result<(), HeldError> {
-    if ends.base() != EndCondition::Clamped {
+    if ends.base() == EndCondition::Pinned && ends.tip() == EndCondition::Clamped {
         return Err(HeldError::Target {
             field: "base_condition",
-            why: "a pinned base is not built for the 3-D rod (its orientation would be an \
-                  unknown); the planar rod has it"
+            why: "a 3-D rod pinned at its base and clamped at its tip is the same cable as one \
+                  clamped at its base and pinned at its tip: hold it by the other gripper \
+                  (the planar rod takes both)"
                 .into(),
         });
     }
@@ -160,27 +165,63 @@ fn check_target(tip: EndCondition, target: Option<&Vector3<f64>>) -> Result<(), 
     Ok(())
 }
 
-/// The plane Π of the search (module docs) and the target's distance from it.
-fn plane(
-    k: &Stiffness,
-    g: &Gravity3,
-    target: Option<&Vector3<f64>>,
-) -> Option<(PlanarReduction, f64)> {
-    let e1 = Vector3::x();
-    let gd = Vector3::from(g.direction());
-    let candidates = [
-        (!g.is_weightless()).then(|| e1.cross(&gd)),
-        target.map(|p| e1.cross(p)),
-        Some(Vector3::z()),
-    ];
-    let normal = candidates
-        .into_iter()
-        .flatten()
-        .find(|n| n.norm() > 1e-6)?
-        .normalize();
-    let r = PlanarReduction::through(normal, k, g, PlanarPose::new(0.0, 0.0, 0.0))?;
-    let off = target.map_or(0.0, |p| p.dot(&normal).abs());
-    Some((r, off))
+/// Where the search runs: the frame F in which the planar problem is posed (the identity for
+/// a clamped base, whose tangent e1 lies in Π; for a pinned base a turn taking e1 to the
+/// chord, as the base's angle is free), the plane Π (its reduction, in F's coordinates, with
+/// gravity turned into them), and the target's distance from Π.
+struct SearchFrame {
+    frame: UnitQuaternion<f64>,
+    reduction: PlanarReduction,
+    off: f64,
+}
+
+impl SearchFrame {
+    /// The frame of a search (module docs): Π through e1 and ĝ for a clamped base, through
+    /// the chord and ĝ for a pinned one (or, without weight or with ĝ along them, through the
+    /// target, else any).
+    fn of(
+        ends: HeldEnds,
+        k: &Stiffness,
+        g: &Gravity3,
+        target: Option<&Vector3<f64>>,
+    ) -> Option<Self> {
+        let gd = Vector3::from(g.direction());
+        let axis = match (ends.base(), target) {
+            (EndCondition::Pinned, Some(p)) if p.norm() > 1e-9 => p.normalize(),
+            _ => Vector3::x(),
+        };
+        let frame = UnitQuaternion::rotation_between(&Vector3::x(), &axis).unwrap_or_else(|| {
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), std::f64::consts::PI)
+        });
+        let candidates = [
+            (!g.is_weightless()).then(|| axis.cross(&gd)),
+            target.map(|p| axis.cross(p)),
+            Some(axis.cross(&Vector3::z())),
+            Some(axis.cross(&Vector3::y())),
+        ];
+        let normal = candidates
+            .into_iter()
+            .flatten()
+            .find(|n| n.norm() > 1e-6)?
+            .normalize();
+        let local = frame.inverse();
+        let gravity = Gravity3::new(g.weight(), (local * gd).into()).ok()?;
+        let reduction =
+            PlanarReduction::through(local * normal, k, &gravity, PlanarPose::new(0.0, 0.0, 0.0))?;
+        let off = target.map_or(0.0, |p| p.dot(&normal).abs());
+        Some(Self {
+            frame,
+            reduction,
+            off,
+        })
+    }
+
+    /// The target in Π's coordinates: its projection (a pinned tip off Π is carried there
+    /// after).
+    fn planar_target(&self, target: &Vector3<f64>) -> PlanarPose {
+        let p = self.frame.inverse() * target;
+        PlanarPose::new(p.x, p.dot(&self.reduction.in_plane()), 0.0)
+    }
 }
 
 /// The stable 3-D equilibria of the rod of stiffnesses `k` under `gravity`, held by `ends`
@@ -198,26 +239,18 @@ pub fn equilibria(
     let tip = ends.tip();
     check_target(tip, target)?;
     let _deadline = crate::deadline::scope(options.deadline);
-    let Some((reduction, off)) = plane(k, gravity, target) else {
+    let Some(frame) = SearchFrame::of(ends, k, gravity, target) else {
         return Err(HeldError::Target {
             field: "gravity",
-            why: "no plane through the base tangent holds gravity".into(),
+            why: "no plane through the base holds gravity and the target".into(),
         });
     };
-    // The target as Π sees it: its projection (a pinned tip off Π is carried there after).
-    let planar_target = target.map(|p| {
-        let b2 = reduction.in_plane();
-        PlanarPose::new(p.x, p.dot(&b2), 0.0)
-    });
-    let planar_ends = HeldEnds::new(EndCondition::Clamped, tip).map_err(|e| HeldError::Target {
-        field: "tip_condition",
-        why: e.to_string(),
-    })?;
+    let planar_target = target.map(|p| frame.planar_target(p));
     let planar = {
         let _share = crate::deadline::share_of_remaining(0.6);
         planar_held::equilibria(
-            planar_ends,
-            &reduction.gravity,
+            ends,
+            &frame.reduction.gravity,
             planar_target.as_ref(),
             options,
         )?
@@ -239,7 +272,7 @@ pub fn equilibria(
             break;
         }
         out.starts += 1;
-        match lifted(&reduction, s, &goal, off, k, gravity) {
+        match lifted(&frame, s, &goal, k, gravity) {
             Ok(Some(solution)) if solution.stability.stable => out.solutions.push(solution),
             _ => out.rejected += 1,
         }
@@ -248,27 +281,42 @@ pub fn equilibria(
     Ok(out)
 }
 
-/// The planar held rod `s` lifted to 3-D, solved on `goal` (carried there along a line of
-/// positions when the target is `off` Π) and evaluated; None where Newton fails.
+/// The planar held rod `s` lifted to 3-D (in the search's frame, then turned by it), solved
+/// on `goal` (carried there along a line of positions when the target is off Π) and
+/// evaluated; None where Newton fails.
 fn lifted(
-    reduction: &PlanarReduction,
+    frame: &SearchFrame,
     s: &HeldSolution,
     goal: &TipGoal,
-    off: f64,
     k: &Stiffness,
     gravity: &Gravity3,
 ) -> Result<Option<SpatialHeldSolution>, RodError> {
-    let a = reduction.lift_params(&s.a);
+    let (f, reduction) = (frame.frame, &frame.reduction);
+    let local = reduction.lift_params(&s.a);
+    let (am, af) = (
+        f * Vector3::new(local[0], local[1], local[2]),
+        f * Vector3::new(local[3], local[4], local[5]),
+    );
+    let a = SpatialParams::new(am.x, am.y, am.z, af.x, af.y, af.z);
     let poses: Vec<_> = s
         .cable
         .nodes()
         .iter()
-        .map(|n| reduction.lift_node(n))
+        .map(|n| {
+            let (r, p) = reduction.lift_node(n);
+            (f * r, f * p)
+        })
         .collect();
-    let mut cable = SpatialCable::from_poses(&a, k, gravity, s.cable.mesh().to_vec(), &poses)?;
+    let mesh = s.cable.mesh().to_vec();
+    let pinned_base = s.cable.ends().base() == EndCondition::Pinned;
+    let mut cable = if pinned_base {
+        SpatialCable::pinned_from_poses(&a, k, gravity, mesh, &poses)?
+    } else {
+        SpatialCable::from_poses(&a, k, gravity, mesh, &poses)?
+    };
     let solved = match goal {
-        TipGoal::Position(p) if off > IN_PLANE => {
-            let start = TipGoal::Position(reduction.lift_point(s.tip.x, s.tip.y));
+        TipGoal::Position(_) if frame.off > IN_PLANE => {
+            let start = TipGoal::Position(f * reduction.lift_point(s.tip.x, s.tip.y));
             cable.carry_goal(&start, goal)
         }
         _ => cable.solve_goal(goal),
@@ -285,50 +333,48 @@ fn lifted(
     SpatialHeldSolution::of(cable, tip, s.turns, s.self_intersects).map(Some)
 }
 
-/// The forward map of the 3-D rod held by a clamped base with base wrench `a` and a tip held
-/// by `tip` (no search): the cable integrated from the base ([`SpatialCable::from_params`];
-/// exact where single shooting keeps its digits, w ≲ 300), its energies, wrenches and the
-/// stability with the tip's natural conditions. A free tip's base force must be w ĝ (it holds
-/// no force); refused otherwise, naming the field.
+/// The forward map of the 3-D rod held by `ends` with base wrench `a` (no search): the cable
+/// integrated from the base ([`SpatialCable::from_params`]; exact where single shooting keeps
+/// its digits, w ≲ 300), a pinned base turned to `base_rotation` (ignored for a clamped base),
+/// its energies, wrenches and the stability with the natural conditions. Refused, naming the
+/// field: a moment at a pinned base (a_m ≠ 0), a free tip's base force other than w ĝ (it
+/// holds no force).
 pub fn evaluate(
     a: &SpatialParams,
     k: &Stiffness,
     gravity: &Gravity3,
-    tip: EndCondition,
+    ends: HeldEnds,
+    base_rotation: UnitQuaternion<f64>,
 ) -> Result<SpatialHeldSolution, HeldError> {
-    check(
-        HeldEnds::new(EndCondition::Clamped, tip).map_err(|e| HeldError::Target {
-            field: "tip_condition",
-            why: e.to_string(),
-        })?,
-        k,
-    )?;
-    if tip == EndCondition::Free {
+    check(ends, k)?;
+    let refuse = |why: String| HeldError::Target { field: "a", why };
+    if ends.tip() == EndCondition::Free {
         let l = gravity.load();
         if (0..3).any(|i| (a[3 + i] - l[i]).abs() > 1e-9 * (1.0 + gravity.weight())) {
-            return Err(HeldError::Target {
-                field: "a",
-                why: format!(
-                    "a free tip holds no force: (a4, a5, a6) must be w ĝ = ({}, {}, {})",
-                    l[0], l[1], l[2]
-                ),
-            });
+            return Err(refuse(format!(
+                "a free tip holds no force: (a4, a5, a6) must be w ĝ = ({}, {}, {})",
+                l[0], l[1], l[2]
+            )));
         }
     }
-    let rod = |e: RodError| HeldError::Target {
-        field: "a",
-        why: e.to_string(),
-    };
-    let cable = SpatialCable::from_params(a, k, gravity).map_err(rod)?;
-    let shape = cable
-        .poses_at(
-            &(0..=SHAPE_CHECK_SAMPLES)
-                .map(|i| i as f64 / SHAPE_CHECK_SAMPLES as f64)
-                .collect::<Vec<_>>(),
-        )
-        .map_err(rod)?;
-    let turns = winding(&shape);
-    SpatialHeldSolution::of(cable, tip, turns, false).map_err(rod)
+    let pinned_base = ends.base() == EndCondition::Pinned;
+    if pinned_base && (0..3).any(|i| a[i] != 0.0) {
+        return Err(refuse(
+            "a pinned base holds no moment: (a1, a2, a3) must be 0".into(),
+        ));
+    }
+    let rod = |e: RodError| refuse(e.to_string());
+    let cable = if pinned_base {
+        SpatialCable::pinned_from_params(a, k, gravity, base_rotation)
+    } else {
+        SpatialCable::from_params(a, k, gravity)
+    }
+    .map_err(rod)?;
+    let ts: Vec<f64> = (0..=SHAPE_CHECK_SAMPLES)
+        .map(|i| i as f64 / SHAPE_CHECK_SAMPLES as f64)
+        .collect();
+    let turns = winding(&cable.poses_at(&ts).map_err(rod)?);
+    SpatialHeldSolution::of(cable, ends.tip(), turns, false).map_err(rod)
 }
 
 /// Full turns of the tangent (its total turning over 2π, rounded down): a 3-D rod's loops.
