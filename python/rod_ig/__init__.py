@@ -676,9 +676,12 @@ def _solve_held3d(
     weight: npt.ArrayLike | None,
     gravity: npt.ArrayLike | None,
     max_turns: int,
+    quaternion: npt.ArrayLike | None = None,
 ) -> SolveResult:
     """``solve3d`` with a pinned or free end (the native ``solve_held3d``)."""
     arrays = []
+    if quaternion is not None:
+        arrays.append(_batch("quaternion", quaternion, 4)[0])
     if tip_condition == "free":
         if position is not None:
             raise ValueError("position: a free tip has no target (the cable hangs from its base)")
@@ -691,9 +694,11 @@ def _solve_held3d(
         heavy = _weight_arrays(0.0, None, 3)
     flat, batch = _broadcast(*arrays, *heavy)
     n = int(np.prod(batch, dtype=np.int64))
+    pose = quaternion is not None
     d = _rod_ig.solve_held3d(
         n,
-        positions=flat[0] if arrays else None,
+        positions=flat[1 if pose else 0] if arrays else None,
+        quaternions=flat[0] if pose else None,
         base_condition=base_condition,
         tip_condition=tip_condition,
         stiffness=tuple(stiffness),
@@ -756,8 +761,8 @@ def solve3d(
 
     ``base_condition`` / ``tip_condition`` (docs/ends.md, "3-D"; isotropic bending): a clamped
     base with a pinned tip (targets ``position`` alone, ``quaternion=None``: a hook) or a free
-    one (``position=None``: the cable hanging from its gripper, one per weight), or both
-    pinned (a cable between two hooks). Such a solve answers the least-energy stable rod found
+    one (``position=None``: the cable hanging from its gripper, one per weight), a pinned base
+    with a pinned tip (a cable between two hooks) or a clamped one (its pose). Such a solve answers the least-energy stable rod found
     (default deadline 1000 ms; ``max_turns`` as for :func:`solve`) and fills ``tip`` (..., 7:
     position and quaternion) and ``base_quaternion``; ``a0``, ``method``, ``tolerance``,
     ``max_iterations`` and ``alpha`` apply to clamped ends only."""
@@ -766,18 +771,14 @@ def solve3d(
             raise ValueError("a0, method and tolerance apply to clamped ends only")
         if max_iterations is not None or alpha is not None:
             raise ValueError("max_iterations and alpha apply to clamped ends only")
-        if tip_condition == "clamped":
-            raise ValueError(
-                "base_condition: a 3-D rod pinned at its base and clamped at its tip is the same "
-                "cable as one clamped at its base and pinned at its tip: hold it by the other "
-                "gripper"
-            )
-        if quaternion is not None:
+        if tip_condition == "clamped" and (position is None or quaternion is None):
+            raise ValueError("position and quaternion: a clamped tip's target is a pose")
+        if tip_condition != "clamped" and quaternion is not None:
             raise ValueError("quaternion: a pinned tip turns freely (its target is a position)")
         return _solve_held3d(
             position, base_condition, tip_condition, stiffness,
             deadline_ms, all, threads, weight, gravity,
-            max_turns,
+            max_turns, quaternion,
         )
     if position is None or quaternion is None:
         raise ValueError("position and quaternion are required (clamped ends)")

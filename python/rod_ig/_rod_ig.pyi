@@ -77,6 +77,7 @@ def solve_held3d(
     deadline_ms: float | None = None,
     max_turns: int = 0,
     threads: int | None = None,
+    quaternions: npt.NDArray[np.float64] | None = None,
 ) -> dict[str, Any]: ...
 def forward_held3d(
     a: npt.NDArray[np.float64],

@@ -106,7 +106,7 @@ impl Columns {
 #[pyfunction]
 #[pyo3(signature = (n, positions=None, base_condition="clamped", tip_condition="free",
                     stiffness=(1.0, 1.0, 1.0), weight=None, gravity=None, all=false,
-                    deadline_ms=None, max_turns=0, threads=None))]
+                    deadline_ms=None, max_turns=0, threads=None, quaternions=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn solve_held3d<'py>(
     py: Python<'py>,
@@ -121,6 +121,7 @@ pub fn solve_held3d<'py>(
     deadline_ms: Option<f64>,
     max_turns: u32,
     threads: Option<i64>,
+    quaternions: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let ends = ends_of(base_condition, tip_condition)?;
     let k = stiffness_of(stiffness)?;
@@ -128,21 +129,12 @@ pub fn solve_held3d<'py>(
     if p.is_some_and(|p| p.len() != 3 * n) {
         return Err(PyValueError::new_err("positions: expected n rows of 3"));
     }
+    let q = quaternions.as_ref().map(|q| q.as_slice()).transpose()?;
+    if q.is_some_and(|q| q.len() != 4 * n) {
+        return Err(PyValueError::new_err("quaternions: expected n rows of 4"));
+    }
     let gravities = gravities3(n, weight.as_ref(), gravity.as_ref())?;
-    let deadline = match deadline_ms {
-        Some(ms) if ms.is_finite() && ms > 0.0 && ms <= 1e7 => Duration::from_secs_f64(ms / 1e3),
-        Some(ms) => {
-            return Err(PyValueError::new_err(format!(
-                "deadline_ms must be a positive number of milliseconds, got {ms}"
-            )))
-        }
-        None => Duration::from_millis(1000),
-    };
-    let options = rod_ig_core::planar::ig::SolveOptions {
-        deadline,
-        max_turns,
-        ..Default::default()
-    };
+    let options = options_of(deadline_ms, max_turns)?;
     let target_of = |i: usize| p.map(|p| [p[3 * i], p[3 * i + 1], p[3 * i + 2]]);
     rod_ig_core::planar::ig::warm_up();
     let mut rows: Vec<Option<Result<SpatialHeldSearch, String>>> = (0..n).map(|_| None).collect();
@@ -154,15 +146,68 @@ pub fn solve_held3d<'py>(
         |i| {
             let g = gravities.as_ref().map_or(Gravity3::NONE, |g| g[i]);
             let target = target_of(i).map(nalgebra::Vector3::from);
-            held::equilibria(ends, &k, &g, target.as_ref(), &options).map_err(|e| e.to_string())
+            match (q, target) {
+                // A pinned base with a clamped tip: the tip's pose.
+                (Some(q), Some(p)) => {
+                    let xyzw = [q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]];
+                    SpatialPose::from_xyzw(p, xyzw)
+                        .map_err(|e| format!("quaternions: {e}"))
+                        .and_then(|pose| {
+                            held::equilibria_to_pose(&k, &g, &pose, &options)
+                                .map_err(|e| e.to_string())
+                        })
+                }
+                _ => held::equilibria(ends, &k, &g, target.as_ref(), &options)
+                    .map_err(|e| e.to_string()),
+            }
         },
         |i, r| rows[i] = Some(r),
     )?;
+    let targets: Vec<Option<[f64; 3]>> = (0..n).map(target_of).collect();
+    search_dict(
+        py,
+        ends,
+        rows.into_iter().flatten().collect(),
+        &targets,
+        all,
+    )
+}
+
+/// The options of a held search: `deadline_ms` (default 1 s) and `max_turns`.
+fn options_of(
+    deadline_ms: Option<f64>,
+    max_turns: u32,
+) -> PyResult<rod_ig_core::planar::ig::SolveOptions> {
+    let deadline = match deadline_ms {
+        Some(ms) if ms.is_finite() && ms > 0.0 && ms <= 1e7 => Duration::from_secs_f64(ms / 1e3),
+        Some(ms) => {
+            return Err(PyValueError::new_err(format!(
+                "deadline_ms must be a positive number of milliseconds, got {ms}"
+            )))
+        }
+        None => Duration::from_millis(1000),
+    };
+    Ok(rod_ig_core::planar::ig::SolveOptions {
+        deadline,
+        max_turns,
+        ..Default::default()
+    })
+}
+
+/// The dict of `solve_held3d` from each rod's search (or why it was refused).
+fn search_dict<'py>(
+    py: Python<'py>,
+    ends: rod_ig_core::ends::HeldEnds,
+    rows: Vec<Result<SpatialHeldSearch, String>>,
+    targets: &[Option<[f64; 3]>],
+    all: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let n = rows.len();
     let mut columns = Columns::default();
     let (mut complete, mut starts) = (vec![false; n], vec![0u32; n]);
     let (mut termination, mut reason) = (Vec::with_capacity(n), Vec::with_capacity(n));
     let solutions = PyList::empty(py);
-    for (i, row) in rows.into_iter().flatten().enumerate() {
+    for (i, row) in rows.into_iter().enumerate() {
         let found = match row {
             Ok(f) => f,
             Err(e) => {
@@ -175,7 +220,7 @@ pub fn solve_held3d<'py>(
         };
         starts[i] = found.starts;
         complete[i] = !found.cut_short;
-        columns.push(found.solutions.first(), target_of(i));
+        columns.push(found.solutions.first(), targets[i]);
         let (why, text) = match (found.solutions.first(), found.cut_short) {
             (Some(_), _) => ("converged", String::new()),
             (None, true) => ("deadline", found.not_found(ends).to_string()),

@@ -722,8 +722,15 @@ def test_3d_pinned_and_free_ends() -> None:
     assert hook.success and hook.position_error < 1e-9
     with pytest.raises(ValueError, match="quaternion"):
         rod_ig.solve3d([0.6, 0.2, -0.3], [0.0, 0.0, 0.0, 1.0], tip_condition="pinned")
-    with pytest.raises(ValueError, match="base_condition"):
-        rod_ig.solve3d([0.6, 0.2, -0.3], [0.0, 0.0, 0.0, 1.0], base_condition="pinned")
+    gripped = rod_ig.solve3d(
+        [0.6, 0.2, -0.3], [0.0, 0.2, 0.0, 0.98], base_condition="pinned", weight=20.0,
+        deadline_ms=5000,
+    )
+    assert gripped.success and gripped.position_error < 1e-9
+    assert gripped.base_wrench is not None
+    np.testing.assert_allclose(gripped.base_wrench.moment, 0.0, atol=1e-12)
+    with pytest.raises(ValueError, match="quaternion"):
+        rod_ig.solve3d([0.6, 0.2, -0.3], base_condition="pinned")
     with pytest.raises(ValueError, match="position"):
         rod_ig.solve3d([0.6, 0.2, -0.3], tip_condition="free")
     aniso = rod_ig.solve3d(None, tip_condition="free", weight=5.0, stiffness=(1.0, 1.0, 2.0))

@@ -38,13 +38,13 @@ pub fn forward3d_line(line: &str) -> Result<Value, String> {
     }
 }
 
-/// A pinned tip's target: its position (its orientation is free).
+/// A held tip's target: a pinned tip's position (its orientation is free: a quaternion is
+/// refused with the reason), or a clamped tip's pose (a pinned base).
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct PositionJson {
     position: [f64; 3],
-    /// Refused with the reason (a pinned tip turns freely).
-    quaternion: Option<Value>,
+    quaternion: Option<[f64; 4]>,
 }
 
 /// One `solve3d` request with a pinned or free tip.
@@ -139,24 +139,11 @@ fn gravity3(weight: Option<f64>, gravity: Option<[f64; 3]>) -> Result<Gravity3, 
         .map_err(|e| e.to_string())
 }
 
-/// Answers one `solve3d` line whose tip is pinned or free.
+/// Answers one `solve3d` line with pinned or free ends: a pinned tip's position, a free tip
+/// (no target), or a pinned base with a clamped tip's pose.
 pub fn solve3d_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
     let started = Instant::now();
     let request: Held3dRequest = jsonl::parse(line)?;
-    let target =
-        match (request.target, ends.tip()) {
-            (
-                Some(PositionJson {
-                    quaternion: Some(_),
-                    ..
-                }),
-                EndCondition::Pinned,
-            ) => return Err(
-                "target: a pinned tip's target is {\"position\"} (it turns freely: no quaternion)"
-                    .into(),
-            ),
-            (t, _) => t.map(|t| Vector3::from(t.position)),
-        };
     let max_turns = request.max_turns.unwrap_or(0);
     if max_turns > MAX_TURNS {
         return Err(format!(
@@ -173,12 +160,43 @@ pub fn solve3d_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
     };
     let k = stiffness(request.stiffness)?;
     let g = gravity3(request.weight, request.gravity)?;
-    let found =
-        held::equilibria(ends, &k, &g, target.as_ref(), &options).map_err(|e| e.to_string())?;
+    let (found, position) =
+        match (request.target, ends.tip()) {
+            (
+                Some(PositionJson {
+                    quaternion: Some(_),
+                    ..
+                }),
+                EndCondition::Pinned,
+            ) => return Err(
+                "target: a pinned tip's target is {\"position\"} (it turns freely: no quaternion)"
+                    .into(),
+            ),
+            (
+                Some(PositionJson {
+                    position,
+                    quaternion: Some(q),
+                }),
+                EndCondition::Clamped,
+            ) => {
+                let pose = SpatialPose::from_xyzw(Vector3::from(position), q)
+                    .map_err(|e| format!("target: {e}"))?;
+                let found = held::equilibria_to_pose(&k, &g, &pose, &options);
+                (found, Some(pose.position))
+            }
+            (_, EndCondition::Clamped) => {
+                return Err("target: a clamped tip needs {\"position\", \"quaternion\"}".into())
+            }
+            (t, _) => {
+                let p = t.map(|t| Vector3::from(t.position));
+                (held::equilibria(ends, &k, &g, p.as_ref(), &options), p)
+            }
+        };
+    let found = found.map_err(|e| e.to_string())?;
     jsonl::to_value(&answer_of(
         ends,
         &found,
-        target.as_ref(),
+        position.as_ref(),
         request.all,
         started,
     )?)

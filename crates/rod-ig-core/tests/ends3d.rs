@@ -29,6 +29,8 @@ struct Reference {
     /// The base is pinned: ξ(0) is free (cosines cos(kπt) in place of the sines), less the
     /// spin about the tangent, a gauge of the isotropic rod pinned at both ends.
     pinned_base: bool,
+    /// The tip is clamped: ξ(1) = 0 (a pinned base's cosines cos((k + ½)πt)).
+    tip_clamped: bool,
     frames: Vec<UnitQuaternion<f64>>,
     stiffness: Stiffness,
     load: Vector3<f64>,
@@ -38,11 +40,16 @@ struct Reference {
 
 impl Reference {
     fn of(s: &SpatialHeldSolution, k: &Stiffness, g: &Gravity3) -> Self {
+        Self::with_tip(s, k, g, false)
+    }
+
+    fn with_tip(s: &SpatialHeldSolution, k: &Stiffness, g: &Gravity3, tip_clamped: bool) -> Self {
         let ts: Vec<f64> = (0..=STEPS).map(|j| j as f64 / STEPS as f64).collect();
         let poses = s.cable.poses_at(&ts).unwrap();
         let load = Vector3::from(g.load());
         Self {
             pinned_base: s.cable.is_base_pinned(),
+            tip_clamped,
             frames: poses.iter().map(|p| p.rotation).collect(),
             stiffness: *k,
             load,
@@ -54,7 +61,9 @@ impl Reference {
         let mut v = Vector3::zeros();
         for c in 0..3 {
             for k in 0..MODES {
-                let mode = if self.pinned_base {
+                let mode = if self.pinned_base && self.tip_clamped {
+                    ((k as f64 + 0.5) * std::f64::consts::PI * t).cos()
+                } else if self.pinned_base {
                     (k as f64 * std::f64::consts::PI * t).cos()
                 } else {
                     ((k as f64 + 0.5) * std::f64::consts::PI * t).sin()
@@ -123,7 +132,8 @@ impl Reference {
             }
         }
         // A pinned base: the spin's coefficient (c = 0, k = 0) is left out (the gauge).
-        let kept: Vec<usize> = (0..n).filter(|&i| !(self.pinned_base && i == 0)).collect();
+        let gauge = self.pinned_base && !self.tip_clamped;
+        let kept: Vec<usize> = (0..n).filter(|&i| !(gauge && i == 0)).collect();
         let h = h.select_rows(&kept).select_columns(&kept);
         let dp = dp.select_columns(&kept);
         let n = kept.len();
@@ -369,4 +379,81 @@ fn pinned_at_both_ends_against_the_energy() {
         }
     }
     assert!(unstable_seen > 0, "no unstable rod checked");
+}
+
+/// Pinned at the base, clamped at the tip (the gripper holds the tip, the base hangs on a
+/// hook): rods leaving a turned base with a = (0, a_f), each an equilibrium for the pose its
+/// tip reaches, get the reference's verdict (stable and unstable ones); the search, reading
+/// the clamped–pinned rod from its other end, answers on target with no base moment, stable
+/// by the reference.
+#[test]
+fn pinned_base_clamped_tip_against_the_energy() {
+    let k = Stiffness::default();
+    let ends = HeldEnds::new(EndCondition::Pinned, EndCondition::Clamped).unwrap();
+    let g3 = Gravity3::new(20.0, [0.0, 0.0, -1.0]).unwrap();
+    let base = UnitQuaternion::from_euler_angles(0.3, -0.4, 0.2);
+    let (mut stable, mut unstable) = (0, 0);
+    for f in [
+        [-5.0, 3.0, 1.0],
+        [10.0, -20.0, 4.0],
+        [-30.0, 5.0, -2.0],
+        [4.0, 2.0, 25.0],
+        [-60.0, 10.0, 30.0],
+        [1.0, 0.5, -8.0],
+    ] {
+        let a = SpatialParams::new(0.0, 0.0, 0.0, f[0], f[1], f[2]);
+        let e = held3d_evaluate(&a, &k, &g3, ends, base);
+        let (grad, least, index) = Reference::with_tip(&e, &k, &g3, true).second_variation(true);
+        assert!(grad < 1e-3, "{f:?}: gradient {grad}");
+        assert_eq!(
+            e.stability.stable,
+            index == 0,
+            "{f:?}: ref {least} {index}, {:?}",
+            e.stability
+        );
+        stable += usize::from(index == 0);
+        unstable += usize::from(index > 0);
+    }
+    assert!(
+        stable > 0 && unstable > 0,
+        "{stable} stable, {unstable} unstable"
+    );
+    for (w, target) in [
+        (
+            20.0,
+            rod_ig_core::spatial::SpatialPose {
+                position: Vector3::new(0.6, 0.2, -0.3),
+                rotation: UnitQuaternion::from_euler_angles(0.0, 0.4, 0.0),
+            },
+        ),
+        (
+            50.0,
+            rod_ig_core::spatial::SpatialPose {
+                position: Vector3::new(0.5, -0.3, 0.2),
+                rotation: UnitQuaternion::identity(),
+            },
+        ),
+    ] {
+        let g3 = Gravity3::new(w, [0.0, 0.0, -1.0]).unwrap();
+        let found = held3::equilibria_to_pose(&k, &g3, &target, &options()).unwrap();
+        assert!(!found.solutions.is_empty(), "w {w}: none");
+        for s in &found.solutions {
+            let (dp, dr) = s.tip.distance_to(&target);
+            assert!(dp < 1e-9 && dr < 1e-9, "w {w}: {dp} {dr}");
+            assert_eq!(&s.a.as_slice()[..3], &[0.0, 0.0, 0.0]);
+            let (grad, least, index) = Reference::with_tip(s, &k, &g3, true).second_variation(true);
+            assert!(grad < 1e-4 * (1.0 + w), "w {w}: gradient {grad}");
+            assert_eq!(index, 0, "w {w}: answer {:?} has ref least {least}", s.a);
+        }
+    }
+}
+
+fn held3d_evaluate(
+    a: &SpatialParams,
+    k: &Stiffness,
+    g: &Gravity3,
+    ends: HeldEnds,
+    base: UnitQuaternion<f64>,
+) -> SpatialHeldSolution {
+    held3::evaluate(a, k, g, ends, base).unwrap()
 }

@@ -283,6 +283,19 @@ impl SpatialCable {
         Ok(cable)
     }
 
+    /// The mesh t₀ = 0 < … < t_M = 1.
+    pub fn mesh(&self) -> &[f64] {
+        &self.mesh
+    }
+
+    /// The orientation and position of the nodes at t₀ … t_{M−1} (the first is the base).
+    pub fn node_poses(&self) -> Vec<(UnitQuaternion<f64>, Vector3<f64>)> {
+        self.nodes
+            .iter()
+            .map(|n| (n.rotation, n.position))
+            .collect()
+    }
+
     /// The base's orientation (the identity unless the base is pinned).
     pub fn base_rotation(&self) -> UnitQuaternion<f64> {
         self.nodes[0].rotation
@@ -794,8 +807,13 @@ impl SpatialCable {
                     let pose = x.fixed_view::<6, 6>(0, 0).into_owned();
                     let det = pose.determinant();
                     let rows: f64 = (0..6).map(|i| pose.row(i).norm()).product();
+                    let ratio = (det / rows).abs();
                     if rows > 0.0 && t >= super::stability::MARGIN_T_MIN - 1e-12 {
-                        least_ratio = least_ratio.min((det / rows).abs());
+                        least_ratio = least_ratio.min(ratio);
+                    } else if !(ratio > MARGIN_FLOOR) {
+                        // Near the base det J(t) ~ t¹⁶ with no base moment (a pinned base):
+                        // below its rounding its sign says nothing.
+                        return ControlFlow::Continue(());
                     }
                     let lead = super::det_leading_term(&a_vec, t);
                     let sign = det.signum() * sign_u;

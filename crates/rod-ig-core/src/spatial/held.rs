@@ -1,19 +1,22 @@
-//! The 3-D rod held by a clamped base and a pinned or free tip (issue 52; docs/ends.md, "3-D").
+//! The 3-D rod with pinned or free ends (issue 52; docs/ends.md, "3-D"): a clamped base with a
+//! pinned or free tip, a pinned base with a pinned tip (a cable between two hooks) or a
+//! clamped one ([`equilibria_to_pose`]).
 //!
 //! The equations are the long cable's multiple shooting ([`super::cable`]) with the tip's six
 //! rows chosen by its condition ([`TipGoal`]): a pinned tip holds its position and has no
-//! moment, a free tip has no moment and no force (the base carries the weight). Stability is
+//! moment, a free tip has no moment and no force (the base carries the weight); a pinned
+//! base's orientation is an unknown in a_m's place. Stability is
 //! [`SpatialCable::held_stability`]: the rod clamped at both ends stable, and the energy
-//! reduced to the tip's free coordinates convex there.
+//! reduced to the ends' free coordinates convex there.
 //!
 //! The search starts where the problem is planar: with isotropic bending and gravity in the
-//! plane Π through the base tangent e1 and ĝ, the planar held rods of
-//! [`crate::planar::heavy::held`] (stiffness c, weight w / c) are 3-D equilibria. Each is
+//! plane Π through the base tangent e1 (a pinned base: the chord) and ĝ, the planar held rods
+//! of [`crate::planar::heavy::held`] (stiffness c, weight w / c) are 3-D equilibria. Each is
 //! lifted, polished by the 3-D Newton and admitted by the 3-D test (out-of-plane buckling
 //! included). A pinned tip off Π starts from its projection on Π and is carried there along a
 //! line of positions. Without weight Π is the plane through e1 and the target.
-//! Not built: a pinned base in 3-D (its orientation is an unknown), anisotropic bending
-//! (c2 ≠ c3: no plane is invariant), and a free tip's point load.
+//! Not built: anisotropic bending (c2 ≠ c3: no plane is invariant) and a free tip's point
+//! load.
 
 use super::cable::{SpatialCable, TipGoal};
 use super::cable_search::PlanarReduction;
@@ -113,18 +116,8 @@ impl SpatialHeldSearch {
     }
 }
 
-/// The ends the 3-D rod supports: a clamped base, a pinned or free tip (refusals name the
-/// field), with isotropic bending.
-fn check(ends: HeldEnds, k: &Stiffness) -> Result<(), HeldError> {
-    if ends.base() == EndCondition::Pinned && ends.tip() == EndCondition::Clamped {
-        return Err(HeldError::Target {
-            field: "base_condition",
-            why: "a 3-D rod pinned at its base and clamped at its tip is the same cable as one \
-                  clamped at its base and pinned at its tip: hold it by the other gripper \
-                  (the planar rod takes both)"
-                .into(),
-        });
-    }
+/// Held ends of the 3-D rod need isotropic bending (the search starts from a plane).
+fn check_bending(k: &Stiffness) -> Result<(), HeldError> {
     if !k.is_bending_isotropic() {
         return Err(HeldError::Target {
             field: "stiffness",
@@ -235,8 +228,16 @@ pub fn equilibria(
     target: Option<&Vector3<f64>>,
     options: &SolveOptions,
 ) -> Result<SpatialHeldSearch, HeldError> {
-    check(ends, k)?;
+    check_bending(k)?;
     let tip = ends.tip();
+    if tip == EndCondition::Clamped {
+        return Err(HeldError::Target {
+            field: "tip_condition",
+            why: "a clamped tip's target is a pose: equilibria_to_pose (pinned base), or the \
+                  clamped solver"
+                .into(),
+        });
+    }
     check_target(tip, target)?;
     let _deadline = crate::deadline::scope(options.deadline);
     let Some(frame) = SearchFrame::of(ends, k, gravity, target) else {
@@ -279,6 +280,99 @@ pub fn equilibria(
     }
     out.solutions.sort_by(|a, b| a.energy.total_cmp(&b.energy));
     Ok(out)
+}
+
+/// The stable 3-D equilibria of the rod pinned at its base (the origin) and clamped at its
+/// tip at `target`, least energy first: the same cable as one clamped by the tip's gripper
+/// and pinned at the origin, read from its other end. That one is found by [`equilibria`]
+/// in the tip gripper's frame turned half a turn about z (so that the rod leaves it along
+/// +x), each answer read back (arc length s → 1 − s, tangent and force reversed: the base
+/// force is −n(1) of the reversed rod) and polished on `target`.
+pub fn equilibria_to_pose(
+    k: &Stiffness,
+    gravity: &Gravity3,
+    target: &SpatialPose,
+    options: &SolveOptions,
+) -> Result<SpatialHeldSearch, HeldError> {
+    check_bending(k)?;
+    let frame = target.rotation * half_turn();
+    let local = frame.inverse();
+    let hook = local * (-target.position);
+    let gravity_local = Gravity3::new(
+        gravity.weight(),
+        (local * Vector3::from(gravity.direction())).into(),
+    )
+    .map_err(|e| HeldError::Target {
+        field: "gravity",
+        why: e.to_string(),
+    })?;
+    let _deadline = crate::deadline::scope(options.deadline);
+    let reversed_ends =
+        HeldEnds::new(EndCondition::Clamped, EndCondition::Pinned).map_err(|e| {
+            HeldError::Target {
+                field: "tip_condition",
+                why: e.to_string(),
+            }
+        })?;
+    let found = {
+        let _share = crate::deadline::share_of_remaining(0.8);
+        equilibria(reversed_ends, k, &gravity_local, Some(&hook), options)?
+    };
+    let mut out = SpatialHeldSearch {
+        rejected: found.rejected,
+        starts: found.starts,
+        cut_short: found.cut_short,
+        ..SpatialHeldSearch::default()
+    };
+    for s in &found.solutions {
+        match read_back(s, &gravity_local, frame, target, k, gravity) {
+            Ok(Some(solution)) if solution.stability.stable => out.solutions.push(solution),
+            Err(RodError::Deadline { .. }) => {
+                out.cut_short = true;
+                break;
+            }
+            _ => out.rejected += 1,
+        }
+    }
+    out.solutions.sort_by(|a, b| a.energy.total_cmp(&b.energy));
+    Ok(out)
+}
+
+/// Half a turn about z: x → −x, y → −y (a tangent reversed, the material frame kept right-handed).
+fn half_turn() -> UnitQuaternion<f64> {
+    UnitQuaternion::from_axis_angle(&Vector3::z_axis(), std::f64::consts::PI)
+}
+
+/// The reversed rod `s` (clamped in `frame` under `gravity_local`, pinned at the origin) read
+/// from its other end ([`equilibria_to_pose`]): pinned at the origin, clamped at `target`.
+fn read_back(
+    s: &SpatialHeldSolution,
+    gravity_local: &Gravity3,
+    frame: UnitQuaternion<f64>,
+    target: &SpatialPose,
+    k: &Stiffness,
+    gravity: &Gravity3,
+) -> Result<Option<SpatialHeldSolution>, RodError> {
+    let cable = &s.cable;
+    let (tip, _) = cable.tip_and_moment_arm()?;
+    let nodes = cable.node_poses();
+    let m = cable.segments();
+    let flip = half_turn();
+    let map =
+        |r: UnitQuaternion<f64>, p: Vector3<f64>| (frame * r * flip, target.position + frame * p);
+    let mut poses = vec![map(tip.rotation, tip.position)];
+    poses.extend((1..m).map(|j| nodes[m - j]).map(|(r, p)| map(r, p)));
+    let mesh: Vec<f64> = (0..=m).map(|j| 1.0 - cable.mesh()[m - j]).collect();
+    let n1 = Vector3::new(s.a[3], s.a[4], s.a[5]) - Vector3::from(gravity_local.load());
+    let f = -(frame * n1);
+    let a = SpatialParams::new(0.0, 0.0, 0.0, f.x, f.y, f.z);
+    let mut back = SpatialCable::pinned_from_poses(&a, k, gravity, mesh, &poses)?;
+    match back.solve_goal(&TipGoal::Pose(*target)) {
+        Ok(_) => {}
+        Err(CableError::Rod(e @ RodError::Deadline { .. })) => return Err(e),
+        Err(_) => return Ok(None),
+    }
+    SpatialHeldSolution::of(back, EndCondition::Clamped, s.turns, s.self_intersects).map(Some)
 }
 
 /// The planar held rod `s` lifted to 3-D (in the search's frame, then turned by it), solved
@@ -346,7 +440,7 @@ pub fn evaluate(
     ends: HeldEnds,
     base_rotation: UnitQuaternion<f64>,
 ) -> Result<SpatialHeldSolution, HeldError> {
-    check(ends, k)?;
+    check_bending(k)?;
     let refuse = |why: String| HeldError::Target { field: "a", why };
     if ends.tip() == EndCondition::Free {
         let l = gravity.load();
