@@ -110,3 +110,30 @@ def test_a_held_rod_follows_its_gripper(cable):
             assert abs(sol.base_angle - first.base_angle) < 0.2
             last = path.poses[-1].pose.position
             assert math.hypot(last.x - (0.8 - 0.02 * i), last.y - 0.02 * i) < 1e-9
+
+
+def test_off_the_plane_held_ends_take_the_3d_rod(cable):
+    """A target off the plane with pinned or free ends: refused naming solve_3d by default;
+    with solve_3d the 3-D rod held by the ends answers (RodSolution.spatial): a hook (pinned
+    tip) on its position with no moment there, a cable between two hooks with no moment at
+    either end, its path ending at the target."""
+    _, c = cable
+    s = h.next_seq()
+    c.pub.publish(c.make_target(0.6, -0.2, 0.0, s, z=0.2))
+    sol = c.solution_for(s, timeout=10.0)
+    assert not sol.success and "solve_3d" in sol.message
+    for base in ("clamped", "pinned"):
+        with params_set(c, solve_3d=True, base_condition=base):
+            s = h.next_seq()
+            c.pub.publish(c.make_target(0.6, -0.2, 0.0, s, z=0.2))
+            sol, path = c.solution_for(s, timeout=20.0), c.path_for(s, timeout=20.0)
+            assert sol.success, sol.message
+            assert sol.spatial and sol.stable
+            assert (sol.base_condition, sol.tip_condition) == (base, "pinned")
+            assert sol.position_error < 1e-9
+            t = sol.tip_wrench.torque
+            assert max(abs(t.x), abs(t.y), abs(t.z)) < 1e-9
+            last = path.poses[-1].pose.position
+            assert math.dist((last.x, last.y, last.z), (0.6, -0.2, 0.2)) < 1e-9
+            if base == "pinned":
+                assert list(sol.a_spatial[:3]) == [0.0, 0.0, 0.0]

@@ -116,11 +116,12 @@ pub fn ends_of(params: &Params) -> Result<rod_ig_core::ends::HeldEnds, TargetErr
         .map_err(|e| TargetError::Ends(e.to_string()))
 }
 
-/// A non-planar target (`e`) while an end is pinned or free: refused, since end conditions
-/// other than clamped are planar (the 3-D solver holds both ends clamped).
+/// A non-planar target (`e`) while an end is pinned or free and `solve_3d` is off: refused,
+/// with the parameter that takes it.
 pub fn planar_ends_only(e: TargetError, params: &Params) -> TargetError {
     TargetError::Ends(format!(
-        "{e}; pinned and free ends (base_condition {}, tip_condition {}) are planar",
+        "{e}; pinned and free ends (base_condition {}, tip_condition {}) off the plane need \
+         solve_3d",
         params.base_condition, params.tip_condition
     ))
 }

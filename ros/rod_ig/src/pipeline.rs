@@ -174,6 +174,22 @@ pub struct Planned {
     pub marker: Option<Marker>,
 }
 
+/// The settings of a request with solver overrides (a one-off solve that neither follows nor
+/// moves the warm starts); None without any (the path's sample count is not one).
+fn one_off_settings(overrides: &Overrides, settings: SolverSettings) -> Option<SolverSettings> {
+    let solver_overrides = Overrides {
+        path_samples: None,
+        ..overrides.clone()
+    };
+    (!solver_overrides.is_empty()).then(|| SolverSettings {
+        method: overrides.method.unwrap_or(settings.method),
+        tolerance: overrides.tolerance.unwrap_or(settings.tolerance),
+        max_iterations: overrides.max_iterations.unwrap_or(settings.max_iterations),
+        follow_branch: false,
+        ..settings
+    })
+}
+
 impl Processor {
     /// A processor for the given parameters (no warm start yet).
     pub fn new(params: &Params) -> Self {
@@ -202,17 +218,7 @@ impl Processor {
             self.solver.set_settings(settings);
         }
         let samples = overrides.path_samples.unwrap_or(params.path_samples);
-        let solver_overrides = Overrides {
-            path_samples: None,
-            ..overrides.clone()
-        };
-        let one_off = (!solver_overrides.is_empty()).then(|| SolverSettings {
-            method: overrides.method.unwrap_or(settings.method),
-            tolerance: overrides.tolerance.unwrap_or(settings.tolerance),
-            max_iterations: overrides.max_iterations.unwrap_or(settings.max_iterations),
-            follow_branch: false,
-            ..settings
-        });
+        let one_off = one_off_settings(overrides, settings);
         let rejected = |e: crate::convert::TargetError| Outcome {
             failure: e.key(),
             solution: failure_message(
@@ -246,17 +252,20 @@ impl Processor {
             }
             // Non-planar (or under gravity out of the rod's plane) but otherwise valid: the
             // 3-D solver when enabled (the planar initial guess of a service request is
-            // embedded as (0, 0, a3, a4, a5, 0)).
-            Err(e) if e.is_non_planar() && !settings.ends.both_clamped() => {
-                rejected(crate::convert::planar_ends_only(e, params))
-            }
+            // embedded as (0, 0, a3, a4, a5, 0)); with pinned or free ends, the 3-D rod held
+            // by them.
             Err(e) if e.is_non_planar() && params.solve_3d => {
                 let spatial = match target_to_spatial(&target.pose, params) {
                     Ok(t) => t,
                     Err(e) => return rejected(e),
                 };
-                let guess = overrides.initial_guess.as_ref().map(spatial_of_planar);
-                let result = self.solver.solve_3d(&spatial, guess, one_off, samples);
+                let result = if settings.ends.both_clamped() {
+                    let guess = overrides.initial_guess.as_ref().map(spatial_of_planar);
+                    self.solver.solve_3d(&spatial, guess, one_off, samples)
+                } else {
+                    let s = one_off.unwrap_or(settings);
+                    crate::solver::solve_3d_held(&s, &spatial, samples)
+                };
                 let elapsed = started.elapsed().as_secs_f64();
                 outcome(result, &header, params, elapsed, |s| {
                     (
@@ -265,6 +274,9 @@ impl Processor {
                         s.solution.stable,
                     )
                 })
+            }
+            Err(e) if e.is_non_planar() && !settings.ends.both_clamped() => {
+                rejected(crate::convert::planar_ends_only(e, params))
             }
             Err(e) => rejected(e),
         }

@@ -530,6 +530,109 @@ fn held_solved(
     Ok((solved, best))
 }
 
+/// A non-planar target with pinned or free ends (`solve_3d`): the least-energy stable 3-D rod
+/// held by the ends (`spatial::held`: a pinned tip holds the target's position, a free tip
+/// ignores the target, a pinned base with a clamped tip holds its pose), a fresh search every
+/// time, as a solver `Solution` with its shape. The rod is isotropic (the core's default
+/// stiffnesses).
+pub fn solve_3d_held(
+    s: &SolverSettings,
+    target: &SpatialPose,
+    samples: usize,
+) -> Result<Solved3d, Failed> {
+    use rod_ig_core::spatial::held as held3;
+    let started = std::time::Instant::now();
+    let options = SolveOptions {
+        deadline: s.deadline.max(HELD_MIN_DEADLINE),
+        ..SolveOptions::default()
+    };
+    let (k, g) = (Stiffness::default(), s.gravity_3d);
+    let found = match s.ends.tip() {
+        EndCondition::Clamped => held3::equilibria_to_pose(&k, &g, target, &options),
+        EndCondition::Pinned => held3::equilibria(s.ends, &k, &g, Some(&target.position), &options),
+        EndCondition::Free => held3::equilibria(s.ends, &k, &g, None, &options),
+    }
+    .map_err(|e| Failed {
+        spatial: true,
+        ..held_failure(e.to_string(), "invalid_input")
+    })?;
+    let Some(best) = found.solutions.first() else {
+        let termination = if found.cut_short {
+            "deadline"
+        } else {
+            "no_stable_solution"
+        };
+        return Err(Failed {
+            spatial: true,
+            ..held_failure(found.not_found(s.ends).to_string(), termination)
+        });
+    };
+    let shape_failure = |e: rod_ig_core::RodError| Failed {
+        spatial: true,
+        ..held_failure(
+            format!("cannot evaluate the solution's shape: {e}"),
+            "evaluation_failed",
+        )
+    };
+    let ts: Vec<f64> = (0..samples)
+        .map(|i| i as f64 / (samples.max(2) - 1) as f64)
+        .collect();
+    let shape = best.cable.poses_at(&ts).map_err(shape_failure)?;
+    let mut solution = held_3d_solution(s.ends.tip(), best, target, found.starts);
+    solution.elapsed_us = started.elapsed().as_secs_f64() * 1e6;
+    solution.complete = !found.cut_short;
+    let t = best.wrenches().map_err(shape_failure)?.tip;
+    Ok(WithShape {
+        solution,
+        shape,
+        event: "",
+        critical: None,
+        weight: g.weight(),
+        elastic_energy: best.elastic_energy,
+        tip_wrench: [
+            t.force[0],
+            t.force[1],
+            t.force[2],
+            t.moment[0],
+            t.moment[1],
+            t.moment[2],
+        ],
+        base_angle: 0.0,
+    })
+}
+
+/// The 3-D held rod `best` as a solver `Solution` (iterations 0: a search): its errors to
+/// `target` as the tip's condition defines them (NaN where the tip is free to move).
+fn held_3d_solution(
+    tip: EndCondition,
+    best: &rod_ig_core::spatial::held::SpatialHeldSolution,
+    target: &SpatialPose,
+    starts: u32,
+) -> Solution3d {
+    let (dp, dr) = best.tip.distance_to(target);
+    let errors = match tip {
+        EndCondition::Clamped => (dp, dr),
+        EndCondition::Pinned => (dp, f64::NAN),
+        EndCondition::Free => (f64::NAN, f64::NAN),
+    };
+    let mut solution = Solution3d::new(
+        best.a,
+        rod_ig_core::solver::Verified {
+            tip: best.tip,
+            errors,
+            energy: best.energy,
+            margin: best.stability.margin,
+        },
+        rod_ig_core::solver::Work {
+            iterations: 0,
+            evaluations: 0,
+            starts,
+        },
+    );
+    solution.residual = if errors.0.is_nan() { 0.0 } else { errors.0 };
+    solution
+}
+
 /// A held-ends solve that failed, and why.
 fn held_failure(reason: String, termination: &'static str) -> Failed {
     Failed {
