@@ -216,8 +216,8 @@ class Forward3dResult:
     """(...): ||J(1)||_inf * max(1, ||a||_inf), as :class:`ForwardResult`'s."""
     base_quaternion: FloatArray | None = None
     """With a pinned or free end: (..., 4) the base's orientation (x, y, z, w); the identity
-    unless the base is pinned (its x axis is where the rod leaves the hook). ``jacobian`` and
-    ``condition`` are NaN then (not formed for held ends)."""
+    unless the base is pinned (its x axis is where the rod leaves the hook). ``jacobian``'s
+    first three columns are then the base's turn (body twist), and ``condition`` is NaN."""
     elastic_energy: FloatArray | None = None
     """With a pinned or free end: (...) the elastic part of ``energy``."""
 
@@ -652,7 +652,7 @@ def _forward_held3d(
     return Forward3dResult(
         position=tip[..., :3],
         quaternion=tip[..., 3:],
-        jacobian=np.full(batch + (6, 6), np.nan),
+        jacobian=d["jacobian"].reshape(batch + (6, 6)),
         stable=_shaped(d["stable"], batch),
         margin=_shaped(d["margin"], batch),
         energy=_shaped(d["energy"], batch),

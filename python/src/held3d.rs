@@ -274,6 +274,7 @@ pub fn forward_held3d<'py>(
     let q = base_quaternion.as_ref().map(|q| q.as_slice()).transpose()?;
     let gravities = gravities3(n, weight.as_ref(), gravity.as_ref())?;
     let mut columns = Columns::default();
+    let mut jacobians = Vec::with_capacity(36 * n);
     for i in 0..n {
         let rotation = match q {
             Some(q) => {
@@ -288,9 +289,15 @@ pub fn forward_held3d<'py>(
         let ai = SpatialParams::from_row_slice(&a[6 * i..6 * i + 6]);
         let s = held::evaluate(&ai, &k, &g, ends, rotation)
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        // Row-major 6 × 6 (rows ω, v; columns a_m or a pinned base's turn, then a_f).
+        match s.cable.tip_jacobian() {
+            Ok(Some(j)) => jacobians.extend(j.transpose().iter()),
+            _ => jacobians.extend([f64::NAN; 36]),
+        }
         columns.push(Some(&s), None);
     }
     let d = PyDict::new(py);
     columns.into_dict(&d)?;
+    d.set_item("jacobian", f64_out(py, jacobians))?;
     Ok(d)
 }

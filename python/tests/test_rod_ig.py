@@ -713,6 +713,8 @@ def test_3d_pinned_and_free_ends() -> None:
     assert back.stable and back.base_quaternion is not None
     np.testing.assert_allclose(back.position, [0.8, 0.0, 0.0], atol=1e-9)
     np.testing.assert_allclose(back.energy, both.energy, rtol=1e-9)
+    # J(1): columns the base's turn and a_f (checked against differences in the crate's tests).
+    assert np.isfinite(back.jacobian).all() and abs(back.jacobian[3:, 3:]).max() > 0
     free = rod_ig.solve3d(None, tip_condition="free", weight=[5.0, 50.0])
     assert free.success.all() and free.tip_wrench is not None
     np.testing.assert_allclose(free.tip_wrench.force, 0.0, atol=1e-9)

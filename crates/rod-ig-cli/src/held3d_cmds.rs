@@ -280,10 +280,15 @@ pub fn forward3d_held(line: &str, ends: HeldEnds) -> Result<Value, String> {
     let g = gravity3(request.weight, request.gravity)?;
     let s = held::evaluate(&SpatialParams::from(request.a), &k, &g, ends, base)
         .map_err(|e| e.to_string())?;
+    let jacobian = s.cable.tip_jacobian().map_err(|e| e.to_string())?;
     let mut value = jsonl::to_value(&rod_of(&s, None)?)?;
     if let Value::Object(map) = &mut value {
         map.insert("base_condition".into(), ends.base().name().into());
         map.insert("tip_condition".into(), ends.tip().name().into());
+        // Rows ω, v of the tip's body twist; columns a_m (a pinned base: its turn), a_f.
+        let rows: Option<Vec<[f64; 6]>> =
+            jacobian.map(|j| (0..6).map(|r| std::array::from_fn(|c| j[(r, c)])).collect());
+        map.insert("jacobian".into(), jsonl::to_value(&rows)?);
     }
     Ok(value)
 }

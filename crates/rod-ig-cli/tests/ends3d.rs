@@ -125,6 +125,7 @@ fn pinned_base_round_trip(tip: &str) {
         ),
     )[0];
     assert_eq!(back["stable"], true, "{back}");
+    assert_eq!(back["jacobian"].as_array().map(Vec::len), Some(6), "{back}");
     let p = floats(&back["tip"]["position"]);
     assert!(
         p.iter()

@@ -457,3 +457,50 @@ fn held3d_evaluate(
 ) -> SpatialHeldSolution {
     held3::evaluate(a, k, g, ends, base).unwrap()
 }
+
+/// `SpatialCable::tip_jacobian` of held rods against central differences of the forward map:
+/// columns a_m and a_f from a clamped base, the base's turn and a_f from a pinned one
+/// (w = 20, step 1e-6, agreement 1e-6 of the column's size: the difference's truncation
+/// error is ~h² ‖∂³‖, its rounding ~1e-16/h).
+#[test]
+fn held_tip_jacobian_against_differences() {
+    let k = Stiffness::default();
+    let g3 = Gravity3::new(20.0, [0.0, 0.0, -1.0]).unwrap();
+    let base = UnitQuaternion::from_euler_angles(0.3, -0.4, 0.2);
+    let pinned = HeldEnds::new(EndCondition::Pinned, EndCondition::Pinned).unwrap();
+    let hooked = HeldEnds::new(EndCondition::Clamped, EndCondition::Pinned).unwrap();
+    for (ends, a) in [
+        (hooked, [2.0, -3.0, 1.5, 4.0, 6.0, -2.0]),
+        (pinned, [0.0, 0.0, 0.0, -5.0, 3.0, 1.0]),
+    ] {
+        let a = SpatialParams::from_row_slice(&a);
+        let e = held3::evaluate(&a, &k, &g3, ends, base).unwrap();
+        let j = e.cable.tip_jacobian().unwrap().unwrap();
+        let h = 1e-6;
+        for c in 0..6 {
+            let tip = |sign: f64| {
+                let (mut ai, mut bi) = (a, base);
+                if c < 3 && ends.base() == EndCondition::Pinned {
+                    let mut d = Vector3::zeros();
+                    d[c] = sign * h;
+                    bi = base * UnitQuaternion::from_scaled_axis(d);
+                } else {
+                    ai[c] += sign * h;
+                }
+                held3::evaluate(&ai, &k, &g3, ends, bi).unwrap().tip
+            };
+            let (plus, minus) = (tip(1.0), tip(-1.0));
+            let column = minus.body_error_to(&plus) / (2.0 * h);
+            // The body error is taken at `minus`; J's rows at the centre: equal to O(h).
+            let scale = 1.0 + column.amax();
+            for r in 0..6 {
+                assert!(
+                    (column[r] - j[(r, c)]).abs() < 1e-6 * scale,
+                    "{ends:?} column {c} row {r}: {} vs {}",
+                    column[r],
+                    j[(r, c)]
+                );
+            }
+        }
+    }
+}

@@ -846,6 +846,27 @@ impl SpatialCable {
         unreachable!("a cable has at least one segment")
     }
 
+    /// J(1) = ∂(tip body twist)/∂(the base's unknowns), rows (ω, v) as [`super::tip_and_jacobian`]'s:
+    /// columns a_m (a clamped base) or the base's turn ε₀ (a pinned base, R₀ ← R₀ exp(ε₀)),
+    /// then a_f. From the stability scan's Jacobi fields: X_η B⁻¹, with B the fields'
+    /// coordinates in (δa, δφ₀) (the QR steps' product, never singular). None if it were.
+    pub fn tip_jacobian(&self) -> Result<Option<SMatrix<f64, 6, 6>>, RodError> {
+        let (_, x, _) = self.conjugate_scan()?;
+        let b = x.fixed_view::<9, 9>(ROWS, 0).into_owned();
+        let Some(b_inv) = b.try_inverse() else {
+            return Ok(None);
+        };
+        let full = x.fixed_view::<6, 9>(0, 0) * b_inv;
+        let first = if self.pinned_base { 6 } else { 0 };
+        Ok(Some(SMatrix::<f64, 6, 6>::from_fn(|r, c| {
+            if c < 3 {
+                full[(r, first + c)]
+            } else {
+                full[(r, c)]
+            }
+        })))
+    }
+
     /// a in the base's own frame (a pinned base is turned): what the leading term of det J(t)
     /// takes.
     fn params_in_base_frame(&self) -> SpatialParams {
