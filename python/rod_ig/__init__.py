@@ -262,7 +262,8 @@ class SolveResult:
     or pinned tip's angle is part of the answer)."""
     shape: FloatArray | None = None
     """With a pinned or free end and ``samples``: (..., samples, 3) the rod found, poses
-    (x, y, theta) from base to tip (NaN where the solve failed)."""
+    (x, y, theta) from base to tip (3-D: (..., samples, 7), position and quaternion x y z w;
+    NaN where the solve failed)."""
     base_quaternion: FloatArray | None = None
     """3-D with a pinned or free end: (..., 4) the base's orientation (x, y, z, w): the
     identity for a clamped base, a pinned base's own (NaN where the solve failed)."""
@@ -569,16 +570,17 @@ def _solve_held(
 
 
 def _held_shapes(
-    rows: list[FloatArray], batch: tuple[int, ...], samples: int
+    rows: list[FloatArray], batch: tuple[int, ...], samples: int, width: int = 3
 ) -> FloatArray | None:
-    """The rods' shapes (..., samples, 3), NaN where a solve failed; None without samples."""
+    """The rods' shapes (..., samples, width), NaN where a solve failed; None without
+    samples."""
     if samples < 2:
         return None
-    out = np.full((len(rows), samples, 3), np.nan)
+    out = np.full((len(rows), samples, width), np.nan)
     for i, r in enumerate(rows):
         if len(r):
-            out[i] = r.reshape(samples, 3)
-    return out.reshape(batch + (samples, 3))
+            out[i] = r.reshape(samples, width)
+    return out.reshape(batch + (samples, width))
 
 
 def forward3d(
@@ -677,6 +679,7 @@ def _solve_held3d(
     gravity: npt.ArrayLike | None,
     max_turns: int,
     quaternion: npt.ArrayLike | None = None,
+    samples: int = 0,
 ) -> SolveResult:
     """``solve3d`` with a pinned or free end (the native ``solve_held3d``)."""
     arrays = []
@@ -699,6 +702,7 @@ def _solve_held3d(
         n,
         positions=flat[1 if pose else 0] if arrays else None,
         quaternions=flat[0] if pose else None,
+        samples=_integer("samples", samples, 0, 1_000_000),
         base_condition=base_condition,
         tip_condition=tip_condition,
         stiffness=tuple(stiffness),
@@ -733,6 +737,7 @@ def _solve_held3d(
         tip_wrench=_wrench(d["tip_wrench"], batch, 3),
         tip=d["tip"].reshape(batch + (7,)),
         base_quaternion=d["base_quaternion"].reshape(batch + (4,)),
+        shape=_held_shapes(d["shapes"], batch, samples, 7),
     )
 
 
@@ -754,6 +759,7 @@ def solve3d(
     base_condition: EndName = "clamped",
     tip_condition: EndName = "clamped",
     max_turns: int = 0,
+    samples: int = 0,
 ) -> SolveResult:
     """3-D inverse geometry: targets given by ``position`` (..., 3) and ``quaternion``
     (..., 4) as (x, y, z, w), broadcast together; the options of :func:`solve`; ``weight``
@@ -764,7 +770,8 @@ def solve3d(
     one (``position=None``: the cable hanging from its gripper, one per weight), a pinned base
     with a pinned tip (a cable between two hooks) or a clamped one (its pose). Such a solve answers the least-energy stable rod found
     (default deadline 1000 ms; ``max_turns`` as for :func:`solve`) and fills ``tip`` (..., 7:
-    position and quaternion) and ``base_quaternion``; ``a0``, ``method``, ``tolerance``,
+    position and quaternion) and ``base_quaternion``; ``samples`` >= 2 fills ``shape``
+    (..., samples, 7: poses base to tip); ``a0``, ``method``, ``tolerance``,
     ``max_iterations`` and ``alpha`` apply to clamped ends only."""
     if base_condition != "clamped" or tip_condition != "clamped":
         if a0 is not None or method != "robust" or tolerance is not None:
@@ -778,12 +785,12 @@ def solve3d(
         return _solve_held3d(
             position, base_condition, tip_condition, stiffness,
             deadline_ms, all, threads, weight, gravity,
-            max_turns, quaternion,
+            max_turns, quaternion, samples,
         )
     if position is None or quaternion is None:
         raise ValueError("position and quaternion are required (clamped ends)")
-    if max_turns:
-        raise ValueError("max_turns applies to pinned or free ends in 3-D")
+    if max_turns or samples:
+        raise ValueError("max_turns and samples apply to pinned or free ends in 3-D")
     arrays = [_batch("position", position, 3)[0], _batch("quaternion", quaternion, 4)[0]]
     if a0 is not None:
         arrays.append(_batch("a0", a0, 6)[0])

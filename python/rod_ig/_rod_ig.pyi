@@ -78,6 +78,7 @@ def solve_held3d(
     max_turns: int = 0,
     threads: int | None = None,
     quaternions: npt.NDArray[np.float64] | None = None,
+    samples: int = 0,
 ) -> dict[str, Any]: ...
 def forward_held3d(
     a: npt.NDArray[np.float64],

@@ -106,7 +106,7 @@ impl Columns {
 #[pyfunction]
 #[pyo3(signature = (n, positions=None, base_condition="clamped", tip_condition="free",
                     stiffness=(1.0, 1.0, 1.0), weight=None, gravity=None, all=false,
-                    deadline_ms=None, max_turns=0, threads=None, quaternions=None))]
+                    deadline_ms=None, max_turns=0, threads=None, quaternions=None, samples=0))]
 #[allow(clippy::too_many_arguments)]
 pub fn solve_held3d<'py>(
     py: Python<'py>,
@@ -122,7 +122,13 @@ pub fn solve_held3d<'py>(
     max_turns: u32,
     threads: Option<i64>,
     quaternions: Option<PyReadonlyArray1<'py, f64>>,
+    samples: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if samples == 1 || samples > 1_000_000 {
+        return Err(PyValueError::new_err(format!(
+            "samples must be 0 (no shape) or in [2, 1000000], got {samples}"
+        )));
+    }
     let ends = ends_of(base_condition, tip_condition)?;
     let k = stiffness_of(stiffness)?;
     let p = positions.as_ref().map(|p| p.as_slice()).transpose()?;
@@ -137,7 +143,7 @@ pub fn solve_held3d<'py>(
     let options = options_of(deadline_ms, max_turns)?;
     let target_of = |i: usize| p.map(|p| [p[3 * i], p[3 * i + 1], p[3 * i + 2]]);
     rod_ig_core::planar::ig::warm_up();
-    let mut rows: Vec<Option<Result<SpatialHeldSearch, String>>> = (0..n).map(|_| None).collect();
+    let mut rows: Vec<Option<Row>> = (0..n).map(|_| None).collect();
     batch(
         py,
         n,
@@ -146,7 +152,7 @@ pub fn solve_held3d<'py>(
         |i| {
             let g = gravities.as_ref().map_or(Gravity3::NONE, |g| g[i]);
             let target = target_of(i).map(nalgebra::Vector3::from);
-            match (q, target) {
+            let found = match (q, target) {
                 // A pinned base with a clamped tip: the tip's pose.
                 (Some(q), Some(p)) => {
                     let xyzw = [q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]];
@@ -159,7 +165,16 @@ pub fn solve_held3d<'py>(
                 }
                 _ => held::equilibria(ends, &k, &g, target.as_ref(), &options)
                     .map_err(|e| e.to_string()),
-            }
+            };
+            let shape = match (&found, samples) {
+                (Ok(f), 2..) => f
+                    .solutions
+                    .first()
+                    .and_then(|s| shape_of(s, samples))
+                    .unwrap_or_default(),
+                _ => Vec::new(),
+            };
+            (found, shape)
         },
         |i, r| rows[i] = Some(r),
     )?;
@@ -170,6 +185,35 @@ pub fn solve_held3d<'py>(
         rows.into_iter().flatten().collect(),
         &targets,
         all,
+    )
+}
+
+/// One rod's search (or why it was refused) and its best rod's shape (`samples` poses of 7:
+/// position, quaternion x y z w; empty when not asked or when there is none).
+type Row = (Result<SpatialHeldSearch, String>, Vec<f64>);
+
+/// The rod's shape, `samples` poses from base to tip, flattened.
+fn shape_of(s: &SpatialHeldSolution, samples: usize) -> Option<Vec<f64>> {
+    let ts: Vec<f64> = (0..samples)
+        .map(|i| i as f64 / (samples - 1) as f64)
+        .collect();
+    let poses = s.cable.poses_at(&ts).ok()?;
+    Some(
+        poses
+            .iter()
+            .flat_map(|p| {
+                let q = p.quaternion_xyzw();
+                [
+                    p.position.x,
+                    p.position.y,
+                    p.position.z,
+                    q[0],
+                    q[1],
+                    q[2],
+                    q[3],
+                ]
+            })
+            .collect(),
     )
 }
 
@@ -198,16 +242,18 @@ fn options_of(
 fn search_dict<'py>(
     py: Python<'py>,
     ends: rod_ig_core::ends::HeldEnds,
-    rows: Vec<Result<SpatialHeldSearch, String>>,
+    rows: Vec<Row>,
     targets: &[Option<[f64; 3]>],
     all: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let n = rows.len();
+    let shapes = PyList::empty(py);
     let mut columns = Columns::default();
     let (mut complete, mut starts) = (vec![false; n], vec![0u32; n]);
     let (mut termination, mut reason) = (Vec::with_capacity(n), Vec::with_capacity(n));
     let solutions = PyList::empty(py);
-    for (i, row) in rows.into_iter().enumerate() {
+    for (i, (row, shape)) in rows.into_iter().enumerate() {
+        shapes.append(f64_out(py, shape))?;
         let found = match row {
             Ok(f) => f,
             Err(e) => {
@@ -246,6 +292,7 @@ fn search_dict<'py>(
     d.set_item("termination", termination)?;
     d.set_item("reason", reason)?;
     d.set_item("solutions", solutions)?;
+    d.set_item("shapes", shapes)?;
     Ok(d)
 }
 

@@ -720,8 +720,16 @@ def test_3d_pinned_and_free_ends() -> None:
     np.testing.assert_allclose(free.tip_wrench.force, 0.0, atol=1e-9)
     np.testing.assert_allclose(free.tip_wrench.moment, 0.0, atol=1e-8)
     np.testing.assert_allclose(free.a[:, 3:], [[0.0, 0.0, -5.0], [0.0, 0.0, -50.0]])
-    hook = rod_ig.solve3d([0.6, 0.2, -0.3], tip_condition="pinned", weight=10.0, deadline_ms=5000)
+    hook = rod_ig.solve3d(
+        [0.6, 0.2, -0.3], tip_condition="pinned", weight=10.0, deadline_ms=5000, samples=50
+    )
     assert hook.success and hook.position_error < 1e-9
+    assert hook.shape is not None and hook.shape.shape == (50, 7)
+    np.testing.assert_allclose(hook.shape[0, :3], 0.0, atol=1e-15)
+    np.testing.assert_allclose(hook.shape[-1, :3], [0.6, 0.2, -0.3], atol=1e-9)
+    # Unit length: the polyline's chords add up to just under 1.
+    chords = np.linalg.norm(np.diff(hook.shape[:, :3], axis=0), axis=1).sum()
+    assert 0.99 < chords <= 1.0 + 1e-12
     with pytest.raises(ValueError, match="quaternion"):
         rod_ig.solve3d([0.6, 0.2, -0.3], [0.0, 0.0, 0.0, 1.0], tip_condition="pinned")
     gripped = rod_ig.solve3d(
