@@ -956,9 +956,56 @@ impl SpatialCable {
         let h = h.select_rows(&free).select_columns(&free);
         let sym = (&h + h.transpose()) * 0.5;
         let asym = (&h - h.transpose()).norm() * 0.5;
-        let least = sym.clone().symmetric_eigenvalues().min();
         let error = asym + 1e-9 * sym.norm();
+        let sym = match self.symmetry_field(&node, tip) {
+            Some(v) => deflated(sym, &v.select_rows(&free), error),
+            None => sym,
+        };
+        let least = sym.symmetric_eigenvalues().min();
         (least.is_finite() && error.is_finite()).then_some((least, error))
+    }
+
+    /// The ends' motion (ε₀, ε₁ as in [`SpatialCable::end_hessian`]) of a turn of the whole
+    /// problem about an axis u through the base, where the problem has that symmetry: the
+    /// rod turned by R ← Rot(u, φ) R Rot(e1, −φ) is again an equilibrium (isotropic bending)
+    /// when gravity is along u (or absent), a clamped base's tangent is u (u = e1), and a
+    /// pinned tip lies on the axis. Such rods form a family, and H is singular along it: a
+    /// neutral direction of the family, not a loss of stability. None without the symmetry.
+    fn symmetry_field(&self, end: &Node, tip: EndCondition) -> Option<nalgebra::DVector<f64>> {
+        let gd = Vector3::from(self.gravity.direction());
+        let p1 = end.position;
+        let u = match (self.pinned_base, tip) {
+            (false, _) => Vector3::x(),
+            (true, EndCondition::Pinned) if !self.gravity.is_weightless() => gd,
+            (true, EndCondition::Pinned) if p1.norm() > 0.0 => p1.normalize(),
+            _ => return None,
+        };
+        let along = |v: &Vector3<f64>| v.cross(&u).norm() <= 1e-9 * v.norm().max(1.0);
+        let tip_on_axis = tip == EndCondition::Free || along(&p1);
+        if !(self.gravity.is_weightless() || along(&gd)) || !tip_on_axis {
+            return None;
+        }
+        let e1 = Vector3::x();
+        let (r0, r1) = (self.nodes[0].rotation, end.rotation);
+        let mut w = nalgebra::DVector::zeros(9);
+        let (b, t, v) = (
+            r0.inverse() * u - e1,
+            r1.inverse() * u - e1,
+            r1.inverse() * u.cross(&p1),
+        );
+        for i in 0..3 {
+            w[i] = b[i];
+            w[3 + i] = t[i];
+            w[6 + i] = v[i];
+        }
+        if self.pinned_base && tip == EndCondition::Pinned {
+            // The gauge (a spin of the whole rod about its tangent: ε₀ = ε₁_ω = e1) is left
+            // out of the free coordinates: take the field with no base spin.
+            let spin = w[0];
+            w[0] = 0.0;
+            w[3] -= spin;
+        }
+        Some(w)
     }
 
     /// The state at the start of segment `k`; with `N` = the full state, unit columns.
@@ -977,6 +1024,26 @@ impl SpatialCable {
         }
         y
     }
+}
+
+/// The symmetric `h` restricted to the complement of `v` when `v` is (to `error`) a null
+/// direction of it; `h` itself otherwise (or when `v` vanishes).
+fn deflated(
+    h: nalgebra::DMatrix<f64>,
+    v: &nalgebra::DVector<f64>,
+    error: f64,
+) -> nalgebra::DMatrix<f64> {
+    let norm = v.norm();
+    if !(norm > 1e-12) || (&h * v).norm() > 10.0 * error * norm {
+        return h;
+    }
+    let v = v / norm;
+    let n = h.nrows();
+    let projector = nalgebra::DMatrix::identity(n, n) - &v * v.transpose();
+    let e = projector.symmetric_eigen();
+    let keep: Vec<usize> = (0..n).filter(|&i| e.eigenvalues[i] > 0.5).collect();
+    let z = e.eigenvectors.select_columns(&keep);
+    z.transpose() * h * z
 }
 
 /// λ₀ of [`SpatialCable::held_stability`]: the least eigenvalue of the straight weightless

@@ -424,7 +424,49 @@ fn lifted(
         TipGoal::Free { .. } => EndCondition::Free,
         _ => EndCondition::Pinned,
     };
-    SpatialHeldSolution::of(cable, tip, s.turns, s.self_intersects).map(Some)
+    let mut out = SpatialHeldSolution::of(cable, tip, s.turns, s.self_intersects)?;
+    if let Some(verdict) = straight_verdict(&out.a, k, gravity, s.cable.ends()) {
+        out.stability = verdict;
+    }
+    Ok(Some(out))
+}
+
+/// The verdict on a straight rod along the clamped base's tangent e1 (a_m = 0, a_f and
+/// gravity along e1, or no weight), where J(1) is singular (the rod is inextensible) and the
+/// 3-D test undecided: its second variation splits into two equal bending problems, in a
+/// plane through e1 and across it (isotropic bending), and torsion, which holds nothing
+/// (c1 > 0). So the planar held rod's verdict (stiffness c, weight w / c) is the 3-D one.
+/// None for any other rod.
+fn straight_verdict(
+    a: &SpatialParams,
+    k: &Stiffness,
+    gravity: &Gravity3,
+    ends: HeldEnds,
+) -> Option<StabilityReport> {
+    let gd = Vector3::from(gravity.direction());
+    let across = |v: Vector3<f64>| v.y.abs().max(v.z.abs());
+    let force = Vector3::new(a[3], a[4], a[5]);
+    let straight = ends.base() == EndCondition::Clamped
+        && a[0] == 0.0
+        && a[1] == 0.0
+        && a[2] == 0.0
+        && across(force) == 0.0
+        && (gravity.is_weightless() || across(gd) == 0.0);
+    if !straight {
+        return None;
+    }
+    let c = k.c2;
+    let along = if gravity.is_weightless() { 1.0 } else { gd.x };
+    let planar_gravity =
+        crate::planar::heavy::Gravity::new(gravity.weight() / c, [along, 0.0]).ok()?;
+    let planar = crate::PlanarParams::new(0.0, force.x / c, 0.0);
+    let e = planar_held::evaluate(0.0, &planar, &planar_gravity, ends, [0.0; 2]).ok()?;
+    Some(StabilityReport {
+        stable: e.stable(),
+        margin: e.solution.stability.normalised(),
+        first_conjugate_t: None,
+        uncertain: e.uncertain(),
+    })
 }
 
 /// The forward map of the 3-D rod held by `ends` with base wrench `a` (no search): the cable
@@ -468,7 +510,11 @@ pub fn evaluate(
         .map(|i| i as f64 / SHAPE_CHECK_SAMPLES as f64)
         .collect();
     let turns = winding(&cable.poses_at(&ts).map_err(rod)?);
-    SpatialHeldSolution::of(cable, ends.tip(), turns, false).map_err(rod)
+    let mut out = SpatialHeldSolution::of(cable, ends.tip(), turns, false).map_err(rod)?;
+    if let Some(verdict) = straight_verdict(a, k, gravity, ends) {
+        out.stability = verdict;
+    }
+    Ok(out)
 }
 
 /// Full turns of the tangent (its total turning over 2π, rounded down): a 3-D rod's loops.
