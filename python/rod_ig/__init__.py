@@ -540,32 +540,43 @@ def _solve_held(
         samples=_integer("samples", samples, 0, 1_000_000),
         **_weight_kwargs(flat, len(arrays)),
     )
+    return SolveResult(
+        **_held_fields(d, batch, 3, all),
+        turns=_shaped(d["turns"], batch),
+        base_angle=_shaped(d["base_angle"], batch),
+        tip=d["tip"].reshape(batch + (3,)),
+        shape=_held_shapes(d["shapes"], batch, samples),
+    )
+
+
+def _held_fields(
+    d: dict[str, Any], batch: tuple[int, ...], dim: int, all: bool
+) -> dict[str, Any]:
+    """The :class:`SolveResult` fields every held-ends search fills (planar ``dim`` 3, 3-D 6)
+    from the native dict ``d``."""
+    n = int(np.prod(batch, dtype=np.int64))
     solutions = None
     if all:
         solutions = np.empty(n, dtype=object)
-        for i, s in enumerate(d["solutions"]):
-            solutions[i] = s.reshape(-1, 3)
+        for i, sol in enumerate(d["solutions"]):
+            solutions[i] = sol.reshape(-1, dim)
         solutions = _shaped(solutions, batch)
-    nan = np.full(n, np.nan)
-    return SolveResult(
+    width = 2 if dim == 3 else 3
+    return dict(
         success=_shaped(d["success"], batch),
-        a=d["a"].reshape(batch + (3,)),
+        a=d["a"].reshape(batch + (dim,)),
         termination=_shaped(np.array(d["termination"], dtype=str), batch),
         reason=_shaped(np.array(d["reason"], dtype=str), batch),
         iterations=_shaped(np.zeros(n, dtype=np.uint32), batch),
         margin=_shaped(d["margin"], batch),
         energy=_shaped(d["energy"], batch),
         position_error=_shaped(d["position_error"], batch),
-        orientation_error=_shaped(nan, batch),
+        orientation_error=_shaped(np.full(n, np.nan), batch),
         starts=_shaped(d["starts"], batch),
         complete=_shaped(d["complete"], batch),
         solutions=solutions,
-        turns=_shaped(d["turns"], batch),
-        base_wrench=_wrench(d["base_wrench"], batch, 2),
-        tip_wrench=_wrench(d["tip_wrench"], batch, 2),
-        base_angle=_shaped(d["base_angle"], batch),
-        tip=d["tip"].reshape(batch + (3,)),
-        shape=_held_shapes(d["shapes"], batch, samples),
+        base_wrench=_wrench(d["base_wrench"], batch, width),
+        tip_wrench=_wrench(d["tip_wrench"], batch, width),
     )
 
 
@@ -712,29 +723,9 @@ def _solve_held3d(
         threads=_threads(threads),
         **_weight_kwargs(flat, len(arrays)),
     )
-    solutions = None
-    if all:
-        solutions = np.empty(n, dtype=object)
-        for i, sol in enumerate(d["solutions"]):
-            solutions[i] = sol.reshape(-1, 6)
-        solutions = _shaped(solutions, batch)
-    nan = np.full(n, np.nan)
     return SolveResult(
-        success=_shaped(d["success"], batch),
-        a=d["a"].reshape(batch + (6,)),
-        termination=_shaped(np.array(d["termination"], dtype=str), batch),
-        reason=_shaped(np.array(d["reason"], dtype=str), batch),
-        iterations=_shaped(np.zeros(n, dtype=np.uint32), batch),
-        margin=_shaped(d["margin"], batch),
-        energy=_shaped(d["energy"], batch),
-        position_error=_shaped(d["position_error"], batch),
-        orientation_error=_shaped(nan, batch),
-        starts=_shaped(d["starts"], batch),
-        complete=_shaped(d["complete"], batch),
-        solutions=solutions,
+        **_held_fields(d, batch, 6, all),
         turns=_shaped(np.where(d["success"], d["turns"], -1).astype(np.int64), batch),
-        base_wrench=_wrench(d["base_wrench"], batch, 3),
-        tip_wrench=_wrench(d["tip_wrench"], batch, 3),
         tip=d["tip"].reshape(batch + (7,)),
         base_quaternion=d["base_quaternion"].reshape(batch + (4,)),
         shape=_held_shapes(d["shapes"], batch, samples, 7),

@@ -9,7 +9,6 @@ use pyo3::types::{PyDict, PyList};
 use rod_ig_core::spatial::heavy::Gravity3;
 use rod_ig_core::spatial::held::{self, SpatialHeldSearch, SpatialHeldSolution};
 use rod_ig_core::spatial::{SpatialParams, SpatialPose};
-use std::time::Duration;
 
 /// Rods per work item of the batch (each is a search of up to its deadline).
 const SEARCH_BLOCK: usize = 1;
@@ -140,7 +139,7 @@ pub fn solve_held3d<'py>(
         return Err(PyValueError::new_err("quaternions: expected n rows of 4"));
     }
     let gravities = gravities3(n, weight.as_ref(), gravity.as_ref())?;
-    let options = options_of(deadline_ms, max_turns)?;
+    let options = crate::held_options(deadline_ms, max_turns)?;
     let target_of = |i: usize| p.map(|p| [p[3 * i], p[3 * i + 1], p[3 * i + 2]]);
     rod_ig_core::planar::ig::warm_up();
     let mut rows: Vec<Option<Row>> = (0..n).map(|_| None).collect();
@@ -215,27 +214,6 @@ fn shape_of(s: &SpatialHeldSolution, samples: usize) -> Option<Vec<f64>> {
             })
             .collect(),
     )
-}
-
-/// The options of a held search: `deadline_ms` (default 1 s) and `max_turns`.
-fn options_of(
-    deadline_ms: Option<f64>,
-    max_turns: u32,
-) -> PyResult<rod_ig_core::planar::ig::SolveOptions> {
-    let deadline = match deadline_ms {
-        Some(ms) if ms.is_finite() && ms > 0.0 && ms <= 1e7 => Duration::from_secs_f64(ms / 1e3),
-        Some(ms) => {
-            return Err(PyValueError::new_err(format!(
-                "deadline_ms must be a positive number of milliseconds, got {ms}"
-            )))
-        }
-        None => Duration::from_millis(1000),
-    };
-    Ok(rod_ig_core::planar::ig::SolveOptions {
-        deadline,
-        max_turns,
-        ..Default::default()
-    })
 }
 
 /// The dict of `solve_held3d` from each rod's search (or why it was refused).

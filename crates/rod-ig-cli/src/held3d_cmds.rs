@@ -1,7 +1,7 @@
 //! `rod-ig solve3d` and `forward3d` with pinned or free ends (`base_condition`,
 //! `tip_condition`): JSON in, JSON out; the search is `rod_ig_core::spatial::held`.
 
-use crate::held_cmds::{held_ends_of, DEFAULT_HELD_DEADLINE};
+use crate::held_cmds::{held_ends_of, HeldAnswer, DEFAULT_HELD_DEADLINE};
 use crate::jsonl::{self, ObjectiveName};
 use crate::planar_cmds::MAX_TURNS;
 use crate::spatial_cmds::{stiffness, PoseJson};
@@ -88,26 +88,6 @@ struct Held3dRod {
     /// Distance from the tip to a pinned tip's target.
     #[serde(skip_serializing_if = "Option::is_none")]
     position_error: Option<f64>,
-}
-
-/// One 3-D held answer: the least-energy rod (or why none), and with `all` every stable one.
-#[derive(Serialize)]
-struct Held3dAnswer {
-    success: bool,
-    #[serde(flatten)]
-    rod: Option<Held3dRod>,
-    base_condition: EndCondition,
-    tip_condition: EndCondition,
-    termination: &'static str,
-    starts: u32,
-    elapsed_ms: f64,
-    complete: bool,
-    /// Equilibria found and not admitted (unstable in 3-D or in the plane, or looped).
-    rejected: usize,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    reason: Option<String>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    solutions: Option<Vec<Held3dRod>>,
 }
 
 fn rod_of(s: &SpatialHeldSolution, target: Option<&Vector3<f64>>) -> Result<Held3dRod, String> {
@@ -208,37 +188,31 @@ fn answer_of(
     target: Option<&Vector3<f64>>,
     all: bool,
     started: Instant,
-) -> Result<Held3dAnswer, String> {
-    let best = found.solutions.first();
-    let termination = match (best, found.cut_short) {
-        (Some(_), _) => "converged",
-        (None, true) => "deadline",
-        (None, false) => "no_stable_solution",
-    };
-    let solutions = if all {
-        Some(
+) -> Result<HeldAnswer<Held3dRod>, String> {
+    let solutions = match all {
+        true => Some(
             found
                 .solutions
                 .iter()
                 .map(|s| rod_of(s, target))
                 .collect::<Result<Vec<_>, _>>()?,
-        )
-    } else {
-        None
+        ),
+        false => None,
     };
-    Ok(Held3dAnswer {
-        success: best.is_some(),
-        rod: best.map(|s| rod_of(s, target)).transpose()?,
-        base_condition: ends.base(),
-        tip_condition: ends.tip(),
-        termination,
-        starts: found.starts,
-        elapsed_ms: started.elapsed().as_secs_f64() * 1e3,
-        complete: !found.cut_short,
-        rejected: found.rejected,
-        reason: best.is_none().then(|| found.not_found(ends).to_string()),
+    Ok(HeldAnswer::new(
+        ends,
+        found
+            .solutions
+            .first()
+            .map(|s| rod_of(s, target))
+            .transpose()?,
         solutions,
-    })
+        found.rejected,
+        found.starts,
+        found.cut_short,
+        || found.not_found(ends).to_string(),
+        started,
+    ))
 }
 
 /// One `forward3d` request with a pinned or free tip.

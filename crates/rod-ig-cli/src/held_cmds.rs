@@ -181,12 +181,13 @@ struct HeldRod {
     position_error: Option<f64>,
 }
 
-/// One held answer: the least-energy rod (or why none), and with `all` every stable one.
+/// One held answer (planar `R` = [`HeldRod`], or a 3-D rod): the least-energy rod (or why
+/// none), and with `all` every stable one.
 #[derive(Serialize)]
-struct HeldAnswer {
+pub(crate) struct HeldAnswer<R> {
     success: bool,
     #[serde(flatten)]
-    rod: Option<HeldRod>,
+    rod: Option<R>,
     base_condition: EndCondition,
     tip_condition: EndCondition,
     termination: &'static str,
@@ -198,7 +199,43 @@ struct HeldAnswer {
     #[serde(skip_serializing_if = "Option::is_none")]
     reason: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    solutions: Option<Vec<HeldRod>>,
+    solutions: Option<Vec<R>>,
+}
+
+impl<R> HeldAnswer<R> {
+    /// The answer of a search held by `ends`: its best rod `rod` (None: it found none, and
+    /// `reason` says why), with `all` the list `solutions`, `rejected` equilibria not admitted,
+    /// after `starts` starts, `cut_short` by its deadline or not, begun at `started`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new(
+        ends: HeldEnds,
+        rod: Option<R>,
+        solutions: Option<Vec<R>>,
+        rejected: usize,
+        starts: u32,
+        cut_short: bool,
+        reason: impl FnOnce() -> String,
+        started: Instant,
+    ) -> Self {
+        let termination = match (rod.is_some(), cut_short) {
+            (true, _) => "converged",
+            (false, true) => "deadline",
+            (false, false) => "no_stable_solution",
+        };
+        HeldAnswer {
+            success: rod.is_some(),
+            reason: rod.is_none().then(reason),
+            rod,
+            base_condition: ends.base(),
+            tip_condition: ends.tip(),
+            termination,
+            starts,
+            elapsed_ms: started.elapsed().as_secs_f64() * 1e3,
+            complete: !cut_short,
+            rejected,
+            solutions,
+        }
+    }
 }
 
 fn rod_of(s: &HeldSolution, target: Option<&PlanarPose>) -> HeldRod {
@@ -276,29 +313,17 @@ fn answer_of(
     target: Option<&PlanarPose>,
     all: bool,
     started: Instant,
-) -> HeldAnswer {
-    let best = found.solutions.first();
-    let reason = best
-        .is_none()
-        .then(|| held::not_found(ends, found).to_string());
-    let termination = match (best, found.cut_short) {
-        (Some(_), _) => "converged",
-        (None, true) => "deadline",
-        (None, false) => "no_stable_solution",
-    };
-    HeldAnswer {
-        success: best.is_some(),
-        rod: best.map(|s| rod_of(s, target)),
-        base_condition: ends.base(),
-        tip_condition: ends.tip(),
-        termination,
-        starts: found.starts,
-        elapsed_ms: started.elapsed().as_secs_f64() * 1e3,
-        complete: !found.cut_short,
-        rejected: found.equilibria.len() - found.solutions.len(),
-        reason,
-        solutions: all.then(|| found.solutions.iter().map(|s| rod_of(s, target)).collect()),
-    }
+) -> HeldAnswer<HeldRod> {
+    HeldAnswer::new(
+        ends,
+        found.solutions.first().map(|s| rod_of(s, target)),
+        all.then(|| found.solutions.iter().map(|s| rod_of(s, target)).collect()),
+        found.equilibria.len() - found.solutions.len(),
+        found.starts,
+        found.cut_short,
+        || held::not_found(ends, found).to_string(),
+        started,
+    )
 }
 
 /// A `track` stream whose grippers hold the rod by pinned or free ends: the ends of its first

@@ -80,6 +80,12 @@ fn planar_tip_wrench(a: &rod_ig_core::PlanarParams, g: &Gravity) -> [f64; 6] {
     })
 }
 
+/// A 3-D wrench as [`WithShape::tip_wrench`]: (fx, fy, fz, mx, my, mz).
+fn spatial_row(w: &rod_ig_core::wrench::SpatialWrench) -> [f64; 6] {
+    let (f, m) = (w.force, w.moment);
+    [f[0], f[1], f[2], m[0], m[1], m[2]]
+}
+
 /// A converged planar solve and its shape.
 pub type Solved = WithShape<Solution, PlanarPose>;
 /// A converged 3-D solve and its shape.
@@ -589,14 +595,7 @@ pub fn solve_3d_held(
         critical: None,
         weight: g.weight(),
         elastic_energy: best.elastic_energy,
-        tip_wrench: [
-            t.force[0],
-            t.force[1],
-            t.force[2],
-            t.moment[0],
-            t.moment[1],
-            t.moment[2],
-        ],
+        tip_wrench: spatial_row(&t),
         base_angle: 0.0,
     })
 }
@@ -745,17 +744,7 @@ fn with_shape_3d(s: &Solution3d, g: &Gravity3, samples: usize) -> Result<Solved3
         critical: None,
         weight: g.weight(),
         elastic_energy,
-        tip_wrench: heavy3::wrenches(&s.a, &k, g).map_or([f64::NAN; 6], |w| {
-            let t = w.tip;
-            [
-                t.force[0],
-                t.force[1],
-                t.force[2],
-                t.moment[0],
-                t.moment[1],
-                t.moment[2],
-            ]
-        }),
+        tip_wrench: heavy3::wrenches(&s.a, &k, g).map_or([f64::NAN; 6], |w| spatial_row(&w.tip)),
         base_angle: 0.0,
     })
 }
