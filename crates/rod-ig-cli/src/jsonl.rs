@@ -199,6 +199,30 @@ pub fn apply_newton_knobs(
     Ok(())
 }
 
+/// The options of a branch-following line (`track`, `track3d`): the default options with the
+/// line's `tolerance` and `deadline_ms`, each checked; with weight the least-energy objective,
+/// so that a fresh solve answers the hanging cable (as `solve`).
+pub fn follow_options<P>(
+    tolerance: Option<f64>,
+    deadline_ms: Option<f64>,
+    weighted: bool,
+) -> Result<rod_ig_core::solver::SolveOptions<P>, String>
+where
+    rod_ig_core::solver::SolveOptions<P>: Default,
+{
+    let mut options = rod_ig_core::solver::SolveOptions::<P>::default();
+    if let Some(t) = tolerance {
+        options.tolerance = check_tolerance(t)?;
+    }
+    if let Some(ms) = deadline_ms {
+        options.deadline = deadline_from_ms(ms)?;
+    }
+    if weighted {
+        options.objective = rod_ig_core::solver::Objective::LeastEnergy;
+    }
+    Ok(options)
+}
+
 /// The message for a Newton request without a start.
 pub const NEWTON_NEEDS_A0: &str = "method \"newton\" needs an initial guess \"a0\"";
 

@@ -205,23 +205,12 @@ impl Tracking {
             return self.held.line(line, ends);
         }
         let request: TrackRequest = jsonl::parse(line)?;
-        let mut options = SolveOptions::default();
-        jsonl::apply_newton_knobs(
-            (None, None, request.tolerance),
-            (
-                &mut options.alpha,
-                &mut options.max_iterations,
-                &mut options.tolerance,
-            ),
-        )?;
-        if let Some(ms) = request.deadline_ms {
-            options.deadline = jsonl::deadline_from_ms(ms)?;
-        }
         let gravity = self.requested_gravity(&request)?;
-        if !gravity.is_weightless() {
-            // A fresh solve with weight answers the hanging cable (least energy), as `solve`.
-            options.objective = Objective::LeastEnergy;
-        }
+        let options = jsonl::follow_options(
+            request.tolerance,
+            request.deadline_ms,
+            !gravity.is_weightless(),
+        )?;
         let change = self.hold(&request, gravity, options)?;
         let follower = self
             .follower

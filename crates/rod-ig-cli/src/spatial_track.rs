@@ -6,7 +6,7 @@ use crate::answer::MoveAnswer;
 use crate::follower::{Follower, Model};
 use crate::jsonl;
 use crate::spatial_cmds::{stiffness, with_wrenches, PoseJson};
-use rod_ig_core::solver::{Objective, SolveOptions};
+use rod_ig_core::solver::SolveOptions;
 use rod_ig_core::spatial::heavy::Gravity3;
 use rod_ig_core::spatial::{HeavySpatial, Spatial, SpatialParams, Stiffness};
 use serde::Deserialize;
@@ -69,22 +69,11 @@ impl Tracking3d {
         let request: Track3dRequest = jsonl::parse(line)?;
         let target = request.target.to_pose()?;
         let model = self.model_of(&request)?;
-        let mut options = SolveOptions::<SpatialParams>::default();
-        jsonl::apply_newton_knobs(
-            (None, None, request.tolerance),
-            (
-                &mut options.alpha,
-                &mut options.max_iterations,
-                &mut options.tolerance,
-            ),
+        let options: SolveOptions<SpatialParams> = jsonl::follow_options(
+            request.tolerance,
+            request.deadline_ms,
+            !model.gravity.is_weightless(),
         )?;
-        if let Some(ms) = request.deadline_ms {
-            options.deadline = jsonl::deadline_from_ms(ms)?;
-        }
-        if !model.gravity.is_weightless() {
-            // A fresh solve with weight answers the hanging cable (least energy), as `track`.
-            options.objective = Objective::LeastEnergy;
-        }
         if let Some(a0) = request.a0 {
             if self.follower.is_some() {
                 return Err(
