@@ -2,17 +2,20 @@
 //! out, optional SVG pictures of the rod sequence. No math here.
 
 use crate::answer::MoveAnswer;
-use crate::follower::{Follower, Model};
+use crate::follower::{Follower, LoadChange, Model};
 use crate::jsonl;
 use crate::svg::{Obstacle as DrawnObstacle, SequenceKind, SequenceRod};
 use rod_ig_core::plan::{self, Obstacle, PlanRequest, Planner};
 use rod_ig_core::planar::heavy::{self, Gravity, HeavyPlanar};
 use rod_ig_core::planar::ig::SolveOptions;
 use rod_ig_core::planar::PlanarClosedForm;
-use rod_ig_core::solver::{self, BranchEvent, Move, Objective};
+use rod_ig_core::solver::{BranchEvent, Move};
 use rod_ig_core::{PlanarParams, PlanarPose};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
+
+/// What a change of gravity did to the held rod.
+type GravityChange = LoadChange<PlanarParams, PlanarPose>;
 
 /// Samples per drawn rod.
 const DRAW_SAMPLES: usize = 60;
@@ -47,19 +50,6 @@ fn model_of(g: Gravity) -> Model<PlanarClosedForm, HeavyPlanar> {
     } else {
         Model::Heavy(HeavyPlanar::new(g))
     }
-}
-
-/// What a change of gravity did to the held rod.
-struct GravityChange {
-    /// The rod before the change, when the branch folded and the rod snapped.
-    snapped_from: Option<PlanarParams>,
-    /// Where the gripper stood when it snapped.
-    gripper: Option<PlanarPose>,
-    /// Total energy released by the snap.
-    energy_released: f64,
-    /// No stable rod was found under the new gravity where the gripper stands: the rod was
-    /// lost (the event "lost"; the line's target is then solved afresh).
-    lost: bool,
 }
 
 /// Most rods kept for a `track --svg` picture: past it, every other rod along the motion is
@@ -139,62 +129,25 @@ fn shape(a: &PlanarParams, g: &Gravity) -> Vec<PlanarPose> {
     heavy::shape(a, g, DRAW_SAMPLES).unwrap_or_default()
 }
 
-/// Carries the rod `follower` holds from gravity `from` to `to`, the gripper fixed: along its
-/// branch, or, where the branch folds, by a snap to the least-energy stable rod under `to`.
+/// Carries the rod `follower` holds from gravity `from` to `to`, the gripper fixed
+/// ([`crate::follower::change_load`]).
 fn change_gravity(
     follower: &PlanarFollower,
     from: &Gravity,
     to: &Gravity,
     options: SolveOptions,
 ) -> Result<(PlanarFollower, GravityChange), String> {
-    let (Some(a), Some(gripper)) = (follower.rod(), follower.gripper()) else {
-        return Ok((
-            PlanarFollower::new(model_of(*to), options),
-            GravityChange {
-                snapped_from: None,
-                gripper: None,
-                energy_released: 0.0,
-                lost: false,
-            },
-        ));
-    };
-    if let Ok(s) = heavy::carry(&a, from, to, &gripper, &options) {
-        let change = GravityChange {
-            snapped_from: None,
-            gripper: None,
-            energy_released: 0.0,
-            lost: false,
-        };
-        return Ok((
-            PlanarFollower::holding(model_of(*to), options, s.a)?,
-            change,
-        ));
-    }
-    let least = SolveOptions {
-        objective: Objective::LeastEnergy,
-        ..options
-    };
-    let Ok(s) = solver::solve(&HeavyPlanar::new(*to), &gripper, &least) else {
-        // Lost: an event, not an error; the follower starts afresh.
-        let change = GravityChange {
-            snapped_from: None,
-            gripper: Some(gripper),
-            energy_released: 0.0,
-            lost: true,
-        };
-        return Ok((PlanarFollower::new(model_of(*to), options), change));
-    };
-    let before = heavy::energy(&a, to).map(|e| e.0).unwrap_or(f64::NAN);
-    let change = GravityChange {
-        snapped_from: Some(a),
-        gripper: Some(gripper),
-        energy_released: before - s.energy,
-        lost: false,
-    };
-    Ok((
-        PlanarFollower::holding(model_of(*to), options, s.a)?,
-        change,
-    ))
+    crate::follower::change_load(
+        follower,
+        (model_of(*to), HeavyPlanar::new(*to)),
+        options,
+        |a, gripper| {
+            heavy::carry(a, from, to, gripper, &options)
+                .map(|s| s.a)
+                .map_err(|f| f.termination())
+        },
+        |a| heavy::energy(a, to).map(|e| e.0).unwrap_or(f64::NAN),
+    )
 }
 
 impl Tracking {
@@ -286,20 +239,8 @@ impl Tracking {
         let mut answer = MoveAnswer::of(m, held_a.as_ref(), params3, |t| *t);
         if let BranchEvent::Snap { critical_a, .. } = m.event {
             self.draw(&critical_a, &gravity, SequenceKind::Critical);
-        } else if let Some(GravityChange { lost: true, .. }) = change {
-            answer.event = "lost";
-        } else if let Some(GravityChange {
-            snapped_from: Some(from),
-            gripper,
-            energy_released,
-            ..
-        }) = change
-        {
-            // The gravity change snapped the rod where the gripper stood.
-            answer.event = "snap";
-            answer.critical = gripper;
-            answer.critical_a = Some(params3(&from));
-            answer.energy_released = Some(energy_released);
+        } else if let Some(change) = change {
+            change.mark(&mut answer, params3, |t| *t);
         }
         if let Ok(s) = &m.result {
             let kind = if matches!(m.event, BranchEvent::Snap { .. }) {

@@ -3,12 +3,12 @@
 //! solver crate's one `BranchFollower` on `Spatial` or `HeavySpatial`.
 
 use crate::answer::MoveAnswer;
-use crate::follower::{Follower, Model};
+use crate::follower::{change_load, Follower, LoadChange, Model};
 use crate::jsonl;
 use crate::spatial_cmds::{stiffness, with_wrenches, PoseJson};
 use rod_ig_core::solver::SolveOptions;
-use rod_ig_core::spatial::heavy::Gravity3;
-use rod_ig_core::spatial::{HeavySpatial, Spatial, SpatialParams, Stiffness};
+use rod_ig_core::spatial::heavy::{self, Gravity3};
+use rod_ig_core::spatial::{HeavySpatial, Spatial, SpatialParams, SpatialPose, Stiffness};
 use serde::Deserialize;
 use serde_json::Value;
 
@@ -88,20 +88,23 @@ impl Tracking3d {
             .map_err(|e| format!("a0 cannot be held: {e}"))?;
             self.follower = Some(held);
         }
-        self.model = Some(model);
+        let change = self.carry_to(model, options)?;
         let follower = self.follower.get_or_insert_with(|| {
             Follower3d::new(model_of(model.stiffness, model.gravity), options)
         });
         let m = follower.follow(&target, options);
         let held = follower.rod();
-        let answer = MoveAnswer::of(&m, held.as_ref(), params6, PoseJson::from_pose);
+        let mut answer = MoveAnswer::of(&m, held.as_ref(), params6, PoseJson::from_pose);
+        if let Some(change) = change {
+            change.mark(&mut answer, params6, PoseJson::from_pose);
+        }
         let mut value = jsonl::to_value(&answer)?;
         with_wrenches(&mut value, &model.stiffness, &model.gravity);
         Ok(value)
     }
 
-    /// The line's model: the stream's, which a later line may restate but not change (a
-    /// change of weight or gravity at fixed grippers is not followed in 3-D yet).
+    /// The line's model: the stream's, with the line's weight and gravity (a change carries
+    /// the held rod: [`Tracking3d::carry_to`]); the stiffness is the stream's.
     fn model_of(&self, request: &Track3dRequest) -> Result<StreamModel, String> {
         let k = match (request.stiffness, self.model) {
             (None, Some(m)) => m.stiffness,
@@ -123,13 +126,51 @@ impl Tracking3d {
             gravity: g,
         };
         match self.model {
-            Some(m) if m != model && self.follower.is_some() => Err(
-                "track3d: weight, gravity and stiffness are the stream's (set by its first \
-                 line); changing them under a held 3-D rod is not supported yet"
+            Some(m) if m.stiffness != model.stiffness && self.follower.is_some() => Err(
+                "track3d: the stiffness is the stream's (set by its first line); changing it \
+                 under a held 3-D rod is not supported"
                     .into(),
             ),
             _ => Ok(model),
         }
+    }
+
+    /// Makes `model` the stream's: a change of weight or gravity at fixed grippers carries
+    /// the held rod ([`crate::follower::change_load`] with
+    /// [`rod_ig_core::spatial::carry`]).
+    fn carry_to(
+        &mut self,
+        model: StreamModel,
+        options: SolveOptions<SpatialParams>,
+    ) -> Result<Option<LoadChange<SpatialParams, SpatialPose>>, String> {
+        let before = self.model.replace(model);
+        let (Some(from), Some(follower)) = (before, &self.follower) else {
+            return Ok(None);
+        };
+        if from == model {
+            return Ok(None);
+        }
+        let heavy = |m: StreamModel| HeavySpatial {
+            stiffness: m.stiffness,
+            gravity: m.gravity,
+        };
+        let (f, change) = change_load(
+            follower,
+            (model_of(model.stiffness, model.gravity), heavy(model)),
+            options,
+            |a, gripper| {
+                rod_ig_core::spatial::carry(a, &heavy(from), &heavy(model), gripper, &options)
+                    .map(|s| s.a)
+                    .map_err(|f| f.termination())
+            },
+            |a| {
+                heavy::evaluate(a, &model.stiffness, &model.gravity)
+                    .map(|e| e.energy)
+                    .unwrap_or(f64::NAN)
+            },
+        )?;
+        self.follower = Some(f);
+        Ok(Some(change))
     }
 }
 

@@ -34,6 +34,8 @@ use nalgebra::{DMatrix, DVector, Quaternion, SMatrix, UnitQuaternion, Vector3};
 use std::ops::ControlFlow;
 use std::sync::Mutex;
 
+mod motion;
+
 /// Variational columns of a segment: ε_ω, ε_v, δP at its start (9), then δa (6).
 const COLUMNS: usize = 15;
 /// Rows per column: η (6), δP (3).
@@ -635,12 +637,19 @@ impl SpatialCable {
     /// Newton on the multiple-shooting equations with the tip held by `goal` ([`TipGoal`]):
     /// as [`SpatialCable::solve`].
     pub fn solve_goal(&mut self, goal: &TipGoal) -> Result<usize, CableError> {
+        self.solve_goal_signed(goal).map(|(it, _)| it)
+    }
+
+    /// [`SpatialCable::solve_goal`], with the sign of the determinant of the last Newton
+    /// matrix it factored (None when it factored none: the cable was on `goal` already).
+    fn solve_goal_signed(&mut self, goal: &TipGoal) -> Result<(usize, Option<f64>), CableError> {
         let target = goal;
+        let mut sign = None;
         let (r, _) = self.residual(target, false)?;
         let mut norm = r.amax();
         for it in 0..NEWTON_ITERATIONS {
             if norm <= 1e-14 {
-                return Ok(it);
+                return Ok((it, sign));
             }
             // Newton that has not come near after a third of its budget will not: give the
             // caller (a continuation halving its step) its time back.
@@ -654,7 +663,9 @@ impl SpatialCable {
             let Some(j) = j else {
                 return Err(CableError::Singular);
             };
-            let Some(step) = j.lu().solve(&(-&r)) else {
+            let lu = j.lu();
+            sign = Some(lu_sign(&lu));
+            let Some(step) = lu.solve(&(-&r)) else {
                 return Err(CableError::Singular);
             };
             if !step.iter().all(|v| v.is_finite()) {
@@ -672,7 +683,7 @@ impl SpatialCable {
                     }
                     Err(RodError::Deadline { t }) => return Err(RodError::Deadline { t }.into()),
                     _ if alpha > 1.0 / 64.0 => alpha *= 0.5,
-                    _ if norm <= RESIDUAL_TOLERANCE => return Ok(it),
+                    _ if norm <= RESIDUAL_TOLERANCE => return Ok((it, sign)),
                     _ => {
                         return Err(CableError::NoConvergence {
                             iterations: it,
@@ -684,11 +695,11 @@ impl SpatialCable {
             let small = alpha * step.amax()
                 <= 1e-10 * (1.0 + self.a.iter().fold(0.0, |m: f64, v| m.max(v.abs())));
             if norm <= RESIDUAL_TOLERANCE && small {
-                return Ok(it + 1);
+                return Ok((it + 1, sign));
             }
         }
         if norm <= RESIDUAL_TOLERANCE {
-            return Ok(NEWTON_ITERATIONS);
+            return Ok((NEWTON_ITERATIONS, sign));
         }
         Err(CableError::NoConvergence {
             iterations: NEWTON_ITERATIONS,
@@ -1173,4 +1184,18 @@ pub fn recall(
         .rev()
         .find(|c| c.params() == *a && c.gravity == *gravity && c.stiffness == *stiffness)
         .cloned()
+}
+
+/// The sign of a determinant from its LU factors.
+fn lu_sign(lu: &nalgebra::linalg::LU<f64, nalgebra::Dyn, nalgebra::Dyn>) -> f64 {
+    let u = lu.u();
+    let mut sign = if lu.p().determinant::<f64>() < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    for i in 0..u.nrows() {
+        sign *= u[(i, i)].signum();
+    }
+    sign
 }

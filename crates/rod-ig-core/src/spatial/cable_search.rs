@@ -351,3 +351,87 @@ pub(crate) fn from_guess(
         ),
     })
 }
+
+/// One corrector step of the branch follower on a long 3-D cable's node states
+/// ([`crate::solver::RodModel::branch_step`]): the rod of `cable`'s branch with its tip at
+/// `goal` within `tolerance`, with its tip and J(1), when one step reaches it
+/// ([`SpatialCable::branch_to`]); None otherwise. The rod reached is remembered, so that the
+/// follower's evaluations of its `a` use its node states.
+pub(crate) fn branch_step(
+    cable: &SpatialCable,
+    goal: &SpatialPose,
+    tolerance: f64,
+) -> Option<(SpatialParams, SpatialPose, nalgebra::SMatrix<f64, 6, 6>)> {
+    use super::cable::TipGoal;
+    let here = TipGoal::Pose(cable.tip().ok()?);
+    let next = cable.branch_to(&here, &TipGoal::Pose(*goal)).ok()??;
+    let tip = next.tip().ok()?;
+    let (pe, oe) = tip.distance_to(goal);
+    if pe > tolerance || oe > tolerance {
+        return None;
+    }
+    let jacobian = next.tip_jacobian().ok()??;
+    super::cable::remember(&next);
+    Some((next.params(), tip, jacobian))
+}
+
+/// The held rod `a` under `from` carried to `rod`'s gravity with the tip gripper fixed at
+/// `gripper`, on its node states ([`SpatialCable::carry_load`]): the cable a solver returned
+/// for `a`, or, at a weight single shooting keeps its digits, the one `a` integrates to,
+/// corrected on `gripper`. The rod returned passed the 3-D stability test; fails where the
+/// branch folds (the rod would snap), where it ends unstable, or on the deadline.
+pub(crate) fn carry(
+    rod: Rod<'_>,
+    a: &SpatialParams,
+    from: &Gravity3,
+    gripper: &SpatialPose,
+    options: &SolveOptions<SVector<f64, 6>>,
+) -> Result<Solution<SpatialParams, SpatialPose>, Failure<SpatialParams>> {
+    use super::cable::TipGoal;
+    let _deadline = crate::deadline::scope(options.deadline);
+    let failed = |detail: String| {
+        let reason = if crate::deadline::expired() {
+            IgError::Deadline { iteration: 0 }
+        } else {
+            IgError::NoStableSolution {
+                starts: 1,
+                last: Some(Box::new(IgError::Evaluation {
+                    iteration: 0,
+                    detail,
+                })),
+            }
+        };
+        Failure {
+            starts: 1,
+            last_a: Some(*a),
+            ..Failure::early(reason)
+        }
+    };
+    let known = super::cable::recall(a, rod.0, from).or_else(|| {
+        if from.weight() > cable_search::LONG_CABLE_WEIGHT {
+            return None;
+        }
+        let mut c = SpatialCable::from_params(a, rod.0, from).ok()?;
+        c.solve(gripper).ok()?;
+        Some(c)
+    });
+    let Some(mut cable) = known else {
+        return Err(failed(
+            "the held rod's node states are not known (an `a` a solver returned at this \
+             weight, or one at weight <= 200, is needed)"
+                .into(),
+        ));
+    };
+    let steps = cable
+        .carry_load(rod.1, &TipGoal::Pose(*gripper))
+        .map_err(|e| failed(e.to_string()))?;
+    let work = Work {
+        iterations: steps,
+        evaluations: steps,
+        starts: 1,
+    };
+    admitted(&cable, gripper, work).map_err(|e| match e {
+        None => failed("the carried rod is unstable".into()),
+        Some(e) => failed(e.to_string()),
+    })
+}

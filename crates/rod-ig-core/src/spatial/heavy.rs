@@ -81,6 +81,14 @@ pub fn tip_and_jacobian(
         return super::tip_and_jacobian(a, k, super::PRODUCTION_RTOL);
     }
     check(a, k)?;
+    if g.weight() > crate::planar::heavy::cable_search::LONG_CABLE_WEIGHT {
+        // A long cable a solver returned: from its node states (as `evaluate`).
+        if let Some(cable) = super::cable::recall(a, k, g) {
+            if let Some(j) = cable.tip_jacobian()? {
+                return Ok((cable.tip()?, j));
+            }
+        }
+    }
     let (ci, av, load) = (k.inv(), super::reduced::params(a), g.load());
     let (s, _) = solve(
         |t, s, ds| rhs::<NV, 6>(&ci, &av, load, t, s, ds, true),

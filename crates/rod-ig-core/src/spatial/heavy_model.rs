@@ -157,6 +157,52 @@ impl RodModel<6> for HeavySpatial {
     fn check_settings(&self) -> Result<(), IgError> {
         self.spatial().check_settings()
     }
+
+    /// A long cable's branch is followed on its node states
+    /// (`SpatialCable::branch_to`) when the rod held is one a solver returned.
+    fn branch_step(
+        &self,
+        from: &SpatialParams,
+        goal: &SpatialPose,
+        tolerance: f64,
+    ) -> Option<Option<(SpatialParams, SpatialPose, SMatrix<f64, 6, 6>)>> {
+        if !self.is_long_cable() {
+            return None;
+        }
+        let cable = super::cable::recall(from, &self.stiffness, &self.gravity)?;
+        Some(cable_search::branch_step(&cable, goal, tolerance))
+    }
+}
+
+/// Carries the stable rod `a`, which holds the tip gripper at `gripper` under gravity `from`,
+/// to `to`'s gravity with the gripper fixed (the 3-D twin of
+/// [`crate::planar::heavy::carry`]): by the continuation in load on single shooting
+/// ([`load::carry`]) while both weights are at most 200, else on the cable's node states
+/// ([`super::cable::SpatialCable::carry_load`]). The rod returned passed the stability test
+/// under `to`; fails where the branch folds or loses stability on the way (the rod would
+/// snap), or on the deadline of `options`.
+pub fn carry(
+    a: &SpatialParams,
+    from: &HeavySpatial,
+    to: &HeavySpatial,
+    gripper: &SpatialPose,
+    options: &Options6,
+) -> Result<Solution<SpatialParams, SpatialPose>, Failure<SpatialParams>> {
+    if from.stiffness != to.stiffness {
+        return Err(Failure::early(IgError::InvalidOptions(
+            "a carried rod keeps its stiffness".into(),
+        )));
+    }
+    if !(from.is_long_cable() || to.is_long_cable()) {
+        return load::carry(from, to, a, gripper, options);
+    }
+    cable_search::carry(
+        (&to.stiffness, &to.gravity),
+        a,
+        &from.gravity,
+        gripper,
+        options,
+    )
 }
 
 impl LoadedModel<6> for HeavySpatial {

@@ -34,7 +34,7 @@ mod model;
 mod reduced;
 mod stability;
 
-pub use heavy_model::HeavySpatial;
+pub use heavy_model::{carry, HeavySpatial};
 pub use model::Spatial;
 pub use stability::{
     det_leading_term, stability, stability_full_grid, stability_with, StabilityOptions,
