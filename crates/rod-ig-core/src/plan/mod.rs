@@ -24,8 +24,12 @@
 //! way: its margins, bodies, tips and goal rods are the heavy rod's, the roadmap nodes the same
 //! rods of the atlas (a node that is not a stable heavy rod fails its edges' checks), and the
 //! edge verdicts kept across queries are dropped when the weight or its direction changes.
+//! Long cables (w > 200) are planned in the gripper's pose space on their node states instead
+//! (module `cable`: an f64 `a` no longer fixes the rod there).
 //!
 //! [`solve_all`]: crate::planar::ig::solve_all
+
+mod cable;
 
 use crate::planar;
 use crate::planar::heavy::{self, Gravity, HeavyPlanar};
@@ -201,6 +205,9 @@ impl Planner {
         // The roadmap comes from the atlas, built once per process in steps charged to the
         // deadline of the query that needs it.
         let _deadline = crate::deadline::scope(request.deadline);
+        if cable::is_long_cable(&request.gravity) {
+            return cable::plan(request);
+        }
         if !self.ensure_roadmap() {
             return Err(PlanError::Deadline { edges_checked: 0 });
         }
@@ -361,6 +368,11 @@ fn collides(a: &PlanarParams, g: &Gravity, obstacles: &[Obstacle]) -> Option<boo
     let Ok(body) = heavy::shape(a, g, BODY_SAMPLES) else {
         return Some(true);
     };
+    body_collides(&body, obstacles)
+}
+
+/// True when the polyline `body` touches an obstacle; `None` when the deadline passed first.
+fn body_collides(body: &[PlanarPose], obstacles: &[Obstacle]) -> Option<bool> {
     let mut tests = 0u64;
     for o in obstacles {
         if body.windows(2).any(|w| segment_touches(&w[0], &w[1], o)) {
@@ -368,8 +380,8 @@ fn collides(a: &PlanarParams, g: &Gravity, obstacles: &[Obstacle]) -> Option<boo
         }
         // A polygon costs one test per edge and segment.
         tests += match o {
-            Obstacle::Disc { .. } => BODY_SAMPLES as u64,
-            Obstacle::Polygon { points } => (BODY_SAMPLES * points.len()) as u64,
+            Obstacle::Disc { .. } => body.len() as u64,
+            Obstacle::Polygon { points } => (body.len() * points.len()) as u64,
         };
         let units = tests / crate::deadline::units::DISC_TESTS_PER_UNIT;
         if units > 0 {

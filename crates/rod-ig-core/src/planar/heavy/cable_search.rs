@@ -578,7 +578,7 @@ static SOLVED: Mutex<Vec<Cable>> = Mutex::new(Vec::new());
 /// Cables remembered.
 pub const REMEMBERED: usize = 256;
 
-fn remember(c: &Cable) {
+pub(crate) fn remember(c: &Cable) {
     if let Ok(mut v) = SOLVED.lock() {
         if v.iter().any(|o| o.same_rod(c)) {
             return;
