@@ -201,3 +201,34 @@ def test_a_one_metre_harness_in_3d(harness_3d):
         s = h.next_seq()
         c.pub.publish(c.make_target(x, y, 0.0, s, z=z, q=q))
         check_heavy_3d(c, s, x, y, z, w=2000.0)
+
+
+def _yaw(pose):
+    q = pose.orientation
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def test_rod_plan_moves_the_one_metre_harness_around_a_disc(harness):
+    """rod/plan at w = 2,000 (issue 51, item 4) from the rod the node holds: the hanging cable is
+    a start (the a-space planner refused it: its conjugate-point margin shrinks with w), the
+    plan goes around a disc its straight path would cross, ends on the goal, its gripper steps
+    are at most 0.1 m (+ 0.3 m/rad of turn) apart and its margin is the second variation's."""
+    _, c = harness
+    sol, _ = solve_topic(c, 0.8, 0.0, 0.0)
+    assert sol.success, sol.message
+    resp = c.plan(use_current=True, goal=c.make_target(0.6, 0.2, 0.3, h.next_seq()),
+                  disc_x=[0.7], disc_y=[0.1], disc_radius=[0.05])
+    assert resp is not None and resp.success, resp and resp.reason
+    assert resp.min_margin >= 1e-3
+    assert max(abs(u - v) for u, v in zip(resp.rods[:3], sol.a)) < 1e-9
+    poses = [p.pose for p in resp.gripper_path.poses]
+    assert len(poses) > 5  # a detour around the disc
+    last = poses[-1]
+    assert math.hypot(last.position.x - 0.6, last.position.y - 0.2) < 1e-6
+    assert abs(_yaw(last) - 0.3) < 1e-6
+    for p, q in zip(poses, poses[1:]):
+        step = math.hypot(q.position.x - p.position.x, q.position.y - p.position.y)
+        turn = abs(math.remainder(_yaw(q) - _yaw(p), math.tau))
+        assert step + 0.3 * turn <= 0.1 + 1e-9
+        # The gripper stays off the disc (its tip is a point of the rod).
+        assert math.hypot(q.position.x - 0.7, q.position.y - 0.1) > 0.05

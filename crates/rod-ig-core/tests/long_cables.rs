@@ -274,3 +274,33 @@ fn the_weight_is_carried_to_ten_thousand() {
     let shape = heavy::shape(&s.a, &heavy_g, 401).unwrap();
     assert!(shape.iter().all(|p| p.y <= 1e-12) && !self_intersects(&shape));
 }
+
+/// A target behind a fold (`search_coverage long 300 52`, w = 235, gravity tilted, the tip
+/// below the base turned down): every start's continuation straight to it folds on the way,
+/// and the search found none before its last stage, a tree of cables in the gripper's pose
+/// space grown around the folds from the hanging cable. Its answer is on target, loop-free,
+/// and stable by the independent discretised energy (its Hessian on the constraints' tangent
+/// space, N = 320).
+#[test]
+fn a_target_behind_a_fold_is_reached_around_it() {
+    let gravity = Gravity::new(235.0183, [0.296602, -0.955001]).unwrap();
+    let target = PlanarPose::new(0.562666683, -0.774933227, -1.086283450);
+    let options = SolveOptions {
+        deadline: Duration::from_secs(2),
+        ..SolveOptions::default()
+    };
+    let s = solver::solve(&HeavyPlanar::new(gravity), &target, &options).unwrap();
+    assert!(s.stable && s.position_error < 1e-9, "{s:?}");
+    let shape = heavy::shape(&s.a, &gravity, 4001).unwrap();
+    assert!(turns_of(&shape) == 0 && !self_intersects(&shape));
+    let p = Problem {
+        weight: gravity.weight(),
+        direction: gravity.direction(),
+        target: [target.x, target.y, shape[4000].theta],
+    };
+    let theta = |t: f64| shape[(t * 4000.0).round() as usize].theta;
+    let discrete = p
+        .solve(&angles(320, theta), gravity.tip_force(&s.a))
+        .expect("the KKT Newton converges");
+    assert!(discrete.min_eig > 0.0, "{}", discrete.min_eig);
+}

@@ -275,6 +275,38 @@ impl Searcher<'_> {
         }
     }
 
+    /// Stage 8, where no start reached an admitted rod: a tree of cables in the gripper's pose
+    /// space ([`super::cable_tree`]) grown from a stable hanging cable toward the target, each
+    /// of its rods stable and admitted: it goes around the folds that stopped every
+    /// continuation straight to the target (a 2-D path where the others are lines).
+    fn tree_start(&mut self) {
+        if self.done() || !self.out.solutions.is_empty() {
+            return;
+        }
+        let Some(root) = tree_root(self.gravity, self.target, self.admission) else {
+            return;
+        };
+        let admission = self.admission;
+        self.start(|s| {
+            let admit = |c: &Cable| admitted_margin(c, admission);
+            match super::cable_tree::path_to(root, 1.0, s.target, admit) {
+                Ok(path) => {
+                    let steps = path.len() as u32;
+                    let last = path.into_iter().last().map(|state| state.cable);
+                    last.map(|c| (c, steps)).ok_or(CableError::Singular)
+                }
+                Err(super::cable_tree::NotReached { edges }) => Err(CableError::Lost {
+                    weight: s.gravity.weight(),
+                    target_weight: s.gravity.weight(),
+                    why: format!(
+                        "a tree of {edges} gripper moves from a hanging cable did not reach the \
+                         target"
+                    ),
+                }),
+            }
+        });
+    }
+
     /// Stage 6: cables hanging from the base, moved to the target.
     fn hanging_starts(&mut self) {
         for seed in hanging_seeds(self.gravity) {
@@ -334,8 +366,35 @@ pub fn search(
     s.single_shooting_starts(options);
     s.hanging_starts();
     s.atlas_starts();
+    s.tree_start();
     s.done();
     sorted(s.out)
+}
+
+/// The second variation's normalised margin of `c` when `admission` admits it (stable, within
+/// the admitted turns, not crossing itself where no turn is admitted).
+fn admitted_margin(c: &Cable, admission: Admission) -> Option<f64> {
+    let turns_ok = c.turns().is_ok_and(|t| t <= admission.max_turns);
+    let crossing_ok = admission.max_turns > 0 || c.self_intersects() == Ok(false);
+    match c.second_variation() {
+        Ok(sv) if sv.stable() && turns_ok && crossing_ok => Some(sv.normalised()),
+        _ => None,
+    }
+}
+
+/// The root of the last stage's tree: the catenary through grippers 0.8 apart on the chord
+/// toward the target (else level), corrected at the full weight and admitted.
+fn tree_root(gravity: &Gravity, target: &PlanarPose, admission: Admission) -> Option<Cable> {
+    let r = target.x.hypot(target.y);
+    let mut roots = vec![PlanarPose::new(0.8, 0.0, 0.0)];
+    if r > 0.3 {
+        let k = 0.8 / r;
+        roots.insert(0, PlanarPose::new(k * target.x, k * target.y, target.theta));
+    }
+    roots.into_iter().find_map(|p| {
+        let (c, _) = catenary_seeded(gravity, &p).ok()?;
+        admitted_margin(&c, admission).map(|_| c)
+    })
 }
 
 /// Rods hanging from the clamped base under their weight: n(0) = s w ĝ (s = 1: the tip

@@ -22,6 +22,7 @@
 
 pub mod cable;
 pub mod cable_search;
+pub mod cable_tree;
 pub mod catenary;
 pub mod held;
 mod model;
