@@ -28,7 +28,7 @@ use super::{SpatialParams, SpatialPose, Stiffness};
 use crate::conjugate::Stream;
 use crate::ends::EndCondition;
 use crate::ode::{dop853, OdeOptions};
-use crate::planar::heavy::cable::{CableError, GROWTH_PER_SEGMENT, MAX_SEGMENTS};
+use crate::planar::heavy::cable::{lu_sign, CableError, GROWTH_PER_SEGMENT, MAX_SEGMENTS};
 use crate::{RodError, StabilityReport};
 use nalgebra::{DMatrix, DVector, Quaternion, SMatrix, UnitQuaternion, Vector3};
 use std::ops::ControlFlow;
@@ -1184,18 +1184,4 @@ pub fn recall(
         .rev()
         .find(|c| c.params() == *a && c.gravity == *gravity && c.stiffness == *stiffness)
         .cloned()
-}
-
-/// The sign of a determinant from its LU factors.
-fn lu_sign(lu: &nalgebra::linalg::LU<f64, nalgebra::Dyn, nalgebra::Dyn>) -> f64 {
-    let u = lu.u();
-    let mut sign = if lu.p().determinant::<f64>() < 0.0 {
-        -1.0
-    } else {
-        1.0
-    };
-    for i in 0..u.nrows() {
-        sign *= u[(i, i)].signum();
-    }
-    sign
 }

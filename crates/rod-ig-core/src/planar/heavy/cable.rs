@@ -984,7 +984,7 @@ impl Cable {
 }
 
 /// The sign of a determinant from its LU factors.
-fn lu_sign(lu: &nalgebra::linalg::LU<f64, nalgebra::Dyn, nalgebra::Dyn>) -> f64 {
+pub(crate) fn lu_sign(lu: &nalgebra::linalg::LU<f64, nalgebra::Dyn, nalgebra::Dyn>) -> f64 {
     let u = lu.u();
     let mut sign = if lu.p().determinant::<f64>() < 0.0 {
         -1.0

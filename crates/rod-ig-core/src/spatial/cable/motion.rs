@@ -9,7 +9,7 @@
 //! invertible), so a change of its sign is a fold of the branch, where the rod snaps.
 
 use super::{segments_for, SpatialCable, TipGoal, ROWS};
-use crate::planar::heavy::cable::CableError;
+use crate::planar::heavy::cable::{lu_sign, CableError};
 use crate::spatial::heavy_ode::Gravity3;
 use crate::RodError;
 use nalgebra::{DVector, Vector3};
@@ -30,7 +30,7 @@ impl SpatialCable {
     /// a fold of the branch: module docs).
     pub fn matrix_sign(&self, goal: &TipGoal) -> Result<f64, RodError> {
         let (_, j) = self.residual(goal, true)?;
-        Ok(j.map_or(0.0, |j| super::lu_sign(&j.lu())))
+        Ok(j.map_or(0.0, |j| lu_sign(&j.lu())))
     }
 
     /// True when `other` is this rod moved a little: the base wrenches within 0.3 of their
@@ -110,9 +110,14 @@ impl SpatialCable {
     }
 
     /// One step of the branch from this cable (in equilibrium, its Newton matrix's sign
-    /// `side`) to `goal`: the cable reached, when Newton converges in a few iterations, near
-    /// this one, on the same side of the fold.
-    fn stepped(&self, goal: &TipGoal, side: f64) -> Result<Option<Self>, CableError> {
+    /// `side`; None after a remesh, which changes the matrix) to `goal`: the cable reached and
+    /// its matrix's sign, when Newton converges in a few iterations, near this one, on the
+    /// same side of the fold.
+    fn stepped(
+        &self,
+        goal: &TipGoal,
+        side: Option<f64>,
+    ) -> Result<Option<(Self, f64)>, CableError> {
         let mut next = self.clone();
         let sign = match next.solve_goal_signed(goal) {
             Ok((it, sign)) if it <= STEP_ITERATIONS && next.close_to(self) => sign,
@@ -128,7 +133,8 @@ impl SpatialCable {
             Some(s) => s,
             None => next.matrix_sign(goal)?,
         };
-        Ok((sign == side && sign != 0.0).then_some(next))
+        let same_side = side.is_none_or(|side| sign == side);
+        Ok((same_side && sign != 0.0).then_some((next, sign)))
     }
 
     /// The rod of this cable's branch with its tip held by `goal`, in one corrector step
@@ -136,7 +142,7 @@ impl SpatialCable {
     /// long, or across a fold). `from` is the goal this cable holds now.
     pub fn branch_to(&self, from: &TipGoal, goal: &TipGoal) -> Result<Option<Self>, CableError> {
         let side = self.matrix_sign(from)?;
-        self.stepped(goal, side)
+        Ok(self.stepped(goal, Some(side))?.map(|(c, _)| c))
     }
 
     /// Carries this cable, in equilibrium with its tip held by `goal`, from its gravity to
@@ -189,26 +195,11 @@ impl SpatialCable {
             if let Some(m) = trial.remeshed()? {
                 trial = m;
             }
+            // A new mesh changes the matrix: its sign is read afresh after the step.
             let remeshed = trial.segments() != self.segments();
-            let side_here = if remeshed { 0.0 } else { side };
-            let taken = if remeshed {
-                // A new mesh changes the matrix: its sign is read afresh after the step.
-                let mut t = trial.clone();
-                match t.solve_goal(goal) {
-                    Ok(it) if it <= STEP_ITERATIONS && t.close_to(&trial) => Some(t),
-                    Err(CableError::Rod(RodError::Deadline { t })) => {
-                        return Err(RodError::Deadline { t }.into())
-                    }
-                    _ => None,
-                }
-            } else {
-                trial.stepped(goal, side_here)?
-            };
-            match taken {
-                Some(c) => {
-                    if remeshed {
-                        side = c.matrix_sign(goal)?;
-                    }
+            match trial.stepped(goal, (!remeshed).then_some(side))? {
+                Some((c, sign)) => {
+                    side = sign;
                     previous = Some((s, self.clone()));
                     *self = c;
                     s = next;
