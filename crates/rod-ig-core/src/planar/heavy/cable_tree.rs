@@ -9,7 +9,7 @@
 //!   |Δp| + [`ANGLE_WEIGHT`]·|Δθ|; the edge's midpoint and end must pass the caller's `admit`
 //!   (which returns the rod's margin, or None);
 //! - **growth**: a rapidly-exploring tree from the root, straight at the goal until that fails
-//!   once, then every [`GOAL_EVERY`]-th extension toward the goal and the others toward a pose
+//!   once, then every third extension toward the goal and the others toward a pose
 //!   drawn in the reach (a fixed seed: the same tree on every call), until an extension lands
 //!   on the goal or the deadline passes.
 
