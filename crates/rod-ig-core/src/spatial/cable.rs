@@ -80,6 +80,20 @@ impl Node {
         }
     }
 
+    /// This node's offset from `from`: the body turn log(R_fromᵀ R), the shift p − p_from
+    /// in the frame `frame`, and P − P_from (the residual's node rows and a continuation's
+    /// secant, module docs).
+    fn offset_from(&self, from: &Node, frame: &UnitQuaternion<f64>) -> [f64; ROWS] {
+        let turn = (from.rotation.inverse() * self.rotation).scaled_axis();
+        let shift = frame.inverse() * (self.position - from.position);
+        let arm = self.moment_arm - from.moment_arm;
+        std::array::from_fn(|i| match i / 3 {
+            0 => turn[i],
+            1 => shift[i - 3],
+            _ => arm[i - 6],
+        })
+    }
+
     /// The node moved by the correction (ε_ω, ε_v, δP) (module docs).
     fn moved(&self, d: &[f64]) -> Self {
         let eps = Vector3::new(d[0], d[1], d[2]);
@@ -591,16 +605,10 @@ impl SpatialCable {
         j: Option<&mut DMatrix<f64>>,
     ) {
         let (end, goal, row) = (Node::of_state(e), &self.nodes[k + 1], ROWS * k);
-        let rel = goal.rotation.inverse() * end.rotation;
-        let rho_w = rel.scaled_axis();
-        let rho_v = goal.rotation.inverse() * (end.position - goal.position);
-        let rho_p = end.moment_arm - goal.moment_arm;
-        for i in 0..3 {
-            r[row + i] = rho_w[i];
-            r[row + 3 + i] = rho_v[i];
-            r[row + 6 + i] = rho_p[i];
-        }
+        let rho = end.offset_from(goal, &goal.rotation);
+        r.rows_mut(row, ROWS).copy_from_slice(&rho);
         let Some(j) = j else { return };
+        let rel = goal.rotation.inverse() * end.rotation;
         let rel_m = rel.to_rotation_matrix().into_inner();
         let col = |rr: usize, c: usize| e[NB + COLUMNS * rr + c];
         for c in 0..COLUMNS {
@@ -617,7 +625,7 @@ impl SpatialCable {
         // The next node's own columns: R exp(ε) and p + R ε_v move the residual by −ε_ω,
         // ρ_v × ε_ω − ε_v and −δP.
         let next = 6 + ROWS * k;
-        let skew = rho_v.cross_matrix();
+        let skew = Vector3::new(rho[3], rho[4], rho[5]).cross_matrix();
         for i in 0..3 {
             j[(row + i, next + i)] = -1.0;
             j[(row + 3 + i, next + 3 + i)] = -1.0;

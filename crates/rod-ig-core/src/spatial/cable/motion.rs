@@ -65,15 +65,9 @@ impl SpatialCable {
         }
         for k in 1..self.segments() {
             let (now, then) = (&self.nodes[k], &before.nodes[k]);
-            let o = 6 + ROWS * (k - 1);
-            let turn = (then.rotation.inverse() * now.rotation).scaled_axis();
-            let shift = now.rotation.inverse() * (now.position - then.position);
-            let arm = now.moment_arm - then.moment_arm;
-            for c in 0..3 {
-                d[o + c] = turn[c];
-                d[o + 3 + c] = shift[c];
-                d[o + 6 + c] = arm[c];
-            }
+            let offset = now.offset_from(then, &now.rotation);
+            d.rows_mut(6 + ROWS * (k - 1), ROWS)
+                .copy_from_slice(&offset);
         }
         d
     }
